@@ -1,0 +1,61 @@
+#pragma once
+// The TOML case format (docs/case-format.md): two bodies, an optional gap function,
+// solver and coupling options. Unknown keys are errors.
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "numerics/body_definition.hpp"
+#include "numerics/body_solver.hpp"
+#include "numerics/gmsh_reader.hpp"
+#include "numerics/mprgp.hpp"
+
+namespace robin {
+
+/// One body as written in the case file. `definition.mesh` is empty until load_body_mesh.
+struct BodyCase {
+  BodyDefinition definition;
+  std::filesystem::path mesh_path;  // absolute (resolved against the case file's directory)
+  MeshReadOptions mesh_options;
+  std::string context;  // "case.toml: body 'upper'" for messages
+};
+
+/// Options of the Robin iteration (coordinator); command-line flags override them.
+struct CouplingOptions {
+  double relaxation = 0.5;        // delta of paper (13)
+  double tolerance = 1e-8;        // on every scaled residual
+  int max_iterations = 200;
+  std::string initial_obstacle = "gap";  // "gap": g^alpha_0 = d; "zero": g^alpha_0 = 0
+  double request_timeout_seconds = 60.0;  // deadline of each request to a server
+  double divergence_factor = 1e3;   // residual growth over its minimum that means divergence
+  int stagnation_window = 50;       // iterations without residual decrease that mean stagnation
+};
+
+struct SolverOptions {
+  MprgpParameters qp;
+  BodySolverOptions body;
+  double pairing_tolerance = 1e-6;  // relative to the shortest contact edge
+};
+
+struct CaseDefinition {
+  std::filesystem::path file;
+  std::string title;
+  std::array<BodyCase, 2> bodies;
+  std::optional<std::string> gap_expression;
+  std::map<std::string, double> gap_constants;
+  SolverOptions solver;
+  CouplingOptions coupling;
+};
+
+/// Parses and validates a case file (without reading meshes). Throws InputError naming
+/// the file, line and field.
+CaseDefinition read_case_file(const std::filesystem::path& path);
+
+/// Reads the body's mesh and checks every boundary name against it; returns the complete
+/// definition. Throws InputError naming the case file, body, field and mesh file.
+BodyDefinition load_body(const BodyCase& body);
+
+}  // namespace robin

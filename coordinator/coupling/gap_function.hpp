@@ -1,0 +1,32 @@
+#pragma once
+// The optional analytic initial gap g0(x, y), added to the geometric normal gap of each
+// contact pair. Parsed by muParser; variables x and y, plus user constants.
+
+#include <map>
+#include <memory>
+#include <string>
+
+namespace robin {
+
+class GapFunction {
+ public:
+  /// Parses `expression`. Throws InputError starting with `context` (e.g.
+  /// "case.toml:12: gap.expression") and giving the parser's message and position.
+  GapFunction(const std::string& expression, const std::map<std::string, double>& constants,
+              const std::string& context);
+  ~GapFunction();
+  GapFunction(const GapFunction&) = delete;
+  GapFunction& operator=(const GapFunction&) = delete;
+
+  /// Value at (x, y). Throws InputError when the value is not finite.
+  double operator()(double x, double y) const;
+  const std::string& expression() const { return expression_; }
+
+ private:
+  struct Implementation;
+  std::unique_ptr<Implementation> implementation_;
+  std::string expression_;
+  std::string context_;
+};
+
+}  // namespace robin

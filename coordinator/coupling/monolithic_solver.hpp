@@ -1,0 +1,41 @@
+#pragma once
+// The monolithic two-body reference (paper (5)): minimise sum_alpha 1/2 u'K u - f'u subject
+// to B1 u1 + B2 u2 <= d, solved in its dual form
+//   minimise 1/2 lambda'(F1 + F2) lambda - lambda'(e1 + e2 - d),  lambda >= 0,
+// with the same factors and the same MPRGP as the subdomain solves.
+
+#include <Eigen/Core>
+
+#include "coupling/contact_pairing.hpp"
+#include "numerics/body_solver.hpp"
+
+namespace robin {
+
+/// Scaled residuals of a two-body contact state; see docs/case-format.md "Residuals".
+struct InterfaceResiduals {
+  double penetration = 0.0;      // max(0, u1_N + u2_N - d) / displacement scale
+  double force_balance = 0.0;    // max |lambda1 - lambda2| / force scale
+  double complementarity = 0.0;  // max |lambda_i (d - u1_N - u2_N)_i| / (force scale * displacement scale)
+};
+
+struct MonolithicResult {
+  Eigen::VectorXd contact_force;  // lambda (same on both bodies)
+  Eigen::VectorXd normal_trace1;  // u1_N
+  Eigen::VectorXd normal_trace2;  // u2_N
+  MprgpResult qp;
+  InterfaceResiduals residuals;
+  double solve_seconds = 0.0;
+};
+
+/// Both bodies must have been given pairing.assignment(0) and (1).
+MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& body2,
+                                  const ContactPairing& pairing, const MprgpParameters& parameters);
+
+/// Residuals of (u1_N, u2_N, lambda1, lambda2) against the gaps d. Displacement scale:
+/// max(max|d|, max|u1_N|, max|u2_N|, tiny); force scale: max(max lambda, tiny).
+InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::VectorXd& trace1,
+                                       const Eigen::VectorXd& trace2,
+                                       const Eigen::VectorXd& force1,
+                                       const Eigen::VectorXd& force2);
+
+}  // namespace robin

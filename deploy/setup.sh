@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package robin-contact needs to build, test and run.
+# Idempotent: when everything is present it returns without touching apt.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git
+  libeigen3-dev libsuitesparse-dev
+  libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
+  libspdlog-dev libfmt-dev
+  libgmsh-dev gmsh
+  libcli11-dev libtomlplusplus-dev libmuparser-dev nlohmann-json3-dev
+  googletest libgtest-dev libgmock-dev libbenchmark-dev
+  python3 python3-numpy python3-scipy python3-matplotlib python3-zmq python3-protobuf
+  iproute2 procps
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+sudo_prefix=""
+if [ "$(id -u)" -ne 0 ]; then sudo_prefix="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo_prefix apt-get update -qq
+$sudo_prefix apt-get install -y -qq --no-install-recommends "${missing[@]}"

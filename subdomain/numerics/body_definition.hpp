@@ -1,0 +1,41 @@
+#pragma once
+// Everything that defines one elastic body: mesh, material, loads, Dirichlet
+// conditions and the name of its contact boundary. Plain data; no files.
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "numerics/material.hpp"
+#include "numerics/mesh.hpp"
+
+namespace robin {
+
+/// u_x and/or u_y prescribed on every node of a named boundary.
+struct DirichletCondition {
+  std::string boundary;
+  std::optional<double> x;  // prescribed u_x (length), absent = free
+  std::optional<double> y;  // prescribed u_y (length), absent = free
+};
+
+/// A traction on a named boundary, force per unit length: either a fixed vector, or a
+/// normal pressure p (compression positive), i.e. traction = -p n with n the outward normal.
+struct TractionCondition {
+  std::string boundary;
+  bool is_pressure = false;
+  Eigen::Vector2d vector = Eigen::Vector2d::Zero();
+  double pressure = 0.0;
+};
+
+struct BodyDefinition {
+  std::string name;                 // used in every message about this body
+  Mesh mesh;
+  Material material;
+  Eigen::Vector2d body_force = Eigen::Vector2d::Zero();  // force per unit area
+  std::vector<DirichletCondition> dirichlet;
+  std::vector<TractionCondition> tractions;
+  std::string contact_boundary;     // name of the boundary group that may touch the other body
+};
+
+}  // namespace robin

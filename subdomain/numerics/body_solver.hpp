@@ -1,0 +1,156 @@
+#pragma once
+// One body of the contact problem: assembled stiffness, Dirichlet reduction, a Cholesky
+// factor computed once, and the operators of the dual (contact-force) formulation on the
+// contact nodes assigned to it.
+//
+// With B the normal-trace operator on the assigned contact nodes ((B u)_i = u(node_i).n_i,
+// n_i the normal assigned to node i), K the stiffness on free dofs and f the reduced load:
+//   e = B K^{-1} f + B u_p          free normal trace (no contact force)
+//   F = B K^{-1} B'                 interface compliance (Neumann-to-Dirichlet map)
+//   u_N = e - F lambda              normal trace under nodal contact forces lambda
+// where lambda_i >= 0 is the compressive nodal normal force, K u = f - B' lambda.
+//
+// Local contact problem (paper (10)): minimise 1/2 u'Ku - f'u subject to B u <= g, solved
+// in its dual form  minimise 1/2 lambda'F lambda - lambda'(e - g), lambda >= 0, by MPRGP.
+// Correction problem (paper (11)-(12)): K w = B' r, returns w_N = B w = F r.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "numerics/body_definition.hpp"
+#include "numerics/cholesky.hpp"
+#include "numerics/dof_map.hpp"
+#include "numerics/elasticity.hpp"
+#include "numerics/linear_operator.hpp"
+#include "numerics/mprgp.hpp"
+
+namespace robin {
+
+/// The candidate contact nodes of a body as the body sees them.
+struct InterfaceDescription {
+  std::vector<int> node_ids;                 // mesh node indices, ascending
+  std::vector<Eigen::Vector2d> coordinates;  // reference positions
+  std::vector<Eigen::Vector2d> normals;      // unit outward normals from the geometry
+  std::vector<double> weights;               // m_i = int_{contact boundary} phi_i ds (length)
+  std::vector<bool> x_fixed;                 // u_x prescribed by a Dirichlet condition
+  std::vector<bool> y_fixed;                 // u_y prescribed by a Dirichlet condition
+};
+
+/// The contact nodes the body must use, in pair order, with the normal to use for each.
+struct ContactAssignment {
+  std::vector<int> node_ids;
+  std::vector<Eigen::Vector2d> normals;  // unit; body 2 gets n2 = -n1
+};
+
+enum class InterfaceOperatorKind {
+  automatic,  // dense when the contact size is at most dense_limit
+  dense,      // F assembled once by blocked multi-right-hand-side solves; products cost O(n_c^2)
+  factor,     // F applied through the factor: one solve (two triangular solves) per product
+};
+
+struct BodySolverOptions {
+  InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
+  int dense_limit = 3000;
+};
+
+struct ContactSolveResult {
+  Eigen::VectorXd normal_trace;   // u_N (length)
+  Eigen::VectorXd contact_force;  // lambda >= 0 (force; nodal, compression positive)
+  std::vector<bool> active;       // lambda_i > 0
+  QpStatus status = QpStatus::not_converged;
+  int iterations = 0;
+  int operator_applications = 0;
+  double projected_gradient_norm = 0.0;
+  double penetration = 0.0;      // max_i max(0, u_N,i - g_i)  (length)
+  double complementarity = 0.0;  // max_i |lambda_i (g_i - u_N,i)| (work)
+  double seconds = 0.0;
+  std::string message;
+};
+
+struct BodyTimings {
+  double assembly_seconds = 0.0;
+  double factorization_seconds = 0.0;
+  double interface_seconds = 0.0;  // building e and (when dense) F
+};
+
+class BodySolver {
+ public:
+  /// Assembles and factorizes. Throws InputError for an unknown boundary name and
+  /// SingularBodyError when the Dirichlet conditions leave a rigid motion free.
+  explicit BodySolver(BodyDefinition definition, BodySolverOptions options = {});
+  ~BodySolver();
+  BodySolver(const BodySolver&) = delete;
+  BodySolver& operator=(const BodySolver&) = delete;
+
+  const std::string& name() const { return definition_.name; }
+  const BodyDefinition& definition() const { return definition_; }
+  const Mesh& mesh() const { return definition_.mesh; }
+  const DofMap& dofs() const { return *dofs_; }
+  int free_dof_count() const { return dofs_->free_count(); }
+  const BodyTimings& timings() const { return timings_; }
+  long factor_nonzeros() const { return factor_->factor_nonzeros(); }
+  long solve_count() const { return factor_->solve_count(); }
+
+  /// The nodes of the contact boundary with geometric normals and weights.
+  InterfaceDescription contact_boundary() const;
+
+  /// Sets the contact nodes and normals (pair order) and builds e and F. Resets the warm start.
+  /// Throws InputError if a node id is not on the contact boundary or a normal is not unit.
+  void assign_contact(const ContactAssignment& assignment);
+  int contact_size() const { return static_cast<int>(contact_nodes_.size()); }
+  const std::vector<int>& contact_nodes() const { return contact_nodes_; }
+  const std::vector<Eigen::Vector2d>& contact_normals() const { return contact_normals_; }
+
+  /// e = B K^{-1} f + B u_p.
+  const Eigen::VectorXd& free_trace() const { return free_trace_; }
+  /// The compliance F as an operator (valid after assign_contact).
+  const LinearOperator& compliance() const { return *compliance_; }
+
+  /// Paper step 1: contact with obstacle g (B u <= g), warm-started from the previous result.
+  ContactSolveResult solve_contact(const Eigen::VectorXd& obstacle,
+                                   const MprgpParameters& parameters = {});
+  /// Forget the warm start (next solve starts from lambda = 0).
+  void reset_warm_start();
+
+  /// Paper step 2: w_N = B K^{-1} B' r for an interface force vector r (force).
+  Eigen::VectorXd solve_correction(const Eigen::VectorXd& interface_force) const;
+
+  /// Full displacement (2 per node, prescribed values included) under contact forces lambda.
+  Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force) const;
+  /// Reaction forces K u - f at prescribed dofs (zero at free dofs), full size.
+  Eigen::VectorXd reactions(const Eigen::VectorXd& displacement) const;
+  /// Total applied external force (body force + tractions), (F_x, F_y).
+  Eigen::Vector2d applied_force() const;
+  /// Contact force field as nodal vectors: -lambda_i n_i at node i (force acting on this body).
+  Eigen::VectorXd contact_force_field(const Eigen::VectorXd& contact_force) const;
+  /// Boundary weight m_i of each assigned contact node.
+  const Eigen::VectorXd& contact_weights() const { return contact_weights_; }
+
+ private:
+  void assemble();
+  void build_interface_operator();
+  Eigen::VectorXd apply_transpose_trace(const Eigen::VectorXd& contact_force) const;  // B' lambda
+
+  BodyDefinition definition_;
+  BodySolverOptions options_;
+  BodyTimings timings_;
+  std::unique_ptr<DofMap> dofs_;
+  SparseMatrix full_stiffness_;
+  Eigen::VectorXd full_load_;
+  Eigen::VectorXd reduced_load_;
+  std::unique_ptr<CholeskyFactor> factor_;
+  Eigen::VectorXd free_solution_;  // K^{-1} f (free dofs)
+
+  std::vector<int> contact_nodes_;
+  std::vector<Eigen::Vector2d> contact_normals_;
+  Eigen::VectorXd contact_weights_;
+  SparseMatrix trace_;  // B on free dofs (n_c x free)
+  Eigen::VectorXd prescribed_trace_;  // B u_p
+  Eigen::VectorXd free_trace_;
+  std::unique_ptr<LinearOperator> compliance_;
+  Eigen::VectorXd warm_start_;
+};
+
+}  // namespace robin

@@ -1,0 +1,46 @@
+#pragma once
+// Splits the 2n degrees of freedom of a body into free and prescribed ones
+// (Dirichlet conditions) and reduces K u = f to the free block:
+//   K_ff u_f = f_f - K_fp u_p.
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "numerics/elasticity.hpp"
+
+namespace robin {
+
+class DofMap {
+ public:
+  /// `prescribed[d]` holds the value of degree of freedom d when it is fixed.
+  explicit DofMap(std::vector<std::optional<double>> prescribed);
+
+  int total_count() const { return static_cast<int>(prescribed_.size()); }
+  int free_count() const { return free_count_; }
+  /// Index of dof d among the free ones, or -1 when d is prescribed.
+  int free_index(int dof) const { return free_index_[dof]; }
+  bool is_prescribed(int dof) const { return prescribed_[dof].has_value(); }
+  /// Full vector of prescribed values (zero at free dofs).
+  const Eigen::VectorXd& prescribed_values() const { return prescribed_values_; }
+
+  /// Free-free block of K and the reduced load f_f - K_fp u_p.
+  SparseMatrix reduce_matrix(const SparseMatrix& full) const;
+  Eigen::VectorXd reduce_load(const SparseMatrix& full, const Eigen::VectorXd& full_load) const;
+  /// Full field from free values plus the prescribed values.
+  Eigen::VectorXd expand(const Eigen::VectorXd& free_values) const;
+  /// Restriction of a full vector to the free dofs.
+  Eigen::VectorXd restrict(const Eigen::VectorXd& full) const;
+
+ private:
+  std::vector<std::optional<double>> prescribed_;
+  std::vector<int> free_index_;
+  Eigen::VectorXd prescribed_values_;
+  int free_count_ = 0;
+};
+
+/// True when the prescribed dofs remove every rigid motion (two translations and the
+/// rotation) of the mesh: the 3 rigid modes restricted to the prescribed dofs have rank 3.
+bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs);
+
+}  // namespace robin

@@ -1,0 +1,62 @@
+#pragma once
+// MPRGP (Modified Proportioning with Reduced Gradient Projections, Dostal & Schoberl,
+// Comput. Optim. Appl. 30, 2005) for the bound-constrained quadratic program
+//
+//   minimise q(x) = 1/2 x'Ax - b'x   subject to   x >= lower,
+//
+// with A symmetric positive definite (semidefinite is tolerated as long as q is bounded
+// below on the feasible set). Conjugate gradients on the free set, proportioning steps that
+// release constraints, and expansion steps (a projected gradient step of fixed length
+// alpha in (0, 2/||A||]) that add them.
+//
+// Gradient g = Ax - b. Free set F = {i : x_i > lower_i}. Free gradient phi_i = g_i on F,
+// chopped gradient beta_i = min(g_i, 0) off F; the projected gradient g^P = phi + beta is
+// zero exactly at the KKT point (x >= l, g >= 0, g'(x - l) = 0).
+// Stopping: ||g^P|| <= relative_tolerance * ||b|| (or absolute_tolerance when b = 0).
+
+#include <Eigen/Core>
+#include <string>
+
+#include "numerics/linear_operator.hpp"
+
+namespace robin {
+
+struct MprgpParameters {
+  double relative_tolerance = 1e-12;
+  double absolute_tolerance = 1e-300;
+  int max_iterations = 20000;
+  /// Proportioning constant Gamma > 0: a proportioning step is taken when
+  /// ||beta||^2 > Gamma^2 phi~'phi (phi~ the reduced free gradient).
+  double proportioning = 1.0;
+  /// Expansion step alpha = step_factor / ||A||, step_factor in (0, 2].
+  double step_factor = 1.9;
+  /// ||A|| estimate; computed with power iterations when <= 0.
+  double operator_norm = 0.0;
+};
+
+enum class QpStatus { converged, not_converged, breakdown };
+std::string to_string(QpStatus status);
+
+struct MprgpResult {
+  Eigen::VectorXd solution;
+  Eigen::VectorXd gradient;  // A x - b at the solution
+  QpStatus status = QpStatus::not_converged;
+  int iterations = 0;              // CG + expansion + proportioning steps
+  int conjugate_gradient_steps = 0;
+  int expansion_steps = 0;
+  int proportioning_steps = 0;
+  int operator_applications = 0;   // products with A, including the norm estimate
+  double projected_gradient_norm = 0.0;
+  double operator_norm = 0.0;      // the ||A|| estimate used
+  std::string message;             // reason for not_converged / breakdown
+};
+
+/// Solves the QP from the starting point `initial` (projected onto the feasible set).
+MprgpResult solve_mprgp(const LinearOperator& matrix, const Eigen::VectorXd& right_hand_side,
+                        const Eigen::VectorXd& lower, const Eigen::VectorXd& initial,
+                        const MprgpParameters& parameters = {});
+
+/// Largest eigenvalue estimate of A by power iterations (returns an upper-biased value).
+double estimate_operator_norm(const LinearOperator& matrix, int iterations, int& applications);
+
+}  // namespace robin
