@@ -5,9 +5,12 @@
 #include <array>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "coupling/gap_function.hpp"
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/gmsh_reader.hpp"
@@ -15,12 +18,22 @@
 
 namespace robin {
 
-/// One body as written in the case file. `definition.mesh` is empty until load_body_mesh.
+/// A boundary name a body refers to, and where the case file gives it (for messages).
+struct BoundaryReference {
+  std::string name;      // the physical curve name
+  std::string field;     // full key path, e.g. "body[2].dirichlet[1].boundary"
+  std::string location;  // "case.toml:31" (file:line of the value)
+};
+
+/// One body as written in the case file. `definition.mesh` is empty until load_body.
 struct BodyCase {
   BodyDefinition definition;
   std::filesystem::path mesh_path;  // absolute (resolved against the case file's directory)
   MeshReadOptions mesh_options;
   std::string context;  // "case.toml: body 'upper'" for messages
+  /// contact_boundary, then every dirichlet and traction boundary, in file order. When empty
+  /// (a BodyCase built by hand), load_body checks the names in `definition` instead.
+  std::vector<BoundaryReference> boundary_references;
 };
 
 /// Options of the Robin iteration (coordinator); command-line flags override them.
@@ -46,16 +59,23 @@ struct CaseDefinition {
   std::array<BodyCase, 2> bodies;
   std::optional<std::string> gap_expression;
   std::map<std::string, double> gap_constants;
+  std::string gap_context;  // "case.toml:12: gap.expression", the GapFunction context
   SolverOptions solver;
   CouplingOptions coupling;
 };
 
-/// Parses and validates a case file (without reading meshes). Throws InputError naming
-/// the file, line and field.
+/// Parses and validates a case file (without reading meshes): every key, type and range,
+/// the materials, the existence of the mesh files, and the gap expression (parsed and
+/// evaluated once). Throws InputError naming the file, line and field (and the body).
+/// The title defaults to the file's stem.
 CaseDefinition read_case_file(const std::filesystem::path& path);
 
 /// Reads the body's mesh and checks every boundary name against it; returns the complete
-/// definition. Throws InputError naming the case file, body, field and mesh file.
+/// definition. Throws InputError naming the case file, body, field and mesh file and listing
+/// the mesh's boundary names; a mesh reader error is rethrown with `context` prepended.
 BodyDefinition load_body(const BodyCase& body);
+
+/// The case's gap function, or null when the case has no [gap] table.
+std::unique_ptr<GapFunction> make_gap_function(const CaseDefinition& definition);
 
 }  // namespace robin

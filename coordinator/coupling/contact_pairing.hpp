@@ -40,9 +40,7 @@ struct ContactPairing {
 /// shortest contact edge; every node of both sides must be matched. Throws InputError naming
 /// the first unmatched node (body, mesh node tag, coordinates).
 ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::string& name1,
-                                  const std::vector<std::size_t>& tags1,
                                   const InterfaceDescription& body2, const std::string& name2,
-                                  const std::vector<std::size_t>& tags2, const GapFunction* gap,
-                                  double relative_tolerance);
+                                  const GapFunction* gap, double relative_tolerance);
 
 }  // namespace robin

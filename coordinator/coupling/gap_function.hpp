@@ -1,6 +1,9 @@
 #pragma once
 // The optional analytic initial gap g0(x, y), added to the geometric normal gap of each
 // contact pair. Parsed by muParser; variables x and y, plus user constants.
+//
+// Thread compatibility: evaluation is const but writes the parser's bound variables, so one
+// object must not be evaluated from several threads at once (give each thread its own object).
 
 #include <map>
 #include <memory>
@@ -10,8 +13,10 @@ namespace robin {
 
 class GapFunction {
  public:
-  /// Parses `expression`. Throws InputError starting with `context` (e.g.
-  /// "case.toml:12: gap.expression") and giving the parser's message and position.
+  /// Parses `expression` and evaluates it once at (0, 0) so that syntax errors and unknown
+  /// names surface here (the value there is not checked). Throws InputError starting with
+  /// `context` (e.g. "case.toml:12: gap.expression") and giving the parser's message and
+  /// position (0-based character index), also for a constant named x or y or not finite.
   GapFunction(const std::string& expression, const std::map<std::string, double>& constants,
               const std::string& context);
   ~GapFunction();

@@ -1,6 +1,9 @@
 #pragma once
 // Result files of a run, shared by robin-monolithic and robin-coordinator:
 //   <body>.vtu per body, solution.pvd, contact.csv, summary.json (and history.csv for DD).
+// Every writer creates the missing directories of its target and throws std::runtime_error
+// naming the path when a directory cannot be created or a file cannot be written. Numbers are
+// written as the shortest decimal text that reads back to the same double.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -20,12 +23,18 @@ struct InterfaceState {
   Eigen::VectorXd contact_force1, contact_force2;
 };
 
+/// Header line "pair,x,y,nx,ny,gap0,un1,un2,lambda1,lambda2,pressure", then one row per pair
+/// (pair = zero-based index). Throws std::runtime_error when a state vector is not of the
+/// pairing's size.
 void write_contact_csv(const std::filesystem::path& path, const ContactPairing& pairing,
                        const InterfaceState& state);
 
 /// Nodal fields of one body: displacement (2), stress (3: xx, yy, xy, nodal average),
 /// von_mises, contact_pressure (lambda_i / m_i on contact nodes, 0 elsewhere), contact_force
-/// (2), reaction (2); cell fields: stress, von_mises. Returns the written file name.
+/// (2), reaction (2); cell fields: stress, von_mises. The file is "<body name>.vtu" in
+/// `directory`; contact_force is lambda in the body's assignment order (size contact_size()).
+/// 2-component fields are written with a zero z component (see numerics/vtu_writer.hpp).
+/// Returns the written file name (relative to `directory`).
 std::string write_body_vtu(const std::filesystem::path& directory, const BodySolver& body,
                            const Eigen::VectorXd& contact_force);
 
@@ -33,9 +42,12 @@ std::string write_body_vtu(const std::filesystem::path& directory, const BodySol
 void write_solution_pvd(const std::filesystem::path& directory, const std::string& file1,
                         const std::string& file2);
 
+/// Pretty-printed JSON (2-space indent) followed by a newline.
 void write_json(const std::filesystem::path& path, const nlohmann::json& document);
 
-/// Contact force resultant sum_i lambda_i n_i acting on body 2 (= minus that on body 1).
+/// Contact force resultant sum_i lambda_i n1_i acting on body 2 (= minus that on body 1):
+/// lambda is compressive and n1 points from body 1 towards body 2. Throws std::runtime_error
+/// when force is not of the pairing's size.
 Eigen::Vector2d contact_resultant(const ContactPairing& pairing, const Eigen::VectorXd& force);
 
 }  // namespace robin

@@ -31,6 +31,7 @@ namespace robin {
 /// The candidate contact nodes of a body as the body sees them.
 struct InterfaceDescription {
   std::vector<int> node_ids;                 // mesh node indices, ascending
+  std::vector<std::size_t> node_tags;        // the nodes' tags in the mesh file (for messages)
   std::vector<Eigen::Vector2d> coordinates;  // reference positions
   std::vector<Eigen::Vector2d> normals;      // unit outward normals from the geometry
   std::vector<double> weights;               // m_i = int_{contact boundary} phi_i ds (length)

@@ -1,0 +1,20 @@
+#pragma once
+// Reading one [[body]] table of a case file (internal to case_file.cpp).
+
+#include <filesystem>
+
+#include "coupling/case_file.hpp"
+#include "coupling/case_file_table.hpp"
+
+namespace robin {
+
+/// Reads and checks the [[body]] table `entry` (keys, types, ranges, material, mesh file
+/// existence and options). Relative mesh paths are resolved against `directory`.
+/// `file` carries the case file label (its body part is ignored). Throws InputError.
+BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
+                        const std::filesystem::path& directory);
+
+/// Formats a number for messages (up to 12 significant digits).
+std::string format_number(double value);
+
+}  // namespace robin

@@ -1,0 +1,159 @@
+#include "coupling/contact_pairing.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+#include "numerics/errors.hpp"
+
+namespace robin {
+namespace {
+
+std::string format_point(const Eigen::Vector2d& point) {
+  std::ostringstream stream;
+  stream.precision(10);
+  stream << "(" << point.x() << ", " << point.y() << ")";
+  return stream.str();
+}
+
+/// Shortest distance between two distinct contact nodes of one side: the length scale of the
+/// matching tolerance.
+double shortest_spacing(const std::vector<Eigen::Vector2d>& points) {
+  double shortest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (std::size_t j = i + 1; j < points.size(); ++j) {
+      const double distance = (points[i] - points[j]).norm();
+      if (distance > 0) shortest = std::min(shortest, distance);
+    }
+  }
+  return std::isfinite(shortest) ? shortest : 1.0;
+}
+
+/// True when the prescribed components of a node fix its displacement along `normal`.
+bool normal_is_prescribed(bool x_fixed, bool y_fixed, const Eigen::Vector2d& normal) {
+  constexpr double aligned = 1e-12;
+  return (x_fixed && y_fixed) || (x_fixed && std::abs(normal.y()) < aligned) ||
+         (y_fixed && std::abs(normal.x()) < aligned);
+}
+
+/// Index of the body-2 node whose offset from `point`, less its component along `normal`, is
+/// the shortest and below `tolerance`; -1 if none.
+int find_partner(const Eigen::Vector2d& point, const Eigen::Vector2d& normal,
+                 const InterfaceDescription& other, double tolerance) {
+  int best = -1;
+  double best_offset = tolerance;
+  for (std::size_t j = 0; j < other.coordinates.size(); ++j) {
+    const Eigen::Vector2d offset = other.coordinates[j] - point;
+    const double tangential = (offset - offset.dot(normal) * normal).norm();
+    if (tangential <= best_offset) {
+      best_offset = tangential;
+      best = static_cast<int>(j);
+    }
+  }
+  return best;
+}
+
+/// Orders pairs along the principal direction of the contact zone (a curve parameter for
+/// flat and gently curved zones), so that contact.csv reads as a profile.
+void order_along_zone(std::vector<ContactPair>& pairs) {
+  if (pairs.size() < 2) return;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const ContactPair& pair : pairs) mean += pair.position;
+  mean /= static_cast<double>(pairs.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const ContactPair& pair : pairs) {
+    scatter += (pair.position - mean) * (pair.position - mean).transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+  Eigen::Vector2d direction = eigen.eigenvectors().col(1);
+  if (direction.x() < 0 || (direction.x() == 0 && direction.y() < 0)) direction = -direction;
+  std::stable_sort(pairs.begin(), pairs.end(), [&](const ContactPair& a, const ContactPair& b) {
+    return (a.position - mean).dot(direction) < (b.position - mean).dot(direction);
+  });
+}
+
+std::string describe_node(const std::string& body, std::size_t tag, const Eigen::Vector2d& point) {
+  return "body '" + body + "' contact node (tag " + std::to_string(tag) + ") at " +
+         format_point(point);
+}
+
+}  // namespace
+
+ContactAssignment ContactPairing::assignment(int body_index) const {
+  ContactAssignment assignment;
+  const double sign = body_index == 0 ? 1.0 : -1.0;
+  for (const ContactPair& pair : pairs) {
+    assignment.node_ids.push_back(body_index == 0 ? pair.node1 : pair.node2);
+    assignment.normals.push_back(sign * pair.normal);
+  }
+  return assignment;
+}
+
+Eigen::VectorXd ContactPairing::gaps() const {
+  Eigen::VectorXd values(static_cast<Eigen::Index>(pairs.size()));
+  for (std::size_t i = 0; i < pairs.size(); ++i) values[i] = pairs[i].gap;
+  return values;
+}
+
+Eigen::VectorXd ContactPairing::weights() const {
+  Eigen::VectorXd values(static_cast<Eigen::Index>(pairs.size()));
+  for (std::size_t i = 0; i < pairs.size(); ++i) values[i] = pairs[i].weight;
+  return values;
+}
+
+ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::string& name1,
+                                  const InterfaceDescription& body2, const std::string& name2,
+                                  const GapFunction* gap, double relative_tolerance) {
+  if (body1.node_ids.empty() || body2.node_ids.empty()) {
+    throw InputError("contact pairing: body '" + (body1.node_ids.empty() ? name1 : name2) +
+                     "' has no contact nodes");
+  }
+  const double tolerance = relative_tolerance * std::min(shortest_spacing(body1.coordinates),
+                                                         shortest_spacing(body2.coordinates));
+  std::vector<int> partner_of_second(body2.node_ids.size(), -1);
+  ContactPairing pairing;
+  for (std::size_t i = 0; i < body1.node_ids.size(); ++i) {
+    const Eigen::Vector2d& point = body1.coordinates[i];
+    const int j = find_partner(point, body1.normals[i], body2, tolerance);
+    if (j < 0 || partner_of_second[j] >= 0) {
+      throw InputError(
+          "contact pairing: " + describe_node(name1, body1.node_tags[i], point) +
+          " has no matching node on body '" + name2 + "' within " + std::to_string(tolerance) +
+          " (non-matching contact meshes are not supported: mesh both contact boundaries with "
+          "the same nodes)");
+    }
+    partner_of_second[j] = static_cast<int>(i);
+    ContactPair pair;
+    pair.node1 = body1.node_ids[i];
+    pair.node2 = body2.node_ids[j];
+    pair.position = point;
+    pair.normal = (body1.normals[i] - body2.normals[j]).normalized();
+    pair.gap = (body2.coordinates[j] - point).dot(pair.normal);
+    if (gap != nullptr) pair.gap += (*gap)(point.x(), point.y());
+    pair.weight = 0.5 * (body1.weights[i] + body2.weights[j]);
+    const bool fixed1 = normal_is_prescribed(body1.x_fixed[i], body1.y_fixed[i], pair.normal);
+    const bool fixed2 = normal_is_prescribed(body2.x_fixed[j], body2.y_fixed[j], pair.normal);
+    if (fixed1 || fixed2) {
+      pairing.excluded.push_back(
+          describe_node(fixed1 ? name1 : name2,
+                        fixed1 ? body1.node_tags[i] : body2.node_tags[j], point) +
+          ": normal displacement prescribed by a Dirichlet condition; pair excluded from contact");
+      continue;
+    }
+    pairing.pairs.push_back(pair);
+  }
+  for (std::size_t j = 0; j < body2.node_ids.size(); ++j) {
+    if (partner_of_second[j] < 0) {
+      throw InputError("contact pairing: " +
+                       describe_node(name2, body2.node_tags[j], body2.coordinates[j]) +
+                       " has no matching node on body '" + name1 + "'");
+    }
+  }
+  order_along_zone(pairing.pairs);
+  return pairing;
+}
+
+}  // namespace robin

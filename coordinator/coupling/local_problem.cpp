@@ -1,0 +1,35 @@
+#include "coupling/local_problem.hpp"
+
+#include <chrono>
+
+namespace robin {
+
+std::unique_ptr<GapFunction> make_gap_function(const CaseDefinition& definition) {
+  if (!definition.gap_expression) return nullptr;
+  return std::make_unique<GapFunction>(*definition.gap_expression, definition.gap_constants,
+                                       definition.file.string() + ": gap.expression");
+}
+
+LocalProblem prepare_local_problem(const CaseDefinition& definition) {
+  LocalProblem problem;
+  problem.definition = definition;
+  problem.gap = make_gap_function(definition);
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    const auto start = std::chrono::steady_clock::now();
+    BodyDefinition body = load_body(definition.bodies[alpha]);
+    problem.mesh_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    problem.bodies[alpha] = std::make_unique<BodySolver>(std::move(body), definition.solver.body);
+  }
+  const BodySolver& body1 = *problem.bodies[0];
+  const BodySolver& body2 = *problem.bodies[1];
+  problem.pairing =
+      pair_contact_nodes(body1.contact_boundary(), body1.name(), body2.contact_boundary(),
+                         body2.name(), problem.gap.get(), definition.solver.pairing_tolerance);
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    problem.bodies[alpha]->assign_contact(problem.pairing.assignment(alpha));
+  }
+  return problem;
+}
+
+}  // namespace robin

@@ -1,0 +1,31 @@
+#pragma once
+// A case built entirely in this process: both bodies read, assembled, factorized, their
+// contact boundaries paired and assigned. Used by robin-monolithic, by the in-process
+// subdomain ports and by tests.
+
+#include <array>
+#include <filesystem>
+#include <memory>
+
+#include "coupling/case_file.hpp"
+#include "coupling/contact_pairing.hpp"
+#include "coupling/gap_function.hpp"
+#include "numerics/body_solver.hpp"
+
+namespace robin {
+
+struct LocalProblem {
+  CaseDefinition definition;
+  std::unique_ptr<GapFunction> gap;  // null when the case has no [gap]
+  std::array<std::unique_ptr<BodySolver>, 2> bodies;
+  ContactPairing pairing;
+  double mesh_seconds = 0.0;  // reading and meshing both bodies
+};
+
+/// The case's gap function, or null when it has none.
+std::unique_ptr<GapFunction> make_gap_function(const CaseDefinition& definition);
+
+/// Reads, assembles, factorizes and pairs. Throws InputError / SingularBodyError.
+LocalProblem prepare_local_problem(const CaseDefinition& definition);
+
+}  // namespace robin

@@ -1,0 +1,129 @@
+// robin-monolithic CASE --output DIR
+// The single-process reference solver of the whole two-body contact problem (paper (5)).
+// Exit codes: 0 converged, 1 bad input or failure, 2 the QP did not converge.
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <filesystem>
+
+#include "coupling/local_problem.hpp"
+#include "coupling/monolithic_solver.hpp"
+#include "coupling/result_files.hpp"
+#include "numerics/errors.hpp"
+
+namespace {
+
+using robin::LocalProblem;
+using robin::MonolithicResult;
+
+nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult& result,
+                            double total_seconds) {
+  nlohmann::json summary;
+  const Eigen::Vector2d resultant =
+      robin::contact_resultant(problem.pairing, result.contact_force);
+  summary["method"] = "monolithic";
+  summary["case"] = problem.definition.file.string();
+  summary["converged"] = result.qp.status == robin::QpStatus::converged;
+  summary["qp_status"] = robin::to_string(result.qp.status);
+  summary["iterations"] = result.qp.iterations;
+  summary["operator_applications"] = result.qp.operator_applications;
+  summary["contact_pairs"] = problem.pairing.size();
+  summary["excluded_pairs"] = problem.pairing.excluded;
+  summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
+  summary["residuals"] = {{"penetration", result.residuals.penetration},
+                          {"force_balance", result.residuals.force_balance},
+                          {"complementarity", result.residuals.complementarity}};
+  double assembly = 0, factorization = 0;
+  for (const auto& body : problem.bodies) {
+    summary["bodies"].push_back({{"name", body->name()},
+                                 {"dofs", body->free_dof_count()},
+                                 {"nodes", body->mesh().node_count()},
+                                 {"elements", body->mesh().element_count()},
+                                 {"factor_nonzeros", body->factor_nonzeros()},
+                                 {"applied_force", {body->applied_force().x(),
+                                                    body->applied_force().y()}}});
+    assembly += body->timings().assembly_seconds;
+    factorization += body->timings().factorization_seconds + body->timings().interface_seconds;
+  }
+  summary["timings"] = {{"mesh", problem.mesh_seconds},
+                        {"assembly", assembly},
+                        {"factorization", factorization},
+                        {"solve", result.solve_seconds},
+                        {"total", total_seconds}};
+  return summary;
+}
+
+void write_outputs(const std::filesystem::path& directory, const LocalProblem& problem,
+                   const MonolithicResult& result, const nlohmann::json& summary) {
+  std::filesystem::create_directories(directory);
+  const std::string file1 = robin::write_body_vtu(directory, *problem.bodies[0], result.contact_force);
+  const std::string file2 = robin::write_body_vtu(directory, *problem.bodies[1], result.contact_force);
+  robin::write_solution_pvd(directory, file1, file2);
+  robin::InterfaceState state{result.normal_trace1, result.normal_trace2, result.contact_force,
+                              result.contact_force};
+  robin::write_contact_csv(directory / "contact.csv", problem.pairing, state);
+  robin::write_json(directory / "summary.json", summary);
+}
+
+int run(const std::filesystem::path& case_path, const std::filesystem::path& output) {
+  auto log = spdlog::get("monolithic");
+  const auto start = std::chrono::steady_clock::now();
+  const robin::CaseDefinition definition = robin::read_case_file(case_path);
+  log->info("case {}: bodies '{}' and '{}'", case_path.string(), definition.bodies[0].definition.name,
+            definition.bodies[1].definition.name);
+  const LocalProblem problem = robin::prepare_local_problem(definition);
+  for (const auto& body : problem.bodies) {
+    log->info("body '{}': {} dofs, assembly {:.3f} s, factorization {:.3f} s ({} nonzeros in L)",
+              body->name(), body->free_dof_count(), body->timings().assembly_seconds,
+              body->timings().factorization_seconds, body->factor_nonzeros());
+  }
+  log->info("{} contact pairs ({} excluded)", problem.pairing.size(), problem.pairing.excluded.size());
+  for (const std::string& line : problem.pairing.excluded) log->warn("{}", line);
+  const MonolithicResult result = robin::solve_monolithic(
+      *problem.bodies[0], *problem.bodies[1], problem.pairing, definition.solver.qp);
+  const double total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  log->info("MPRGP {}: {} iterations, {} operator products, {:.3f} s; residuals penetration {:.2e}, "
+            "complementarity {:.2e}",
+            robin::to_string(result.qp.status), result.qp.iterations,
+            result.qp.operator_applications, result.solve_seconds, result.residuals.penetration,
+            result.residuals.complementarity);
+  const nlohmann::json summary = make_summary(problem, result, total);
+  write_outputs(output, problem, result, summary);
+  log->info("results in {} (open solution.pvd in ParaView)", output.string());
+  if (result.qp.status != robin::QpStatus::converged) {
+    log->error("the contact QP did not converge: {}", result.qp.message);
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"robin-monolithic: single-process reference solve of a two-body contact case"};
+  std::filesystem::path case_path, output;
+  std::string level = "info";
+  app.add_option("case", case_path, "case file (TOML, see docs/case-format.md)")->required();
+  app.add_option("--output,-o", output, "directory for the result files")->required();
+  app.add_option("--log-level", level, "trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  CLI11_PARSE(app, argc, argv);
+
+  auto log = spdlog::stderr_color_mt("monolithic");
+  log->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%^%l%$] %v");
+  log->set_level(spdlog::level::from_str(level));
+  try {
+    return run(case_path, output);
+  } catch (const robin::InputError& error) {
+    log->error("{}", error.what());
+  } catch (const robin::SingularBodyError& error) {
+    log->error("{}", error.what());
+  } catch (const std::exception& error) {
+    log->error("failed: {}", error.what());
+  }
+  return 1;
+}

@@ -1,0 +1,292 @@
+#include "numerics/body_solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "numerics/errors.hpp"
+
+namespace robin {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// F = B K^{-1} B' applied through the factor: one solve (two triangular solves) per product.
+class FactorComplianceOperator final : public LinearOperator {
+ public:
+  FactorComplianceOperator(const SparseMatrix& trace, const CholeskyFactor& factor)
+      : trace_(trace), trace_transpose_(trace.transpose()), factor_(factor) {}
+  int size() const override { return static_cast<int>(trace_.rows()); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
+    // y = B K^{-1} (B' x)
+    y.noalias() = trace_ * factor_.solve(Eigen::VectorXd(trace_transpose_ * x));
+  }
+
+ private:
+  const SparseMatrix& trace_;
+  SparseMatrix trace_transpose_;
+  const CholeskyFactor& factor_;
+};
+
+/// F assembled column block by column block: F(:, J) = B K^{-1} B'(:, J).
+Eigen::MatrixXd assemble_dense_compliance(const SparseMatrix& trace, const CholeskyFactor& factor) {
+  const Eigen::Index contact_count = trace.rows();
+  const SparseMatrix trace_transpose = trace.transpose();
+  Eigen::MatrixXd compliance(contact_count, contact_count);
+  constexpr Eigen::Index block_width = 64;
+  for (Eigen::Index first = 0; first < contact_count; first += block_width) {
+    const Eigen::Index width = std::min(block_width, contact_count - first);
+    const Eigen::MatrixXd loads = Eigen::MatrixXd(trace_transpose.middleCols(first, width));
+    compliance.middleCols(first, width).noalias() = trace * factor.solve(loads);
+  }
+  // Symmetrise away the rounding of the solves: F is symmetric by construction.
+  const Eigen::MatrixXd symmetric = 0.5 * (compliance + compliance.transpose());
+  return symmetric;
+}
+
+/// Prescribed value of every dof from the Dirichlet conditions. Two conditions that give the
+/// same dof different values are an error.
+std::vector<std::optional<double>> prescribed_dofs(const BodyDefinition& body) {
+  std::vector<std::optional<double>> prescribed(2 * body.mesh.node_count());
+  std::vector<std::string> source(prescribed.size());
+  auto prescribe = [&](int dof, double value, const std::string& boundary) {
+    if (prescribed[dof] && std::abs(*prescribed[dof] - value) > 1e-14 * (1 + std::abs(value))) {
+      throw InputError("body '" + body.name + "': Dirichlet conditions on '" + source[dof] +
+                       "' and '" + boundary + "' prescribe different values to node tag " +
+                       std::to_string(body.mesh.node_tags[dof / 2]) +
+                       (dof % 2 == 0 ? " (u_x)" : " (u_y)"));
+    }
+    prescribed[dof] = value;
+    source[dof] = boundary;
+  };
+  for (const DirichletCondition& condition : body.dirichlet) {
+    for (int node : body.mesh.boundary(condition.boundary).nodes()) {
+      if (condition.x) prescribe(2 * node, *condition.x, condition.boundary);
+      if (condition.y) prescribe(2 * node + 1, *condition.y, condition.boundary);
+    }
+  }
+  return prescribed;
+}
+
+Eigen::VectorXd assemble_external_load(const BodyDefinition& body) {
+  const Mesh& mesh = body.mesh;
+  const Eigen::Vector2d body_force = body.body_force;
+  Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(mesh.node_count()));
+  if (body_force.squaredNorm() > 0) {
+    load += assemble_body_force(mesh, [body_force](const Eigen::Vector2d&) { return body_force; });
+  }
+  for (const TractionCondition& traction : body.tractions) {
+    const BoundaryGroup& group = mesh.boundary(traction.boundary);
+    if (traction.is_pressure) {
+      const double pressure = traction.pressure;
+      load += assemble_boundary_traction(
+          mesh, group, [pressure](const Eigen::Vector2d&, const Eigen::Vector2d& normal) {
+            return Eigen::Vector2d(-pressure * normal);  // compression positive
+          });
+    } else {
+      const Eigen::Vector2d vector = traction.vector;
+      load += assemble_boundary_traction(
+          mesh, group, [vector](const Eigen::Vector2d&, const Eigen::Vector2d&) { return vector; });
+    }
+  }
+  return load;
+}
+
+}  // namespace
+
+BodySolver::BodySolver(BodyDefinition definition, BodySolverOptions options)
+    : definition_(std::move(definition)), options_(options) {
+  assemble();
+}
+
+BodySolver::~BodySolver() = default;
+
+void BodySolver::assemble() {
+  auto start = std::chrono::steady_clock::now();
+  const Mesh& mesh = definition_.mesh;
+  if (mesh.node_count() == 0 || mesh.element_count() == 0) {
+    throw InputError("body '" + name() + "': the mesh has no elements");
+  }
+  mesh.boundary(definition_.contact_boundary);  // throws InputError for an unknown name
+  dofs_ = std::make_unique<DofMap>(prescribed_dofs(definition_));
+  if (!removes_rigid_motions(mesh, *dofs_)) {
+    throw SingularBodyError(
+        "body '" + name() +
+        "': the Dirichlet conditions leave a rigid motion free (translation or rotation); "
+        "fix u_x and u_y on a boundary segment, or enough components on several boundaries");
+  }
+  full_stiffness_ = assemble_stiffness(mesh, definition_.material);
+  full_load_ = assemble_external_load(definition_);
+  const SparseMatrix reduced_stiffness = dofs_->reduce_matrix(full_stiffness_);
+  reduced_load_ = dofs_->reduce_load(full_stiffness_, full_load_);
+  timings_.assembly_seconds = seconds_since(start);
+
+  start = std::chrono::steady_clock::now();
+  factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name());
+  free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
+  timings_.factorization_seconds = seconds_since(start);
+}
+
+InterfaceDescription BodySolver::contact_boundary() const {
+  const Mesh& mesh = definition_.mesh;
+  const BoundaryGroup& group = mesh.boundary(definition_.contact_boundary);
+  InterfaceDescription interface;
+  interface.node_ids = group.nodes();
+  interface.normals = boundary_node_normals(mesh, group);
+  const Eigen::VectorXd weights = boundary_weights(mesh, group);
+  for (int node : interface.node_ids) {
+    interface.node_tags.push_back(mesh.node_tags[node]);
+    interface.coordinates.push_back(mesh.nodes[node]);
+    interface.weights.push_back(weights[node]);
+    interface.x_fixed.push_back(dofs_->is_prescribed(2 * node));
+    interface.y_fixed.push_back(dofs_->is_prescribed(2 * node + 1));
+  }
+  return interface;
+}
+
+void BodySolver::assign_contact(const ContactAssignment& assignment) {
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh& mesh = definition_.mesh;
+  const BoundaryGroup& group = mesh.boundary(definition_.contact_boundary);
+  const std::vector<int> boundary_nodes = group.nodes();
+  const Eigen::VectorXd weights = boundary_weights(mesh, group);
+  if (assignment.node_ids.size() != assignment.normals.size()) {
+    throw InputError("body '" + name() + "': contact assignment has " +
+                     std::to_string(assignment.node_ids.size()) + " nodes but " +
+                     std::to_string(assignment.normals.size()) + " normals");
+  }
+  const int contact_count = static_cast<int>(assignment.node_ids.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  prescribed_trace_ = Eigen::VectorXd::Zero(contact_count);
+  contact_weights_ = Eigen::VectorXd::Zero(contact_count);
+  for (int i = 0; i < contact_count; ++i) {
+    const int node = assignment.node_ids[i];
+    const Eigen::Vector2d& normal = assignment.normals[i];
+    if (!std::binary_search(boundary_nodes.begin(), boundary_nodes.end(), node)) {
+      throw InputError("body '" + name() + "': contact node " + std::to_string(node) +
+                       " is not on the contact boundary '" + definition_.contact_boundary + "'");
+    }
+    if (!std::isfinite(normal.norm()) || std::abs(normal.norm() - 1.0) > 1e-8) {
+      throw InputError("body '" + name() + "': the normal of contact node " +
+                       std::to_string(node) + " is not a unit vector");
+    }
+    contact_weights_[i] = weights[node];
+    for (int component = 0; component < 2; ++component) {
+      const int dof = 2 * node + component;
+      if (dofs_->is_prescribed(dof)) {
+        prescribed_trace_[i] += normal[component] * dofs_->prescribed_values()[dof];
+      } else {
+        triplets.emplace_back(i, dofs_->free_index(dof), normal[component]);
+      }
+    }
+  }
+  contact_nodes_ = assignment.node_ids;
+  contact_normals_ = assignment.normals;
+  trace_.resize(contact_count, dofs_->free_count());
+  trace_.setFromTriplets(triplets.begin(), triplets.end());
+  free_trace_ = trace_ * free_solution_ + prescribed_trace_;  // e = B K^{-1} f + B u_p
+  build_interface_operator();
+  reset_warm_start();
+  timings_.interface_seconds = seconds_since(start);
+}
+
+void BodySolver::build_interface_operator() {
+  const bool dense =
+      options_.interface_operator == InterfaceOperatorKind::dense ||
+      (options_.interface_operator == InterfaceOperatorKind::automatic &&
+       contact_size() <= options_.dense_limit);
+  if (dense) {
+    compliance_ = std::make_unique<DenseOperator>(assemble_dense_compliance(trace_, *factor_));
+  } else {
+    compliance_ = std::make_unique<FactorComplianceOperator>(trace_, *factor_);
+  }
+}
+
+void BodySolver::reset_warm_start() { warm_start_ = Eigen::VectorXd::Zero(contact_size()); }
+
+ContactSolveResult BodySolver::solve_contact(const Eigen::VectorXd& obstacle,
+                                             const MprgpParameters& parameters) {
+  const auto start = std::chrono::steady_clock::now();
+  if (obstacle.size() != contact_size()) {
+    throw InputError("body '" + name() + "': obstacle has " + std::to_string(obstacle.size()) +
+                     " values for " + std::to_string(contact_size()) + " contact nodes");
+  }
+  // Dual problem: minimise 1/2 l'F l - l'(e - g), l >= 0. Its gradient F l - (e - g) equals
+  // g - u_N, so u_N = g - gradient and the KKT conditions are the Signorini conditions.
+  const Eigen::VectorXd right_hand_side = free_trace_ - obstacle;
+  const Eigen::VectorXd lower = Eigen::VectorXd::Zero(contact_size());
+  const MprgpResult qp = solve_mprgp(*compliance_, right_hand_side, lower, warm_start_, parameters);
+
+  ContactSolveResult result;
+  result.contact_force = qp.solution;
+  result.normal_trace = obstacle - qp.gradient;
+  result.status = qp.status;
+  result.iterations = qp.iterations;
+  result.operator_applications = qp.operator_applications;
+  result.projected_gradient_norm = qp.projected_gradient_norm;
+  result.message = qp.message;
+  result.active.resize(contact_size());
+  for (int i = 0; i < contact_size(); ++i) {
+    const double clearance = obstacle[i] - result.normal_trace[i];
+    result.active[i] = result.contact_force[i] > 0.0;
+    result.penetration = std::max(result.penetration, -clearance);
+    result.complementarity =
+        std::max(result.complementarity, std::abs(result.contact_force[i] * clearance));
+  }
+  if (qp.status == QpStatus::converged) warm_start_ = qp.solution;
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_force) const {
+  if (interface_force.size() != contact_size()) {
+    throw InputError("body '" + name() + "': interface force has " +
+                     std::to_string(interface_force.size()) + " values for " +
+                     std::to_string(contact_size()) + " contact nodes");
+  }
+  Eigen::VectorXd trace;
+  compliance_->apply(interface_force, trace);  // w_N = B K^{-1} B' r
+  return trace;
+}
+
+Eigen::VectorXd BodySolver::apply_transpose_trace(const Eigen::VectorXd& contact_force) const {
+  return trace_.transpose() * contact_force;
+}
+
+Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force) const {
+  // u_f = K^{-1} (f - B' lambda)
+  Eigen::VectorXd free_values = free_solution_;
+  if (contact_force.size() > 0 && contact_force.lpNorm<Eigen::Infinity>() > 0) {
+    free_values -= factor_->solve(apply_transpose_trace(contact_force));
+  }
+  return dofs_->expand(free_values);
+}
+
+Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& displacement) const {
+  Eigen::VectorXd reaction = full_stiffness_ * displacement - full_load_;
+  for (int dof = 0; dof < dofs_->total_count(); ++dof) {
+    if (!dofs_->is_prescribed(dof)) reaction[dof] = 0.0;
+  }
+  return reaction;
+}
+
+Eigen::Vector2d BodySolver::applied_force() const {
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (Eigen::Index node = 0; node < full_load_.size() / 2; ++node) {
+    total += full_load_.segment<2>(2 * node);
+  }
+  return total;
+}
+
+Eigen::VectorXd BodySolver::contact_force_field(const Eigen::VectorXd& contact_force) const {
+  Eigen::VectorXd field = Eigen::VectorXd::Zero(dofs_->total_count());
+  for (int i = 0; i < contact_size(); ++i) {
+    field.segment<2>(2 * contact_nodes_[i]) -= contact_force[i] * contact_normals_[i];
+  }
+  return field;
+}
+
+}  // namespace robin
