@@ -1,0 +1,46 @@
+#pragma once
+// A whole coupled run on two ports: setup of both bodies (in parallel), pairing of their
+// interfaces, contact assignment, the Robin iteration, the final fields, and the result files.
+// Shared by robin-coordinator (remote ports) and the in-process mode / tests.
+
+#include <array>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "coupling/case_file.hpp"
+#include "coupling/contact_pairing.hpp"
+#include "coupling/robin_iteration.hpp"
+#include "coupling/subdomain_port.hpp"
+
+namespace robin {
+
+struct CoupledRunResult {
+  ContactPairing pairing;
+  RobinResult iteration;
+  std::array<BodyOutput, 2> outputs;
+  std::array<InterfaceDescription, 2> interfaces;
+  std::array<PortTimings, 2> port_timings;
+  double setup_seconds = 0.0;
+  double total_seconds = 0.0;
+};
+
+/// Observer of the run's stages ("setup", "pairing", iteration records) for progress lines.
+struct RunObserver {
+  std::function<void(const std::string&)> stage;
+  IterationObserver iteration;
+};
+
+/// Runs the case on the ports (ports[0] gets body 1). `options` replaces the case's
+/// [coupling] table (the caller merges command-line overrides). Throws PortError, InputError.
+CoupledRunResult run_coupled_case(const CaseDefinition& definition,
+                                  const std::array<SubdomainPort*, 2>& ports,
+                                  const CouplingOptions& options, const RunObserver& observer = {});
+
+/// Writes <body>.vtu x2, solution.pvd, contact.csv, history.csv and summary.json.
+void write_coupled_outputs(const std::filesystem::path& directory, const CaseDefinition& definition,
+                           const CoupledRunResult& result);
+
+/// Exit code of a run: 0 converged, 3 iteration limit, 4 diverged, 5 stagnated.
+int exit_code(IterationStatus status);
+
+}  // namespace robin

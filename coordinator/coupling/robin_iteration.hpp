@@ -1,0 +1,62 @@
+#pragma once
+// Algorithm (Q_m) of Ipopa & Sassi (2008), paper (10)-(13), driven through two subdomain
+// ports. One iteration, with d the initial gaps:
+//   step 1 (both bodies in parallel): u^a = argmin 1/2 u'K^a u - f^a'u s.t. B^a u <= g^a,
+//          returning u^a_N and lambda^a >= 0;
+//   step 2 (both in parallel): w^1_N = F^1 (lambda^2 - lambda^1), w^2_N = F^2 (lambda^1 - lambda^2);
+//   step 3: g^1 <- (1 - delta) g^1 + delta (w^2_N - u^2_N + d),
+//           g^2 <- (1 - delta) g^2 + delta (w^1_N - u^1_N + d).
+// Convergence: every scaled residual of IterationRecord below the tolerance. At the fixed point
+// lambda^1 = lambda^2, w = 0 and the state solves the monolithic problem (Prop. 3.2).
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "coupling/case_file.hpp"
+#include "coupling/subdomain_port.hpp"
+
+namespace robin {
+
+/// Residuals of one iteration, all dimensionless: displacement-like quantities are divided by
+/// the displacement scale D = max(|d|, |u1_N|, |u2_N|), forces by F = max(|lambda1|, |lambda2|).
+struct IterationRecord {
+  int iteration = 0;
+  double obstacle_change = 0.0;  // |g_new - g_old| / max(|g_new|, D), both bodies, max norm
+  double penetration = 0.0;      // max(0, u1_N + u2_N - d) / D
+  double force_balance = 0.0;    // |lambda1 - lambda2| / F
+  double complementarity = 0.0;  // |lambda (d - u1_N - u2_N)| / (F D), lambda = mean
+  double correction = 0.0;       // max(|w1_N|, |w2_N|) / D
+  int active1 = 0, active2 = 0;  // closed pairs seen by each body
+  int qp_iterations1 = 0, qp_iterations2 = 0;
+  double seconds = 0.0;          // wall time of the iteration
+  double largest() const;        // the largest residual
+};
+
+enum class IterationStatus { converged, max_iterations, diverged, stagnated };
+std::string to_string(IterationStatus status);
+
+struct RobinResult {
+  IterationStatus status = IterationStatus::max_iterations;
+  std::string message;  // why it stopped, for people
+  std::vector<IterationRecord> history;
+  // The state of the last iteration (pair order).
+  Eigen::VectorXd obstacle1, obstacle2;          // g used in the last contact solves
+  Eigen::VectorXd normal_trace1, normal_trace2;  // u_N
+  Eigen::VectorXd contact_force1, contact_force2;
+  Eigen::VectorXd correction1, correction2;      // w_N
+  double coordinator_seconds = 0.0;  // time in the coordinator's own computations
+  double wall_seconds = 0.0;
+};
+
+using IterationObserver = std::function<void(const IterationRecord&)>;
+
+/// Runs the iteration on two ports whose contact has been assigned (pair order of `gaps`).
+/// Throws PortError when a port fails (the message names server, body and step) and
+/// std::runtime_error when a contact solve does not converge.
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const Eigen::VectorXd& gaps, const CouplingOptions& options,
+                                const IterationObserver& observer = {});
+
+}  // namespace robin

@@ -1,0 +1,58 @@
+#pragma once
+// The coordinator's view of one subdomain (one body), independent of where it runs.
+// Two implementations: InProcessPort (calls BodySolver directly) and RemotePort (speaks the
+// protocol of proto/robin.proto to a server over ZeroMQ). The Robin iteration only sees this
+// interface, so the same algorithm code runs in one process or across machines.
+//
+// Requests are split into start_* / finish_* so that the two bodies compute in parallel:
+// the iteration starts a request on both ports, then finishes both. Every method throws
+// PortError (naming the server, the body and the step) on failure, including deadlines.
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "coupling/case_file.hpp"
+#include "numerics/body_output.hpp"
+#include "numerics/body_solver.hpp"
+
+namespace robin {
+
+class PortError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct CorrectionSolveResult {
+  Eigen::VectorXd normal_trace;  // w_N
+  double seconds = 0.0;          // compute time where the body lives
+};
+
+/// Time spent by a port, for the summary's split of the wall time.
+struct PortTimings {
+  double compute_seconds = 0.0;    // reported by the body (server compute)
+  double round_trip_seconds = 0.0; // request sent to reply decoded (remote); = compute in process
+  long bytes_sent = 0;
+  long bytes_received = 0;
+};
+
+class SubdomainPort {
+ public:
+  virtual ~SubdomainPort() = default;
+  /// "server tcp://host:port" or "in-process", for messages.
+  virtual std::string describe() const = 0;
+  /// Sends the body; returns its contact boundary. Throws PortError.
+  virtual InterfaceDescription setup(const BodyCase& body, const SolverOptions& solver) = 0;
+  virtual void assign_contact(const ContactAssignment& assignment) = 0;
+  virtual void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) = 0;
+  virtual ContactSolveResult finish_contact_solve() = 0;
+  virtual void start_correction(const Eigen::VectorXd& interface_force, int iteration) = 0;
+  virtual CorrectionSolveResult finish_correction() = 0;
+  virtual BodyOutput fields(const Eigen::VectorXd& contact_force) = 0;
+  /// Ends the run (the server stays up for the next one). Must not throw.
+  virtual void end_run() noexcept = 0;
+  virtual const PortTimings& timings() const = 0;
+};
+
+}  // namespace robin

@@ -1,0 +1,31 @@
+#pragma once
+// A body's result fields for output (ParaView files), computed from its final contact forces.
+// Mirrors FieldsReply of proto/robin.proto.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "numerics/body_solver.hpp"
+#include "numerics/vtu_writer.hpp"
+
+namespace robin {
+
+struct BodyOutput {
+  std::string body_name;
+  Mesh mesh;
+  /// displacement (2), stress (3: xx, yy, xy; nodal average), von_mises, contact_pressure
+  /// (lambda_i / m_i at contact nodes, 0 elsewhere), contact_force (2: -lambda_i n_i), reaction (2)
+  std::vector<OutputField> point_fields;
+  /// stress (3, at element centroids), von_mises
+  std::vector<OutputField> cell_fields;
+  Eigen::Vector2d reaction_resultant = Eigen::Vector2d::Zero();  // sum of reactions
+  Eigen::Vector2d applied_force = Eigen::Vector2d::Zero();       // body forces + tractions
+};
+
+/// Fields of `body` under contact forces lambda (pair order of its assignment).
+BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force);
+
+/// Writes <directory>/<body_name>.vtu; returns the file name.
+std::string write_body_output(const std::filesystem::path& directory, const BodyOutput& output);
+
+}  // namespace robin
