@@ -15,6 +15,7 @@
 namespace robin {
 
 struct CoupledRunResult {
+  CouplingOptions options;  // the options the iteration ran with
   ContactPairing pairing;
   RobinResult iteration;
   std::array<BodyOutput, 2> outputs;

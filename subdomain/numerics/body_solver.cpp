@@ -134,6 +134,7 @@ InterfaceDescription BodySolver::contact_boundary() const {
   const Mesh& mesh = definition_.mesh;
   const BoundaryGroup& group = mesh.boundary(definition_.contact_boundary);
   InterfaceDescription interface;
+  interface.dof_count = dofs_->free_count();
   interface.node_ids = group.nodes();
   interface.normals = boundary_node_normals(mesh, group);
   const Eigen::VectorXd weights = boundary_weights(mesh, group);

@@ -37,6 +37,7 @@ struct InterfaceDescription {
   std::vector<double> weights;               // m_i = int_{contact boundary} phi_i ds (length)
   std::vector<bool> x_fixed;                 // u_x prescribed by a Dirichlet condition
   std::vector<bool> y_fixed;                 // u_y prescribed by a Dirichlet condition
+  int dof_count = 0;                         // free degrees of freedom of the body
 };
 
 /// The contact nodes the body must use, in pair order, with the normal to use for each.

@@ -1,0 +1,168 @@
+#include "coupling/coupled_run.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <future>
+#include <iomanip>
+#include <limits>
+
+#include "coupling/local_problem.hpp"
+#include "coupling/result_files.hpp"
+
+namespace robin {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void report_stage(const RunObserver& observer, const std::string& text) {
+  if (observer.stage) observer.stage(text);
+}
+
+/// Calls `request(port, alpha)` on both ports concurrently and returns both results; the
+/// first exception (body 1 first) is rethrown after both have finished.
+template <typename Request>
+auto on_both_ports(const std::array<SubdomainPort*, 2>& ports, Request request) {
+  auto second = std::async(std::launch::async, [&] { return request(*ports[1], 1); });
+  std::exception_ptr failure;
+  decltype(request(*ports[0], 0)) first{};
+  try {
+    first = request(*ports[0], 0);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  auto other = second.get();  // rethrows body 2's failure if body 1 succeeded
+  if (failure) std::rethrow_exception(failure);
+  return std::array<decltype(first), 2>{std::move(first), std::move(other)};
+}
+
+void write_history_csv(const std::filesystem::path& path, const std::vector<IterationRecord>& history) {
+  std::ofstream file(path);
+  if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
+  file << std::setprecision(std::numeric_limits<double>::max_digits10);
+  file << "iteration,obstacle_change,penetration,force_balance,complementarity,correction,"
+          "active1,active2,qp_iterations1,qp_iterations2,seconds\n";
+  for (const IterationRecord& record : history) {
+    file << record.iteration << ',' << record.obstacle_change << ',' << record.penetration << ','
+         << record.force_balance << ',' << record.complementarity << ',' << record.correction << ','
+         << record.active1 << ',' << record.active2 << ',' << record.qp_iterations1 << ','
+         << record.qp_iterations2 << ',' << record.seconds << '\n';
+  }
+  if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
+}
+
+nlohmann::json residuals_json(const IterationRecord& record) {
+  return {{"obstacle_change", record.obstacle_change},
+          {"penetration", record.penetration},
+          {"force_balance", record.force_balance},
+          {"complementarity", record.complementarity},
+          {"correction", record.correction}};
+}
+
+nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunResult& result) {
+  const RobinResult& iteration = result.iteration;
+  const Eigen::VectorXd mean_force = 0.5 * (iteration.contact_force1 + iteration.contact_force2);
+  const Eigen::Vector2d resultant = contact_resultant(result.pairing, mean_force);
+  nlohmann::json summary;
+  summary["method"] = "robin";
+  summary["case"] = definition.file.string();
+  summary["converged"] = iteration.status == IterationStatus::converged;
+  summary["status"] = to_string(iteration.status);
+  summary["message"] = iteration.message;
+  summary["iterations"] = iteration.history.size();
+  summary["relaxation"] = result.options.relaxation;
+  summary["tolerance"] = result.options.tolerance;
+  summary["initial_obstacle"] = result.options.initial_obstacle;
+  if (!iteration.history.empty()) summary["final_residuals"] = residuals_json(iteration.history.back());
+  summary["contact_pairs"] = result.pairing.size();
+  summary["excluded_pairs"] = result.pairing.excluded;
+  summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
+  double server_compute = 0.0, messaging = 0.0;
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    const PortTimings& timings = result.port_timings[alpha];
+    const BodyOutput& output = result.outputs[alpha];
+    summary["bodies"].push_back(
+        {{"name", output.body_name},
+         {"dofs", result.interfaces[alpha].dof_count},
+         {"server_compute_seconds", timings.compute_seconds},
+         {"round_trip_seconds", timings.round_trip_seconds},
+         {"bytes_sent", timings.bytes_sent},
+         {"bytes_received", timings.bytes_received},
+         {"reaction_resultant", {output.reaction_resultant.x(), output.reaction_resultant.y()}},
+         {"applied_force", {output.applied_force.x(), output.applied_force.y()}}});
+    server_compute += timings.compute_seconds;
+    messaging += timings.round_trip_seconds - timings.compute_seconds;
+  }
+  summary["timings"] = {{"setup", result.setup_seconds},
+                        {"iteration", iteration.wall_seconds},
+                        {"server_compute", server_compute},
+                        {"coordinator_compute", iteration.coordinator_seconds},
+                        {"messaging", messaging},
+                        {"total", result.total_seconds}};
+  return summary;
+}
+
+}  // namespace
+
+CoupledRunResult run_coupled_case(const CaseDefinition& definition,
+                                  const std::array<SubdomainPort*, 2>& ports,
+                                  const CouplingOptions& options, const RunObserver& observer) {
+  const auto start = Clock::now();
+  CoupledRunResult result;
+  result.options = options;
+  report_stage(observer, "setting up both bodies (mesh, assembly, factorization)");
+  result.interfaces = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
+    return port.setup(definition.bodies[alpha], definition.solver);
+  });
+  const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
+  result.pairing = pair_contact_nodes(result.interfaces[0], definition.bodies[0].definition.name,
+                                      result.interfaces[1], definition.bodies[1].definition.name,
+                                      gap.get(), definition.solver.pairing_tolerance);
+  report_stage(observer, std::to_string(result.pairing.size()) + " contact pairs (" +
+                             std::to_string(result.pairing.excluded.size()) + " excluded)");
+  for (const std::string& line : result.pairing.excluded) report_stage(observer, line);
+  for (int alpha = 0; alpha < 2; ++alpha) ports[alpha]->assign_contact(result.pairing.assignment(alpha));
+  result.setup_seconds = seconds_since(start);
+
+  result.iteration =
+      run_robin_iteration(*ports[0], *ports[1], result.pairing.gaps(), options, observer.iteration);
+  report_stage(observer, "collecting the fields of both bodies");
+  const RobinResult& iteration = result.iteration;
+  result.outputs = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
+    return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
+  });
+  for (int alpha = 0; alpha < 2; ++alpha) result.port_timings[alpha] = ports[alpha]->timings();
+  result.total_seconds = seconds_since(start);
+  return result;
+}
+
+void write_coupled_outputs(const std::filesystem::path& directory, const CaseDefinition& definition,
+                           const CoupledRunResult& result) {
+  std::filesystem::create_directories(directory);
+  const std::string file1 = write_body_output(directory, result.outputs[0]);
+  const std::string file2 = write_body_output(directory, result.outputs[1]);
+  write_solution_pvd(directory, file1, file2);
+  const RobinResult& iteration = result.iteration;
+  const InterfaceState state{iteration.normal_trace1, iteration.normal_trace2,
+                             iteration.contact_force1, iteration.contact_force2};
+  if (state.normal_trace1.size() == static_cast<Eigen::Index>(result.pairing.size())) {
+    write_contact_csv(directory / "contact.csv", result.pairing, state);
+  }
+  write_history_csv(directory / "history.csv", iteration.history);
+  write_json(directory / "summary.json", make_summary(definition, result));
+}
+
+int exit_code(IterationStatus status) {
+  switch (status) {
+    case IterationStatus::converged: return 0;
+    case IterationStatus::max_iterations: return 3;
+    case IterationStatus::diverged: return 4;
+    case IterationStatus::stagnated: return 5;
+  }
+  return 1;
+}
+
+}  // namespace robin

@@ -1,0 +1,50 @@
+#include "coupling/in_process_port.hpp"
+
+#include <chrono>
+
+namespace robin {
+
+BodySolver& InProcessPort::body() {
+  if (!body_) throw PortError(describe() + ": request before setup");
+  return *body_;
+}
+
+InterfaceDescription InProcessPort::setup(const BodyCase& body_case, const SolverOptions& solver) {
+  name_ = body_case.definition.name;
+  qp_ = solver.qp;
+  body_ = std::make_unique<BodySolver>(load_body(body_case), solver.body);
+  timings_.compute_seconds +=
+      body_->timings().assembly_seconds + body_->timings().factorization_seconds;
+  return body_->contact_boundary();
+}
+
+void InProcessPort::assign_contact(const ContactAssignment& assignment) {
+  body().assign_contact(assignment);
+}
+
+void InProcessPort::start_contact_solve(const Eigen::VectorXd& obstacle, int /*iteration*/) {
+  contact_result_ = body().solve_contact(obstacle, qp_);
+  timings_.compute_seconds += contact_result_.seconds;
+  timings_.round_trip_seconds += contact_result_.seconds;
+}
+
+ContactSolveResult InProcessPort::finish_contact_solve() { return contact_result_; }
+
+void InProcessPort::start_correction(const Eigen::VectorXd& interface_force, int /*iteration*/) {
+  const auto start = std::chrono::steady_clock::now();
+  correction_result_.normal_trace = body().solve_correction(interface_force);
+  correction_result_.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  timings_.compute_seconds += correction_result_.seconds;
+  timings_.round_trip_seconds += correction_result_.seconds;
+}
+
+CorrectionSolveResult InProcessPort::finish_correction() { return correction_result_; }
+
+BodyOutput InProcessPort::fields(const Eigen::VectorXd& contact_force) {
+  return make_body_output(body(), contact_force);
+}
+
+void InProcessPort::end_run() noexcept { body_.reset(); }
+
+}  // namespace robin

@@ -1,0 +1,79 @@
+#include "numerics/body_output.hpp"
+
+#include <stdexcept>
+
+#include "numerics/elasticity.hpp"
+
+namespace robin {
+namespace {
+
+std::vector<double> to_values(const double* data, Eigen::Index size) {
+  return std::vector<double>(data, data + size);
+}
+
+/// lambda_i / m_i at the contact nodes (force per unit length), zero elsewhere.
+std::vector<double> nodal_contact_pressure(const BodySolver& body,
+                                           const Eigen::VectorXd& contact_force) {
+  std::vector<double> pressure(body.mesh().node_count(), 0.0);
+  for (int i = 0; i < body.contact_size(); ++i) {
+    const double weight = body.contact_weights()[i];
+    if (weight > 0) pressure[body.contact_nodes()[i]] = contact_force[i] / weight;
+  }
+  return pressure;
+}
+
+Eigen::Vector2d resultant(const Eigen::VectorXd& nodal_vectors) {
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (Eigen::Index node = 0; node < nodal_vectors.size() / 2; ++node) {
+    total += nodal_vectors.segment<2>(2 * node);
+  }
+  return total;
+}
+
+}  // namespace
+
+BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force) {
+  if (contact_force.size() != body.contact_size()) {
+    throw std::invalid_argument("body '" + body.name() + "': " +
+                                std::to_string(contact_force.size()) + " contact forces for " +
+                                std::to_string(body.contact_size()) + " contact nodes");
+  }
+  const Eigen::VectorXd displacement = body.displacement(contact_force);
+  const StressField stress = recover_stress(body.mesh(), body.definition().material, displacement);
+  const Eigen::VectorXd reaction = body.reactions(displacement);
+  const Eigen::VectorXd force_field = body.contact_force_field(contact_force);
+  const std::vector<std::string> stress_components = {"xx", "yy", "xy"};
+
+  BodyOutput output;
+  output.body_name = body.name();
+  output.mesh = body.mesh();
+  output.point_fields = {
+      {"displacement", 2, to_values(displacement.data(), displacement.size())},
+      {"stress", 3, to_values(stress.nodal_stress.data(), stress.nodal_stress.size()),
+       stress_components},
+      {"von_mises", 1, to_values(stress.nodal_von_mises.data(), stress.nodal_von_mises.size())},
+      {"contact_pressure", 1, nodal_contact_pressure(body, contact_force)},
+      {"contact_force", 2, to_values(force_field.data(), force_field.size())},
+      {"reaction", 2, to_values(reaction.data(), reaction.size())}};
+  output.cell_fields = {
+      {"stress", 3, to_values(stress.element_stress.data(), stress.element_stress.size()),
+       stress_components},
+      {"von_mises", 1,
+       to_values(stress.element_von_mises.data(), stress.element_von_mises.size())}};
+  output.reaction_resultant = resultant(reaction);
+  output.applied_force = body.applied_force();
+  return output;
+}
+
+std::string write_body_output(const std::filesystem::path& directory, const BodyOutput& output) {
+  const std::string file_name = output.body_name + ".vtu";
+  if (output.body_name.empty() || std::filesystem::path(output.body_name).has_parent_path()) {
+    throw std::runtime_error("cannot write '" + (directory / file_name).string() +
+                             "': body name '" + output.body_name + "' is not usable as a file name");
+  }
+  std::filesystem::create_directories(directory);
+  write_vtu(directory / file_name, output.mesh, output.point_fields, output.cell_fields);
+  return file_name;
+}
+
+}  // namespace robin

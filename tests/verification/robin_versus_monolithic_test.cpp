@@ -1,0 +1,105 @@
+// The Robin iteration (in-process ports) converges to the monolithic reference (paper Prop. 3.2):
+// contact forces and displacements to 1e-7 relative, lambda1 = lambda2 and w -> 0, on the
+// symmetric blocks, the asymmetric cantilever-on-block pair and the Hertz case. Also records the
+// iteration counts of the paper's plain relaxation and checks that a too-large delta is reported
+// as diverging.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "coupling/coupled_run.hpp"
+#include "coupling/in_process_port.hpp"
+#include "coupling/local_problem.hpp"
+#include "coupling/monolithic_solver.hpp"
+
+namespace robin {
+namespace {
+
+CaseDefinition example(const std::string& name) {
+  return read_case_file(std::filesystem::path(ROBIN_EXAMPLES) / name);
+}
+
+CoupledRunResult run_in_process(const CaseDefinition& definition, const CouplingOptions& options) {
+  InProcessPort port1, port2;
+  return run_coupled_case(definition, {&port1, &port2}, options);
+}
+
+const OutputField& point_field(const BodyOutput& output, const std::string& name) {
+  for (const OutputField& field : output.point_fields) {
+    if (field.name == name) return field;
+  }
+  throw std::runtime_error("no field " + name);
+}
+
+double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& reference) {
+  return (value - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>();
+}
+
+void expect_matches_monolithic(const std::string& case_name, double relaxation) {
+  const CaseDefinition definition = example(case_name);
+  CouplingOptions options = definition.coupling;
+  options.relaxation = relaxation;
+  options.tolerance = 1e-10;
+  options.max_iterations = 5000;
+  const CoupledRunResult robin = run_in_process(definition, options);
+  std::printf("%s: plain relaxation delta = %.3g: %s after %zu iterations\n", case_name.c_str(),
+              relaxation, to_string(robin.iteration.status).c_str(), robin.iteration.history.size());
+  ASSERT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
+
+  const LocalProblem reference = prepare_local_problem(definition);
+  const MonolithicResult monolithic =
+      solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing,
+                       definition.solver.qp);
+  ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
+  ASSERT_EQ(robin.pairing.size(), reference.pairing.size());
+  const RobinResult& state = robin.iteration;
+  EXPECT_LE(relative_difference(state.contact_force1, monolithic.contact_force), 1e-7);
+  EXPECT_LE(relative_difference(state.contact_force2, monolithic.contact_force), 1e-7);
+  EXPECT_LE(relative_difference(state.normal_trace1, monolithic.normal_trace1), 1e-7);
+  EXPECT_LE(relative_difference(state.normal_trace2, monolithic.normal_trace2), 1e-7);
+  // Proposition 3.2: lambda1 = lambda2 and w = 0 at the fixed point.
+  const double force_scale = monolithic.contact_force.lpNorm<Eigen::Infinity>();
+  EXPECT_LE((state.contact_force1 - state.contact_force2).lpNorm<Eigen::Infinity>(),
+            1e-8 * force_scale);
+  const double trace_scale = monolithic.normal_trace1.lpNorm<Eigen::Infinity>() +
+                             monolithic.normal_trace2.lpNorm<Eigen::Infinity>();
+  EXPECT_LE(state.correction1.lpNorm<Eigen::Infinity>(), 1e-8 * trace_scale);
+  EXPECT_LE(state.correction2.lpNorm<Eigen::Infinity>(), 1e-8 * trace_scale);
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    const BodySolver& body = *reference.bodies[alpha];
+    const Eigen::VectorXd expected = body.displacement(monolithic.contact_force);
+    const std::vector<double>& values = point_field(robin.outputs[alpha], "displacement").values;
+    const Eigen::VectorXd actual = Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
+    EXPECT_LE(relative_difference(actual, expected), 1e-7) << body.name();
+  }
+}
+
+TEST(RobinVersusMonolithic, SymmetricBlocks) { expect_matches_monolithic("two_blocks.toml", 0.5); }
+
+TEST(RobinVersusMonolithic, PartialContactBlocks) {
+  expect_matches_monolithic("two_blocks_partial.toml", 0.5);
+}
+
+TEST(RobinVersusMonolithic, AsymmetricCantileverOnBlock) {
+  expect_matches_monolithic("asymmetric.toml", 0.5);
+}
+
+TEST(RobinVersusMonolithic, Hertz) { expect_matches_monolithic("hertz.toml", 0.5); }
+
+TEST(RobinIteration, TooLargeRelaxationIsReportedAsDiverging) {
+  // Identical bodies: in the all-active regime the error is multiplied by (1 - 2 delta) per
+  // iteration, so delta = 1.5 doubles it every iteration.
+  const CaseDefinition definition = example("two_blocks.toml");
+  CouplingOptions options = definition.coupling;
+  options.relaxation = 1.5;
+  options.max_iterations = 200;
+  const CoupledRunResult robin = run_in_process(definition, options);
+  std::printf("delta = 1.5: %s after %zu iterations: %s\n", to_string(robin.iteration.status).c_str(),
+              robin.iteration.history.size(), robin.iteration.message.c_str());
+  EXPECT_EQ(robin.iteration.status, IterationStatus::diverged);
+  EXPECT_NE(exit_code(robin.iteration.status), 0);
+}
+
+}  // namespace
+}  // namespace robin
