@@ -55,8 +55,7 @@ void define_constants(mu::Parser& parser, const std::map<std::string, double>& c
 }  // namespace
 
 GapFunction::GapFunction(const std::string& expression,
-                         const std::map<std::string, double>& constants,
-                         const std::string& context)
+                         const std::map<std::string, double>& constants, const std::string& context)
     : implementation_(std::make_unique<Implementation>()),
       expression_(expression),
       context_(context) {
@@ -88,8 +87,8 @@ double GapFunction::operator()(double x, double y) const {
   if (!std::isfinite(value)) {
     std::ostringstream message;
     message.precision(17);
-    message << context_ << ": '" << expression_ << "' is not finite at (x, y) = (" << x << ", "
-            << y << "): " << value;
+    message << context_ << ": '" << expression_ << "' is not finite at (x, y) = (" << x << ", " << y
+            << "): " << value;
     throw InputError(message.str());
   }
   return value;
