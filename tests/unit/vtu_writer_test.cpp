@@ -1,0 +1,284 @@
+// write_vtu / write_pvd: the files are parsed back by an independent XML reader (Python's
+// xml.etree) and checked against hand-computed counts, cell types, offsets, geometry and values.
+
+#include "numerics/vtu_writer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "numerics/rectangle_mesher.hpp"
+#include "vtk_xml_test_reader.hpp"
+
+namespace robin {
+namespace {
+
+using nlohmann::json;
+using test::find_array;
+using test::read_vtk_xml;
+using test::TemporaryDirectory;
+
+/// Written point k of a piece as (x, y, z).
+Eigen::Vector3d written_point(const json& piece, std::size_t k) {
+  const json& values = find_array(piece["Points"], "Points")["values"];
+  return {values[3 * k].get<double>(), values[3 * k + 1].get<double>(),
+          values[3 * k + 2].get<double>()};
+}
+
+/// Shoelace area of cell `cell` from the written points, connectivity and offsets, using its
+/// first `corners` nodes (positive when counter-clockwise).
+double written_signed_area(const json& piece, std::size_t cell, int corners) {
+  const json& connectivity = find_array(piece["Cells"], "connectivity")["values"];
+  const json& offsets = find_array(piece["Cells"], "offsets")["values"];
+  const std::size_t begin = cell == 0 ? 0 : offsets[cell - 1].get<std::size_t>();
+  double twice_area = 0.0;
+  for (int a = 0; a < corners; ++a) {
+    const Eigen::Vector3d p = written_point(piece, connectivity[begin + a].get<std::size_t>());
+    const Eigen::Vector3d q =
+        written_point(piece, connectivity[begin + (a + 1) % corners].get<std::size_t>());
+    twice_area += p.x() * q.y() - q.x() * p.y();
+  }
+  return 0.5 * twice_area;
+}
+
+/// One triangle3 block, one quadrilateral4 block and one triangle6 block, side by side:
+/// [0,1]^2 split into two triangles, the square [1,2]x[0,1], and the right triangle
+/// (2,0), (3,0), (2,1) with its edge midpoints.
+Mesh make_mixed_mesh() {
+  Mesh mesh;
+  mesh.nodes = {{0, 0}, {1, 0}, {1, 1},   {0, 1},     {2, 0},
+                {2, 1}, {3, 0}, {2.5, 0}, {2.5, 0.5}, {2, 0.5}};
+  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2, 0, 2, 3}});
+  mesh.blocks.push_back({ElementType::quadrilateral4, {1, 4, 5, 2}});
+  mesh.blocks.push_back({ElementType::triangle6, {4, 6, 5, 7, 8, 9}});
+  return mesh;
+}
+
+TEST(VtuWriter, QuadrilateralRectangleWritesPointsCellsAndFields) {
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 2, 1, ElementType::quadrilateral4);
+  ASSERT_EQ(mesh.node_count(), 6u);
+  OutputField temperature{"temperature", 1, {}};
+  OutputField displacement{"displacement", 2, {}};
+  for (const Eigen::Vector2d& node : mesh.nodes) {
+    temperature.values.push_back(node.x() + 10.0 * node.y());
+    displacement.values.insert(displacement.values.end(), {node.x(), -node.y()});
+  }
+  const OutputField cell_index{"index", 1, {0.0, 1.0}};
+  const auto path = directory.path() / "rectangle.vtu";
+  write_vtu(path, mesh, {temperature, displacement}, {cell_index});
+
+  const json document = read_vtk_xml(path);
+  EXPECT_EQ(document["root"]["type"], "UnstructuredGrid");
+  EXPECT_EQ(document["root"]["version"], "1.0");
+  ASSERT_EQ(document["pieces"].size(), 1u);
+  const json& piece = document["pieces"][0];
+  EXPECT_EQ(piece["attributes"]["NumberOfPoints"], "6");
+  EXPECT_EQ(piece["attributes"]["NumberOfCells"], "2");
+  EXPECT_EQ(find_array(piece["Points"], "Points")["attributes"]["type"], "Float64");
+
+  // every grid point of [0,2]x[0,1] with unit spacing appears, in the plane z = 0
+  for (double x : {0.0, 1.0, 2.0}) {
+    for (double y : {0.0, 1.0}) {
+      int found = 0;
+      for (std::size_t k = 0; k < 6; ++k)
+        found += written_point(piece, k) == Eigen::Vector3d(x, y, 0);
+      EXPECT_EQ(found, 1) << "grid point (" << x << ", " << y << ")";
+    }
+  }
+  EXPECT_EQ(find_array(piece["Cells"], "types")["values"], json({9, 9}));
+  EXPECT_EQ(find_array(piece["Cells"], "offsets")["values"], json({4, 8}));
+  EXPECT_EQ(find_array(piece["Cells"], "connectivity")["values"],
+            json(mesh.blocks[0].connectivity));
+  for (std::size_t cell = 0; cell < 2; ++cell) {
+    EXPECT_DOUBLE_EQ(written_signed_area(piece, cell, 4), 1.0) << "cell " << cell;
+  }
+
+  const json& written_temperature = find_array(piece["PointData"], "temperature");
+  const json& written_displacement = find_array(piece["PointData"], "displacement");
+  EXPECT_EQ(written_temperature["attributes"]["NumberOfComponents"], "1");
+  EXPECT_EQ(written_displacement["attributes"]["NumberOfComponents"], "3");
+  for (std::size_t k = 0; k < 6; ++k) {
+    const Eigen::Vector3d point = written_point(piece, k);
+    EXPECT_EQ(written_temperature["values"][k].get<double>(), point.x() + 10.0 * point.y());
+    EXPECT_EQ(written_displacement["values"][3 * k].get<double>(), point.x());
+    EXPECT_EQ(written_displacement["values"][3 * k + 1].get<double>(), -point.y());
+    EXPECT_EQ(written_displacement["values"][3 * k + 2].get<double>(), 0.0);
+  }
+  EXPECT_EQ(find_array(piece["CellData"], "index")["values"], json({0.0, 1.0}));
+}
+
+TEST(VtuWriter, TriangleRectangleHasCounterClockwiseTrianglesCoveringTheArea) {
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_rectangle_mesh(0.0, 0.0, 3.0, 2.0, 3, 2, ElementType::triangle3);
+  const auto path = directory.path() / "triangles.vtu";
+  write_vtu(path, mesh, {}, {});
+
+  const json piece = read_vtk_xml(path)["pieces"][0];
+  EXPECT_EQ(piece["attributes"]["NumberOfPoints"], "12");
+  EXPECT_EQ(piece["attributes"]["NumberOfCells"], "12");
+  const json& types = find_array(piece["Cells"], "types")["values"];
+  const json& offsets = find_array(piece["Cells"], "offsets")["values"];
+  ASSERT_EQ(types.size(), 12u);
+  double total_area = 0.0;
+  for (std::size_t cell = 0; cell < 12; ++cell) {
+    EXPECT_EQ(types[cell], 5);
+    EXPECT_EQ(offsets[cell], 3 * (cell + 1));
+    const double area = written_signed_area(piece, cell, 3);
+    EXPECT_DOUBLE_EQ(area, 0.5) << "cell " << cell;  // half of a unit cell, counter-clockwise
+    total_area += area;
+  }
+  EXPECT_DOUBLE_EQ(total_area, 6.0);
+}
+
+TEST(VtuWriter, MixedBlocksGetTheirCellTypesInBlockOrder) {
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_mixed_mesh();
+  const OutputField stress{
+      "stress", 3, {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12}, {"xx", "yy", "xy"}};
+  const auto path = directory.path() / "mixed.vtu";
+  write_vtu(path, mesh, {}, {stress});
+
+  const json piece = read_vtk_xml(path)["pieces"][0];
+  EXPECT_EQ(piece["attributes"]["NumberOfCells"], "4");
+  EXPECT_EQ(find_array(piece["Cells"], "types")["values"], json({5, 5, 9, 22}));
+  EXPECT_EQ(find_array(piece["Cells"], "offsets")["values"], json({3, 6, 10, 16}));
+  EXPECT_EQ(find_array(piece["Cells"], "connectivity")["values"],
+            json({0, 1, 2, 0, 2, 3, 1, 4, 5, 2, 4, 6, 5, 7, 8, 9}));
+  EXPECT_DOUBLE_EQ(written_signed_area(piece, 2, 4), 1.0);
+  EXPECT_DOUBLE_EQ(written_signed_area(piece, 3, 3), 0.5);
+
+  // VTK_QUADRATIC_TRIANGLE: nodes 3, 4, 5 are the midpoints of edges 01, 12, 20
+  const json& connectivity = find_array(piece["Cells"], "connectivity")["values"];
+  const auto node = [&](int local) {
+    return written_point(piece, connectivity[10 + local].get<std::size_t>());
+  };
+  EXPECT_EQ(node(3), 0.5 * (node(0) + node(1)));
+  EXPECT_EQ(node(4), 0.5 * (node(1) + node(2)));
+  EXPECT_EQ(node(5), 0.5 * (node(2) + node(0)));
+
+  const json& written_stress = find_array(piece["CellData"], "stress");
+  EXPECT_EQ(written_stress["attributes"]["NumberOfComponents"], "3");
+  EXPECT_EQ(written_stress["attributes"]["ComponentName0"], "xx");
+  EXPECT_EQ(written_stress["attributes"]["ComponentName2"], "xy");
+  EXPECT_EQ(written_stress["values"], json(stress.values));
+}
+
+TEST(VtuWriter, NumbersRoundTripExactly) {
+  const TemporaryDirectory directory("vtu_writer");
+  Mesh mesh;
+  mesh.nodes = {{0.1, 0.7}, {1.0 / 3.0, -2.0 / 7.0}, {std::numbers::pi, 1e-17}};
+  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}});
+  const std::vector<double> values = {0.1,
+                                      1.0 / 3.0,
+                                      -2.0 / 7.0,
+                                      1e-300,
+                                      std::numeric_limits<double>::denorm_min(),
+                                      std::numeric_limits<double>::max(),
+                                      -0.0,
+                                      123456789.12345679,
+                                      std::numbers::e * 1e22,
+                                      -1.0 - std::numeric_limits<double>::epsilon(),
+                                      6.02214076e23,
+                                      42.0};
+  const auto path = directory.path() / "numbers.vtu";
+  write_vtu(path, mesh, {{"four", 4, values}}, {{"single", 1, {std::numbers::sqrt2}}});
+
+  const json piece = read_vtk_xml(path)["pieces"][0];
+  const json& written = find_array(piece["PointData"], "four");
+  EXPECT_EQ(written["attributes"]["NumberOfComponents"], "4");
+  ASSERT_EQ(written["values"].size(), values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double value = written["values"][i].get<double>();
+    EXPECT_EQ(value, values[i]) << "value " << i;
+    EXPECT_EQ(std::signbit(value), std::signbit(values[i])) << "value " << i;
+  }
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(written_point(piece, k), Eigen::Vector3d(mesh.nodes[k].x(), mesh.nodes[k].y(), 0));
+  }
+  EXPECT_EQ(find_array(piece["CellData"], "single")["values"][0].get<double>(),
+            std::numbers::sqrt2);
+}
+
+TEST(VtuWriter, NamesWithXmlCharactersAreEscaped) {
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_mixed_mesh();
+  const std::string name = "a<b & \"c\" 'd'>";
+  const auto path = directory.path() / "escaped.vtu";
+  write_vtu(path, mesh, {{name, 1, std::vector<double>(10, 2.5)}}, {});
+  const json piece = read_vtk_xml(path)["pieces"][0];
+  EXPECT_EQ(find_array(piece["PointData"], name)["values"], json(std::vector<double>(10, 2.5)));
+}
+
+/// Runs `write` expecting a std::runtime_error whose message contains every `fragment`.
+template <typename Write>
+void expect_error_naming(Write write, const std::vector<std::string>& fragments) {
+  try {
+    write();
+    ADD_FAILURE() << "no exception thrown";
+  } catch (const std::runtime_error& error) {
+    for (const std::string& fragment : fragments) {
+      EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos)
+          << "message '" << error.what() << "' does not name '" << fragment << "'";
+    }
+  }
+}
+
+TEST(VtuWriter, MalformedFieldIsRejectedNamingFieldAndPath) {
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_mixed_mesh();  // 10 nodes, 4 cells
+  const auto path = directory.path() / "bad.vtu";
+  expect_error_naming(
+      [&] {
+        write_vtu(path, mesh, {{"pressure", 1, std::vector<double>(9)}}, {});
+      },
+      {"pressure", path.string(), "10", "9"});
+  expect_error_naming(
+      [&] {
+        write_vtu(path, mesh, {}, {{"cell_stress", 3, std::vector<double>(4)}});
+      },
+      {"cell_stress", path.string(), "12"});
+  expect_error_naming(
+      [&] {
+        write_vtu(path, mesh, {{"nothing", 0, {}}}, {});
+      },
+      {"nothing", path.string()});
+  expect_error_naming(
+      [&] {
+        write_vtu(path, mesh, {{"", 1, std::vector<double>(10)}}, {});
+      },
+      {path.string()});
+  EXPECT_FALSE(std::filesystem::exists(path)) << "nothing is written for a malformed field";
+}
+
+TEST(VtuWriter, UnwritablePathGivesAnErrorNamingIt) {
+  const TemporaryDirectory directory("vtu_writer");
+  const auto vtu_path = directory.path() / "no_such_directory" / "mesh.vtu";
+  expect_error_naming([&] { write_vtu(vtu_path, make_mixed_mesh(), {}, {}); }, {vtu_path.string()});
+  const auto pvd_path = directory.path() / "no_such_directory" / "solution.pvd";
+  expect_error_naming([&] { write_pvd(pvd_path, {"a.vtu"}); }, {pvd_path.string()});
+}
+
+TEST(VtuWriter, CollectionListsEachDatasetAsAPart) {
+  const TemporaryDirectory directory("vtu_writer");
+  const auto path = directory.path() / "solution.pvd";
+  write_pvd(path, {"upper.vtu", "lower & base.vtu"});
+  const json document = read_vtk_xml(path);
+  EXPECT_EQ(document["root"]["type"], "Collection");
+  ASSERT_EQ(document["datasets"].size(), 2u);
+  EXPECT_EQ(document["datasets"][0]["part"], "0");
+  EXPECT_EQ(document["datasets"][0]["file"], "upper.vtu");
+  EXPECT_EQ(document["datasets"][1]["part"], "1");
+  EXPECT_EQ(document["datasets"][1]["file"], "lower & base.vtu");
+}
+
+TEST(VtuWriter, CellTypeNumbersAreVtks) {
+  EXPECT_EQ(vtk_cell_type(ElementType::triangle3), 5);
+  EXPECT_EQ(vtk_cell_type(ElementType::triangle6), 22);
+  EXPECT_EQ(vtk_cell_type(ElementType::quadrilateral4), 9);
+}
+
+}  // namespace
+}  // namespace robin
