@@ -24,8 +24,8 @@ Eigen::VectorXd assemble_body_force(const Mesh& mesh, const VectorField& body_fo
 
 /// Consistent load of a traction t(x, n) on boundary `group` (force per unit length);
 /// `outward_normal` is the unit outward normal of the edge at x.
-using TractionField =
-    std::function<Eigen::Vector2d(const Eigen::Vector2d& point, const Eigen::Vector2d& outward_normal)>;
+using TractionField = std::function<Eigen::Vector2d(const Eigen::Vector2d& point,
+                                                    const Eigen::Vector2d& outward_normal)>;
 Eigen::VectorXd assemble_boundary_traction(const Mesh& mesh, const BoundaryGroup& group,
                                            const TractionField& traction);
 

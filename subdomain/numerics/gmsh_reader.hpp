@@ -16,9 +16,9 @@
 namespace robin {
 
 struct MeshReadOptions {
-  double size = 0.0;         // value of the .geo variable `h`; 0 leaves the script's default
-  int element_order = 1;     // 1 or 2: order of elements generated from a .geo
-  bool recombine = false;    // generate quadrilaterals from a .geo (Mesh.RecombineAll)
+  double size = 0.0;       // value of the .geo variable `h`; 0 leaves the script's default
+  int element_order = 1;   // 1 or 2: order of elements generated from a .geo
+  bool recombine = false;  // generate quadrilaterals from a .geo (Mesh.RecombineAll)
 };
 
 /// Reads `path`. Throws InputError naming the file on any problem (missing file,

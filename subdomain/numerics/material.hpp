@@ -31,4 +31,10 @@ Material make_voigt_material(const Eigen::Matrix3d& stiffness, PlaneModel model,
 /// Von Mises stress of an in-plane stress (s_xx, s_yy, s_xy) with out-of-plane s_zz.
 double von_mises(const Eigen::Vector3d& stress, double stress_zz);
 
+/// Out-of-plane stress s_zz = out_of_plane_poisson (s_xx + s_yy) of `material`.
+double out_of_plane_stress(const Material& material, const Eigen::Vector3d& stress);
+
+/// Von Mises stress of an in-plane stress of `material`, with s_zz from out_of_plane_stress.
+double von_mises(const Material& material, const Eigen::Vector3d& stress);
+
 }  // namespace robin

@@ -52,6 +52,9 @@ struct Mesh {
   std::size_t element_count() const;
   /// The boundary group called `name`; throws InputError listing the known names.
   const BoundaryGroup& boundary(const std::string& name) const;
+  /// "'name'" of a group of this mesh (found by address), "(unnamed boundary)" otherwise;
+  /// for messages.
+  std::string boundary_label(const BoundaryGroup& group) const;
 };
 
 }  // namespace robin

@@ -1,0 +1,101 @@
+#include "numerics/dof_map.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <stdexcept>
+
+namespace robin {
+
+DofMap::DofMap(std::vector<std::optional<double>> prescribed)
+    : prescribed_(std::move(prescribed)),
+      free_index_(prescribed_.size(), -1),
+      prescribed_values_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(prescribed_.size()))) {
+  for (std::size_t dof = 0; dof < prescribed_.size(); ++dof) {
+    if (prescribed_[dof]) {
+      prescribed_values_(static_cast<Eigen::Index>(dof)) = *prescribed_[dof];
+    } else {
+      free_index_[dof] = free_count_++;
+    }
+  }
+}
+
+SparseMatrix DofMap::reduce_matrix(const SparseMatrix& full) const {
+  if (full.rows() != total_count() || full.cols() != total_count()) {
+    throw std::invalid_argument("DofMap::reduce_matrix: matrix size differs from the dof count");
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(full.nonZeros()));
+  for (int column = 0; column < full.outerSize(); ++column) {
+    const int free_column = free_index_[column];
+    if (free_column < 0) continue;
+    for (SparseMatrix::InnerIterator entry(full, column); entry; ++entry) {
+      const int free_row = free_index_[entry.row()];
+      if (free_row >= 0) triplets.emplace_back(free_row, free_column, entry.value());
+    }
+  }
+  SparseMatrix reduced(free_count_, free_count_);
+  reduced.setFromTriplets(triplets.begin(), triplets.end());
+  return reduced;
+}
+
+Eigen::VectorXd DofMap::reduce_load(const SparseMatrix& full,
+                                    const Eigen::VectorXd& full_load) const {
+  if (full.rows() != total_count() || full.cols() != total_count() ||
+      full_load.size() != total_count()) {
+    throw std::invalid_argument("DofMap::reduce_load: sizes differ from the dof count");
+  }
+  // f_f - K_fp u_p, as the free rows of f - K u_p (u_p is zero on the free dofs).
+  const Eigen::VectorXd residual = full_load - full * prescribed_values_;
+  return restrict(residual);
+}
+
+Eigen::VectorXd DofMap::expand(const Eigen::VectorXd& free_values) const {
+  if (free_values.size() != free_count_) {
+    throw std::invalid_argument("DofMap::expand: vector size differs from the free dof count");
+  }
+  Eigen::VectorXd full = prescribed_values_;
+  for (int dof = 0; dof < total_count(); ++dof) {
+    if (free_index_[dof] >= 0) full(dof) = free_values(free_index_[dof]);
+  }
+  return full;
+}
+
+Eigen::VectorXd DofMap::restrict(const Eigen::VectorXd& full) const {
+  if (full.size() != total_count()) {
+    throw std::invalid_argument("DofMap::restrict: vector size differs from the dof count");
+  }
+  Eigen::VectorXd free_values(free_count_);
+  for (int dof = 0; dof < total_count(); ++dof) {
+    if (free_index_[dof] >= 0) free_values(free_index_[dof]) = full(dof);
+  }
+  return free_values;
+}
+
+bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs) {
+  if (dofs.total_count() != static_cast<int>(2 * mesh.node_count())) {
+    throw std::invalid_argument("removes_rigid_motions: dof count is not 2 x nodes");
+  }
+  if (mesh.node_count() == 0) return false;
+  // Centred, scaled coordinates make the test independent of position and size.
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& node : mesh.nodes) centre += node;
+  centre /= static_cast<double>(mesh.node_count());
+  double scale = 0.0;
+  for (const Eigen::Vector2d& node : mesh.nodes) scale = std::max(scale, (node - centre).norm());
+  if (scale == 0.0) scale = 1.0;
+  // Gram matrix G = R^T R of the rigid modes (1, 0), (0, 1), (-(y - yc), x - xc) / scale,
+  // restricted to the prescribed dofs (rows of R).
+  Eigen::Matrix3d gram = Eigen::Matrix3d::Zero();
+  for (int dof = 0; dof < dofs.total_count(); ++dof) {
+    if (!dofs.is_prescribed(dof)) continue;
+    const Eigen::Vector2d relative = (mesh.nodes[dof / 2] - centre) / scale;
+    const Eigen::Vector3d row = dof % 2 == 0 ? Eigen::Vector3d(1.0, 0.0, -relative.y())
+                                             : Eigen::Vector3d(0.0, 1.0, relative.x());
+    gram += row * row.transpose();
+  }
+  const Eigen::Vector3d eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(gram, Eigen::EigenvaluesOnly).eigenvalues();
+  // Rank 3 when the smallest eigenvalue is not negligible relative to the largest.
+  return eigenvalues(2) > 0.0 && eigenvalues(0) > 1e-10 * eigenvalues(2);
+}
+
+}  // namespace robin

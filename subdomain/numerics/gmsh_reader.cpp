@@ -1,0 +1,389 @@
+#include "numerics/gmsh_reader.hpp"
+
+#include <gmsh.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <random>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+#include "numerics/errors.hpp"
+
+namespace robin {
+
+namespace {
+
+/// Gmsh is global state and not thread safe: one reader at a time.
+std::mutex& gmsh_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+/// One Gmsh initialize/finalize pair. `-setnumber h SIZE` defines the .geo variable h
+/// before any script is parsed. AbortOnError = 0 keeps Gmsh from throwing out of its
+/// parser (which would leave the parser's state corrupt for later reads); errors are
+/// collected from Gmsh's logger instead.
+class GmshSession {
+ public:
+  explicit GmshSession(double size) {
+    std::vector<std::string> arguments = {"robin"};
+    if (size > 0.0) {
+      std::ostringstream value;
+      value.precision(17);
+      value << size;
+      arguments.insert(arguments.end(), {"-setnumber", "h", value.str()});
+    }
+    std::vector<char*> argv;
+    for (std::string& argument : arguments) argv.push_back(argument.data());
+    gmsh::initialize(static_cast<int>(argv.size()), argv.data(), false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.Verbosity", 1);
+    gmsh::option::setNumber("General.AbortOnError", 0);
+    gmsh::logger::start();
+  }
+  ~GmshSession() {
+    gmsh::logger::stop();
+    gmsh::finalize();
+  }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+};
+
+/// Builds error messages "<source>: <problem>", with Gmsh's mentions of the file read
+/// replaced by the source name.
+struct ErrorSource {
+  std::string file;
+  std::string name;
+  InputError error(const std::string& problem) const {
+    std::string text = problem;
+    for (std::size_t at = text.find(file); !file.empty() && at != std::string::npos;
+         at = text.find(file, at + name.size())) {
+      text.replace(at, file.size(), name);
+    }
+    return InputError(name + ": " + text);
+  }
+};
+
+/// The errors Gmsh logged during this session ("" when none), joined by "; ".
+std::string gmsh_errors() {
+  std::vector<std::string> log;
+  gmsh::logger::get(log);
+  const std::string prefix = "Error: ";
+  std::string errors;
+  for (const std::string& line : log) {
+    if (line.rfind(prefix, 0) != 0) continue;
+    errors += (errors.empty() ? "" : "; ") + line.substr(prefix.size());
+  }
+  if (errors.empty()) gmsh::logger::getLastError(errors);
+  return errors;
+}
+
+/// Runs a Gmsh call; a Gmsh error (thrown or only logged) becomes an InputError.
+template <typename Call>
+void call_gmsh(const ErrorSource& source, const std::string& action, Call&& call) {
+  try {
+    call();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& exception) {
+    throw source.error(action + " failed: " + exception.what());
+  } catch (...) {
+    const std::string error = gmsh_errors();
+    throw source.error(action + " failed: " + (error.empty() ? "unknown Gmsh error" : error));
+  }
+  const std::string error = gmsh_errors();
+  if (!error.empty()) throw source.error(action + " failed: " + error);
+}
+
+std::string gmsh_element_name(int gmsh_type) {
+  std::string name;
+  int dimension = 0, order = 0, node_count = 0, primary_count = 0;
+  std::vector<double> coordinates;
+  try {
+    gmsh::model::mesh::getElementProperties(gmsh_type, name, dimension, order, node_count,
+                                            coordinates, primary_count);
+  } catch (...) {
+    name = "unknown";
+  }
+  return name + " (Gmsh type " + std::to_string(gmsh_type) + ")";
+}
+
+/// Area elements and boundary edges with Gmsh node tags, before compaction.
+struct GmshElements {
+  std::map<ElementType, std::vector<std::size_t>> areas;
+  std::map<std::string, std::pair<EdgeType, std::vector<std::size_t>>> edges;
+};
+
+std::set<int> surfaces_to_read() {
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups, 2);
+  std::set<int> surfaces;
+  if (groups.empty()) {
+    gmsh::vectorpair all;
+    gmsh::model::getEntities(all, 2);
+    for (const auto& [dimension, tag] : all) surfaces.insert(tag);
+    return surfaces;
+  }
+  for (const auto& [dimension, tag] : groups) {
+    std::vector<int> entities;
+    gmsh::model::getEntitiesForPhysicalGroup(dimension, tag, entities);
+    surfaces.insert(entities.begin(), entities.end());
+  }
+  return surfaces;
+}
+
+void read_area_elements(const ErrorSource& source, GmshElements& elements) {
+  for (const int surface : surfaces_to_read()) {
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> element_tags, node_tags;
+    gmsh::model::mesh::getElements(types, element_tags, node_tags, 2, surface);
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      ElementType type;
+      if (types[k] == 2) {
+        type = ElementType::triangle3;
+      } else if (types[k] == 9) {
+        type = ElementType::triangle6;
+      } else if (types[k] == 3) {
+        type = ElementType::quadrilateral4;
+      } else {
+        throw source.error("unsupported 2D element " + gmsh_element_name(types[k]) +
+                           "; use 3-node or 6-node triangles or 4-node quadrilaterals");
+      }
+      std::vector<std::size_t>& block = elements.areas[type];
+      block.insert(block.end(), node_tags[k].begin(), node_tags[k].end());
+    }
+  }
+  if (elements.areas.empty()) {
+    throw source.error("contains no 2D elements (is the surface meshed, with a Physical Surface?)");
+  }
+}
+
+void read_boundary_edges(const ErrorSource& source, GmshElements& elements) {
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups, 1);
+  for (const auto& [dimension, group_tag] : groups) {
+    std::string name;
+    gmsh::model::getPhysicalName(dimension, group_tag, name);
+    if (name.empty()) name = std::to_string(group_tag);
+    std::vector<int> curves;
+    gmsh::model::getEntitiesForPhysicalGroup(dimension, group_tag, curves);
+    for (const int curve : curves) {
+      std::vector<int> types;
+      std::vector<std::vector<std::size_t>> element_tags, node_tags;
+      gmsh::model::mesh::getElements(types, element_tags, node_tags, 1, curve);
+      for (std::size_t k = 0; k < types.size(); ++k) {
+        if (types[k] != 1 && types[k] != 8) {
+          throw source.error("boundary '" + name + "': unsupported 1D element " +
+                             gmsh_element_name(types[k]) + "; use 2-node or 3-node lines");
+        }
+        const EdgeType type = types[k] == 1 ? EdgeType::line2 : EdgeType::line3;
+        auto [entry, inserted] = elements.edges.try_emplace(name, type, std::vector<std::size_t>{});
+        if (entry->second.first != type) {
+          throw source.error("boundary '" + name + "' mixes 2-node and 3-node lines");
+        }
+        entry->second.second.insert(entry->second.second.end(), node_tags[k].begin(),
+                                    node_tags[k].end());
+      }
+    }
+  }
+}
+
+/// Node tag -> compact index, for the nodes used by elements or edges, in ascending tag order.
+std::unordered_map<std::size_t, int> compact_nodes(const GmshElements& elements) {
+  std::vector<std::size_t> used;
+  for (const auto& [type, tags] : elements.areas) used.insert(used.end(), tags.begin(), tags.end());
+  for (const auto& [name, edges] : elements.edges) {
+    used.insert(used.end(), edges.second.begin(), edges.second.end());
+  }
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  std::unordered_map<std::size_t, int> index;
+  for (std::size_t i = 0; i < used.size(); ++i) index.emplace(used[i], static_cast<int>(i));
+  return index;
+}
+
+void fill_nodes(const ErrorSource& source, const std::unordered_map<std::size_t, int>& index,
+                Mesh& mesh) {
+  std::vector<std::size_t> tags;
+  std::vector<double> coordinates, parametric;
+  gmsh::model::mesh::getNodes(tags, coordinates, parametric, -1, -1, false, false);
+  mesh.nodes.assign(index.size(), Eigen::Vector2d::Zero());
+  mesh.node_tags.assign(index.size(), 0);
+  double extent = 0.0;
+  for (const double value : coordinates) extent = std::max(extent, std::abs(value));
+  for (std::size_t k = 0; k < tags.size(); ++k) {
+    const auto found = index.find(tags[k]);
+    if (found == index.end()) continue;
+    const double z = coordinates[3 * k + 2];
+    if (std::abs(z) > 1e-10 * extent) {
+      throw source.error("node " + std::to_string(tags[k]) + " has z = " + std::to_string(z) +
+                         ": the mesh must lie in the z = 0 plane");
+    }
+    mesh.nodes[found->second] = {coordinates[3 * k], coordinates[3 * k + 1]};
+    mesh.node_tags[found->second] = tags[k];
+  }
+  for (std::size_t i = 0; i < mesh.node_tags.size(); ++i) {
+    if (mesh.node_tags[i] == 0) throw source.error("an element uses a node that is not defined");
+  }
+}
+
+std::vector<int> to_indices(const std::vector<std::size_t>& tags,
+                            const std::unordered_map<std::size_t, int>& index) {
+  std::vector<int> indices(tags.size());
+  std::transform(tags.begin(), tags.end(), indices.begin(),
+                 [&](std::size_t tag) { return index.at(tag); });
+  return indices;
+}
+
+/// Twice the signed area of the element's corner polygon (positive when counter-clockwise).
+double twice_signed_area(const Mesh& mesh, ElementType type, const int* nodes) {
+  const int corners = type == ElementType::quadrilateral4 ? 4 : 3;
+  double sum = 0.0;
+  for (int i = 0; i < corners; ++i) {
+    const Eigen::Vector2d& a = mesh.nodes[nodes[i]];
+    const Eigen::Vector2d& b = mesh.nodes[nodes[(i + 1) % corners]];
+    sum += a.x() * b.y() - b.x() * a.y();
+  }
+  return sum;
+}
+
+/// Reorders the nodes of clockwise elements so that every element is counter-clockwise.
+void orient_counter_clockwise(const ErrorSource& source, Mesh& mesh, ElementBlock& block) {
+  // Clockwise -> counter-clockwise: reverse the corner order (triangle6 midpoints follow).
+  static const std::map<ElementType, std::vector<int>> reversed = {
+      {ElementType::triangle3, {0, 2, 1}},
+      {ElementType::triangle6, {0, 2, 1, 5, 4, 3}},
+      {ElementType::quadrilateral4, {0, 3, 2, 1}}};
+  const int count = nodes_per_element(block.type);
+  const std::vector<int>& order = reversed.at(block.type);
+  for (std::size_t e = 0; e < block.element_count(); ++e) {
+    int* nodes = &block.connectivity[e * count];
+    const double area = twice_signed_area(mesh, block.type, nodes);
+    if (area == 0.0) {
+      throw source.error("a " + to_string(block.type) + " element at node " +
+                         std::to_string(mesh.node_tags[nodes[0]]) + " has zero area");
+    }
+    if (area > 0.0) continue;
+    const std::vector<int> original(nodes, nodes + count);
+    for (int i = 0; i < count; ++i) nodes[i] = original[order[i]];
+  }
+}
+
+Mesh extract_mesh(const ErrorSource& source) {
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups);
+  if (groups.empty()) {
+    throw source.error(
+        "defines no physical groups: add a Physical Surface for the body and Physical Curves for "
+        "its boundaries");
+  }
+  GmshElements elements;
+  read_area_elements(source, elements);
+  read_boundary_edges(source, elements);
+  const std::unordered_map<std::size_t, int> index = compact_nodes(elements);
+  Mesh mesh;
+  fill_nodes(source, index, mesh);
+  for (const auto& [type, tags] : elements.areas) {
+    ElementBlock block{type, to_indices(tags, index)};
+    orient_counter_clockwise(source, mesh, block);
+    mesh.blocks.push_back(std::move(block));
+  }
+  for (const auto& [name, edges] : elements.edges) {
+    mesh.boundaries[name] = BoundaryGroup{edges.first, to_indices(edges.second, index)};
+  }
+  return mesh;
+}
+
+void check_options(const ErrorSource& source, const MeshReadOptions& options) {
+  if (!std::isfinite(options.size) || options.size < 0.0) {
+    throw source.error("mesh size " + std::to_string(options.size) + " is not >= 0");
+  }
+  if (options.element_order != 1 && options.element_order != 2) {
+    throw source.error("element order " + std::to_string(options.element_order) + " is not 1 or 2");
+  }
+}
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source,
+                    const MeshReadOptions& options) {
+  check_options(source, options);
+  const std::string extension = lower_extension(path);
+  if (extension != ".msh" && extension != ".geo") {
+    throw source.error("unsupported extension '" + extension + "': give a .msh or .geo file");
+  }
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    throw source.error("the file does not exist or is not a regular file");
+  }
+  const std::lock_guard<std::mutex> lock(gmsh_mutex());
+  const GmshSession session(options.size);
+  call_gmsh(source, "reading", [&] { gmsh::open(path.string()); });
+  if (extension == ".geo") {
+    call_gmsh(source, "meshing", [&] {
+      gmsh::option::setNumber("Mesh.ElementOrder", options.element_order);
+      if (options.recombine) gmsh::option::setNumber("Mesh.RecombineAll", 1);
+      gmsh::model::mesh::generate(2);
+    });
+  }
+  Mesh mesh;
+  call_gmsh(source, "extracting the mesh", [&] { mesh = extract_mesh(source); });
+  return mesh;
+}
+
+/// A file in the temporary directory with a unique name, removed on destruction.
+class TemporaryFile {
+ public:
+  TemporaryFile(const std::string& content, const std::string& extension) {
+    static std::atomic<unsigned long> counter{0};
+    std::random_device random;
+    const std::filesystem::path directory = std::filesystem::temp_directory_path();
+    do {
+      path_ = directory / ("robin-mesh-" + std::to_string(random()) + "-" +
+                           std::to_string(counter++) + extension);
+    } while (std::filesystem::exists(path_));
+    std::ofstream stream(path_, std::ios::binary);
+    stream << content;
+    if (!stream) throw InputError("cannot write the temporary mesh file " + path_.string());
+  }
+  ~TemporaryFile() {
+    std::error_code error;
+    std::filesystem::remove(path_, error);
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+}  // namespace
+
+Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& options) {
+  const ErrorSource source{"", "mesh file '" + path.string() + "'"};
+  return read_mesh_file(path, source, options);
+}
+
+Mesh read_gmsh_mesh_from_text(const std::string& content, const std::string& extension,
+                              const std::string& label, const MeshReadOptions& options) {
+  const std::string lowered = lower_extension("mesh" + extension);
+  if (lowered != ".msh" && lowered != ".geo") {
+    throw InputError(label + ": unsupported mesh extension '" + extension + "': give .msh or .geo");
+  }
+  const TemporaryFile file(content, lowered);
+  const ErrorSource source{file.path().string(), label};
+  return read_mesh_file(file.path(), source, options);
+}
+
+}  // namespace robin
