@@ -1,0 +1,84 @@
+// robin-subdomain: serves one elastic body of a robin-contact run over ZeroMQ
+// (proto/robin.proto). Prints "listening on ENDPOINT" on stdout once bound; logs go to stderr.
+// Exit codes: 0 after Shutdown, SIGINT or SIGTERM; 1 when the endpoint cannot be bound or the
+// transport fails; CLI11's codes for bad command lines.
+
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <cstdint>
+#include <iostream>
+
+#include "protocol_version.hpp"
+#include "server/server_logging.hpp"
+#include "server/server_loop.hpp"
+#include "server/subdomain_server.hpp"
+
+namespace {
+
+std::atomic<bool> stop_requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
+
+void request_stop(int) {
+  stop_requested.store(true);
+}
+
+void install_signal_handlers() {
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+struct CommandLine {
+  robin::ServerLoopOptions loop;
+  robin::ServerSettings server;
+  std::string log_level = "info";
+};
+
+void add_options(CLI::App& app, CommandLine& command_line) {
+  app.add_option("--listen", command_line.loop.endpoint,
+                 "ZeroMQ endpoint to bind: tcp://HOST:PORT, tcp://*:PORT, tcp://127.0.0.1:* "
+                 "(ephemeral port) or ipc://PATH")
+      ->required();
+  app.add_option("--log-level", command_line.log_level, "trace, debug, info, warn, error or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}))
+      ->capture_default_str();
+  app.add_option("--max-message-size", command_line.loop.max_message_size,
+                 "largest accepted request in bytes; libzmq drops a larger message and "
+                 "disconnects its sender, who gets no reply")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--name", command_line.server.name, "label for the logs and HelloReply");
+  // Testing only: announce and accept another protocol major version.
+  app.add_option("--protocol-major", command_line.server.protocol_major)->group("");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"robin-subdomain: serves one elastic body of a robin-contact run over ZeroMQ"};
+  CommandLine command_line;
+  add_options(app, command_line);
+  CLI11_PARSE(app, argc, argv);
+
+  const auto logger = robin::subdomain_logger();
+  logger->set_level(spdlog::level::from_str(command_line.log_level));
+  install_signal_handlers();
+  robin::SubdomainServer server(command_line.server);
+  try {
+    const std::string reason = robin::run_server_loop(
+        server, command_line.loop, stop_requested, [](const std::string& endpoint) {
+          std::cout << "listening on " << endpoint << std::endl;  // the launcher reads this line
+        });
+    logger->info("stopped: {}", reason);
+    return 0;
+  } catch (const robin::BindError& error) {
+    logger->error("{}", error.what());
+  } catch (const std::exception& error) {
+    logger->critical("transport failure: {}", error.what());
+  }
+  return 1;
+}

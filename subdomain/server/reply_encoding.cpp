@@ -1,0 +1,94 @@
+#include "server/reply_encoding.hpp"
+
+namespace robin {
+namespace {
+
+void add_vector(const Eigen::Vector2d& vector, google::protobuf::RepeatedField<double>& values) {
+  values.Add(vector.x());
+  values.Add(vector.y());
+}
+
+void add_values(const Eigen::VectorXd& vector, google::protobuf::RepeatedField<double>& values) {
+  values.Reserve(values.size() + static_cast<int>(vector.size()));
+  for (double value : vector) values.Add(value);
+}
+
+void encode_field(const OutputField& field, protocol::Field& message) {
+  message.set_name(field.name);
+  message.set_components(static_cast<std::uint32_t>(field.components));
+  message.mutable_values()->Assign(field.values.begin(), field.values.end());
+}
+
+void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
+  message.mutable_node_coordinates()->Reserve(2 * static_cast<int>(mesh.node_count()));
+  for (const Eigen::Vector2d& node : mesh.nodes)
+    add_vector(node, *message.mutable_node_coordinates());
+  for (std::size_t tag : mesh.node_tags) message.add_node_tags(static_cast<std::int64_t>(tag));
+  message.add_cell_offsets(0);
+  for (const ElementBlock& block : mesh.blocks) {
+    message.add_cell_types(static_cast<std::uint32_t>(vtk_cell_type(block.type)));
+    for (int node : block.connectivity) message.add_connectivity(node);
+    message.add_cell_offsets(static_cast<std::uint64_t>(message.connectivity_size()));
+  }
+}
+
+}  // namespace
+
+void encode_interface(const std::string& body_name, const InterfaceDescription& interface,
+                      protocol::InterfaceDescription& message) {
+  message.set_body_name(body_name);
+  for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
+    message.add_node_ids(interface.node_ids[i]);
+    message.add_node_tags(static_cast<std::int64_t>(interface.node_tags[i]));
+    add_vector(interface.coordinates[i], *message.mutable_coordinates());
+    add_vector(interface.normals[i], *message.mutable_normals());
+    message.add_weights(interface.weights[i]);
+    message.add_x_fixed(interface.x_fixed[i]);
+    message.add_y_fixed(interface.y_fixed[i]);
+  }
+}
+
+protocol::SolveStatus to_protocol(QpStatus status) {
+  switch (status) {
+    case QpStatus::converged:
+      return protocol::CONVERGED;
+    case QpStatus::not_converged:
+      return protocol::NOT_CONVERGED;
+    case QpStatus::breakdown:
+      return protocol::BREAKDOWN;
+  }
+  return protocol::SOLVE_STATUS_UNSPECIFIED;
+}
+
+void encode_contact_result(const ContactSolveResult& result,
+                           protocol::ContactSolveResult& message) {
+  add_values(result.normal_trace, *message.mutable_normal_trace());
+  add_values(result.contact_force, *message.mutable_contact_force());
+  for (bool active : result.active) message.add_active(active);
+  message.set_status(to_protocol(result.status));
+  message.set_qp_iterations(static_cast<std::uint32_t>(result.iterations));
+  message.set_projected_gradient_norm(result.projected_gradient_norm);
+  message.set_penetration(result.penetration);
+  message.set_complementarity(result.complementarity);
+  message.set_compute_seconds(result.seconds);
+  message.set_message(result.message);
+}
+
+void encode_fields(const BodyOutput& output, protocol::FieldsReply& message) {
+  encode_mesh(output.mesh, message);
+  for (const OutputField& field : output.point_fields) {
+    encode_field(field, *message.add_point_fields());
+  }
+  for (const OutputField& field : output.cell_fields)
+    encode_field(field, *message.add_cell_fields());
+  add_vector(output.reaction_resultant, *message.mutable_reaction_resultant());
+  add_vector(output.applied_force, *message.mutable_applied_force());
+}
+
+Eigen::VectorXd to_vector(const google::protobuf::RepeatedField<double>& values) {
+  Eigen::VectorXd vector(values.size());
+  for (int i = 0; i < values.size(); ++i) vector[i] = values[i];
+  return vector;
+}
+
+}  // namespace robin

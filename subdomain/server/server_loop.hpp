@@ -1,0 +1,50 @@
+#pragma once
+// The subdomain server's transport: a ZeroMQ REP socket that feeds SubdomainServer::handle.
+//
+// The socket is bound to `endpoint` (tcp://host:port, tcp://*:port, tcp://127.0.0.1:* for an
+// ephemeral port, ipc://path). Socket options:
+//  - ZMQ_LINGER 0: closing never waits for unsent replies;
+//  - ZMQ_MAXMSGSIZE = max_message_size: libzmq refuses a larger message by dropping it and
+//    disconnecting its sender, so the sender gets NO reply (its request times out); the server
+//    itself stays up and serves other (and reconnecting) clients;
+//  - ZMQ_SNDTIMEO = send_timeout: a reply that cannot be queued within it (the client vanished
+//    and its pipe is full) is dropped, the socket is re-created on the same endpoint and the
+//    loop goes on.
+// Each message must be one frame (one serialized Envelope); a multi-frame message gets a
+// MALFORMED_MESSAGE reply.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include "server/subdomain_server.hpp"
+
+namespace robin {
+
+struct ServerLoopOptions {
+  std::string endpoint;
+  std::int64_t max_message_size = std::int64_t{1} << 30;  // bytes (1 GiB)
+  std::chrono::milliseconds send_timeout{10000};
+  /// How often the stop flag is checked while no request arrives.
+  std::chrono::milliseconds poll_interval{200};
+};
+
+/// The endpoint cannot be bound (address in use, malformed endpoint, ...). Names the endpoint.
+class BindError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Binds the socket, calls `on_listening` once with the actual endpoint (ZMQ_LAST_ENDPOINT:
+/// wildcards and ephemeral ports resolved), then serves requests until `server` has answered a
+/// Shutdown or `stop` becomes true (checked every poll_interval; a signal handler may set it).
+/// Returns "Shutdown request" or "stop requested", the reason it stopped.
+/// Throws BindError when binding fails, zmq::error_t on other transport failures.
+std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& options,
+                            const std::atomic<bool>& stop,
+                            const std::function<void(const std::string&)>& on_listening);
+
+}  // namespace robin

@@ -1,0 +1,233 @@
+#include "server/setup_decoding.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "numerics/errors.hpp"
+
+namespace robin {
+namespace {
+
+/// "body 'NAME': " (or "SetupBody: " before the name is known), the prefix of every message.
+std::string body_context(const std::string& name) {
+  return "body '" + name + "'";
+}
+
+[[noreturn]] void fail(const std::string& context, const std::string& field,
+                       const std::string& problem) {
+  throw InputError(context + ": SetupBody." + field + " " + problem);
+}
+
+std::string format_value(double value) {
+  std::ostringstream stream;
+  stream.precision(12);
+  stream << value;
+  return stream.str();
+}
+
+std::string decode_body_name(const std::string& name) {
+  const bool valid = !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+    return std::isalnum(c) != 0 || c == '_' || c == '-';
+  });
+  if (!valid) {
+    throw InputError("SetupBody.body_name '" + name +
+                     "' is not a valid body name (letters, digits, '_' and '-', not empty)");
+  }
+  return name;
+}
+
+MeshReadOptions decode_mesh_options(const protocol::SetupBody& message,
+                                    const std::string& context) {
+  MeshReadOptions options;
+  if (!std::isfinite(message.mesh_size()) || message.mesh_size() < 0.0) {
+    fail(context, "mesh_size", "is " + format_value(message.mesh_size()) + ", expected >= 0");
+  }
+  options.size = message.mesh_size();
+  if (message.element_order() > 2) {
+    fail(context, "element_order",
+         "is " + std::to_string(message.element_order()) + ", expected 1 or 2 (0 means 1)");
+  }
+  options.element_order =
+      message.element_order() == 0 ? 1 : static_cast<int>(message.element_order());
+  options.recombine = message.recombine();
+  return options;
+}
+
+/// The mesh from mesh_content (+ mesh_extension) or, when the content is empty, mesh_path.
+/// A reader error is rethrown with the body and field prepended.
+Mesh decode_mesh(const protocol::SetupBody& message, const std::string& context) {
+  const MeshReadOptions options = decode_mesh_options(message, context);
+  if (!message.mesh_content().empty()) {
+    if (message.mesh_extension().empty()) {
+      fail(context, "mesh_extension", "is empty: give \".msh\" or \".geo\" with mesh_content");
+    }
+    return read_gmsh_mesh_from_text(message.mesh_content(), message.mesh_extension(),
+                                    context + ": SetupBody.mesh_content", options);
+  }
+  if (message.mesh_path().empty()) {
+    fail(context, "mesh_content", "and SetupBody.mesh_path are both empty: send the mesh");
+  }
+  try {
+    return read_gmsh_mesh(message.mesh_path(), options);
+  } catch (const InputError& error) {
+    throw InputError(context + ": SetupBody.mesh_path: " + error.what());
+  }
+}
+
+PlaneModel decode_model(const protocol::SetupBody& message, const std::string& context) {
+  switch (message.model()) {
+    case protocol::PLANE_STRAIN:
+      return PlaneModel::plane_strain;
+    case protocol::PLANE_STRESS:
+      return PlaneModel::plane_stress;
+    default:
+      fail(context, "model", "is unspecified: give PLANE_STRAIN or PLANE_STRESS");
+  }
+}
+
+Material decode_material(const protocol::SetupBody& message, const std::string& context) {
+  const PlaneModel model = decode_model(message, context);
+  const std::string material_context = context + ": SetupBody material";
+  if (message.voigt_size() == 0) {
+    return make_isotropic_material(message.young_modulus(), message.poisson_ratio(), model,
+                                   material_context);
+  }
+  if (message.young_modulus() != 0.0 || message.poisson_ratio() != 0.0) {
+    fail(context, "voigt", "is given together with young_modulus/poisson_ratio: give one of them");
+  }
+  if (message.voigt_size() != 9) {
+    fail(context, "voigt",
+         "has " + std::to_string(message.voigt_size()) + " values, expected 9 (row-major 3x3)");
+  }
+  Eigen::Matrix3d stiffness;
+  for (int row = 0; row < 3; ++row) {
+    for (int column = 0; column < 3; ++column)
+      stiffness(row, column) = message.voigt(3 * row + column);
+  }
+  return make_voigt_material(stiffness, model, material_context);
+}
+
+/// A vector of 2 finite values from a repeated field (`field` names it in messages).
+Eigen::Vector2d decode_vector(const google::protobuf::RepeatedField<double>& values,
+                              const std::string& context, const std::string& field) {
+  if (values.size() != 2) {
+    fail(context, field, "has " + std::to_string(values.size()) + " values, expected 2 (x, y)");
+  }
+  if (!std::isfinite(values[0]) || !std::isfinite(values[1])) {
+    fail(context, field, "has a value that is not a finite number");
+  }
+  return {values[0], values[1]};
+}
+
+/// Checks that `name` is a boundary (physical curve) of `mesh`.
+void check_boundary(const Mesh& mesh, const std::string& name, const std::string& context,
+                    const std::string& field) {
+  if (name.empty()) fail(context, field, "is empty: give the name of a physical curve");
+  if (mesh.boundaries.count(name) != 0) return;
+  std::string known;
+  for (const auto& [boundary_name, group] : mesh.boundaries) {
+    known += (known.empty() ? "" : ", ") + boundary_name;
+  }
+  fail(context, field,
+       "'" + name + "' is not a boundary of the mesh (its boundaries: " +
+           (known.empty() ? "none" : known) + ")");
+}
+
+DirichletCondition decode_dirichlet(const protocol::Dirichlet& message, const Mesh& mesh,
+                                    const std::string& context, const std::string& field) {
+  check_boundary(mesh, message.boundary(), context, field + ".boundary");
+  if (!message.has_x() && !message.has_y()) {
+    fail(context, field, "prescribes neither x nor y: give at least one");
+  }
+  DirichletCondition condition{message.boundary(), std::nullopt, std::nullopt};
+  if (message.has_x()) condition.x = message.x();
+  if (message.has_y()) condition.y = message.y();
+  if ((condition.x && !std::isfinite(*condition.x)) ||
+      (condition.y && !std::isfinite(*condition.y))) {
+    fail(context, field, "has a value that is not a finite number");
+  }
+  return condition;
+}
+
+TractionCondition decode_traction(const protocol::Traction& message, const Mesh& mesh,
+                                  const std::string& context, const std::string& field) {
+  check_boundary(mesh, message.boundary(), context, field + ".boundary");
+  TractionCondition condition;
+  condition.boundary = message.boundary();
+  condition.is_pressure = message.is_pressure();
+  if (!message.is_pressure()) {
+    condition.vector = decode_vector(message.vector(), context, field + ".vector");
+    return condition;
+  }
+  if (message.vector_size() != 0) {
+    fail(context, field + ".vector", "is given with is_pressure = true: give one of them");
+  }
+  if (!std::isfinite(message.pressure())) {
+    fail(context, field + ".pressure", "is not a finite number");
+  }
+  condition.pressure = message.pressure();
+  return condition;
+}
+
+InterfaceOperatorKind decode_interface_operator(const std::string& name,
+                                                const std::string& context) {
+  if (name.empty() || name == "auto") return InterfaceOperatorKind::automatic;
+  if (name == "dense") return InterfaceOperatorKind::dense;
+  if (name == "factor") return InterfaceOperatorKind::factor;
+  fail(context, "solver.interface_operator",
+       "is '" + name + "', expected \"auto\", \"dense\" or \"factor\"");
+}
+
+void decode_solver(const protocol::SolverSettings& message, const std::string& context,
+                   DecodedSetup& setup) {
+  const double tolerance = message.qp_tolerance();
+  if (!std::isfinite(tolerance) || tolerance < 0.0) {
+    fail(context, "solver.qp_tolerance",
+         "is " + format_value(tolerance) + ", expected > 0 (or 0 for the default)");
+  }
+  if (tolerance > 0.0) setup.qp.relative_tolerance = tolerance;
+  if (message.qp_max_iterations() > 0) {
+    if (message.qp_max_iterations() > static_cast<unsigned>(std::numeric_limits<int>::max())) {
+      fail(context, "solver.qp_max_iterations", "is too large");
+    }
+    setup.qp.max_iterations = static_cast<int>(message.qp_max_iterations());
+  }
+  setup.body.interface_operator = decode_interface_operator(message.interface_operator(), context);
+  if (message.dense_limit() > 0) {
+    if (message.dense_limit() > static_cast<unsigned>(std::numeric_limits<int>::max())) {
+      fail(context, "solver.dense_limit", "is too large");
+    }
+    setup.body.dense_limit = static_cast<int>(message.dense_limit());
+  }
+}
+
+}  // namespace
+
+DecodedSetup decode_setup_body(const protocol::SetupBody& message) {
+  DecodedSetup setup;
+  BodyDefinition& definition = setup.definition;
+  definition.name = decode_body_name(message.body_name());
+  const std::string context = body_context(definition.name);
+  definition.material = decode_material(message, context);
+  if (message.body_force_size() != 0) {
+    definition.body_force = decode_vector(message.body_force(), context, "body_force");
+  }
+  decode_solver(message.solver(), context, setup);
+  definition.mesh = decode_mesh(message, context);
+  check_boundary(definition.mesh, message.contact_boundary(), context, "contact_boundary");
+  definition.contact_boundary = message.contact_boundary();
+  for (int k = 0; k < message.dirichlet_size(); ++k) {
+    definition.dirichlet.push_back(decode_dirichlet(message.dirichlet(k), definition.mesh, context,
+                                                    "dirichlet[" + std::to_string(k) + "]"));
+  }
+  for (int k = 0; k < message.traction_size(); ++k) {
+    definition.tractions.push_back(decode_traction(message.traction(k), definition.mesh, context,
+                                                   "traction[" + std::to_string(k) + "]"));
+  }
+  return setup;
+}
+
+}  // namespace robin

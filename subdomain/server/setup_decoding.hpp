@@ -1,0 +1,29 @@
+#pragma once
+// Decoding of a SetupBody request (proto/robin.proto) into the numerics' body definition and
+// solver settings. Part of the server's protocol module: the generated types stop here.
+
+#include "numerics/body_definition.hpp"
+#include "numerics/body_solver.hpp"
+#include "numerics/gmsh_reader.hpp"
+#include "numerics/mprgp.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+
+/// Everything a SetupBody defines: the body and how to solve its contact problems.
+struct DecodedSetup {
+  BodyDefinition definition;
+  MprgpParameters qp;
+  BodySolverOptions body;
+};
+
+/// Decodes and checks `message`: body name ([A-Za-z0-9_-]+), mesh (mesh_content with
+/// mesh_extension ".msh"/".geo", or mesh_path; .geo options), plane model (must be given),
+/// material (young_modulus/poisson_ratio, or 9 `voigt` values, not both), body force (0 or 2
+/// values), Dirichlet (at least one of x/y) and traction conditions, the contact boundary, and
+/// the solver settings (0 or empty = server default). Every boundary name is checked against
+/// the mesh. Throws InputError naming the body and the field, e.g.
+///   "body 'upper': SetupBody.voigt has 4 values, expected 9".
+DecodedSetup decode_setup_body(const protocol::SetupBody& message);
+
+}  // namespace robin

@@ -1,0 +1,391 @@
+#include "server/subdomain_server.hpp"
+
+#include <spdlog/spdlog.h>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "numerics/body_output.hpp"
+#include "numerics/errors.hpp"
+#include "robin.pb.h"
+#include "server/reply_encoding.hpp"
+#include "server/request_error.hpp"
+#include "server/server_logging.hpp"
+#include "server/setup_decoding.hpp"
+
+#ifndef ROBIN_VERSION
+#define ROBIN_VERSION "unknown"
+#endif
+
+namespace robin {
+
+/// What the log line of a request says.
+struct SubdomainServer::RequestRecord {
+  std::string type = "(unparsed message)";
+  std::string body;       // the body's name when known
+  std::string iteration;  // " iteration N" for solves
+  std::string outcome = "ok";
+  bool failed = false;
+  double seconds = 0.0;
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string version_text(unsigned major, unsigned minor) {
+  return std::to_string(major) + "." + std::to_string(minor);
+}
+
+/// The request's message type name, e.g. "ContactSolveRequest".
+std::string content_type_name(const protocol::Envelope& request) {
+  const auto* field = request.GetDescriptor()->FindFieldByNumber(request.content_case());
+  return field == nullptr ? "(no content)" : field->message_type()->name();
+}
+
+bool is_request(protocol::Envelope::ContentCase content) {
+  using Envelope = protocol::Envelope;
+  switch (content) {
+    case Envelope::kHello:
+    case Envelope::kSetupBody:
+    case Envelope::kAssignContact:
+    case Envelope::kContactSolve:
+    case Envelope::kCorrection:
+    case Envelope::kFields:
+    case Envelope::kEndRun:
+    case Envelope::kShutdown:
+      return true;
+    default:
+      return false;
+  }
+}
+
+/// Checks a per-contact-node vector of the request: its length and finiteness.
+Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& values,
+                               int contact_size, const std::string& field,
+                               const std::string& body_name) {
+  if (values.size() != contact_size) {
+    throw RequestError(protocol::INVALID_ARGUMENT,
+                       field + " has " + std::to_string(values.size()) + " values for the " +
+                           std::to_string(contact_size) + " contact nodes of body '" + body_name +
+                           "' (pair order of AssignContact)");
+  }
+  for (int i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      throw RequestError(
+          protocol::INVALID_ARGUMENT,
+          field + "[" + std::to_string(i) + "] of body '" + body_name + "' is not a finite number");
+    }
+  }
+  return to_vector(values);
+}
+
+/// The assignment of an AssignContact request, checked against the body's contact boundary:
+/// as many normals as nodes, known and distinct node ids, unit normals (to 1e-8).
+ContactAssignment checked_assignment(const protocol::AssignContact& message,
+                                     const std::vector<int>& interface_nodes,
+                                     const std::string& body_name) {
+  const auto invalid = [&](const std::string& problem) {
+    return RequestError(protocol::INVALID_ARGUMENT,
+                        "AssignContact for body '" + body_name + "': " + problem);
+  };
+  if (message.normals_size() != 2 * message.node_ids_size()) {
+    throw invalid(std::to_string(message.normals_size()) + " normal values for " +
+                  std::to_string(message.node_ids_size()) + " nodes, expected 2 per node");
+  }
+  ContactAssignment assignment;
+  std::vector<bool> used(interface_nodes.size(), false);
+  for (int i = 0; i < message.node_ids_size(); ++i) {
+    const std::int64_t id = message.node_ids(i);
+    const auto found = std::lower_bound(interface_nodes.begin(), interface_nodes.end(), id);
+    if (found == interface_nodes.end() || *found != id) {
+      throw invalid("node id " + std::to_string(id) +
+                    " is not a node of the contact boundary (see InterfaceDescription.node_ids)");
+    }
+    if (used[found - interface_nodes.begin()]) {
+      throw invalid("node id " + std::to_string(id) + " is assigned twice");
+    }
+    used[found - interface_nodes.begin()] = true;
+    const Eigen::Vector2d normal(message.normals(2 * i), message.normals(2 * i + 1));
+    if (!std::isfinite(normal.norm()) || std::abs(normal.norm() - 1.0) > 1e-8) {
+      throw invalid("the normal of node id " + std::to_string(id) + " is not a unit vector");
+    }
+    assignment.node_ids.push_back(*found);
+    assignment.normals.push_back(normal);
+  }
+  return assignment;
+}
+
+void set_error(protocol::Envelope& reply, protocol::ErrorCode code, const std::string& message,
+               ServerState state) {
+  protocol::Error& error = *reply.mutable_error();
+  error.set_code(code);
+  error.set_message(message);
+  error.set_state(to_string(state));
+}
+
+}  // namespace
+
+std::string to_string(ServerState state) {
+  switch (state) {
+    case ServerState::awaiting_setup:
+      return "awaiting_setup";
+    case ServerState::awaiting_assignment:
+      return "awaiting_assignment";
+    case ServerState::ready:
+      return "ready";
+  }
+  return "unknown";
+}
+
+SubdomainServer::SubdomainServer(ServerSettings settings) : settings_(std::move(settings)) {
+  if (!settings_.logger) settings_.logger = subdomain_logger();
+}
+
+SubdomainServer::~SubdomainServer() = default;
+
+std::string SubdomainServer::server_name() const {
+  std::string name = std::string("robin-subdomain ") + ROBIN_VERSION;
+  if (!settings_.name.empty()) name += " (" + settings_.name + ")";
+  return name;
+}
+
+std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
+  const auto start = Clock::now();
+  RequestRecord record;
+  protocol::Envelope reply;
+  try {
+    protocol::Envelope request;
+    if (request_bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()) ||
+        !request.ParseFromArray(request_bytes.data(), static_cast<int>(request_bytes.size()))) {
+      throw RequestError(protocol::MALFORMED_MESSAGE,
+                         "the message (" + std::to_string(request_bytes.size()) +
+                             " bytes) is not a serialized robin.protocol.Envelope");
+    }
+    reply.set_request_id(request.request_id());
+    record.type = content_type_name(request);
+    if (body_) record.body = body_->name();
+    check_version(request);
+    dispatch(request, reply, record);
+  } catch (const RequestError& error) {
+    set_error(reply, error.code(), error.what(), state_);
+  } catch (const SingularBodyError& error) {
+    set_error(reply, protocol::SINGULAR_BODY, error.what(), state_);
+  } catch (const InputError& error) {
+    set_error(reply, protocol::BAD_INPUT, error.what(), state_);
+  } catch (const std::exception& error) {
+    set_error(reply, protocol::INTERNAL, std::string("internal error: ") + error.what(), state_);
+  } catch (...) {
+    set_error(reply, protocol::INTERNAL, "internal error: unknown exception", state_);
+  }
+  if (reply.has_error()) {
+    record.failed = true;
+    record.outcome =
+        protocol::ErrorCode_Name(reply.error().code()) + ": " + reply.error().message();
+  }
+  reply.mutable_version()->set_major(settings_.protocol_major);
+  reply.mutable_version()->set_minor(protocol::protocol_minor);
+  record.seconds = seconds_since(start);
+  try {
+    log(record);
+    return reply.SerializeAsString();
+  } catch (...) {
+    return {};  // out of memory while replying: the loop answers with an empty message
+  }
+}
+
+std::string SubdomainServer::reject(std::string_view reason) noexcept {
+  try {
+    RequestRecord record;
+    record.failed = true;
+    record.outcome = "MALFORMED_MESSAGE: " + std::string(reason);
+    protocol::Envelope reply;
+    set_error(reply, protocol::MALFORMED_MESSAGE, std::string(reason), state_);
+    reply.mutable_version()->set_major(settings_.protocol_major);
+    reply.mutable_version()->set_minor(protocol::protocol_minor);
+    log(record);
+    return reply.SerializeAsString();
+  } catch (...) {
+    return {};
+  }
+}
+
+void SubdomainServer::check_version(const protocol::Envelope& request) const {
+  if (!request.has_version()) {
+    throw RequestError(protocol::MALFORMED_MESSAGE,
+                       "the Envelope carries no version: every message must carry the sender's "
+                       "protocol Version");
+  }
+  const unsigned major = request.version().major();
+  if (major != settings_.protocol_major) {
+    throw RequestError(protocol::VERSION_MISMATCH,
+                       "protocol version mismatch: the request speaks " +
+                           version_text(major, request.version().minor()) + ", this server " +
+                           version_text(settings_.protocol_major, protocol::protocol_minor) +
+                           " (the major versions must be equal); use a matching coordinator "
+                           "or server");
+  }
+}
+
+void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Envelope& reply,
+                               RequestRecord& record) {
+  using Envelope = protocol::Envelope;
+  switch (request.content_case()) {
+    case Envelope::kHello:
+      return on_hello(reply);
+    case Envelope::kSetupBody:
+      return on_setup_body(request, reply, record);
+    case Envelope::kAssignContact:
+      return on_assign_contact(request, reply);
+    case Envelope::kContactSolve:
+      return on_contact_solve(request, reply, record);
+    case Envelope::kCorrection:
+      return on_correction(request, reply, record);
+    case Envelope::kFields:
+      return on_fields(request, reply);
+    case Envelope::kEndRun:
+      body_.reset();
+      interface_nodes_.clear();
+      state_ = ServerState::awaiting_setup;
+      return acknowledge(reply);
+    case Envelope::kShutdown:
+      shutdown_requested_ = true;
+      return acknowledge(reply);
+    case Envelope::CONTENT_NOT_SET:
+      break;
+    default:
+      if (!is_request(request.content_case())) {
+        throw RequestError(protocol::UNSUPPORTED,
+                           content_type_name(request) + " is a reply, not a request");
+      }
+  }
+  if (!request.GetReflection()->GetUnknownFields(request).empty()) {
+    throw RequestError(protocol::UNSUPPORTED,
+                       "the request type is unknown to this server (protocol " +
+                           version_text(settings_.protocol_major, protocol::protocol_minor) +
+                           "); check HelloReply.capabilities");
+  }
+  throw RequestError(protocol::MALFORMED_MESSAGE, "the Envelope carries no request (no content)");
+}
+
+void SubdomainServer::require_state(ServerState minimum, const std::string& request_type) const {
+  if (state_ == ServerState::awaiting_setup && minimum != ServerState::awaiting_setup) {
+    throw RequestError(protocol::WRONG_STATE,
+                       request_type + " before SetupBody: send SetupBody first");
+  }
+  if (state_ == ServerState::awaiting_assignment && minimum == ServerState::ready) {
+    throw RequestError(protocol::WRONG_STATE, request_type +
+                                                  " before AssignContact: send "
+                                                  "AssignContact for body '" +
+                                                  body_->name() + "' first");
+  }
+}
+
+void SubdomainServer::on_hello(protocol::Envelope& reply) {
+  protocol::HelloReply& hello = *reply.mutable_hello_reply();
+  hello.set_server_name(server_name());
+  for (const char* capability : {"contact_solve", "correction_solve", "fields"}) {
+    hello.add_capabilities(capability);
+  }
+  hello.set_state(to_string(state_));
+}
+
+void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol::Envelope& reply,
+                                    RequestRecord& record) {
+  body_.reset();  // a SetupBody starts a new run, whatever its outcome
+  interface_nodes_.clear();
+  state_ = ServerState::awaiting_setup;
+  record.body = request.setup_body().body_name();
+  DecodedSetup setup = decode_setup_body(request.setup_body());
+  auto body = std::make_unique<BodySolver>(std::move(setup.definition), setup.body);
+  const InterfaceDescription interface = body->contact_boundary();
+  protocol::InterfaceDescription& description = *reply.mutable_interface();
+  encode_interface(body->name(), interface, description);
+  description.set_dof_count(static_cast<std::uint64_t>(body->free_dof_count()));
+  description.set_setup_seconds(body->timings().assembly_seconds +
+                                body->timings().factorization_seconds);
+  interface_nodes_ = interface.node_ids;
+  qp_parameters_ = setup.qp;
+  body_ = std::move(body);
+  state_ = ServerState::awaiting_assignment;
+  record.outcome = "ok, " + std::to_string(body_->mesh().node_count()) + " nodes, " +
+                   std::to_string(body_->free_dof_count()) + " free dofs, " +
+                   std::to_string(interface_nodes_.size()) + " contact boundary nodes";
+}
+
+void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
+                                        protocol::Envelope& reply) {
+  require_state(ServerState::awaiting_assignment, "AssignContact");
+  const ContactAssignment assignment =
+      checked_assignment(request.assign_contact(), interface_nodes_, body_->name());
+  state_ = ServerState::awaiting_assignment;  // until the body accepted the assignment
+  body_->assign_contact(assignment);
+  state_ = ServerState::ready;
+  acknowledge(reply);
+}
+
+void SubdomainServer::on_contact_solve(const protocol::Envelope& request, protocol::Envelope& reply,
+                                       RequestRecord& record) {
+  const protocol::ContactSolveRequest& message = request.contact_solve();
+  record.iteration = " iteration " + std::to_string(message.iteration());
+  require_state(ServerState::ready, "ContactSolveRequest");
+  const Eigen::VectorXd obstacle = checked_vector(message.obstacle(), body_->contact_size(),
+                                                  "ContactSolveRequest.obstacle", body_->name());
+  const ContactSolveResult result = body_->solve_contact(obstacle, qp_parameters_);
+  encode_contact_result(result, *reply.mutable_contact_result());
+  record.outcome = protocol::SolveStatus_Name(to_protocol(result.status)) + ", " +
+                   std::to_string(result.iterations) + " QP iterations";
+  if (!result.message.empty()) record.outcome += " (" + result.message + ")";
+}
+
+void SubdomainServer::on_correction(const protocol::Envelope& request, protocol::Envelope& reply,
+                                    RequestRecord& record) {
+  const auto start = Clock::now();
+  const protocol::CorrectionRequest& message = request.correction();
+  record.iteration = " iteration " + std::to_string(message.iteration());
+  require_state(ServerState::ready, "CorrectionRequest");
+  const Eigen::VectorXd interface_force =
+      checked_vector(message.interface_force(), body_->contact_size(),
+                     "CorrectionRequest.interface_force", body_->name());
+  const Eigen::VectorXd trace = body_->solve_correction(interface_force);  // w_N = B K^-1 B' r
+  protocol::CorrectionResult& result = *reply.mutable_correction_result();
+  result.mutable_normal_trace()->Assign(trace.begin(), trace.end());
+  result.set_compute_seconds(seconds_since(start));
+}
+
+void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Envelope& reply) {
+  const protocol::FieldsRequest& message = request.fields();
+  require_state(ServerState::ready, "FieldsRequest");
+  const Eigen::VectorXd contact_force = checked_vector(
+      message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
+  const std::filesystem::path directory = message.write_directory();
+  std::error_code error;
+  if (!directory.empty() && !std::filesystem::is_directory(directory, error)) {
+    throw RequestError(protocol::INVALID_ARGUMENT,
+                       "FieldsRequest.write_directory '" + directory.string() +
+                           "' is not a directory on the server (body '" + body_->name() + "')");
+  }
+  const BodyOutput output = make_body_output(*body_, contact_force);
+  protocol::FieldsReply& fields = *reply.mutable_fields_reply();
+  encode_fields(output, fields);
+  if (!directory.empty()) fields.set_written_file(write_body_output(directory, output));
+}
+
+void SubdomainServer::acknowledge(protocol::Envelope& reply) const {
+  reply.mutable_acknowledge()->set_state(to_string(state_));
+}
+
+void SubdomainServer::log(const RequestRecord& record) const {
+  const std::string body = record.body.empty() ? "" : " body '" + record.body + "'";
+  settings_.logger->log(record.failed ? spdlog::level::warn : spdlog::level::info,
+                        "{}{}{}: {} ({:.3f} ms)", record.type, body, record.iteration,
+                        record.outcome, 1e3 * record.seconds);
+}
+
+}  // namespace robin

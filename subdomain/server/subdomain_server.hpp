@@ -1,0 +1,107 @@
+#pragma once
+// The subdomain server's protocol state machine (proto/robin.proto), free of transport:
+// a serialized request Envelope in, a serialized reply Envelope out. One body at a time.
+//
+// States and the requests they accept (Hello, SetupBody, EndRun and Shutdown in every state):
+//   awaiting_setup       no body
+//   awaiting_assignment  body assembled and factorized (SetupBody done); + AssignContact
+//   ready                contact nodes assigned; + AssignContact, ContactSolveRequest,
+//                        CorrectionRequest, FieldsRequest
+// Transitions: SetupBody -> awaiting_assignment (the previous body is discarded first, so a
+// failed SetupBody leaves awaiting_setup); AssignContact -> ready (a refused assignment keeps
+// the state and the previous assignment); EndRun -> awaiting_setup; Shutdown -> unchanged, and
+// shutdown_requested() becomes true. The body is factorized once per SetupBody; contact solves
+// warm-start from the previous converged solution of the same assignment.
+//
+// Every reply echoes the request_id and carries this server's Version. Failures are Error
+// replies, never exceptions:
+//   MALFORMED_MESSAGE  not a parsable Envelope, no version, or no content
+//   VERSION_MISMATCH   the request's major version differs from ours (both are named)
+//   WRONG_STATE        the request is not accepted in the current state
+//   INVALID_ARGUMENT   wrong sizes, unknown or repeated node ids, non-unit normals, non-finite
+//                      values, a write_directory that is not a directory
+//   BAD_INPUT          the body definition is unusable (robin::InputError while setting up)
+//   SINGULAR_BODY      the Dirichlet conditions leave a rigid motion free (SingularBodyError)
+//   UNSUPPORTED        a reply type sent as a request, or a request unknown to this version
+//   INTERNAL           any other exception
+// The state after the request is in Acknowledge.state, HelloReply.state and Error.state.
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "numerics/body_solver.hpp"
+#include "numerics/mprgp.hpp"
+#include "protocol_version.hpp"
+
+namespace spdlog {
+class logger;
+}
+
+namespace robin {
+
+namespace protocol {
+class Envelope;
+}
+
+enum class ServerState { awaiting_setup, awaiting_assignment, ready };
+/// "awaiting_setup", "awaiting_assignment", "ready".
+std::string to_string(ServerState state);
+
+struct ServerSettings {
+  std::string name;  // optional label, appended to HelloReply.server_name and the logs
+  /// The major version announced and accepted (tests set another one to provoke a mismatch).
+  unsigned protocol_major = protocol::protocol_major;
+  /// Where requests are logged; null means subdomain_logger().
+  std::shared_ptr<spdlog::logger> logger;
+};
+
+class SubdomainServer {
+ public:
+  explicit SubdomainServer(ServerSettings settings = {});
+  ~SubdomainServer();
+  SubdomainServer(const SubdomainServer&) = delete;
+  SubdomainServer& operator=(const SubdomainServer&) = delete;
+
+  /// Handles one request and returns the serialized reply Envelope. Never throws; logs the
+  /// request (type, body, iteration, duration, outcome).
+  std::string handle(std::string_view request_bytes) noexcept;
+  /// The MALFORMED_MESSAGE reply (request_id 0) to a message the transport could not pass to
+  /// handle(), e.g. one of several frames; `reason` says why. Never throws; logs.
+  std::string reject(std::string_view reason) noexcept;
+
+  ServerState state() const { return state_; }
+  /// True once a Shutdown request has been answered.
+  bool shutdown_requested() const { return shutdown_requested_; }
+  /// "robin-subdomain VERSION" plus " (name)" when a name is set.
+  std::string server_name() const;
+
+ private:
+  struct RequestRecord;
+
+  void dispatch(const protocol::Envelope& request, protocol::Envelope& reply,
+                RequestRecord& record);
+  void check_version(const protocol::Envelope& request) const;
+  void require_state(ServerState minimum, const std::string& request_type) const;
+  void on_hello(protocol::Envelope& reply);
+  void on_setup_body(const protocol::Envelope& request, protocol::Envelope& reply,
+                     RequestRecord& record);
+  void on_assign_contact(const protocol::Envelope& request, protocol::Envelope& reply);
+  void on_contact_solve(const protocol::Envelope& request, protocol::Envelope& reply,
+                        RequestRecord& record);
+  void on_correction(const protocol::Envelope& request, protocol::Envelope& reply,
+                     RequestRecord& record);
+  void on_fields(const protocol::Envelope& request, protocol::Envelope& reply);
+  void acknowledge(protocol::Envelope& reply) const;
+  void log(const RequestRecord& record) const;
+
+  ServerSettings settings_;
+  ServerState state_ = ServerState::awaiting_setup;
+  bool shutdown_requested_ = false;
+  std::unique_ptr<BodySolver> body_;
+  std::vector<int> interface_nodes_;  // the contact boundary's node ids, ascending
+  MprgpParameters qp_parameters_;
+};
+
+}  // namespace robin
