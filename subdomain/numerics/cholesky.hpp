@@ -13,7 +13,9 @@ namespace robin {
 class CholeskyFactor {
  public:
   /// Factorizes the symmetric positive definite `matrix` (only its lower triangle is read).
-  /// Throws SingularBodyError naming `body_name` when the matrix is not positive definite.
+  /// Throws SingularBodyError naming `body_name` when the matrix is not positive definite or
+  /// numerically singular (pivot ratio min L_jj^2 / max L_jj^2 < 1e-13, i.e. cond > 1e13);
+  /// InputError when it is empty or not square. Solves are not thread-safe (CHOLMOD workspace).
   CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name);
   ~CholeskyFactor();
   CholeskyFactor(const CholeskyFactor&) = delete;
@@ -22,11 +24,13 @@ class CholeskyFactor {
   int size() const;
   /// x = K^{-1} b: one forward and one backward triangular solve.
   Eigen::VectorXd solve(const Eigen::VectorXd& right_hand_side) const;
-  /// Multiple right-hand sides at once (blocked supernodal solves).
+  /// Multiple right-hand sides at once (supernodal solves in blocks of at most 64 columns).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& right_hand_sides) const;
-  /// Number of nonzeros of the factor L.
+  /// Number of entries stored in the lower triangle of the supernodal factor L (including the
+  /// explicit zeros of supernode amalgamation).
   long factor_nonzeros() const;
-  /// Number of solves performed so far (each is two triangular solves per column).
+  /// Number of right-hand sides solved so far: +1 per vector solve, +columns per matrix solve
+  /// (each right-hand side costs one forward and one backward triangular solve).
   long solve_count() const { return solve_count_; }
 
  private:

@@ -41,17 +41,24 @@ struct MprgpResult {
   Eigen::VectorXd solution;
   Eigen::VectorXd gradient;  // A x - b at the solution
   QpStatus status = QpStatus::not_converged;
-  int iterations = 0;              // CG + expansion + proportioning steps
+  int iterations = 0;  // CG + expansion + proportioning steps
   int conjugate_gradient_steps = 0;
   int expansion_steps = 0;
   int proportioning_steps = 0;
-  int operator_applications = 0;   // products with A, including the norm estimate
+  int operator_applications = 0;  // products with A, including the norm estimate
   double projected_gradient_norm = 0.0;
-  double operator_norm = 0.0;      // the ||A|| estimate used
-  std::string message;             // reason for not_converged / breakdown
+  double operator_norm = 0.0;  // the ||A|| estimate used
+  std::string message;         // reason for not_converged / breakdown
 };
 
 /// Solves the QP from the starting point `initial` (projected onto the feasible set).
+/// Converged means ||g^P|| <= max(relative_tolerance ||b||, absolute_tolerance) for the
+/// gradient recomputed as A x - b (the recurrence gradient is replaced when it drifts). Entries
+/// of `lower` may be -infinity (unbounded); NaN or +infinity, or sizes that differ from
+/// matrix.size(), throw std::invalid_argument. The returned gradient is always A x - b and
+/// the returned x is always feasible (x_i >= lower_i exactly; x_i == lower_i is active).
+/// Products with A: the norm estimate (10 when operator_norm <= 0), 1 for the initial
+/// gradient, 1 per CG or proportioning step, 2 per expansion step, 1 per recomputation.
 MprgpResult solve_mprgp(const LinearOperator& matrix, const Eigen::VectorXd& right_hand_side,
                         const Eigen::VectorXd& lower, const Eigen::VectorXd& initial,
                         const MprgpParameters& parameters = {});
