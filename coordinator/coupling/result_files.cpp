@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "numerics/elasticity.hpp"
+#include "numerics/body_output.hpp"
 #include "numerics/vtu_writer.hpp"
 
 namespace robin {
@@ -54,23 +54,6 @@ void check_size(const Eigen::VectorXd& vector, std::size_t expected, const std::
   }
 }
 
-std::vector<double> to_values(const double* data, Eigen::Index size) {
-  return std::vector<double>(data, data + size);
-}
-
-/// p_node = lambda_i / m_i on the assigned contact nodes, zero elsewhere.
-std::vector<double> nodal_contact_pressure(const BodySolver& body,
-                                           const Eigen::VectorXd& contact_force) {
-  std::vector<double> pressure(body.mesh().node_count(), 0.0);
-  const std::vector<int>& nodes = body.contact_nodes();
-  const Eigen::VectorXd& weights = body.contact_weights();
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const auto index = static_cast<Eigen::Index>(i);
-    pressure[nodes[i]] = contact_force[index] / weights[index];
-  }
-  return pressure;
-}
-
 }  // namespace
 
 void write_contact_csv(const std::filesystem::path& path, const ContactPairing& pairing,
@@ -102,41 +85,15 @@ void write_contact_csv(const std::filesystem::path& path, const ContactPairing& 
 
 std::string write_body_vtu(const std::filesystem::path& directory, const BodySolver& body,
                            const Eigen::VectorXd& contact_force) {
-  const std::string file_name = body.name() + ".vtu";
-  const std::filesystem::path path = directory / file_name;
-  if (body.name().empty() || std::filesystem::path(body.name()).has_parent_path()) {
-    throw std::runtime_error("cannot write '" + path.string() + "': body name '" + body.name() +
-                             "' is not usable as a file name");
-  }
+  const std::filesystem::path path = directory / (body.name() + ".vtu");
   if (contact_force.size() != body.contact_size()) {
     throw std::runtime_error("cannot write '" + path.string() + "': body '" + body.name() +
                              "' has " + std::to_string(body.contact_size()) +
                              " contact nodes but the contact force has " +
                              std::to_string(contact_force.size()) + " entries");
   }
-  const Mesh& mesh = body.mesh();
-  const Eigen::VectorXd displacement = body.displacement(contact_force);
-  const StressField stress = recover_stress(mesh, body.definition().material, displacement);
-  const Eigen::VectorXd reaction = body.reactions(displacement);
-  const Eigen::VectorXd force_field = body.contact_force_field(contact_force);
-  const std::vector<std::string> stress_components = {"xx", "yy", "xy"};
-
-  const std::vector<OutputField> point_fields = {
-      {"displacement", 2, to_values(displacement.data(), displacement.size())},
-      {"stress", 3, to_values(stress.nodal_stress.data(), stress.nodal_stress.size()),
-       stress_components},
-      {"von_mises", 1, to_values(stress.nodal_von_mises.data(), stress.nodal_von_mises.size())},
-      {"contact_pressure", 1, nodal_contact_pressure(body, contact_force)},
-      {"contact_force", 2, to_values(force_field.data(), force_field.size())},
-      {"reaction", 2, to_values(reaction.data(), reaction.size())}};
-  const std::vector<OutputField> cell_fields = {
-      {"stress", 3, to_values(stress.element_stress.data(), stress.element_stress.size()),
-       stress_components},
-      {"von_mises", 1,
-       to_values(stress.element_von_mises.data(), stress.element_von_mises.size())}};
   ensure_directory(directory);
-  write_vtu(path, mesh, point_fields, cell_fields);
-  return file_name;
+  return write_body_output(directory, make_body_output(body, contact_force));
 }
 
 void write_solution_pvd(const std::filesystem::path& directory, const std::string& file1,

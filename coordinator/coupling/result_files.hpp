@@ -34,6 +34,8 @@ void write_contact_csv(const std::filesystem::path& path, const ContactPairing& 
 /// (2), reaction (2); cell fields: stress, von_mises. The file is "<body name>.vtu" in
 /// `directory`; contact_force is lambda in the body's assignment order (size contact_size()).
 /// 2-component fields are written with a zero z component (see numerics/vtu_writer.hpp).
+/// The fields are those of make_body_output (numerics/body_output.hpp), shared with the
+/// remote subdomain path.
 /// Returns the written file name (relative to `directory`).
 std::string write_body_vtu(const std::filesystem::path& directory, const BodySolver& body,
                            const Eigen::VectorXd& contact_force);
