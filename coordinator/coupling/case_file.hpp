@@ -5,12 +5,10 @@
 #include <array>
 #include <filesystem>
 #include <map>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "coupling/gap_function.hpp"
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/gmsh_reader.hpp"
@@ -38,13 +36,13 @@ struct BodyCase {
 
 /// Options of the Robin iteration (coordinator); command-line flags override them.
 struct CouplingOptions {
-  double relaxation = 0.5;        // delta of paper (13)
-  double tolerance = 1e-8;        // on every scaled residual
+  double relaxation = 0.5;  // delta of paper (13)
+  double tolerance = 1e-8;  // on every scaled residual
   int max_iterations = 200;
-  std::string initial_obstacle = "gap";  // "gap": g^alpha_0 = d; "zero": g^alpha_0 = 0
+  std::string initial_obstacle = "gap";   // "gap": g^alpha_0 = d; "zero": g^alpha_0 = 0
   double request_timeout_seconds = 60.0;  // deadline of each request to a server
-  double divergence_factor = 1e3;   // residual growth over its minimum that means divergence
-  int stagnation_window = 50;       // iterations without residual decrease that mean stagnation
+  double divergence_factor = 1e3;         // residual growth over its minimum that means divergence
+  int stagnation_window = 50;  // iterations without residual decrease that mean stagnation
 };
 
 struct SolverOptions {
@@ -74,8 +72,5 @@ CaseDefinition read_case_file(const std::filesystem::path& path);
 /// definition. Throws InputError naming the case file, body, field and mesh file and listing
 /// the mesh's boundary names; a mesh reader error is rethrown with `context` prepended.
 BodyDefinition load_body(const BodyCase& body);
-
-/// The case's gap function, or null when the case has no [gap] table.
-std::unique_ptr<GapFunction> make_gap_function(const CaseDefinition& definition);
 
 }  // namespace robin

@@ -13,16 +13,26 @@ namespace {
 
 std::string type_name(const toml::node& node) {
   switch (node.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a floating-point number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    case toml::node_type::none: break;
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a floating-point number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::date:
+      return "a date";
+    case toml::node_type::time:
+      return "a time";
+    case toml::node_type::date_time:
+      return "a date-time";
+    case toml::node_type::none:
+      break;
   }
   return "nothing";
 }
@@ -41,12 +51,14 @@ std::string join_path(const std::string& path, std::string_view key) {
 
 }  // namespace
 
-int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
+int line_of(const toml::node& node) {
+  return static_cast<int>(node.source().begin.line);
+}
 
 std::string CaseContext::prefix(int line) const {
   std::string text = file;
-  if (line > 0) text += ":" + std::to_string(line);
-  if (!body.empty()) text += ": body '" + body + "'";
+  if (line > 0) text.append(":").append(std::to_string(line));
+  if (!body.empty()) text.append(": body '").append(body).append("'");
   return text;
 }
 
@@ -56,22 +68,28 @@ CheckedTable::CheckedTable(const toml::table& table, std::string path, CaseConte
   const toml::key* first_unknown = nullptr;
   for (const auto& [key, value] : table_) {
     if (std::find(allowed.begin(), allowed.end(), key.str()) != allowed.end()) continue;
-    if (first_unknown == nullptr ||
-        key.source().begin.line < first_unknown->source().begin.line) {
+    if (first_unknown == nullptr || key.source().begin.line < first_unknown->source().begin.line) {
       first_unknown = &key;
     }
   }
   if (first_unknown == nullptr) return;
   std::string message = context_.prefix(static_cast<int>(first_unknown->source().begin.line)) +
                         ": unknown key '" + join_path(path_, first_unknown->str()) + "'";
-  message += allowed.empty() ? " (this table takes no keys)"
-                             : " (expected one of: " + join(allowed) + ")";
+  message +=
+      allowed.empty() ? " (this table takes no keys)" : " (expected one of: " + join(allowed) + ")";
   throw InputError(message);
 }
 
-std::string CheckedTable::field(std::string_view key) const { return join_path(path_, key); }
+CheckedTable::CheckedTable(const toml::table& table, std::string path, CaseContext context)
+    : table_(table), path_(std::move(path)), context_(std::move(context)) {}
 
-int CheckedTable::line() const { return line_of(table_); }
+std::string CheckedTable::field(std::string_view key) const {
+  return join_path(path_, key);
+}
+
+int CheckedTable::line() const {
+  return line_of(table_);
+}
 
 int CheckedTable::line(std::string_view key) const {
   const toml::node* node = table_.get(key);
@@ -180,7 +198,8 @@ std::optional<Eigen::Vector2d> CheckedTable::optional_vector(std::string_view ke
 std::optional<Eigen::Matrix3d> CheckedTable::optional_matrix(std::string_view key) const {
   const toml::node* node = table_.get(key);
   if (node == nullptr) return std::nullopt;
-  const std::string shape = "expected three rows of three numbers [[a, b, c], [d, e, f], [g, h, i]]";
+  const std::string shape =
+      "expected three rows of three numbers [[a, b, c], [d, e, f], [g, h, i]]";
   const auto* rows = node->as_array();
   if (rows == nullptr || rows->size() != 3) fail(key, shape);
   Eigen::Matrix3d matrix;
@@ -200,7 +219,7 @@ std::map<std::string, double> CheckedTable::number_map(std::string_view key) con
   if (node == nullptr) return numbers;
   const auto* table = node->as_table();
   if (table == nullptr) fail_type(key, *node, "a table of numbers such as { R = 50.0 }");
-  const CheckedTable entries(*table, field(key), context_, {});
+  const CheckedTable entries(*table, field(key), context_);
   for (const auto& [name, value] : *table) {
     numbers[std::string(name.str())] = entries.checked_number(name.str(), value);
   }

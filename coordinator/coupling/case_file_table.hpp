@@ -8,13 +8,13 @@
 // is present inside a [[body]] table whose name is known, and FIELD is the full key path
 // ("body[2].dirichlet[1].boundary", 1-based indices).
 
+#include <toml++/toml.h>
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <toml++/toml.h>
 #include <vector>
 
 namespace robin {
@@ -42,6 +42,8 @@ class CheckedTable {
   /// unknown key that comes first in the file, naming its full path and the allowed keys.
   CheckedTable(const toml::table& table, std::string path, CaseContext context,
                std::vector<std::string> allowed);
+  /// A table whose keys are free names (not checked).
+  CheckedTable(const toml::table& table, std::string path, CaseContext context);
 
   const CaseContext& context() const { return context_; }
   /// Full path of `key` in the file ("solver.qp_tolerance"); the table's own path when empty.

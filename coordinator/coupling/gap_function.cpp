@@ -24,7 +24,9 @@ std::string describe_parser_error(const mu::Parser::exception_type& error,
                                   const std::string& expression) {
   std::ostringstream message;
   message << error.GetMsg();
-  if (error.GetPos() >= 0) {
+  if (error.GetMsg().find("position") != std::string::npos) {
+    message << " (in '" << expression << "')";
+  } else if (error.GetPos() >= 0) {
     message << " (position " << error.GetPos() << " of '" << expression << "'";
     if (!error.GetToken().empty()) message << ", token '" << error.GetToken() << "'";
     message << ")";

@@ -1,0 +1,198 @@
+#include "coupling/case_file.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include "coupling/case_file_body.hpp"
+#include "coupling/case_file_table.hpp"
+#include "coupling/gap_function.hpp"
+#include "numerics/errors.hpp"
+
+namespace robin {
+
+namespace {
+
+const std::vector<std::string> root_keys{"title", "gap", "solver", "coupling", "body"};
+const std::vector<std::string> gap_keys{"expression", "constants"};
+const std::vector<std::string> solver_keys{
+    "qp_tolerance", "qp_max_iterations", "interface_operator", "dense_limit", "pairing_tolerance"};
+const std::vector<std::string> coupling_keys{
+    "relaxation",      "tolerance",         "max_iterations",   "initial_obstacle",
+    "request_timeout", "divergence_factor", "stagnation_window"};
+
+toml::table parse_toml(const std::filesystem::path& path, const std::string& label) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    throw InputError(label + ": case file not found (resolved to '" +
+                     std::filesystem::absolute(path).lexically_normal().string() + "')");
+  }
+  try {
+    return toml::parse_file(path.string());
+  } catch (const toml::parse_error& parse_error) {
+    const auto& begin = parse_error.source().begin;
+    throw InputError(label + ":" + std::to_string(begin.line) + ":" + std::to_string(begin.column) +
+                     ": TOML syntax error: " + std::string(parse_error.description()));
+  }
+}
+
+/// The value of `key` when present, checked to be > lower; `fallback` when absent.
+double number_above(const CheckedTable& table, std::string_view key, double lower,
+                    double fallback) {
+  const auto value = table.optional_number(key);
+  if (!value) return fallback;
+  if (!(*value > lower)) {
+    table.fail(key, "must be > " + format_number(lower) + ", got " + format_number(*value));
+  }
+  return *value;
+}
+
+int integer_at_least(const CheckedTable& table, std::string_view key, int lower, int fallback) {
+  const auto value = table.optional_integer(key);
+  if (!value) return fallback;
+  if (*value < lower) {
+    table.fail(key, "must be >= " + std::to_string(lower) + ", got " + std::to_string(*value));
+  }
+  return *value;
+}
+
+bool is_valid_constant_name(const std::string& name) {
+  const auto is_word = [](unsigned char c) { return std::isalnum(c) != 0 || c == '_'; };
+  return !name.empty() && std::isdigit(static_cast<unsigned char>(name.front())) == 0 &&
+         std::all_of(name.begin(), name.end(), is_word);
+}
+
+void read_gap(const CheckedTable& root, CaseDefinition& definition) {
+  const auto table = root.optional_table("gap", gap_keys);
+  if (!table) return;
+  definition.gap_expression = table->string("expression");
+  definition.gap_constants = table->number_map("constants");
+  for (const auto& [name, value] : definition.gap_constants) {
+    if (!is_valid_constant_name(name)) {
+      table->fail("constants", "'" + name +
+                                   "' is not a valid constant name (a letter or '_', then "
+                                   "letters, digits or '_')");
+    }
+    if (name == "x" || name == "y") {
+      table->fail("constants", "'" + name + "' is a variable of the expression, not a constant");
+    }
+  }
+  definition.gap_context = table->location("expression") + ": " + table->field("expression");
+  // Parses and evaluates once: a bad expression is reported here, with its line.
+  const GapFunction validation(*definition.gap_expression, definition.gap_constants,
+                               definition.gap_context);
+}
+
+void read_solver(const CheckedTable& root, SolverOptions& solver) {
+  const auto table = root.optional_table("solver", solver_keys);
+  if (!table) return;
+  solver.qp.relative_tolerance =
+      number_above(*table, "qp_tolerance", 0.0, solver.qp.relative_tolerance);
+  solver.qp.max_iterations =
+      integer_at_least(*table, "qp_max_iterations", 1, solver.qp.max_iterations);
+  if (const auto kind = table->optional_choice("interface_operator", {"auto", "dense", "factor"})) {
+    solver.body.interface_operator = *kind == "auto"    ? InterfaceOperatorKind::automatic
+                                     : *kind == "dense" ? InterfaceOperatorKind::dense
+                                                        : InterfaceOperatorKind::factor;
+  }
+  solver.body.dense_limit = integer_at_least(*table, "dense_limit", 0, solver.body.dense_limit);
+  solver.pairing_tolerance =
+      number_above(*table, "pairing_tolerance", 0.0, solver.pairing_tolerance);
+}
+
+void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
+  const auto table = root.optional_table("coupling", coupling_keys);
+  if (!table) return;
+  coupling.relaxation = table->optional_number("relaxation").value_or(coupling.relaxation);
+  if (!(coupling.relaxation > 0.0 && coupling.relaxation < 2.0)) {
+    table->fail("relaxation", "must be in (0, 2), got " + format_number(coupling.relaxation));
+  }
+  coupling.tolerance = number_above(*table, "tolerance", 0.0, coupling.tolerance);
+  coupling.max_iterations = integer_at_least(*table, "max_iterations", 1, coupling.max_iterations);
+  coupling.initial_obstacle = table->optional_choice("initial_obstacle", {"gap", "zero"})
+                                  .value_or(coupling.initial_obstacle);
+  coupling.request_timeout_seconds =
+      number_above(*table, "request_timeout", 0.0, coupling.request_timeout_seconds);
+  coupling.divergence_factor =
+      number_above(*table, "divergence_factor", 1.0, coupling.divergence_factor);
+  coupling.stagnation_window =
+      integer_at_least(*table, "stagnation_window", 1, coupling.stagnation_window);
+}
+
+void read_bodies(const CheckedTable& root, const std::filesystem::path& directory,
+                 CaseDefinition& definition) {
+  const std::vector<TableEntry> entries = root.array_of_tables("body");
+  if (entries.size() != 2) {
+    const int line = entries.size() > 2      ? line_of(*entries[2].table)
+                     : root.contains("body") ? root.line("body")
+                                             : 0;
+    throw InputError(CaseContext{root.context().file, ""}.prefix(line) +
+                     ": expected exactly two [[body]] tables, found " +
+                     std::to_string(entries.size()));
+  }
+  for (std::size_t index = 0; index < 2; ++index) {
+    definition.bodies[index] = read_body_case(entries[index], root.context(), directory);
+  }
+  if (definition.bodies[0].definition.name == definition.bodies[1].definition.name) {
+    const CaseContext second{root.context().file, definition.bodies[1].definition.name};
+    throw InputError(second.prefix(line_of(*(*entries[1].table).get("name"))) +
+                     ": body[2].name: duplicates the name of body[1]; body names must differ");
+  }
+}
+
+std::string join_boundary_names(const Mesh& mesh) {
+  std::string names;
+  for (const auto& [name, group] : mesh.boundaries) names += (names.empty() ? "" : ", ") + name;
+  return names.empty() ? "none: the mesh has no physical curves" : names;
+}
+
+std::vector<BoundaryReference> references_of(const BodyDefinition& definition) {
+  std::vector<BoundaryReference> references{{definition.contact_boundary, "contact_boundary", ""}};
+  for (std::size_t i = 0; i < definition.dirichlet.size(); ++i) {
+    references.push_back({definition.dirichlet[i].boundary,
+                          "dirichlet[" + std::to_string(i + 1) + "].boundary", ""});
+  }
+  for (std::size_t i = 0; i < definition.tractions.size(); ++i) {
+    references.push_back(
+        {definition.tractions[i].boundary, "traction[" + std::to_string(i + 1) + "].boundary", ""});
+  }
+  return references;
+}
+
+}  // namespace
+
+CaseDefinition read_case_file(const std::filesystem::path& path) {
+  const std::string label = path.string();
+  const toml::table document = parse_toml(path, label);
+  const CheckedTable root(document, "", CaseContext{label, ""}, root_keys);
+  CaseDefinition definition;
+  definition.file = path;
+  definition.title = root.optional_string("title").value_or(path.stem().string());
+  read_gap(root, definition);
+  read_solver(root, definition.solver);
+  read_coupling(root, definition.coupling);
+  read_bodies(root, path.parent_path(), definition);
+  return definition;
+}
+
+BodyDefinition load_body(const BodyCase& body) {
+  BodyDefinition definition = body.definition;
+  try {
+    definition.mesh = read_gmsh_mesh(body.mesh_path, body.mesh_options);
+  } catch (const InputError& error) {
+    throw InputError(body.context + ": mesh: " + error.what());
+  }
+  const std::vector<BoundaryReference> references =
+      body.boundary_references.empty() ? references_of(definition) : body.boundary_references;
+  for (const BoundaryReference& reference : references) {
+    if (definition.mesh.boundaries.count(reference.name) != 0) continue;
+    const std::string where = reference.location.empty()
+                                  ? body.context
+                                  : reference.location + ": body '" + definition.name + "'";
+    throw InputError(where + ": " + reference.field + ": boundary '" + reference.name +
+                     "' is not a physical curve of mesh '" + body.mesh_path.string() +
+                     "' (available: " + join_boundary_names(definition.mesh) + ")");
+  }
+  return definition;
+}
+
+}  // namespace robin

@@ -1,0 +1,182 @@
+#include "coupling/case_file_body.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <sstream>
+
+#include "numerics/errors.hpp"
+
+namespace robin {
+
+namespace {
+
+const std::vector<std::string> body_keys{"name",       "mesh",      "mesh_size", "element_order",
+                                         "recombine",  "model",     "material",  "contact_boundary",
+                                         "body_force", "dirichlet", "traction"};
+const std::vector<std::string> material_keys{"young", "poisson", "voigt"};
+const std::vector<std::string> dirichlet_keys{"boundary", "x", "y", "fix"};
+const std::vector<std::string> traction_keys{"boundary", "vector", "pressure"};
+
+bool is_valid_body_name(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+    return std::isalnum(c) != 0 || c == '_' || c == '-';
+  });
+}
+
+/// "FILE:LINE" of `key` in `table`, without the body part.
+std::string file_location(const CheckedTable& table, std::string_view key) {
+  return CaseContext{table.context().file, ""}.prefix(table.line(key));
+}
+
+/// A non-empty boundary name, recorded for the check against the mesh in load_body.
+std::string read_boundary_name(const CheckedTable& table, std::string_view key,
+                               std::vector<BoundaryReference>& references) {
+  std::string name = table.string(key);
+  if (name.empty()) table.fail(key, "the boundary name is empty");
+  references.push_back({name, table.field(key), file_location(table, key)});
+  return name;
+}
+
+std::string lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+void read_mesh(const CheckedTable& table, const std::filesystem::path& directory, BodyCase& body) {
+  const std::string mesh = table.string("mesh");
+  if (mesh.empty()) table.fail("mesh", "the mesh file name is empty");
+  std::filesystem::path path(mesh);
+  if (path.is_relative()) path = directory / path;
+  body.mesh_path = std::filesystem::absolute(path).lexically_normal();
+  const std::string extension = lowercase(body.mesh_path.extension().string());
+  if (extension != ".msh" && extension != ".geo") {
+    table.fail("mesh", "'" + mesh + "' is neither a .msh nor a .geo file");
+  }
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(body.mesh_path, error)) {
+    table.fail("mesh", "mesh file '" + body.mesh_path.string() + "' does not exist");
+  }
+  for (const char* key : {"mesh_size", "element_order", "recombine"}) {
+    if (extension == ".msh" && table.contains(key)) {
+      table.fail(key, "applies only to a .geo mesh; '" + mesh + "' is already meshed");
+    }
+  }
+  if (auto size = table.optional_number("mesh_size")) {
+    if (*size <= 0.0) table.fail("mesh_size", "must be > 0, got " + format_number(*size));
+    body.mesh_options.size = *size;
+  }
+  if (auto order = table.optional_integer("element_order")) {
+    if (*order != 1 && *order != 2) {
+      table.fail("element_order", "must be 1 or 2, got " + std::to_string(*order));
+    }
+    body.mesh_options.element_order = *order;
+  }
+  body.mesh_options.recombine = table.optional_boolean("recombine").value_or(false);
+}
+
+/// young + poisson, or voigt; the material functions check the values.
+Material read_material(const CheckedTable& body, PlaneModel model) {
+  const CheckedTable table = body.table("material", material_keys);
+  const bool has_young = table.contains("young");
+  const bool has_poisson = table.contains("poisson");
+  const bool has_voigt = table.contains("voigt");
+  if (has_voigt && (has_young || has_poisson)) {
+    table.fail(has_young ? "young" : "poisson",
+               "give either young and poisson, or voigt, not both");
+  }
+  if (!has_voigt && !has_young && !has_poisson) {
+    table.fail("", "give either young and poisson (isotropic), or voigt (3x3 stiffness)");
+  }
+  const std::string context = table.context().prefix(table.line()) + ": material";
+  if (has_voigt) return make_voigt_material(*table.optional_matrix("voigt"), model, context);
+  if (!has_poisson) table.fail("poisson", "missing: young needs poisson");
+  if (!has_young) table.fail("young", "missing: poisson needs young");
+  return make_isotropic_material(table.number("young"), table.number("poisson"), model, context);
+}
+
+DirichletCondition read_dirichlet(const CheckedTable& table,
+                                  std::vector<BoundaryReference>& references) {
+  DirichletCondition condition;
+  condition.boundary = read_boundary_name(table, "boundary", references);
+  condition.x = table.optional_number("x");
+  condition.y = table.optional_number("y");
+  if (auto fix = table.optional_choice("fix", {"both", "x", "y"})) {
+    for (const std::string component : {"x", "y"}) {
+      if (*fix != "both" && *fix != component) continue;
+      std::optional<double>& value = component == "x" ? condition.x : condition.y;
+      if (value) {
+        table.fail("fix", "fix = \"" + *fix + "\" sets u_" + component +
+                              " = 0 and cannot be combined with " + component + " = " +
+                              format_number(*value));
+      }
+      value = 0.0;
+    }
+  }
+  if (!condition.x && !condition.y) {
+    table.fail("", "prescribes nothing: give x and/or y, or fix = \"both\" | \"x\" | \"y\"");
+  }
+  return condition;
+}
+
+TractionCondition read_traction(const CheckedTable& table,
+                                std::vector<BoundaryReference>& references) {
+  TractionCondition condition;
+  condition.boundary = read_boundary_name(table, "boundary", references);
+  const auto vector = table.optional_vector("vector");
+  const auto pressure = table.optional_number("pressure");
+  if (vector && pressure) table.fail("pressure", "give either vector or pressure, not both");
+  if (!vector && !pressure) table.fail("", "give either vector = [tx, ty] or pressure = p");
+  condition.is_pressure = pressure.has_value();
+  if (vector) condition.vector = *vector;
+  if (pressure) condition.pressure = *pressure;
+  return condition;
+}
+
+PlaneModel read_model(const CheckedTable& table) {
+  const auto model = table.optional_choice("model", {"plane_strain", "plane_stress"});
+  if (!model) table.fail("model", "missing required key (\"plane_strain\" or \"plane_stress\")");
+  return *model == "plane_strain" ? PlaneModel::plane_strain : PlaneModel::plane_stress;
+}
+
+}  // namespace
+
+std::string format_number(double value) {
+  std::ostringstream text;
+  text.precision(12);
+  text << value;
+  return text.str();
+}
+
+BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
+                        const std::filesystem::path& directory) {
+  // The name goes into every later message, so it is looked at before the keys are checked.
+  const auto name_node = (*entry.table)["name"].value<std::string>();
+  CaseContext context{file.file, name_node.value_or("")};
+  const CheckedTable table(*entry.table, entry.path, context, body_keys);
+  BodyCase body;
+  BodyDefinition& definition = body.definition;
+  definition.name = table.string("name");
+  if (!is_valid_body_name(definition.name)) {
+    table.fail("name", "'" + definition.name +
+                           "' is not a valid body name (letters, digits, '_' and '-' only)");
+  }
+  body.context = file.file + ": body '" + definition.name + "'";
+  read_mesh(table, directory, body);
+  const PlaneModel model = read_model(table);
+  definition.contact_boundary =
+      read_boundary_name(table, "contact_boundary", body.boundary_references);
+  definition.body_force = table.optional_vector("body_force").value_or(Eigen::Vector2d::Zero());
+  definition.material = read_material(table, model);
+  for (const TableEntry& item : table.array_of_tables("dirichlet")) {
+    const CheckedTable condition(*item.table, item.path, context, dirichlet_keys);
+    definition.dirichlet.push_back(read_dirichlet(condition, body.boundary_references));
+  }
+  for (const TableEntry& item : table.array_of_tables("traction")) {
+    const CheckedTable condition(*item.table, item.path, context, traction_keys);
+    definition.tractions.push_back(read_traction(condition, body.boundary_references));
+  }
+  return body;
+}
+
+}  // namespace robin
