@@ -1,9 +1,11 @@
 // robin-subdomain: serves one elastic body of a robin-contact run over ZeroMQ
-// (proto/robin.proto). Prints "listening on ENDPOINT" on stdout once bound; logs go to stderr.
+// (proto/robin.proto). Prints exactly one line on stdout, "listening on ENDPOINT", once bound
+// (wildcards and ephemeral ports resolved); logs go to stderr.
 // Exit codes: 0 after Shutdown, SIGINT or SIGTERM; 1 when the endpoint cannot be bound or the
 // transport fails; CLI11's codes for bad command lines.
 
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
@@ -72,6 +74,9 @@ int main(int argc, char** argv) {
     const std::string reason = robin::run_server_loop(
         server, command_line.loop, stop_requested, [](const std::string& endpoint) {
           std::cout << "listening on " << endpoint << std::endl;  // the launcher reads this line
+          // Nothing else goes to stdout: stray library output joins the logs on stderr, so a
+          // launcher that stops reading the pipe can never block the server.
+          dup2(STDERR_FILENO, STDOUT_FILENO);
         });
     logger->info("stopped: {}", reason);
     return 0;

@@ -89,7 +89,7 @@ Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& va
 /// The assignment of an AssignContact request, checked against the body's contact boundary:
 /// as many normals as nodes, known and distinct node ids, unit normals (to 1e-8).
 ContactAssignment checked_assignment(const protocol::AssignContact& message,
-                                     const std::vector<int>& interface_nodes,
+                                     const std::vector<int>& interface_nodes, const Mesh& mesh,
                                      const std::string& body_name) {
   const auto invalid = [&](const std::string& problem) {
     return RequestError(protocol::INVALID_ARGUMENT,
@@ -108,18 +108,30 @@ ContactAssignment checked_assignment(const protocol::AssignContact& message,
       throw invalid("node id " + std::to_string(id) +
                     " is not a node of the contact boundary (see InterfaceDescription.node_ids)");
     }
-    if (used[found - interface_nodes.begin()]) {
-      throw invalid("node id " + std::to_string(id) + " is assigned twice");
-    }
+    const std::string node =
+        "node id " + std::to_string(id) + " (tag " + std::to_string(mesh.node_tags[*found]) + ")";
+    if (used[found - interface_nodes.begin()]) throw invalid(node + " is assigned twice");
     used[found - interface_nodes.begin()] = true;
     const Eigen::Vector2d normal(message.normals(2 * i), message.normals(2 * i + 1));
     if (!std::isfinite(normal.norm()) || std::abs(normal.norm() - 1.0) > 1e-8) {
-      throw invalid("the normal of node id " + std::to_string(id) + " is not a unit vector");
+      throw invalid("the normal of " + node + " is not a unit vector");
     }
     assignment.node_ids.push_back(*found);
     assignment.normals.push_back(normal);
   }
   return assignment;
+}
+
+/// Writes <directory>/<body>.vtu (creating the directory); returns the path written. An
+/// unusable directory is an INVALID_ARGUMENT.
+std::string write_fields_file(const std::filesystem::path& directory, const BodyOutput& output) {
+  try {
+    return (directory / write_body_output(directory, output)).string();
+  } catch (const std::exception& error) {
+    throw RequestError(protocol::INVALID_ARGUMENT,
+                       "FieldsRequest.write_directory: cannot write the fields of body '" +
+                           output.body_name + "' to '" + directory.string() + "': " + error.what());
+  }
 }
 
 void set_error(protocol::Envelope& reply, protocol::ErrorCode code, const std::string& message,
@@ -323,7 +335,7 @@ void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
                                         protocol::Envelope& reply) {
   require_state(ServerState::awaiting_assignment, "AssignContact");
   const ContactAssignment assignment =
-      checked_assignment(request.assign_contact(), interface_nodes_, body_->name());
+      checked_assignment(request.assign_contact(), interface_nodes_, body_->mesh(), body_->name());
   state_ = ServerState::awaiting_assignment;  // until the body accepted the assignment
   body_->assign_contact(assignment);
   state_ = ServerState::ready;
@@ -364,17 +376,12 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   require_state(ServerState::ready, "FieldsRequest");
   const Eigen::VectorXd contact_force = checked_vector(
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
-  const std::filesystem::path directory = message.write_directory();
-  std::error_code error;
-  if (!directory.empty() && !std::filesystem::is_directory(directory, error)) {
-    throw RequestError(protocol::INVALID_ARGUMENT,
-                       "FieldsRequest.write_directory '" + directory.string() +
-                           "' is not a directory on the server (body '" + body_->name() + "')");
-  }
   const BodyOutput output = make_body_output(*body_, contact_force);
   protocol::FieldsReply& fields = *reply.mutable_fields_reply();
   encode_fields(output, fields);
-  if (!directory.empty()) fields.set_written_file(write_body_output(directory, output));
+  if (!message.write_directory().empty()) {
+    fields.set_written_file(write_fields_file(message.write_directory(), output));
+  }
 }
 
 void SubdomainServer::acknowledge(protocol::Envelope& reply) const {

@@ -19,7 +19,7 @@
 //   VERSION_MISMATCH   the request's major version differs from ours (both are named)
 //   WRONG_STATE        the request is not accepted in the current state
 //   INVALID_ARGUMENT   wrong sizes, unknown or repeated node ids, non-unit normals, non-finite
-//                      values, a write_directory that is not a directory
+//                      values, a write_directory where the fields cannot be written
 //   BAD_INPUT          the body definition is unusable (robin::InputError while setting up)
 //   SINGULAR_BODY      the Dirichlet conditions leave a rigid motion free (SingularBodyError)
 //   UNSUPPORTED        a reply type sent as a request, or a request unknown to this version
