@@ -73,6 +73,12 @@ void read_mesh(const CheckedTable& table, const std::filesystem::path& directory
     body.mesh_options.element_order = *order;
   }
   body.mesh_options.recombine = table.optional_boolean("recombine").value_or(false);
+  if (body.mesh_options.recombine && body.mesh_options.element_order == 2) {
+    // Mesh (numerics/mesh.hpp) has no quadratic quadrilaterals.
+    table.fail("recombine",
+               "recombine = true with element_order = 2 gives quadratic quadrilaterals, which are "
+               "not supported: use element_order = 1 or recombine = false");
+  }
 }
 
 /// young + poisson, or voigt; the material functions check the values.
