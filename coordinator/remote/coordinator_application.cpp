@@ -1,0 +1,193 @@
+#include "remote/coordinator_application.hpp"
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "coupling/coupled_run.hpp"
+#include "numerics/errors.hpp"
+#include "remote/remote_port.hpp"
+#include "remote/run_interruption.hpp"
+
+namespace robin {
+
+namespace {
+
+const char* const exit_code_footer =
+    "Exit codes: 0 converged; 3 iteration limit reached; 4 diverged; 5 stagnated (results are "
+    "written in these cases); 1 bad input or a server failure; 2 bad command line; 130/143 "
+    "stopped by SIGINT/SIGTERM.";
+
+/// Accepts numbers strictly between `low` and `high` (the case file's ranges).
+CLI::Validator open_interval(double low, double high) {
+  return CLI::Validator(
+      [low, high](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+        if (value > low && value < high) return "";
+        return "must be in (" + fmt::format("{}", low) + ", " + fmt::format("{}", high) +
+               "), got " + text;
+      },
+      "in (" + fmt::format("{}", low) + ", " + fmt::format("{}", high) + ")");
+}
+
+std::shared_ptr<spdlog::logger> coordinator_logger() {
+  auto log = spdlog::get("coordinator");
+  return log ? log : make_coordinator_logger("info");
+}
+
+RunObserver make_observer(const std::shared_ptr<spdlog::logger>& log) {
+  RunObserver observer;
+  observer.stage = [log](const std::string& text) { log->info("{}", text); };
+  observer.iteration = [log](const IterationRecord& record) {
+    log->info("{}", progress_line(record));
+    throw_if_stop_requested();
+  };
+  return observer;
+}
+
+/// Logs how the run ended and where the results are; returns the exit code of its status.
+int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& settings,
+                   spdlog::logger& log) {
+  const RobinResult& iteration = result.iteration;
+  const double largest = iteration.history.empty() ? 0.0 : iteration.history.back().largest();
+  const std::string outcome = to_string(iteration.status) + " after " +
+                              std::to_string(iteration.history.size()) +
+                              " iterations (largest residual " + fmt::format("{:.2e}", largest) +
+                              ")" + (iteration.message.empty() ? "" : ": " + iteration.message);
+  const int code = exit_code(iteration.status);
+  if (code == 0) {
+    log.info("{}", outcome);
+  } else {
+    log.warn("{}", outcome);
+  }
+  double compute = 0.0, round_trip = 0.0;
+  for (const PortTimings& timings : result.port_timings) {
+    compute += timings.compute_seconds;
+    round_trip += timings.round_trip_seconds;
+  }
+  log.info(
+      "wall time {:.3f} s (setup {:.3f} s, iteration {:.3f} s); server compute {:.3f} s, "
+      "messaging {:.3f} s",
+      result.total_seconds, result.setup_seconds, iteration.wall_seconds, compute,
+      round_trip - compute);
+  log.info("results in {} (open solution.pvd in ParaView)", settings.output_directory.string());
+  return code;
+}
+
+}  // namespace
+
+void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
+  app.add_option("case", settings.case_file, "case file (TOML, see docs/case-format.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--output,-o", settings.output_directory, "directory for the result files")
+      ->required();
+  app.add_option("--relaxation", settings.relaxation,
+                 "relaxation delta of the obstacle update, in (0, 2)")
+      ->check(open_interval(0.0, 2.0));
+  app.add_option("--tolerance", settings.tolerance, "tolerance on every scaled residual")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-iterations", settings.max_iterations, "iteration limit")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--initial-obstacle", settings.initial_obstacle,
+                 "initial obstacles: 'gap' (g0 = d) or 'zero' (g0 = 0)")
+      ->check(CLI::IsMember({"gap", "zero"}));
+  app.add_option("--timeout", settings.timeout_seconds,
+                 "deadline of each request to a server, in seconds")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--log-level", settings.log_level, "trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.footer(exit_code_footer);
+}
+
+std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv) {
+  try {
+    app.parse(argc, argv);
+    return std::nullopt;
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error) == 0 ? 0 : 2;
+  }
+}
+
+CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
+                                        const CoordinatorSettings& settings) {
+  CouplingOptions options = from_case;
+  if (settings.relaxation) options.relaxation = *settings.relaxation;
+  if (settings.tolerance) options.tolerance = *settings.tolerance;
+  if (settings.max_iterations) options.max_iterations = *settings.max_iterations;
+  if (settings.initial_obstacle) options.initial_obstacle = *settings.initial_obstacle;
+  if (settings.timeout_seconds) options.request_timeout_seconds = *settings.timeout_seconds;
+  return options;
+}
+
+std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level) {
+  spdlog::drop("coordinator");
+  auto log = spdlog::stderr_color_mt("coordinator");
+  log->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%^%l%$] %v");
+  const auto parsed = spdlog::level::from_str(level);
+  if (parsed == spdlog::level::off && level != "off") {
+    throw std::invalid_argument("unknown log level '" + level + "'");
+  }
+  log->set_level(parsed);
+  spdlog::set_default_logger(log);
+  return log;
+}
+
+std::string progress_line(const IterationRecord& record) {
+  return fmt::format(
+      "iteration {}: obstacle change {:.2e}, penetration {:.2e}, force balance {:.2e}, "
+      "complementarity {:.2e}, correction {:.2e}; active {}/{}, QP iterations {}/{}, {:.3f} s",
+      record.iteration, record.obstacle_change, record.penetration, record.force_balance,
+      record.complementarity, record.correction, record.active1, record.active2,
+      record.qp_iterations1, record.qp_iterations2, record.seconds);
+}
+
+std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {
+  try {
+    return read_case_file(settings.case_file);
+  } catch (const InputError& error) {
+    coordinator_logger()->error("{}", error.what());
+    return std::nullopt;
+  }
+}
+
+int failure_exit_code(const std::exception& error) {
+  auto log = coordinator_logger();
+  if (const int signal_number = stop_signal(); signal_number != 0) {
+    log->warn("{}", RunInterrupted(signal_number).what());
+    return interrupted_exit_code(signal_number);
+  }
+  log->error("{}", error.what());
+  return 1;
+}
+
+int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
+                    const std::array<std::string, 2>& endpoints,
+                    const std::array<ChannelOptions, 2>& channels) {
+  auto log = coordinator_logger();
+  const CouplingOptions options = merged_coupling_options(definition.coupling, settings);
+  std::array<std::unique_ptr<RemotePort>, 2> ports;
+  int code = 1;
+  try {
+    for (int alpha = 0; alpha < 2; ++alpha) {
+      RemotePortOptions port_options;
+      port_options.request_timeout_seconds = options.request_timeout_seconds;
+      port_options.channel = channels[alpha];
+      const std::string& body = definition.bodies[alpha].definition.name;
+      ports[alpha] = std::make_unique<RemotePort>(endpoints[alpha], body, port_options);
+      log->info("body {} '{}' on server {}", alpha + 1, body, endpoints[alpha]);
+    }
+    const CoupledRunResult result =
+        run_coupled_case(definition, {ports[0].get(), ports[1].get()}, options, make_observer(log));
+    write_coupled_outputs(settings.output_directory, definition, result);
+    code = report_outcome(result, settings, *log);
+  } catch (const std::exception& error) {
+    code = failure_exit_code(error);
+  }
+  for (auto& port : ports) {
+    if (port) port->end_run();
+  }
+  return code;
+}
+
+}  // namespace robin

@@ -1,0 +1,74 @@
+#pragma once
+// The coordinator application shared by robin-coordinator (servers given by endpoint) and
+// robin-run (servers started locally): command-line options, the "coordinator" logger,
+// progress lines, the coupled run on two RemotePorts, the result files and the exit code.
+//
+// Exit codes: 0 converged; 3 iteration limit reached; 4 diverged; 5 stagnated (the result
+// files are written in these four cases); 1 bad input, a server failure or any other error
+// (the message is logged); 2 bad command line; 128 + signal when stopped by SIGINT (130) or
+// SIGTERM (143).
+
+#include <CLI/CLI.hpp>
+#include <array>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "coupling/case_file.hpp"
+#include "coupling/robin_iteration.hpp"
+#include "remote/request_channel.hpp"
+
+namespace spdlog {
+class logger;
+}
+
+namespace robin {
+
+/// The command line shared by both executables. Unset options keep the case file's values.
+struct CoordinatorSettings {
+  std::filesystem::path case_file;
+  std::filesystem::path output_directory;
+  std::optional<double> relaxation;
+  std::optional<double> tolerance;
+  std::optional<int> max_iterations;
+  std::optional<std::string> initial_obstacle;  // "gap" or "zero"
+  std::optional<double> timeout_seconds;        // deadline of each request to a server
+  std::string log_level = "info";
+};
+
+/// Adds CASE, --output, --relaxation, --tolerance, --max-iterations, --initial-obstacle,
+/// --timeout and --log-level to `app`, and the exit codes to its footer.
+void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings);
+
+/// Parses the command line; nullopt to go on, otherwise the exit code (0 after --help, 2 for
+/// a bad command line, the message printed).
+std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv);
+
+/// The case's [coupling] options with the command-line overrides applied.
+CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
+                                        const CoordinatorSettings& settings);
+
+/// Creates the logger "coordinator" (standard error, timestamps, `level`) and makes it the
+/// default logger. Throws std::invalid_argument for an unknown level.
+std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level);
+
+/// One line per iteration: the residuals (%.2e), the active set sizes, QP iterations, seconds.
+std::string progress_line(const IterationRecord& record);
+
+/// Reads the case file; logs the InputError and returns nullopt when it is unusable.
+std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings);
+
+/// Runs the case against the servers at `endpoints` (the first gets body 1), writes the result
+/// files into the output directory and returns the exit code (see the file comment). The
+/// servers' runs are always ended. `channels[i]` sets the transport and the waiting hooks of
+/// port i; the iteration also stops between iterations on a stop signal.
+int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
+                    const std::array<std::string, 2>& endpoints,
+                    const std::array<ChannelOptions, 2>& channels = {});
+
+/// Logs a failure and returns its exit code: 128 + signal once a stop signal was received
+/// (whatever exception the interruption surfaced as), 1 otherwise.
+int failure_exit_code(const std::exception& error);
+
+}  // namespace robin

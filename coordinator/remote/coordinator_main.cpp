@@ -1,0 +1,36 @@
+// robin-coordinator CASE --subdomain ENDPOINT --subdomain ENDPOINT --output DIR [options]
+// Runs the Robin domain decomposition of a case on two running robin-subdomain servers; the
+// first --subdomain serves body 1, the second body 2. Exit codes: coordinator_application.hpp.
+
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "remote/coordinator_application.hpp"
+#include "remote/run_interruption.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "robin-coordinator: Robin domain decomposition of a two-body contact case on two "
+      "robin-subdomain servers"};
+  robin::CoordinatorSettings settings;
+  std::vector<std::string> subdomains;
+  robin::add_coordinator_options(app, settings);
+  app.add_option("--subdomain", subdomains,
+                 "endpoint of a robin-subdomain server (e.g. tcp://host:5555); give it twice, "
+                 "the first serves body 1")
+      ->required()
+      ->allow_extra_args(false);  // one endpoint per --subdomain; the count is checked below
+  if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
+  if (subdomains.size() != 2) {
+    std::cerr << "robin-coordinator: give exactly two --subdomain ENDPOINT options (the first "
+                 "serves body 1, the second body 2); got "
+              << subdomains.size() << "\nRun with --help for more information.\n";
+    return 2;
+  }
+  robin::make_coordinator_logger(settings.log_level);
+  robin::install_stop_signal_handlers();
+  const auto definition = robin::load_case(settings);
+  if (!definition) return 1;
+  return robin::run_coordinator(*definition, settings, {subdomains[0], subdomains[1]});
+}

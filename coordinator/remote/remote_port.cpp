@@ -1,0 +1,264 @@
+#include "remote/remote_port.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "protocol_version.hpp"
+#include "remote/reply_decoding.hpp"
+#include "remote/setup_encoding.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+
+namespace {
+
+using protocol::Envelope;
+
+const std::vector<std::string> required_capabilities{"contact_solve", "correction_solve", "fields"};
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string content_name(int content_case) {
+  const auto* field = Envelope::descriptor()->FindFieldByNumber(content_case);
+  return field != nullptr ? field->name() : "no content";
+}
+
+std::string version_text(unsigned major, unsigned minor) {
+  return std::to_string(major) + "." + std::to_string(minor);
+}
+
+std::string join(const google::protobuf::RepeatedPtrField<std::string>& items) {
+  std::string text;
+  for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;
+  return text.empty() ? "nothing" : text;
+}
+
+template <typename Values>
+void append(const Eigen::VectorXd& vector, Values& values) {
+  values.Add(vector.data(), vector.data() + vector.size());
+}
+
+}  // namespace
+
+struct RemotePort::Pending {
+  std::uint64_t request_id = 0;
+  std::string step;
+  Deadline deadline;
+  Clock::time_point sent;
+};
+
+RemotePort::RemotePort(std::string endpoint, std::string body_label, RemotePortOptions options)
+    : endpoint_(std::move(endpoint)), body_label_(std::move(body_label)), options_(options) {
+  try {
+    channel_ = std::make_unique<RequestChannel>(endpoint_, options_.channel);
+  } catch (const ChannelFailure& failure) {
+    fail("connect", failure.what());
+  }
+}
+
+RemotePort::~RemotePort() = default;
+
+std::string RemotePort::describe() const {
+  return "server " + endpoint_ + " (body '" + body_label_ + "')";
+}
+
+void RemotePort::fail(const std::string& step, const std::string& problem) const {
+  throw PortError(describe() + ", step " + step + ": " + problem);
+}
+
+void RemotePort::update_byte_counts() {
+  timings_.bytes_sent = channel_->bytes_sent();
+  timings_.bytes_received = channel_->bytes_received();
+}
+
+void RemotePort::send_request(Envelope& request, const std::string& step, double timeout_seconds) {
+  if (pending_) fail(step, "the previous request ('" + pending_->step + "') is still in flight");
+  const Deadline deadline = Deadline::after(timeout_seconds);
+  const auto sent = Clock::now();
+  std::uint64_t request_id = 0;
+  try {
+    request_id = channel_->send(request, deadline);
+  } catch (const ChannelFailure& failure) {
+    fail(step, failure.what());
+  }
+  update_byte_counts();
+  pending_ = std::make_unique<Pending>(Pending{request_id, step, deadline, sent});
+}
+
+/// The reply to the pending request, checked: protocol version, Error replies, content kind.
+Envelope RemotePort::finish_request(int expected_content) {
+  if (!pending_) fail("reply", "no request in flight");
+  const Pending pending = *pending_;
+  pending_.reset();
+  Envelope reply;
+  try {
+    reply = channel_->receive(pending.request_id, pending.deadline);
+  } catch (const ChannelFailure& failure) {
+    fail(pending.step, failure.what());
+  }
+  update_byte_counts();
+  if (reply.version().major() != protocol::protocol_major) {
+    fail(pending.step, "the server speaks protocol " +
+                           version_text(reply.version().major(), reply.version().minor()) +
+                           ", this coordinator speaks " +
+                           version_text(protocol::protocol_major, protocol::protocol_minor) +
+                           "; use matching versions of robin-subdomain and the coordinator");
+  }
+  if (reply.has_error()) {
+    fail(pending.step, "server error " + protocol::ErrorCode_Name(reply.error().code()) + ": " +
+                           reply.error().message());
+  }
+  if (reply.content_case() != expected_content) {
+    fail(pending.step, "unexpected reply '" + content_name(reply.content_case()) + "' (expected '" +
+                           content_name(expected_content) + "')");
+  }
+  timings_.round_trip_seconds += seconds_since(pending.sent);
+  return reply;
+}
+
+Envelope RemotePort::exchange(Envelope& request, const std::string& step, double timeout_seconds,
+                              int expected_content) {
+  send_request(request, step, timeout_seconds);
+  return finish_request(expected_content);
+}
+
+void RemotePort::handshake() {
+  Envelope request;
+  request.mutable_hello()->set_client_name(
+      "robin-coordinator (protocol " +
+      version_text(protocol::protocol_major, protocol::protocol_minor) + ")");
+  request.mutable_hello()->add_capabilities("fields");
+  const double timeout =
+      std::min(options_.request_timeout_seconds, options_.handshake_timeout_limit);
+  const Envelope reply = exchange(request, "handshake", timeout, Envelope::kHelloReply);
+  const protocol::HelloReply& hello = reply.hello_reply();
+  for (const std::string& capability : required_capabilities) {
+    const auto& offered = hello.capabilities();
+    if (std::find(offered.begin(), offered.end(), capability) == offered.end()) {
+      fail("handshake",
+           "the server does not offer '" + capability + "' (it offers " + join(offered) + ")");
+    }
+  }
+  server_name_ = hello.server_name();
+  spdlog::debug("{}: {} (state {})", describe(), server_name_, hello.state());
+}
+
+InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions& solver) {
+  body_label_ = body.definition.name;
+  if (server_name_.empty()) handshake();
+  Envelope request;
+  *request.mutable_setup_body() = encode_setup_body(body, solver);
+  const Envelope reply =
+      exchange(request, "setup", options_.request_timeout_seconds, Envelope::kInterface);
+  timings_.compute_seconds += reply.interface().setup_seconds();
+  try {
+    InterfaceDescription interface = decode_interface(reply.interface());
+    contact_size_ = 0;
+    set_up_ = true;
+    return interface;
+  } catch (const MalformedReply& malformed) {
+    fail("setup", std::string("malformed reply: ") + malformed.what());
+  }
+}
+
+void RemotePort::assign_contact(const ContactAssignment& assignment) {
+  Envelope request;
+  *request.mutable_assign_contact() = encode_contact_assignment(assignment);
+  exchange(request, "contact assignment", options_.request_timeout_seconds, Envelope::kAcknowledge);
+  contact_size_ = static_cast<long>(assignment.node_ids.size());
+}
+
+void RemotePort::start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) {
+  Envelope request;
+  protocol::ContactSolveRequest& solve = *request.mutable_contact_solve();
+  solve.set_iteration(static_cast<std::uint32_t>(iteration));
+  append(obstacle, *solve.mutable_obstacle());
+  send_request(request, "contact solve (iteration " + std::to_string(iteration) + ")",
+               options_.request_timeout_seconds);
+}
+
+ContactSolveResult RemotePort::finish_contact_solve() {
+  const std::string step = pending_ ? pending_->step : "contact solve";
+  const Envelope reply = finish_request(Envelope::kContactResult);
+  try {
+    ContactSolveResult result = decode_contact_result(reply.contact_result(), contact_size_);
+    timings_.compute_seconds += result.seconds;
+    return result;
+  } catch (const MalformedReply& malformed) {
+    fail(step, std::string("malformed reply: ") + malformed.what());
+  }
+}
+
+void RemotePort::start_correction(const Eigen::VectorXd& interface_force, int iteration) {
+  Envelope request;
+  protocol::CorrectionRequest& correction = *request.mutable_correction();
+  correction.set_iteration(static_cast<std::uint32_t>(iteration));
+  append(interface_force, *correction.mutable_interface_force());
+  send_request(request, "correction (iteration " + std::to_string(iteration) + ")",
+               options_.request_timeout_seconds);
+}
+
+CorrectionSolveResult RemotePort::finish_correction() {
+  const std::string step = pending_ ? pending_->step : "correction";
+  const Envelope reply = finish_request(Envelope::kCorrectionResult);
+  try {
+    CorrectionSolveResult result =
+        decode_correction_result(reply.correction_result(), contact_size_);
+    timings_.compute_seconds += result.seconds;
+    return result;
+  } catch (const MalformedReply& malformed) {
+    fail(step, std::string("malformed reply: ") + malformed.what());
+  }
+}
+
+BodyOutput RemotePort::fields(const Eigen::VectorXd& contact_force) {
+  Envelope request;
+  append(contact_force, *request.mutable_fields()->mutable_contact_force());
+  const Envelope reply =
+      exchange(request, "fields", options_.request_timeout_seconds, Envelope::kFieldsReply);
+  try {
+    return decode_fields(reply.fields_reply(), body_label_);
+  } catch (const MalformedReply& malformed) {
+    fail("fields", std::string("malformed reply: ") + malformed.what());
+  }
+}
+
+void RemotePort::end_run() noexcept {
+  pending_.reset();  // a reply still in flight is discarded by its request id
+  if (!set_up_) return;
+  set_up_ = false;
+  try {
+    if (channel_->connection_lost()) return;
+    channel_->set_hooks_enabled(false);  // also after a cancellation, within its short deadline
+    Envelope request;
+    request.mutable_end_run();
+    exchange(request, "end of run", options_.end_run_timeout_seconds, Envelope::kAcknowledge);
+  } catch (const std::exception& error) {
+    spdlog::debug("{}", error.what());
+  } catch (...) {
+  }
+  channel_->set_hooks_enabled(true);
+}
+
+const PortTimings& RemotePort::timings() const {
+  return timings_;
+}
+
+bool request_server_shutdown(const std::string& endpoint, double timeout_seconds) noexcept {
+  try {
+    RequestChannel channel(endpoint, ChannelOptions{});
+    const Deadline deadline = Deadline::after(timeout_seconds);
+    Envelope request;
+    request.mutable_shutdown();
+    const std::uint64_t request_id = channel.send(request, deadline);
+    return channel.receive(request_id, deadline).has_acknowledge();
+  } catch (...) {
+    return false;
+  }
+}
+
+}  // namespace robin

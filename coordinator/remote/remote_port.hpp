@@ -1,0 +1,83 @@
+#pragma once
+// A subdomain port that speaks the protocol of proto/robin.proto to a robin-subdomain server
+// over ZeroMQ (see request_channel.hpp for the transport and its socket options).
+//
+// setup() performs the handshake (Hello; the reply's major version must equal ours; the
+// handshake's deadline is min(request timeout, 10 s)) and then SetupBody. Each later request
+// has the full request timeout as its deadline. Every failure is a PortError of the form
+//   server tcp://127.0.0.1:5555 (body 'upper'), step contact solve (iteration 7): <problem>
+// where <problem> is e.g. "no reply within 60 s", "the connection to the server was lost (the
+// server stopped or crashed)" or "server error WRONG_STATE: <the server's message>".
+//
+// Timings: compute_seconds adds the server-reported times of setup (assembly and
+// factorization), contact solves and corrections; round_trip_seconds adds, for the same
+// requests, the time from sending the request to the decoded reply; bytes count every
+// message's payload in both directions.
+//
+// Not thread-safe: one thread at a time (the coupled run may move a port between threads).
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "coupling/subdomain_port.hpp"
+#include "remote/request_channel.hpp"
+
+namespace robin {
+
+struct RemotePortOptions {
+  double request_timeout_seconds = 60.0;  // CouplingOptions.request_timeout_seconds
+  double handshake_timeout_limit = 10.0;  // the handshake waits min(request timeout, this)
+  double end_run_timeout_seconds = 2.0;   // EndRun is best effort
+  /// Transport settings and the hooks run while waiting (cancellation, child-process checks).
+  ChannelOptions channel;
+};
+
+class RemotePort final : public SubdomainPort {
+ public:
+  /// Connects to `endpoint` (in the background). `body_label` names the body in messages
+  /// until setup() knows its name. Throws PortError for an endpoint ZeroMQ rejects.
+  RemotePort(std::string endpoint, std::string body_label, RemotePortOptions options = {});
+  ~RemotePort() override;
+
+  std::string describe() const override;
+  InterfaceDescription setup(const BodyCase& body, const SolverOptions& solver) override;
+  void assign_contact(const ContactAssignment& assignment) override;
+  void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) override;
+  ContactSolveResult finish_contact_solve() override;
+  void start_correction(const Eigen::VectorXd& interface_force, int iteration) override;
+  CorrectionSolveResult finish_correction() override;
+  BodyOutput fields(const Eigen::VectorXd& contact_force) override;
+  void end_run() noexcept override;
+  const PortTimings& timings() const override;
+
+  const std::string& endpoint() const { return endpoint_; }
+  /// What the server said about itself in the handshake ("robin-subdomain 0.1.0").
+  const std::string& server_name() const { return server_name_; }
+
+ private:
+  struct Pending;
+  void handshake();
+  void send_request(protocol::Envelope& request, const std::string& step, double timeout_seconds);
+  protocol::Envelope finish_request(int expected_content);
+  protocol::Envelope exchange(protocol::Envelope& request, const std::string& step,
+                              double timeout_seconds, int expected_content);
+  [[noreturn]] void fail(const std::string& step, const std::string& problem) const;
+  void update_byte_counts();
+
+  std::string endpoint_;
+  std::string body_label_;
+  RemotePortOptions options_;
+  std::unique_ptr<RequestChannel> channel_;
+  std::unique_ptr<Pending> pending_;
+  std::string server_name_;
+  long contact_size_ = 0;
+  bool set_up_ = false;
+  PortTimings timings_;
+};
+
+/// Asks the server at `endpoint` to stop (Shutdown request) on a fresh connection; true when
+/// it acknowledged within `timeout_seconds`. Never throws.
+bool request_server_shutdown(const std::string& endpoint, double timeout_seconds) noexcept;
+
+}  // namespace robin

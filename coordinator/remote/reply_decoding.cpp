@@ -1,0 +1,173 @@
+#include "remote/reply_decoding.hpp"
+
+#include <google/protobuf/repeated_field.h>
+
+namespace robin {
+
+namespace {
+
+template <typename Repeated>
+void expect_size(const Repeated& values, long expected, const std::string& what) {
+  if (static_cast<long>(values.size()) != expected) {
+    throw MalformedReply(what + " has " + std::to_string(values.size()) + " values, expected " +
+                         std::to_string(expected));
+  }
+}
+
+Eigen::VectorXd to_vector(const google::protobuf::RepeatedField<double>& values) {
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
+}
+
+std::vector<Eigen::Vector2d> to_points(const google::protobuf::RepeatedField<double>& values) {
+  std::vector<Eigen::Vector2d> points(values.size() / 2);
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = {values[2 * i], values[2 * i + 1]};
+  return points;
+}
+
+QpStatus to_qp_status(protocol::SolveStatus status) {
+  switch (status) {
+    case protocol::CONVERGED:
+      return QpStatus::converged;
+    case protocol::NOT_CONVERGED:
+      return QpStatus::not_converged;
+    case protocol::BREAKDOWN:
+      return QpStatus::breakdown;
+    default:
+      throw MalformedReply("the contact result has no solve status");
+  }
+}
+
+OutputField decode_field(const protocol::Field& message, long count, const std::string& where) {
+  OutputField field;
+  field.name = message.name();
+  field.components = static_cast<int>(message.components());
+  if (field.name.empty() || field.components < 1) {
+    throw MalformedReply(where + " field '" + field.name + "' has no name or no components");
+  }
+  expect_size(message.values(), field.components * count, where + " field '" + field.name + "'");
+  field.values.assign(message.values().begin(), message.values().end());
+  if (field.name == "stress" && field.components == 3) field.component_names = {"xx", "yy", "xy"};
+  return field;
+}
+
+/// Element blocks from cell types, offsets and connectivity; indices checked against the nodes.
+std::vector<ElementBlock> decode_blocks(const protocol::FieldsReply& message, long node_count) {
+  const long block_count = message.cell_types_size();
+  expect_size(message.cell_offsets(), block_count + 1, "cell_offsets");
+  std::vector<ElementBlock> blocks;
+  for (long b = 0; b < block_count; ++b) {
+    ElementBlock block;
+    block.type = element_type_of_vtk_cell(message.cell_types(b));
+    const auto begin = message.cell_offsets(b), end = message.cell_offsets(b + 1);
+    const auto per_element = static_cast<std::uint64_t>(nodes_per_element(block.type));
+    if (begin > end || end > static_cast<std::uint64_t>(message.connectivity_size()) ||
+        (end - begin) % per_element != 0) {
+      throw MalformedReply("element block " + std::to_string(b) + " has inconsistent offsets");
+    }
+    for (auto k = begin; k < end; ++k) {
+      const auto node = message.connectivity(static_cast<int>(k));
+      if (node < 0 || node >= node_count) {
+        throw MalformedReply("element block " + std::to_string(b) + " refers to node " +
+                             std::to_string(node) + " of " + std::to_string(node_count));
+      }
+      block.connectivity.push_back(static_cast<int>(node));
+    }
+    blocks.push_back(std::move(block));
+  }
+  return blocks;
+}
+
+Eigen::Vector2d decode_resultant(const google::protobuf::RepeatedField<double>& values,
+                                 const std::string& what) {
+  if (values.empty()) return Eigen::Vector2d::Zero();
+  expect_size(values, 2, what);
+  return {values[0], values[1]};
+}
+
+}  // namespace
+
+ElementType element_type_of_vtk_cell(unsigned cell_type) {
+  switch (cell_type) {
+    case 5:
+      return ElementType::triangle3;
+    case 22:
+      return ElementType::triangle6;
+    case 9:
+      return ElementType::quadrilateral4;
+    default:
+      throw MalformedReply("unknown VTK cell type " + std::to_string(cell_type) +
+                           " (expected 5, 22 or 9)");
+  }
+}
+
+InterfaceDescription decode_interface(const protocol::InterfaceDescription& message) {
+  const long count = message.node_ids_size();
+  expect_size(message.node_tags(), count, "node_tags");
+  expect_size(message.coordinates(), 2 * count, "coordinates");
+  expect_size(message.normals(), 2 * count, "normals");
+  expect_size(message.weights(), count, "weights");
+  expect_size(message.x_fixed(), count, "x_fixed");
+  expect_size(message.y_fixed(), count, "y_fixed");
+  InterfaceDescription interface;
+  interface.node_ids.assign(message.node_ids().begin(), message.node_ids().end());
+  interface.node_tags.assign(message.node_tags().begin(), message.node_tags().end());
+  interface.coordinates = to_points(message.coordinates());
+  interface.normals = to_points(message.normals());
+  interface.weights.assign(message.weights().begin(), message.weights().end());
+  interface.x_fixed.assign(message.x_fixed().begin(), message.x_fixed().end());
+  interface.y_fixed.assign(message.y_fixed().begin(), message.y_fixed().end());
+  return interface;
+}
+
+ContactSolveResult decode_contact_result(const protocol::ContactSolveResult& message,
+                                         long contact_size) {
+  ContactSolveResult result;
+  result.status = to_qp_status(message.status());
+  result.message = message.message();
+  if (result.status == QpStatus::breakdown) return result;  // values are not usable
+  expect_size(message.normal_trace(), contact_size, "normal_trace");
+  expect_size(message.contact_force(), contact_size, "contact_force");
+  result.normal_trace = to_vector(message.normal_trace());
+  result.contact_force = to_vector(message.contact_force());
+  if (message.active_size() == 0) {
+    for (long i = 0; i < contact_size; ++i) result.active.push_back(result.contact_force[i] > 0);
+  } else {
+    expect_size(message.active(), contact_size, "active");
+    result.active.assign(message.active().begin(), message.active().end());
+  }
+  result.iterations = static_cast<int>(message.qp_iterations());
+  result.projected_gradient_norm = message.projected_gradient_norm();
+  result.penetration = message.penetration();
+  result.complementarity = message.complementarity();
+  result.seconds = message.compute_seconds();
+  return result;
+}
+
+CorrectionSolveResult decode_correction_result(const protocol::CorrectionResult& message,
+                                               long contact_size) {
+  expect_size(message.normal_trace(), contact_size, "normal_trace");
+  return {to_vector(message.normal_trace()), message.compute_seconds()};
+}
+
+BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string& body_name) {
+  BodyOutput output;
+  output.body_name = body_name;
+  const long node_count = message.node_coordinates_size() / 2;
+  expect_size(message.node_coordinates(), 2 * node_count, "node_coordinates");
+  output.mesh.nodes = to_points(message.node_coordinates());
+  if (message.node_tags_size() != 0) expect_size(message.node_tags(), node_count, "node_tags");
+  output.mesh.node_tags.assign(message.node_tags().begin(), message.node_tags().end());
+  output.mesh.blocks = decode_blocks(message, node_count);
+  const long element_count = static_cast<long>(output.mesh.element_count());
+  for (const protocol::Field& field : message.point_fields()) {
+    output.point_fields.push_back(decode_field(field, node_count, "point"));
+  }
+  for (const protocol::Field& field : message.cell_fields()) {
+    output.cell_fields.push_back(decode_field(field, element_count, "cell"));
+  }
+  output.reaction_resultant = decode_resultant(message.reaction_resultant(), "reaction_resultant");
+  output.applied_force = decode_resultant(message.applied_force(), "applied_force");
+  return output;
+}
+
+}  // namespace robin

@@ -1,0 +1,40 @@
+#pragma once
+// Decoding of the servers' replies into the coordinator's types (part of robin_remote's
+// protocol module). Every function checks the sizes and indices it relies on and throws
+// MalformedReply saying what is inconsistent; the port adds server, body and step.
+
+#include <stdexcept>
+#include <string>
+
+#include "coupling/subdomain_port.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+
+class MalformedReply : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The body's contact boundary. Node ids, coordinates, normals, weights and fixed flags must
+/// describe the same number of nodes.
+InterfaceDescription decode_interface(const protocol::InterfaceDescription& message);
+
+/// A contact solve result for `contact_size` contact nodes (pair order). `active` defaults to
+/// lambda_i > 0 when the server sends no flags.
+ContactSolveResult decode_contact_result(const protocol::ContactSolveResult& message,
+                                         long contact_size);
+
+/// A correction result w_N for `contact_size` contact nodes.
+CorrectionSolveResult decode_correction_result(const protocol::CorrectionResult& message,
+                                               long contact_size);
+
+/// The body's mesh (nodes, tags, element blocks from the VTK cell types 5, 22, 9) and fields.
+/// The mesh has no boundary groups (they are not needed for output). Stress fields get the
+/// component names xx, yy, xy.
+BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string& body_name);
+
+/// The element type of a VTK cell type number (5, 22 or 9); throws MalformedReply otherwise.
+ElementType element_type_of_vtk_cell(unsigned cell_type);
+
+}  // namespace robin

@@ -1,0 +1,174 @@
+#include "remote/request_channel.hpp"
+
+#include <zmq.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <sstream>
+#include <zmq.hpp>
+
+#include "protocol_version.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+
+namespace {
+
+constexpr auto wait_slice = std::chrono::milliseconds(100);
+constexpr int send_backstop_milliseconds = 1000;
+
+std::string format_seconds(double seconds) {
+  std::ostringstream text;
+  text << seconds;
+  return text.str();
+}
+
+std::string next_monitor_address() {
+  static std::atomic<unsigned long> counter{0};
+  return "inproc://robin-channel-monitor-" + std::to_string(counter++);
+}
+
+}  // namespace
+
+Deadline Deadline::after(double seconds) {
+  const auto duration = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(std::max(seconds, 0.0)));
+  return {Clock::now() + duration, seconds};
+}
+
+struct RequestChannel::Sockets {
+  zmq::context_t context{1};
+  zmq::socket_t dealer{context, zmq::socket_type::dealer};
+  zmq::socket_t monitor{context, zmq::socket_type::pair};
+};
+
+RequestChannel::RequestChannel(const std::string& endpoint, ChannelOptions options)
+    : sockets_(std::make_unique<Sockets>()), options_(std::move(options)) {
+  zmq::socket_t& dealer = sockets_->dealer;
+  dealer.set(zmq::sockopt::linger, 0);
+  dealer.set(zmq::sockopt::immediate, 1);
+  dealer.set(zmq::sockopt::sndtimeo, send_backstop_milliseconds);
+  dealer.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(options_.max_message_bytes));
+  dealer.set(zmq::sockopt::heartbeat_ivl, options_.heartbeat_interval_milliseconds);
+  dealer.set(zmq::sockopt::heartbeat_timeout, options_.heartbeat_timeout_milliseconds);
+  dealer.set(zmq::sockopt::heartbeat_ttl, 2 * options_.heartbeat_timeout_milliseconds);
+  const std::string monitor_address = next_monitor_address();
+  if (zmq_socket_monitor(
+          dealer.handle(), monitor_address.c_str(),
+          ZMQ_EVENT_CONNECTED | ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_DISCONNECTED) != 0) {
+    throw ChannelFailure(std::string("cannot monitor the connection: ") + zmq_strerror(errno));
+  }
+  sockets_->monitor.set(zmq::sockopt::linger, 0);
+  sockets_->monitor.connect(monitor_address);
+  try {
+    dealer.connect(endpoint);
+  } catch (const zmq::error_t& error) {
+    throw ChannelFailure("cannot connect to '" + endpoint + "': " + error.what() +
+                         " (endpoints look like tcp://HOST:PORT or ipc:///PATH)");
+  }
+}
+
+RequestChannel::~RequestChannel() {
+  zmq_socket_monitor(sockets_->dealer.handle(), nullptr, 0);
+}
+
+std::uint64_t RequestChannel::send(protocol::Envelope& envelope, const Deadline& deadline) {
+  check_connection();
+  envelope.mutable_version()->set_major(protocol::protocol_major);
+  envelope.mutable_version()->set_minor(protocol::protocol_minor);
+  envelope.set_request_id(next_request_id_++);
+  const std::string payload = envelope.SerializeAsString();
+  wait_for(ZMQ_POLLOUT, deadline,
+           "could not send within " + format_seconds(deadline.seconds) +
+               " s: no connection to the server (is it running at that endpoint?)");
+  zmq::socket_t& dealer = sockets_->dealer;
+  const bool sent = dealer.send(zmq::message_t(), zmq::send_flags::sndmore) &&
+                    dealer.send(zmq::buffer(payload), zmq::send_flags::none);
+  if (!sent) throw ChannelFailure("the request could not be queued for sending");
+  bytes_sent_ += static_cast<long>(payload.size());
+  return envelope.request_id();
+}
+
+protocol::Envelope RequestChannel::receive(std::uint64_t request_id, const Deadline& deadline) {
+  const std::string timeout_problem = "no reply within " + format_seconds(deadline.seconds) + " s";
+  for (;;) {
+    wait_for(ZMQ_POLLIN, deadline, timeout_problem);
+    std::vector<zmq::message_t> frames;
+    do {
+      frames.emplace_back();
+      if (!sockets_->dealer.recv(frames.back(), zmq::recv_flags::dontwait)) {
+        throw ChannelFailure("a reply was announced but could not be read");
+      }
+    } while (frames.back().more());
+    for (const zmq::message_t& frame : frames) bytes_received_ += static_cast<long>(frame.size());
+    protocol::Envelope reply;
+    if (frames.size() != 2 || frames[0].size() != 0 ||
+        !reply.ParseFromArray(frames[1].data(), static_cast<int>(frames[1].size()))) {
+      throw ChannelFailure(
+          "the reply is not a protocol message (expected an empty delimiter "
+          "frame and one serialized Envelope); is this a robin-subdomain server?");
+    }
+    if (reply.request_id() == request_id) return reply;
+    // A late reply to an abandoned request: discard it and keep waiting.
+  }
+}
+
+bool RequestChannel::connection_lost() {
+  read_monitor_events();
+  return lost_;
+}
+
+void RequestChannel::check_connection() {
+  if (hooks_enabled_ && options_.server_failure) {
+    if (std::string reason = options_.server_failure(); !reason.empty()) {
+      throw ChannelFailure(reason);
+    }
+  }
+  if (connection_lost()) {
+    throw ChannelFailure("the connection to the server was lost (the server stopped or crashed)");
+  }
+}
+
+void RequestChannel::wait_for(short events, const Deadline& deadline,
+                              const std::string& timeout_problem) {
+  for (;;) {
+    if (hooks_enabled_ && options_.on_wait) options_.on_wait();
+    check_connection();
+    const auto remaining = deadline.at - Clock::now();
+    if (remaining <= Clock::duration::zero()) throw ChannelFailure(timeout_problem);
+    const auto slice =
+        std::min(wait_slice, std::chrono::ceil<std::chrono::milliseconds>(remaining));
+    std::vector<zmq::pollitem_t> items{{sockets_->dealer.handle(), 0, events, 0},
+                                       {sockets_->monitor.handle(), 0, ZMQ_POLLIN, 0}};
+    try {
+      zmq::poll(items, slice);
+    } catch (const zmq::error_t& error) {
+      if (error.num() != EINTR) throw ChannelFailure(std::string("poll failed: ") + error.what());
+      continue;  // a signal: the next round runs on_wait, which may abandon the wait
+    }
+    if ((items[0].revents & events) != 0) return;
+  }
+}
+
+void RequestChannel::read_monitor_events() {
+  // Monitor messages: frame 1 = uint16 event + uint32 value, frame 2 = the endpoint.
+  for (;;) {
+    zmq::message_t event;
+    if (!sockets_->monitor.recv(event, zmq::recv_flags::dontwait)) return;
+    std::uint16_t number = 0;
+    if (event.size() >= sizeof number) std::memcpy(&number, event.data(), sizeof number);
+    while (event.more()) {
+      if (!sockets_->monitor.recv(event, zmq::recv_flags::dontwait)) break;
+    }
+    if (number == ZMQ_EVENT_CONNECTED || number == ZMQ_EVENT_HANDSHAKE_SUCCEEDED) {
+      connected_ = true;
+    } else if (number == ZMQ_EVENT_DISCONNECTED && connected_) {
+      connected_ = false;
+      lost_ = true;
+    }
+  }
+}
+
+}  // namespace robin

@@ -1,0 +1,106 @@
+#pragma once
+// One ZeroMQ connection from the coordinator to a subdomain server (internal to robin_remote).
+//
+// The server binds a REP socket; the channel connects a DEALER socket and speaks the REQ
+// envelope by hand: every message is an empty delimiter frame followed by one serialized
+// protocol Envelope. Each request carries a fresh request id; replies with another id (stale
+// replies to abandoned requests) are discarded. Waits are bounded by a deadline and sliced
+// (<= 100 ms) so that cancellation hooks run while waiting.
+//
+// Socket options, chosen deliberately:
+//   ZMQ_LINGER 0           closing never blocks on unsent messages (a dead server must not hang
+//                          the coordinator's exit);
+//   ZMQ_IMMEDIATE 1        messages are queued only on completed connections, so a request to a
+//                          server that is not there waits (and times out) instead of vanishing;
+//   ZMQ_SNDTIMEO           a backstop: sends happen after the socket polled writable, so they
+//                          never block longer than this;
+//   ZMQ_MAXMSGSIZE         larger inbound messages drop the connection instead of exhausting
+//                          memory;
+//   ZMQ_HEARTBEAT_IVL/TIMEOUT/TTL   ZMTP pings detect a peer whose host vanished without
+//                          closing its TCP connection.
+// A socket monitor reports disconnects: a connection lost after it was established fails the
+// pending and every later request at once, instead of at the deadline (a server that crashed or
+// was killed lost the body's state, so there is nothing to resume).
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace robin::protocol {
+class Envelope;
+}
+
+namespace robin {
+
+using Clock = std::chrono::steady_clock;
+
+/// A point in time to give up at, and the duration it stands for (for messages).
+struct Deadline {
+  Clock::time_point at;
+  double seconds = 0.0;
+  static Deadline after(double seconds);
+};
+
+/// A transport failure. The text says what happened ("no reply within 60 s"); the port adds
+/// the server, the body and the step.
+class ChannelFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ChannelOptions {
+  long max_message_bytes = 1L << 30;  // ZMQ_MAXMSGSIZE of inbound messages
+  int heartbeat_interval_milliseconds = 1000;
+  int heartbeat_timeout_milliseconds = 5000;
+  /// Called at least every 100 ms while waiting; may throw (e.g. RunInterrupted) to abandon the
+  /// wait. The exception propagates unchanged.
+  std::function<void()> on_wait;
+  /// Returns why the server cannot answer any more (e.g. "the server process was killed by
+  /// signal 9"), or an empty string. Checked while waiting; a reason fails the wait.
+  std::function<std::string()> server_failure;
+};
+
+class RequestChannel {
+ public:
+  /// Connects (asynchronously: the connection is made in the background). Throws
+  /// ChannelFailure when ZeroMQ rejects the endpoint.
+  RequestChannel(const std::string& endpoint, ChannelOptions options);
+  ~RequestChannel();
+  RequestChannel(const RequestChannel&) = delete;
+  RequestChannel& operator=(const RequestChannel&) = delete;
+
+  /// Sends `envelope` after setting its version and a new request id; returns that id.
+  /// Throws ChannelFailure when no connection is ready before the deadline or it was lost.
+  std::uint64_t send(protocol::Envelope& envelope, const Deadline& deadline);
+  /// The reply to `request_id`. Throws ChannelFailure on deadline, lost connection or a reply
+  /// that is not a protocol message.
+  protocol::Envelope receive(std::uint64_t request_id, const Deadline& deadline);
+
+  /// Turns the on_wait and server_failure hooks off or on (off for best-effort requests that
+  /// must still be sent after a cancellation, such as EndRun).
+  void set_hooks_enabled(bool enabled) { hooks_enabled_ = enabled; }
+  /// True once an established connection dropped (the server stopped or crashed).
+  bool connection_lost();
+  long bytes_sent() const { return bytes_sent_; }
+  long bytes_received() const { return bytes_received_; }
+
+ private:
+  struct Sockets;
+  void wait_for(short events, const Deadline& deadline, const std::string& timeout_problem);
+  void check_connection();
+  void read_monitor_events();
+
+  std::unique_ptr<Sockets> sockets_;
+  ChannelOptions options_;
+  std::uint64_t next_request_id_ = 1;
+  bool connected_ = false;
+  bool lost_ = false;
+  bool hooks_enabled_ = true;
+  long bytes_sent_ = 0;
+  long bytes_received_ = 0;
+};
+
+}  // namespace robin

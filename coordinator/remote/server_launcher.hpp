@@ -1,0 +1,93 @@
+#pragma once
+// Local robin-subdomain servers for robin-run (and the integration tests): one child process
+// per body, started with `--listen ENDPOINT --name BODY --log-level L`, its standard error in
+// <log directory>/server-<body>.log. A server announces itself with exactly one line
+// "listening on <endpoint>" on its standard output, with wildcard ports resolved.
+//
+// Stopping (request_shutdown + finish_stop, also in the destructor): a Shutdown request, then
+// SIGTERM when the server has not exited within the grace period, then SIGKILL after another grace
+// period; the process is always reaped.
+
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "remote/child_process.hpp"
+
+namespace robin {
+
+struct ServerLaunchOptions {
+  std::filesystem::path executable;     // robin-subdomain
+  std::filesystem::path log_directory;  // created if needed
+  std::string listen = "tcp://127.0.0.1:*";
+  std::string log_level = "info";
+  double startup_timeout_seconds = 20.0;     // until the "listening on" line
+  double shutdown_timeout_seconds = 2.0;     // deadline of the Shutdown request
+  double grace_seconds = 3.0;                // before SIGTERM, and again before SIGKILL
+  std::vector<std::string> extra_arguments;  // appended to the server's command line
+  std::vector<std::string> command_prefix;   // see child_process.hpp; empty: run directly
+};
+
+/// `name` next to the running executable (/proc/self/exe), e.g. build/bin/robin-subdomain.
+std::filesystem::path sibling_executable(const std::string& name);
+
+class SubdomainServer {
+ public:
+  /// Starts the server for `body` (does not wait for it). Throws std::runtime_error naming the
+  /// body and the executable when it cannot be started.
+  SubdomainServer(const std::string& body, const ServerLaunchOptions& options);
+  ~SubdomainServer();
+
+  /// Reads the "listening on" line. Throws std::runtime_error naming the server, why it is
+  /// not listening (exited, no line before the deadline, unexpected output) and the end of
+  /// its log. `on_wait` runs while waiting and may throw to abandon the wait.
+  void await_listening(const std::function<void()>& on_wait = {});
+
+  /// The server's actual endpoint (after await_listening).
+  const std::string& endpoint() const { return endpoint_; }
+  const std::string& body() const { return body_; }
+  pid_t pid() const { return process_->pid(); }
+  const std::filesystem::path& log_file() const { return log_file_; }
+  /// "robin-subdomain for body 'upper' (pid 123)", for messages.
+  std::string label() const;
+  /// Empty while the server runs; otherwise what happened to it, naming it and its log.
+  /// Thread-safe.
+  std::string failure();
+
+  /// Sends Shutdown (when listening) without waiting for the process.
+  void request_shutdown() noexcept;
+  /// Waits for the exit after request_shutdown; SIGTERM, then SIGKILL. Always reaps.
+  void finish_stop() noexcept;
+
+ private:
+  std::string body_;
+  ServerLaunchOptions options_;
+  std::filesystem::path log_file_;
+  std::unique_ptr<ChildProcess> process_;
+  std::string endpoint_;
+  bool stopping_ = false;
+};
+
+/// Starts one server per body and stops both (in parallel) at destruction.
+class LocalServers {
+ public:
+  LocalServers(const std::array<std::string, 2>& bodies, const ServerLaunchOptions& options);
+  ~LocalServers();
+  /// Waits until both listen (see SubdomainServer::await_listening).
+  void await_listening(const std::function<void()>& on_wait = {});
+  std::array<std::string, 2> endpoints() const;
+  SubdomainServer& server(int index) { return *servers_[index]; }
+  /// Stops both servers; idempotent.
+  void stop() noexcept;
+
+ private:
+  std::array<std::unique_ptr<SubdomainServer>, 2> servers_;
+};
+
+/// The last `count` lines of a text file ("" when it cannot be read), for error messages.
+std::string last_lines(const std::filesystem::path& path, int count);
+
+}  // namespace robin

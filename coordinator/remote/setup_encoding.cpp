@@ -1,0 +1,150 @@
+#include "remote/setup_encoding.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <optional>
+
+#include "numerics/errors.hpp"
+
+namespace robin {
+
+namespace {
+
+std::string lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+std::string read_file_bytes(const BodyCase& body) {
+  std::ifstream stream(body.mesh_path, std::ios::binary);
+  if (!stream.is_open()) {
+    throw InputError(body.context + ": cannot open mesh file '" + body.mesh_path.string() +
+                     "' to send it to the server");
+  }
+  std::string content((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  if (stream.bad()) {
+    throw InputError(body.context + ": cannot read mesh file '" + body.mesh_path.string() + "'");
+  }
+  return content;
+}
+
+/// Young's modulus E for which make_isotropic_material(E, nu, plane strain) yields `stiffness`
+/// exactly, searched a few ulps around the closed form E = C_00 (1 + nu)(1 - 2 nu) / (1 - nu);
+/// nullopt when no such E exists (C is not isotropic with this nu).
+std::optional<double> exact_young_modulus(const Eigen::Matrix3d& stiffness, double nu) {
+  const double closed_form = stiffness(0, 0) * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu);
+  if (!(closed_form > 0.0) || !std::isfinite(closed_form)) return std::nullopt;
+  double below = closed_form, above = closed_form;
+  for (int step = 0; step <= 16; ++step) {
+    for (double candidate : {below, above}) {
+      const Material rebuilt = make_isotropic_material(candidate, nu, PlaneModel::plane_strain, "");
+      if (rebuilt.stiffness == stiffness) return candidate;
+    }
+    below = std::nextafter(below, 0.0);
+    above = std::nextafter(above, 2.0 * closed_form);
+  }
+  const Material rebuilt = make_isotropic_material(closed_form, nu, PlaneModel::plane_strain, "");
+  const double scale = stiffness.cwiseAbs().maxCoeff();
+  if ((rebuilt.stiffness - stiffness).cwiseAbs().maxCoeff() <= 1e-14 * scale) return closed_form;
+  return std::nullopt;
+}
+
+void encode_dirichlet(const DirichletCondition& condition, protocol::Dirichlet& message) {
+  message.set_boundary(condition.boundary);
+  if (condition.x) message.set_x(*condition.x);
+  if (condition.y) message.set_y(*condition.y);
+}
+
+void encode_traction(const TractionCondition& condition, protocol::Traction& message) {
+  message.set_boundary(condition.boundary);
+  message.set_is_pressure(condition.is_pressure);
+  if (condition.is_pressure) {
+    message.set_pressure(condition.pressure);
+  } else {
+    message.add_vector(condition.vector.x());
+    message.add_vector(condition.vector.y());
+  }
+}
+
+std::string interface_operator_name(InterfaceOperatorKind kind) {
+  switch (kind) {
+    case InterfaceOperatorKind::dense:
+      return "dense";
+    case InterfaceOperatorKind::factor:
+      return "factor";
+    case InterfaceOperatorKind::automatic:
+      break;
+  }
+  return "auto";
+}
+
+void encode_solver(const SolverOptions& solver, protocol::SolverSettings& message) {
+  message.set_qp_tolerance(solver.qp.relative_tolerance);
+  message.set_qp_max_iterations(static_cast<std::uint32_t>(solver.qp.max_iterations));
+  message.set_interface_operator(interface_operator_name(solver.body.interface_operator));
+  message.set_dense_limit(static_cast<std::uint32_t>(std::max(solver.body.dense_limit, 0)));
+}
+
+}  // namespace
+
+void encode_material(const Material& material, const std::string& context,
+                     protocol::SetupBody& message) {
+  if (material.out_of_plane_poisson != 0.0) {
+    const double nu = material.out_of_plane_poisson;
+    const auto young = material.model == PlaneModel::plane_strain
+                           ? exact_young_modulus(material.stiffness, nu)
+                           : std::nullopt;
+    if (!young) {
+      throw InputError(context +
+                       ": material: an out-of-plane stress factor with a non-isotropic "
+                       "stiffness cannot be sent in protocol 1.0 (give young and poisson)");
+    }
+    message.set_young_modulus(*young);
+    message.set_poisson_ratio(nu);
+    return;
+  }
+  for (int row = 0; row < 3; ++row) {
+    for (int column = 0; column < 3; ++column) message.add_voigt(material.stiffness(row, column));
+  }
+}
+
+protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions& solver) {
+  const BodyDefinition& definition = body.definition;
+  protocol::SetupBody message;
+  message.set_body_name(definition.name);
+  message.set_mesh_content(read_file_bytes(body));
+  message.set_mesh_extension(lowercase(body.mesh_path.extension().string()));
+  message.set_mesh_size(body.mesh_options.size);
+  message.set_element_order(static_cast<std::uint32_t>(body.mesh_options.element_order));
+  message.set_recombine(body.mesh_options.recombine);
+  message.set_model(definition.material.model == PlaneModel::plane_strain ? protocol::PLANE_STRAIN
+                                                                          : protocol::PLANE_STRESS);
+  encode_material(definition.material, body.context, message);
+  message.add_body_force(definition.body_force.x());
+  message.add_body_force(definition.body_force.y());
+  for (const DirichletCondition& condition : definition.dirichlet) {
+    encode_dirichlet(condition, *message.add_dirichlet());
+  }
+  for (const TractionCondition& condition : definition.tractions) {
+    encode_traction(condition, *message.add_traction());
+  }
+  message.set_contact_boundary(definition.contact_boundary);
+  encode_solver(solver, *message.mutable_solver());
+  return message;
+}
+
+protocol::AssignContact encode_contact_assignment(const ContactAssignment& assignment) {
+  protocol::AssignContact message;
+  for (int node : assignment.node_ids) message.add_node_ids(node);
+  for (const Eigen::Vector2d& normal : assignment.normals) {
+    message.add_normals(normal.x());
+    message.add_normals(normal.y());
+  }
+  return message;
+}
+
+}  // namespace robin

@@ -1,0 +1,35 @@
+#pragma once
+// Encoding of one body of a case into the SetupBody request of proto/robin.proto, and of the
+// contact assignment into AssignContact (part of robin_remote's protocol module: generated
+// types stay inside robin_remote).
+
+#include <string>
+
+#include "coupling/case_file.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+
+/// The SetupBody request for `body`: the mesh file's bytes (mesh_content, with its extension,
+/// so that the server needs no access to the coordinator's files) and .geo options, the plane
+/// model, the material (see encode_material), body force, Dirichlet conditions, tractions,
+/// contact boundary and the body solver settings of `solver`.
+/// Throws InputError naming the body and the mesh file when the file cannot be read.
+protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions& solver);
+
+/// Writes `material` into `message` exactly (the server rebuilds the same Material bit for bit):
+///  - an isotropic plane-strain material (the only kind with out_of_plane_poisson != 0) is sent
+///    as young_modulus/poisson_ratio, because the server can only recover the out-of-plane
+///    stress s_zz = nu (s_xx + s_yy) (von Mises) from the isotropic constants; nu is
+///    out_of_plane_poisson and E is chosen so that the server's C equals ours to the last bit;
+///  - every other material (plane stress, or a general Voigt matrix) is sent as the row-major
+///    3x3 `voigt` matrix C, which is exact: for those s_zz is zero on both sides.
+/// `context` names the body for the InputError thrown when a hand-built Material cannot be
+/// expressed in the protocol (s_zz factor without an isotropic C).
+void encode_material(const Material& material, const std::string& context,
+                     protocol::SetupBody& message);
+
+/// The AssignContact request: node ids and unit normals in pair order.
+protocol::AssignContact encode_contact_assignment(const ContactAssignment& assignment);
+
+}  // namespace robin
