@@ -96,8 +96,7 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix) {
     std::string detail = "non-positive pivot " + std::to_string(factor.minor + 1) + " of " +
                          std::to_string(factor.n);
     if (factor.Perm != nullptr && factor.minor < factor.n) {
-      detail += ", degree of freedom " +
-                std::to_string(static_cast<const int*>(factor.Perm)[factor.minor]);
+      detail += ", equation " + std::to_string(static_cast<const int*>(factor.Perm)[factor.minor]);
     }
     throw_singular(body_name, detail);
   }

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -50,22 +51,17 @@ struct EnumeratedSolution {
 VectorXd solve_with_active_set(const MatrixXd& matrix, const VectorXd& right_hand_side,
                                const VectorXd& lower, unsigned mask) {
   const int size = static_cast<int>(matrix.rows());
-  std::vector<int> free;
-  for (int i = 0; i < size; ++i) {
-    if (!(mask & (1u << i))) free.push_back(i);
-  }
+  std::vector<int> free, active;
+  for (int i = 0; i < size; ++i) ((mask & (1u << i)) ? active : free).push_back(i);
   VectorXd candidate = lower;
   if (free.empty()) return candidate;
   const int free_count = static_cast<int>(free.size());
   MatrixXd free_block(free_count, free_count);
   VectorXd free_right_hand_side(free_count);
-  const VectorXd active_part = matrix * lower;  // includes free columns, removed below
   for (int r = 0; r < free_count; ++r) {
-    free_right_hand_side[r] = right_hand_side[free[r]] - active_part[free[r]];
-    for (int c = 0; c < free_count; ++c) {
-      free_block(r, c) = matrix(free[r], free[c]);
-      free_right_hand_side[r] += matrix(free[r], free[c]) * lower[free[c]];
-    }
+    free_right_hand_side[r] = right_hand_side[free[r]];
+    for (const int j : active) free_right_hand_side[r] -= matrix(free[r], j) * lower[j];
+    for (int c = 0; c < free_count; ++c) free_block(r, c) = matrix(free[r], free[c]);
   }
   const VectorXd free_solution = free_block.ldlt().solve(free_right_hand_side);
   for (int r = 0; r < free_count; ++r) candidate[free[r]] = free_solution[r];
@@ -81,7 +77,7 @@ EnumeratedSolution solve_by_enumeration(const MatrixXd& matrix, const VectorXd& 
   for (unsigned mask = 0; mask < (1u << size); ++mask) {
     const VectorXd candidate = solve_with_active_set(matrix, right_hand_side, lower, mask);
     const VectorXd gradient = matrix * candidate - right_hand_side;
-    const double primal_scale = std::max({candidate.norm(), lower.norm(), 1e-300});
+    const double primal_scale = std::max(candidate.norm(), 1e-300);
     const double dual_scale = std::max(right_hand_side.norm(), 1e-300);
     double violation = 0.0;
     for (int i = 0; i < size; ++i) {
@@ -225,6 +221,41 @@ TEST(Mprgp, NoConstraintActiveGivesUnconstrainedSolution) {
             << " proportioning)\n";
 }
 
+TEST(Mprgp, MinusInfinityBoundsAreInactive) {
+  std::mt19937_64 generator(9);
+  const int size = 10;
+  const MatrixXd matrix = random_spd(size, 1e3, 1.0, generator);
+  const VectorXd right_hand_side = random_vector(size, generator);
+  VectorXd lower = random_lower_bound(matrix, right_hand_side, generator);
+  for (int i = 0; i < size; i += 2) lower[i] = -std::numeric_limits<double>::infinity();
+  // Reference: the enumeration with the unbounded components replaced by a bound far below.
+  VectorXd far_lower = lower;
+  for (int i = 0; i < size; i += 2) far_lower[i] = -1e6;
+  const EnumeratedSolution exact = solve_by_enumeration(matrix, right_hand_side, far_lower);
+  ASSERT_LE(exact.violation, 1e-12);
+  for (int i = 0; i < size; i += 2) ASSERT_GT(exact.solution[i], -1e5);
+  const MprgpResult result =
+      solve_mprgp(DenseOperator(matrix), right_hand_side, lower, VectorXd::Zero(size));
+  ASSERT_EQ(result.status, QpStatus::converged) << result.message;
+  EXPECT_LE((result.solution - exact.solution).norm(), 1e-9 * exact.solution.norm());
+}
+
+TEST(Mprgp, UnattainableToleranceIsReportedAsNotConverged) {
+  std::mt19937_64 generator(10);
+  const MatrixXd matrix = random_spd(10, 1e4, 1.0, generator);
+  const VectorXd right_hand_side = random_vector(10, generator);
+  const VectorXd lower = random_lower_bound(matrix, right_hand_side, generator);
+  MprgpParameters parameters;
+  parameters.relative_tolerance = 1e-22;  // far below rounding of A x - b
+  parameters.max_iterations = 5000;
+  const MprgpResult result =
+      solve_mprgp(DenseOperator(matrix), right_hand_side, lower, VectorXd::Zero(10), parameters);
+  EXPECT_EQ(result.status, QpStatus::not_converged);
+  EXPECT_FALSE(result.message.empty());
+  std::cout << "tolerance 1e-22: " << result.iterations << " iterations: " << result.message
+            << "\n";
+}
+
 /// x* with a chosen partition: strictly active (multiplier > 0), touching (x*_i = l_i with
 /// g_i = 0: strict complementarity fails) and free. b = A x* - multiplier.
 TEST(Mprgp, ObstacleExactlyTouching) {
@@ -251,7 +282,9 @@ TEST(Mprgp, ObstacleExactlyTouching) {
     ASSERT_EQ(result.status, QpStatus::converged) << result.message;
     EXPECT_LE((result.solution - solution).norm(), 1e-9 * solution.norm()) << "seed " << seed;
     expect_kkt(matrix, right_hand_side, lower, result, 1e-10);
-    std::cout << "touching, seed " << seed << ": " << result.iterations << " iterations\n";
+    std::cout << "touching, seed " << seed << ": " << result.iterations << " iterations ("
+              << result.conjugate_gradient_steps << " CG, " << result.expansion_steps
+              << " expansion, " << result.proportioning_steps << " proportioning)\n";
   }
 }
 
@@ -345,6 +378,27 @@ class TridiagonalOperator final : public LinearOperator {
   int size_;
   double diagonal_;
 };
+
+TEST(Mprgp, OperatorNormEstimateBoundsTheLargestEigenvalue) {
+  // tridiag(-1, 2 + s, -1) of order n: lambda_max = 2 + s + 2 cos(pi / (n + 1)).
+  const int size = 2000;
+  const double shift = 1e-3;
+  const double largest = 2.0 + shift + 2.0 * std::cos(std::numbers::pi / (size + 1));
+  int applications = 0;
+  const double estimate =
+      estimate_operator_norm(TridiagonalOperator(size, shift), 10, applications);
+  EXPECT_EQ(applications, 10);
+  EXPECT_GE(estimate, largest);
+  EXPECT_LE(estimate, 1.05 * largest);
+  // diag(1, ..., 49, 100): the ratio 0.49 of the top eigenvalues makes 40 iterations exact.
+  VectorXd diagonal = VectorXd::LinSpaced(50, 1.0, 50.0);
+  diagonal[49] = 100.0;
+  const double diagonal_estimate = estimate_operator_norm(
+      DenseOperator(diagonal.asDiagonal().toDenseMatrix()), 40, applications);
+  EXPECT_NEAR(diagonal_estimate, 1.05 * 100.0, 1e-6 * 100.0);
+  std::cout << "||A|| estimates: " << estimate << " for lambda_max " << largest << ", "
+            << diagonal_estimate << " for 100\n";
+}
 
 /// Primal-dual active set iteration (Hintermueller, Ito & Kunisch 2002): with lambda = A x - b,
 /// S = {i : lambda_i + (l_i - x_i) > 0}; solve x_S = l_S, A_FF x_F = b_F - A_FS l_S; repeat
