@@ -66,10 +66,9 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
     round_trip += timings.round_trip_seconds;
   }
   log.info(
-      "wall time {:.3f} s (setup {:.3f} s, iteration {:.3f} s); server compute {:.3f} s, "
-      "messaging {:.3f} s",
-      result.total_seconds, result.setup_seconds, iteration.wall_seconds, compute,
-      round_trip - compute);
+      "wall time {:.3f} s (setup {:.3f} s, iteration {:.3f} s); summed over both servers: "
+      "compute {:.3f} s, request round trips {:.3f} s",
+      result.total_seconds, result.setup_seconds, iteration.wall_seconds, compute, round_trip);
   log.info("results in {} (open solution.pvd in ParaView)", settings.output_directory.string());
   return code;
 }

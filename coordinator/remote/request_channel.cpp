@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <sstream>
+#include <thread>
 #include <zmq.hpp>
 
 #include "protocol_version.hpp"
@@ -18,6 +19,7 @@ namespace {
 
 constexpr auto wait_slice = std::chrono::milliseconds(100);
 constexpr int send_backstop_milliseconds = 1000;
+constexpr auto lost_connection_grace = std::chrono::milliseconds(500);
 
 std::string format_seconds(double seconds) {
   std::ostringstream text;
@@ -121,14 +123,24 @@ bool RequestChannel::connection_lost() {
 }
 
 void RequestChannel::check_connection() {
-  if (hooks_enabled_ && options_.server_failure) {
-    if (std::string reason = options_.server_failure(); !reason.empty()) {
-      throw ChannelFailure(reason);
+  const std::string reason = server_failure_reason();
+  if (!reason.empty()) throw ChannelFailure(reason);
+  if (!connection_lost()) return;
+  // The process behind a lost connection is usually exiting: give its fate a moment to show.
+  const auto give_up = Clock::now() + lost_connection_grace;
+  for (std::string late_reason; Clock::now() < give_up;
+       std::this_thread::sleep_for(std::chrono::milliseconds(10))) {
+    late_reason = server_failure_reason();
+    if (!late_reason.empty()) {
+      throw ChannelFailure("the connection to the server was lost: " + late_reason);
     }
+    if (!hooks_enabled_ || !options_.server_failure) break;
   }
-  if (connection_lost()) {
-    throw ChannelFailure("the connection to the server was lost (the server stopped or crashed)");
-  }
+  throw ChannelFailure("the connection to the server was lost (the server stopped or crashed)");
+}
+
+std::string RequestChannel::server_failure_reason() const {
+  return hooks_enabled_ && options_.server_failure ? options_.server_failure() : std::string();
 }
 
 void RequestChannel::wait_for(short events, const Deadline& deadline,

@@ -91,6 +91,7 @@ class RequestChannel {
   struct Sockets;
   void wait_for(short events, const Deadline& deadline, const std::string& timeout_problem);
   void check_connection();
+  std::string server_failure_reason() const;
   void read_monitor_events();
 
   std::unique_ptr<Sockets> sockets_;

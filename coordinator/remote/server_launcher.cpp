@@ -109,12 +109,12 @@ void SubdomainServer::request_shutdown() noexcept {
   if (stopping_) return;
   stopping_ = true;
   if (!endpoint_.empty() && process_->running()) {
-    request_server_shutdown(endpoint_, options_.shutdown_timeout_seconds);
+    shutdown_acknowledged_ = request_server_shutdown(endpoint_, options_.shutdown_timeout_seconds);
   }
 }
 
 void SubdomainServer::finish_stop() noexcept {
-  if (process_->wait_for_exit(options_.grace_seconds)) return;
+  if (shutdown_acknowledged_ && process_->wait_for_exit(options_.grace_seconds)) return;
   process_->stop(options_.grace_seconds);
 }
 

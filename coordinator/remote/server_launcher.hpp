@@ -5,8 +5,8 @@
 // "listening on <endpoint>" on its standard output, with wildcard ports resolved.
 //
 // Stopping (request_shutdown + finish_stop, also in the destructor): a Shutdown request, then
-// SIGTERM when the server has not exited within the grace period, then SIGKILL after another grace
-// period; the process is always reaped.
+// SIGTERM when the server did not acknowledge it or has not exited within the grace period,
+// then SIGKILL after another grace period; the process is always reaped.
 
 #include <array>
 #include <filesystem>
@@ -69,6 +69,7 @@ class SubdomainServer {
   std::unique_ptr<ChildProcess> process_;
   std::string endpoint_;
   bool stopping_ = false;
+  bool shutdown_acknowledged_ = false;
 };
 
 /// Starts one server per body and stops both (in parallel) at destruction.

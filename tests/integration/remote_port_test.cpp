@@ -1,0 +1,211 @@
+// RemotePort against real robin-subdomain processes (build/bin/robin-subdomain) on
+// examples/two_blocks.toml:
+//  - the coupled run over tcp://127.0.0.1:* and over ipc:// equals the in-process run
+//    (InProcessPort, same iteration code, same numerics in this process) to 1e-12 in contact
+//    forces, normal traces and displacement fields, with the same iteration count;
+//  - a server killed (SIGKILL) after the first iteration ends the run with a PortError naming
+//    the server and the step well before the 5 s request deadline;
+//  - a server that never replies fails the handshake after the 2 s deadline, naming the
+//    endpoint and "handshake";
+//  - a server speaking protocol 2.x is refused with both versions in the message.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <iostream>
+#include <zmq.hpp>
+
+#include "coupling/coupled_run.hpp"
+#include "coupling/in_process_port.hpp"
+#include "remote/remote_port.hpp"
+#include "remote_test_support.hpp"
+
+namespace robin {
+namespace {
+
+using testing::example;
+using testing::seconds_since;
+using testing::server_options;
+using testing::TemporaryDirectory;
+using testing::vectors_close;
+
+CaseDefinition two_blocks() {
+  return read_case_file(example("two_blocks.toml"));
+}
+
+RemotePortOptions port_options(double timeout_seconds) {
+  RemotePortOptions options;
+  options.request_timeout_seconds = timeout_seconds;
+  return options;
+}
+
+const OutputField& point_field(const BodyOutput& output, const std::string& name) {
+  for (const OutputField& field : output.point_fields) {
+    if (field.name == name) return field;
+  }
+  throw std::runtime_error("no point field '" + name + "' in body '" + output.body_name + "'");
+}
+
+Eigen::VectorXd field_values(const OutputField& field) {
+  return Eigen::Map<const Eigen::VectorXd>(field.values.data(),
+                                           static_cast<Eigen::Index>(field.values.size()));
+}
+
+/// The in-process run of two_blocks.toml, computed once.
+const CoupledRunResult& in_process_reference() {
+  static const CoupledRunResult reference = [] {
+    const CaseDefinition definition = two_blocks();
+    InProcessPort body1, body2;
+    CoupledRunResult result = run_coupled_case(definition, {&body1, &body2}, definition.coupling);
+    body1.end_run();
+    body2.end_run();
+    return result;
+  }();
+  return reference;
+}
+
+/// Runs two_blocks.toml on two servers listening on `listen1` / `listen2`.
+CoupledRunResult run_on_servers(const std::string& listen1, const std::string& listen2) {
+  const TemporaryDirectory logs("remote-port-logs");
+  const CaseDefinition definition = two_blocks();
+  SubdomainServer server1(definition.bodies[0].definition.name,
+                          server_options(logs.path(), listen1));
+  SubdomainServer server2(definition.bodies[1].definition.name,
+                          server_options(logs.path(), listen2));
+  server1.await_listening();
+  server2.await_listening();
+  RemotePort body1(server1.endpoint(), "lower", port_options(30.0));
+  RemotePort body2(server2.endpoint(), "upper", port_options(30.0));
+  CoupledRunResult result = run_coupled_case(definition, {&body1, &body2}, definition.coupling);
+  body1.end_run();
+  body2.end_run();
+  return result;
+}
+
+void expect_equal_to_in_process(const CoupledRunResult& remote) {
+  const CoupledRunResult& reference = in_process_reference();
+  ASSERT_EQ(reference.iteration.status, IterationStatus::converged) << reference.iteration.message;
+  EXPECT_EQ(remote.iteration.status, IterationStatus::converged) << remote.iteration.message;
+  EXPECT_EQ(remote.iteration.history.size(), reference.iteration.history.size());
+  const RobinResult& a = remote.iteration;
+  const RobinResult& b = reference.iteration;
+  EXPECT_GT(b.contact_force1.maxCoeff(), 0.0);  // the comparison is about a real contact state
+  std::cout << "largest differences to the in-process run: contact force "
+            << (a.contact_force1 - b.contact_force1).lpNorm<Eigen::Infinity>() << " (of "
+            << b.contact_force1.lpNorm<Eigen::Infinity>() << "), normal trace "
+            << (a.normal_trace2 - b.normal_trace2).lpNorm<Eigen::Infinity>() << " (of "
+            << b.normal_trace2.lpNorm<Eigen::Infinity>() << ")\n";
+  EXPECT_TRUE(vectors_close(a.contact_force1, b.contact_force1, 1e-12));
+  EXPECT_TRUE(vectors_close(a.contact_force2, b.contact_force2, 1e-12));
+  EXPECT_TRUE(vectors_close(a.normal_trace1, b.normal_trace1, 1e-12));
+  EXPECT_TRUE(vectors_close(a.normal_trace2, b.normal_trace2, 1e-12));
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    EXPECT_TRUE(vectors_close(field_values(point_field(remote.outputs[alpha], "displacement")),
+                              field_values(point_field(reference.outputs[alpha], "displacement")),
+                              1e-12))
+        << "body " << alpha + 1;
+    EXPECT_EQ(remote.outputs[alpha].mesh.nodes.size(), reference.outputs[alpha].mesh.nodes.size());
+    EXPECT_GT(remote.port_timings[alpha].bytes_sent, 0);
+    EXPECT_GT(remote.port_timings[alpha].bytes_received, 0);
+    EXPECT_GE(remote.port_timings[alpha].round_trip_seconds,
+              remote.port_timings[alpha].compute_seconds);
+  }
+}
+
+TEST(RemotePort, TcpRunEqualsInProcessRun) {
+  expect_equal_to_in_process(run_on_servers("tcp://127.0.0.1:*", "tcp://127.0.0.1:*"));
+}
+
+TEST(RemotePort, IpcRunEqualsInProcessRun) {
+  const std::string base = "/tmp/robin-remote-test-" + std::to_string(getpid());
+  expect_equal_to_in_process(
+      run_on_servers("ipc://" + base + "-1.ipc", "ipc://" + base + "-2.ipc"));
+  std::filesystem::remove(base + "-1.ipc");
+  std::filesystem::remove(base + "-2.ipc");
+}
+
+TEST(RemotePort, KilledServerEndsTheRunWithAPortError) {
+  const TemporaryDirectory logs("remote-port-kill");
+  const CaseDefinition definition = two_blocks();
+  SubdomainServer server1("lower", server_options(logs.path()));
+  SubdomainServer server2("upper", server_options(logs.path()));
+  server1.await_listening();
+  server2.await_listening();
+  const double timeout = 5.0;
+  RemotePort body1(server1.endpoint(), "lower", port_options(timeout));
+  RemotePort body2(server2.endpoint(), "upper", port_options(timeout));
+  RunObserver observer;
+  auto killed_at = std::chrono::steady_clock::now();
+  observer.iteration = [&](const IterationRecord& record) {
+    if (record.iteration != 1) return;
+    ASSERT_EQ(kill(server2.pid(), SIGKILL), 0);
+    killed_at = std::chrono::steady_clock::now();
+  };
+  CouplingOptions options = definition.coupling;
+  options.request_timeout_seconds = timeout;
+  options.tolerance = 1e-300;  // the run must go on after the first iteration
+  try {
+    run_coupled_case(definition, {&body1, &body2}, options, observer);
+    FAIL() << "the run went on without the killed server";
+  } catch (const PortError& error) {
+    const double elapsed = seconds_since(killed_at);
+    const std::string message = error.what();
+    std::cout << "failed " << elapsed << " s after the kill: " << message << "\n";
+    EXPECT_NE(message.find("server " + server2.endpoint() + " (body 'upper')"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("step contact solve (iteration 2)"), std::string::npos) << message;
+    EXPECT_LT(elapsed, timeout + 1.0) << message;
+    EXPECT_LT(elapsed, 1.0) << "the disconnect was not detected before the deadline: " << message;
+  }
+  body1.end_run();
+  body2.end_run();
+}
+
+TEST(RemotePort, SilentServerFailsTheHandshakeAtTheDeadline) {
+  zmq::context_t context;
+  zmq::socket_t silent(context, zmq::socket_type::rep);
+  silent.set(zmq::sockopt::linger, 0);
+  silent.bind("tcp://127.0.0.1:*");
+  const std::string endpoint = silent.get(zmq::sockopt::last_endpoint);
+  const CaseDefinition definition = two_blocks();
+  RemotePort port(endpoint, "lower", port_options(2.0));
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    port.setup(definition.bodies[0], definition.solver);
+    FAIL() << "setup succeeded against a server that never replies";
+  } catch (const PortError& error) {
+    const double elapsed = seconds_since(start);
+    const std::string message = error.what();
+    std::cout << "failed after " << elapsed << " s: " << message << "\n";
+    EXPECT_NE(message.find("server " + endpoint), std::string::npos) << message;
+    EXPECT_NE(message.find("step handshake"), std::string::npos) << message;
+    EXPECT_NE(message.find("no reply within 2 s"), std::string::npos) << message;
+    EXPECT_GE(elapsed, 2.0 - 0.05);
+    EXPECT_LT(elapsed, 2.0 + 1.0);
+  }
+  zmq::message_t request;
+  EXPECT_TRUE(silent.recv(request, zmq::recv_flags::dontwait)) << "the Hello never arrived";
+}
+
+TEST(RemotePort, ServerOfAnotherMajorVersionIsRefused) {
+  const TemporaryDirectory logs("remote-port-version");
+  ServerLaunchOptions options = server_options(logs.path());
+  options.extra_arguments = {"--protocol-major", "2"};
+  SubdomainServer server("lower", options);
+  server.await_listening();
+  const CaseDefinition definition = two_blocks();
+  RemotePort port(server.endpoint(), "lower", port_options(5.0));
+  try {
+    port.setup(definition.bodies[0], definition.solver);
+    FAIL() << "a protocol 2 server was accepted";
+  } catch (const PortError& error) {
+    const std::string message = error.what();
+    std::cout << message << "\n";
+    EXPECT_NE(message.find("server " + server.endpoint()), std::string::npos) << message;
+    EXPECT_NE(message.find("speaks protocol 2."), std::string::npos) << message;
+    EXPECT_NE(message.find("speaks 1.0"), std::string::npos) << message;
+  }
+}
+
+}  // namespace
+}  // namespace robin
