@@ -28,12 +28,26 @@ fs::path data(const std::string& name) {
   return data_directory / name;
 }
 
-/// A fresh directory for one written case file; removed with the test binary's temp tree.
+/// The root of this process's scratch directories.
+fs::path scratch_root() {
+  return fs::temp_directory_path() / ("robin_case_file_test_" + std::to_string(::getpid()));
+}
+
+/// Removes the scratch directories when the tests end.
+class ScratchCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code error;
+    fs::remove_all(scratch_root(), error);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const scratch_cleanup =
+    ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
+
+/// A fresh directory for one written case file.
 fs::path fresh_directory() {
   static std::atomic<int> counter{0};
-  const fs::path directory =
-      fs::temp_directory_path() /
-      ("robin_case_file_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+  const fs::path directory = scratch_root() / std::to_string(counter++);
   fs::create_directories(directory);
   return directory;
 }
