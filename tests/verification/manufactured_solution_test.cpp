@@ -101,6 +101,9 @@ struct ConvergenceCase {
   MeshReadOptions options;
   double expected_rate;
 };
+void PrintTo(const ConvergenceCase& convergence_case, std::ostream* stream) {
+  *stream << convergence_case.name;
+}
 
 class ManufacturedSolution : public testing::TestWithParam<ConvergenceCase> {};
 

@@ -8,6 +8,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <filesystem>
+#include <iostream>
 #include <string>
 
 #include "numerics/dof_map.hpp"
@@ -84,6 +85,9 @@ struct PatchCase {
   MeshReadOptions options;
   ElementType expected_type;
 };
+void PrintTo(const PatchCase& patch_case, std::ostream* stream) {
+  *stream << patch_case.name;
+}
 
 class PatchTest : public testing::TestWithParam<PatchCase> {
  protected:
