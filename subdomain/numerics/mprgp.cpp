@@ -80,6 +80,7 @@ class MprgpIteration {
   bool conjugate_gradient_or_expansion();
   void expansion(double feasible_step, Eigen::Index blocking_index);
   bool proportioning();
+  bool confirm_convergence();
   bool stop(QpStatus status, const std::string& message);
 
   const LinearOperator& matrix_;
@@ -93,6 +94,8 @@ class MprgpIteration {
   Eigen::VectorXd product_;         // A p
   Eigen::VectorXd free_gradient_;   // phi, scratch
   double expansion_step_ = 0.0;     // alpha_bar
+  double threshold_ = 0.0;          // stopping tolerance on ||g^P||
+  int gradient_replacements_ = 0;   // recurrence gradients replaced by A x - b
   bool gradient_is_fresh_ = false;  // g was computed as A x - b, not by the recurrence
 };
 
@@ -154,12 +157,11 @@ bool MprgpIteration::stop(QpStatus status, const std::string& message) {
 
 void MprgpIteration::run(const Eigen::VectorXd& initial, double expansion_step) {
   expansion_step_ = expansion_step;
+  threshold_ = std::max(parameters_.relative_tolerance * right_hand_side_.norm(),
+                        parameters_.absolute_tolerance);
   x_ = initial.cwiseMax(lower_);
   recompute_gradient();
   compute_free_gradient(direction_);
-  const double threshold = std::max(parameters_.relative_tolerance * right_hand_side_.norm(),
-                                    parameters_.absolute_tolerance);
-  int replacements = 0;
   while (true) {
     const GradientSplit split = split_gradient();
     result_.projected_gradient_norm = std::sqrt(split.projected_squared);
@@ -168,28 +170,15 @@ void MprgpIteration::run(const Eigen::VectorXd& initial, double expansion_step) 
                                     std::to_string(result_.iterations) + " iterations");
       return;
     }
-    if (result_.projected_gradient_norm <= threshold) {
-      if (gradient_is_fresh_) {
-        stop(QpStatus::converged, "");
-        return;
-      }
-      if (++replacements > max_gradient_replacements) {
-        stop(QpStatus::not_converged,
-             "||g^P|| = " + format_number(result_.projected_gradient_norm) +
-                 " of the recurrence is not confirmed by A x - b: the tolerance " +
-                 format_number(threshold) + " is below the attainable accuracy");
-        return;
-      }
-      // Replace the drifting recurrence gradient by A x - b and restart the CG sequence.
-      recompute_gradient();
-      compute_free_gradient(direction_);
+    if (result_.projected_gradient_norm <= threshold_) {
+      if (!confirm_convergence()) return;
       continue;
     }
     if (result_.iterations >= parameters_.max_iterations) {
       stop(QpStatus::not_converged,
            "no convergence in " + std::to_string(parameters_.max_iterations) +
                " iterations: ||g^P|| = " + format_number(result_.projected_gradient_norm) + " > " +
-               format_number(threshold));
+               format_number(threshold_));
       return;
     }
     ++result_.iterations;
@@ -200,6 +189,22 @@ void MprgpIteration::run(const Eigen::VectorXd& initial, double expansion_step) 
                              : proportioning();
     if (!proceed) return;
   }
+}
+
+/// Called at ||g^P|| <= threshold: converged when g is A x - b; otherwise g came from the
+/// recurrence and may have drifted, so it is replaced by A x - b and the CG sequence restarts.
+/// Returns false when the iteration stops.
+bool MprgpIteration::confirm_convergence() {
+  if (gradient_is_fresh_) return stop(QpStatus::converged, "");
+  if (++gradient_replacements_ > max_gradient_replacements) {
+    return stop(QpStatus::not_converged,
+                "||g^P|| = " + format_number(result_.projected_gradient_norm) +
+                    " of the recurrence is not confirmed by A x - b: the tolerance " +
+                    format_number(threshold_) + " is below the attainable accuracy");
+  }
+  recompute_gradient();
+  compute_free_gradient(direction_);
+  return true;
 }
 
 bool MprgpIteration::conjugate_gradient_or_expansion() {
