@@ -4,7 +4,6 @@
 #include <spdlog/spdlog.h>
 
 #include "coupling/coupled_run.hpp"
-#include "numerics/errors.hpp"
 #include "remote/remote_port.hpp"
 #include "remote/run_interruption.hpp"
 
@@ -144,7 +143,7 @@ std::string progress_line(const IterationRecord& record) {
 std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {
   try {
     return read_case_file(settings.case_file);
-  } catch (const InputError& error) {
+  } catch (const std::exception& error) {
     coordinator_logger()->error("{}", error.what());
     return std::nullopt;
   }

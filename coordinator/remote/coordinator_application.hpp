@@ -56,7 +56,8 @@ std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level
 /// One line per iteration: the residuals (%.2e), the active set sizes, QP iterations, seconds.
 std::string progress_line(const IterationRecord& record);
 
-/// Reads the case file; logs the InputError and returns nullopt when it is unusable.
+/// Reads the case file; logs the error (an InputError naming file, line and field) and returns
+/// nullopt when it is unusable.
 std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings);
 
 /// Runs the case against the servers at `endpoints` (the first gets body 1), writes the result

@@ -32,5 +32,7 @@ int main(int argc, char** argv) {
   robin::install_stop_signal_handlers();
   const auto definition = robin::load_case(settings);
   if (!definition) return 1;
-  return robin::run_coordinator(*definition, settings, {subdomains[0], subdomains[1]});
+  std::array<robin::ChannelOptions, 2> channels;
+  for (auto& channel : channels) channel.on_wait = robin::throw_if_stop_requested;
+  return robin::run_coordinator(*definition, settings, {subdomains[0], subdomains[1]}, channels);
 }

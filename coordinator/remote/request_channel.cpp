@@ -35,8 +35,9 @@ std::string next_monitor_address() {
 }  // namespace
 
 Deadline Deadline::after(double seconds) {
+  constexpr double longest = 1e9;  // about 30 years: keeps the clock arithmetic finite
   const auto duration = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(std::max(seconds, 0.0)));
+      std::chrono::duration<double>(std::clamp(seconds, 0.0, longest)));
   return {Clock::now() + duration, seconds};
 }
 
