@@ -68,8 +68,10 @@ MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& bod
   const SumOperator compliance(body1.compliance(), body2.compliance());
   const Eigen::VectorXd right_hand_side = body1.free_trace() + body2.free_trace() - gap;
   MonolithicResult result;
+  MprgpParameters scaled = parameters;
+  scaled.solution_scaled_tolerance = true;  // resolve lambda relative to itself, not to |e - d|
   result.qp = solve_mprgp(compliance, right_hand_side, Eigen::VectorXd::Zero(size),
-                          Eigen::VectorXd::Zero(size), parameters);
+                          Eigen::VectorXd::Zero(size), scaled);
   result.contact_force = result.qp.solution;
   // u_N = e - F lambda on each body
   Eigen::VectorXd product;

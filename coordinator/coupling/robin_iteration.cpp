@@ -31,18 +31,29 @@ class ProgressMonitor {
   std::optional<IterationStatus> check(const IterationRecord& record, std::string& message) {
     const double value = record.largest();
     best_history_.push_back(std::min(best(), value));
+    if (record.iteration == 1) first_step_ = record.obstacle_step;
+    smallest_step_ = std::min(smallest_step_, record.obstacle_step);
     std::ostringstream text;
-    if (!std::isfinite(value)) {
+    if (!std::isfinite(value) || !std::isfinite(record.obstacle_step)) {
       text << "the iteration diverged at iteration " << record.iteration
            << ": a residual is not finite";
-    } else if (record.iteration > 3 && value > options_.divergence_factor * best()) {
+    } else if (record.obstacle_step > first_step_ &&
+               record.obstacle_step > options_.divergence_factor * smallest_step_) {
+      // The scaled residuals saturate when the iterates blow up; the raw obstacle step does not.
       text << "the iteration diverged at iteration " << record.iteration
-           << ": the largest residual " << value << " exceeds " << options_.divergence_factor
-           << " times its smallest value " << best()
+           << ": the obstacle update " << record.obstacle_step << " grew to more than "
+           << options_.divergence_factor << " times its smallest value " << smallest_step_
            << " (the relaxation is too large for these bodies; try a smaller --relaxation)";
+    } else if (stagnated() && best() >= no_contraction_level) {
+      text << "the iteration diverged: after " << record.iteration
+           << " iterations the largest residual is still " << best()
+           << " of the solution's scale (the iterates oscillate without contracting; the "
+              "relaxation is too large for these bodies; try a smaller --relaxation)";
     } else if (stagnated()) {
       text << "the iteration stagnated: the largest residual did not decrease by 1% in "
-           << options_.stagnation_window << " iterations (it is " << value << ")";
+           << options_.stagnation_window << " iterations (it is " << value
+           << "); if it is small, the contact QP tolerance (solver.qp_tolerance) may limit the "
+              "attainable accuracy, otherwise the relaxation does not suit these bodies";
       message = text.str();
       return IterationStatus::stagnated;
     } else {
@@ -62,7 +73,12 @@ class ProgressMonitor {
     return best() > 0.99 * best_history_[best_history_.size() - 1 - window];
   }
 
+  /// A run whose smallest residual is still this large after a stagnation window has not
+  /// contracted at all: the iterates oscillate at the scale of the solution.
+  static constexpr double no_contraction_level = 0.1;
   const CouplingOptions& options_;
+  double first_step_ = 0.0;
+  double smallest_step_ = std::numeric_limits<double>::infinity();
   std::vector<double> best_history_;  // smallest largest-residual up to each iteration
 };
 
@@ -84,7 +100,8 @@ IterationRecord make_record(int iteration, const Eigen::VectorXd& gaps,
                           contact1.contact_force, contact2.contact_force);
   const double displacement_scale =
       std::max({maximum_absolute(gaps), maximum_absolute(contact1.normal_trace),
-                maximum_absolute(contact2.normal_trace), std::numeric_limits<double>::min()});
+                maximum_absolute(contact2.normal_trace), maximum_absolute(correction1),
+                maximum_absolute(correction2), std::numeric_limits<double>::min()});
   record.penetration = residuals.penetration;
   record.force_balance = residuals.force_balance;
   record.complementarity = residuals.complementarity;
@@ -162,6 +179,7 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
         change_scale;
     IterationRecord record = make_record(iteration, gaps, contact1, contact2,
                                          correction1.normal_trace, correction2.normal_trace, change);
+    record.obstacle_step = change * change_scale;
     record.seconds = seconds_between(iteration_start, Clock::now());
     result.history.push_back(record);
     result.obstacle1 = obstacle1;

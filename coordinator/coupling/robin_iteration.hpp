@@ -20,10 +20,18 @@
 namespace robin {
 
 /// Residuals of one iteration, all dimensionless: displacement-like quantities are divided by
-/// the displacement scale D = max(|d|, |u1_N|, |u2_N|), forces by F = max(|lambda1|, |lambda2|).
+/// the displacement scale D = max(|d|, |u1_N|, |u2_N|) (and |w_N| for the correction), forces by
+/// F = max(|lambda1|, |lambda2|).
+///
+/// Stopping: converged when every residual is below the tolerance; diverged when the raw
+/// obstacle step grows beyond divergence_factor times its smallest value (and beyond the first
+/// step), or when the residuals have not contracted at all (still >= 0.1) after a stagnation
+/// window; stagnated when the largest residual has not decreased by 1% in stagnation_window
+/// iterations.
 struct IterationRecord {
   int iteration = 0;
   double obstacle_change = 0.0;  // |g_new - g_old| / max(|g_new|, D), both bodies, max norm
+  double obstacle_step = 0.0;    // |g_new - g_old| (length), unscaled: watched for divergence
   double penetration = 0.0;      // max(0, u1_N + u2_N - d) / D
   double force_balance = 0.0;    // |lambda1 - lambda2| / F
   double complementarity = 0.0;  // |lambda (d - u1_N - u2_N)| / (F D), lambda = mean

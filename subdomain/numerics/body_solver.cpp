@@ -219,7 +219,9 @@ ContactSolveResult BodySolver::solve_contact(const Eigen::VectorXd& obstacle,
   // g - u_N, so u_N = g - gradient and the KKT conditions are the Signorini conditions.
   const Eigen::VectorXd right_hand_side = free_trace_ - obstacle;
   const Eigen::VectorXd lower = Eigen::VectorXd::Zero(contact_size());
-  const MprgpResult qp = solve_mprgp(*compliance_, right_hand_side, lower, warm_start_, parameters);
+  MprgpParameters scaled = parameters;
+  scaled.solution_scaled_tolerance = true;  // resolve lambda relative to itself, not to |e - g|
+  const MprgpResult qp = solve_mprgp(*compliance_, right_hand_side, lower, warm_start_, scaled);
 
   ContactSolveResult result;
   result.contact_force = qp.solution;

@@ -69,6 +69,7 @@ class MprgpIteration {
         gradient_(result.gradient) {}
 
   void run(const Eigen::VectorXd& initial, double expansion_step);
+  void update_threshold();
 
  private:
   bool is_free(Eigen::Index i) const { return x_[i] > lower_[i]; }
@@ -156,14 +157,13 @@ bool MprgpIteration::stop(QpStatus status, const std::string& message) {
 
 void MprgpIteration::run(const Eigen::VectorXd& initial, double expansion_step) {
   expansion_step_ = expansion_step;
-  threshold_ = std::max(parameters_.relative_tolerance * right_hand_side_.norm(),
-                        parameters_.absolute_tolerance);
   x_ = initial.cwiseMax(lower_);
   recompute_gradient();
   compute_free_gradient(direction_);
   while (true) {
     const GradientSplit split = split_gradient();
     result_.projected_gradient_norm = std::sqrt(split.projected_squared);
+    update_threshold();
     if (!std::isfinite(result_.projected_gradient_norm) || !std::isfinite(x_.sum())) {
       stop(QpStatus::breakdown, "non-finite iterate or gradient after " +
                                     std::to_string(result_.iterations) + " iterations");
@@ -188,6 +188,22 @@ void MprgpIteration::run(const Eigen::VectorXd& initial, double expansion_step) 
                              : proportioning();
     if (!proceed) return;
   }
+}
+
+/// threshold = max(relative_tolerance * scale, absolute_tolerance) with scale = ||b||, or, for
+/// a solution-scaled tolerance, ||A|| ||x - l|| over the finite bounds (||b|| while that is 0).
+void MprgpIteration::update_threshold() {
+  double scale = right_hand_side_.norm();
+  if (parameters_.solution_scaled_tolerance) {
+    double distance_squared = 0.0;
+    for (Eigen::Index i = 0; i < x_.size(); ++i) {
+      if (std::isfinite(lower_[i])) distance_squared += (x_[i] - lower_[i]) * (x_[i] - lower_[i]);
+    }
+    const double solution_scale =
+        std::sqrt(distance_squared) / expansion_step_ * parameters_.step_factor;
+    if (solution_scale > 0.0) scale = solution_scale;
+  }
+  threshold_ = std::max(parameters_.relative_tolerance * scale, parameters_.absolute_tolerance);
 }
 
 /// Called at ||g^P|| <= threshold: converged when g is A x - b; otherwise g came from the

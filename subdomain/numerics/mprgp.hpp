@@ -12,7 +12,8 @@
 // Gradient g = Ax - b. Free set F = {i : x_i > lower_i}. Free gradient phi_i = g_i on F,
 // chopped gradient beta_i = min(g_i, 0) off F; the projected gradient g^P = phi + beta is
 // zero exactly at the KKT point (x >= l, g >= 0, g'(x - l) = 0).
-// Stopping: ||g^P|| <= relative_tolerance * ||b|| (or absolute_tolerance when b = 0).
+// Stopping: ||g^P|| <= relative_tolerance * ||b|| (or absolute_tolerance when b = 0), or
+// relative to ||A|| ||x - l|| (MprgpParameters::solution_scaled_tolerance).
 
 #include <Eigen/Core>
 #include <string>
@@ -24,6 +25,12 @@ namespace robin {
 struct MprgpParameters {
   double relative_tolerance = 1e-12;
   double absolute_tolerance = 1e-300;
+  /// When true the relative tolerance multiplies ||A|| ||x - l|| (finite bounds only; ||b||
+  /// while x = l) instead of ||b||. This is the natural scale of the dual contact problem,
+  /// whose right-hand side e - g is dominated by the large gaps of open pairs: relative to
+  /// ||b|| the contact forces of the closed pairs would only be resolved to
+  /// relative_tolerance ||b|| / (||A|| ||x||), which the Robin iteration then cannot beat.
+  bool solution_scaled_tolerance = false;
   int max_iterations = 20000;
   /// Proportioning constant Gamma > 0: a proportioning step is taken when
   /// ||beta||^2 > Gamma^2 phi~'phi (phi~ the reduced free gradient).

@@ -40,7 +40,7 @@ void expect_matches_monolithic(const std::string& case_name, double relaxation) 
   const CaseDefinition definition = example(case_name);
   CouplingOptions options = definition.coupling;
   options.relaxation = relaxation;
-  options.tolerance = 1e-10;
+  options.tolerance = 1e-9;
   options.max_iterations = 5000;
   const CoupledRunResult robin = run_in_process(definition, options);
   std::printf("%s: plain relaxation delta = %.3g: %s after %zu iterations\n", case_name.c_str(),
@@ -82,7 +82,32 @@ TEST(RobinVersusMonolithic, PartialContactBlocks) {
 }
 
 TEST(RobinVersusMonolithic, AsymmetricCantileverOnBlock) {
-  expect_matches_monolithic("asymmetric.toml", 0.5);
+  // The bending cantilever is far more compliant than the block on smooth modes, so one shared
+  // delta must be small (see docs/method.md); acceleration is the cure (a later issue).
+  expect_matches_monolithic("asymmetric.toml", 0.02);
+}
+
+TEST(RobinIteration, PlainRelaxationIterationCounts) {
+  // The paper's plain iteration with delta = 1/2. Symmetric bodies: exact in one step once the
+  // active set is right, so only a few iterations. The asymmetric pair: delta = 1/2 is too large
+  // for the cantilever's obstacle sequence; the count (or the failure) is recorded in the log.
+  for (const std::string name : {"two_blocks.toml", "two_blocks_partial.toml", "asymmetric.toml"}) {
+    const CaseDefinition definition = example(name);
+    CouplingOptions options = definition.coupling;
+    options.relaxation = 0.5;
+    options.max_iterations = 1000;
+    const CoupledRunResult robin = run_in_process(definition, options);
+    std::printf("plain relaxation delta = 0.5 on %s: %s, %zu iterations (%s)\n", name.c_str(),
+                to_string(robin.iteration.status).c_str(), robin.iteration.history.size(),
+                robin.iteration.message.c_str());
+    if (name == "two_blocks.toml") {
+      EXPECT_EQ(robin.iteration.status, IterationStatus::converged);
+      EXPECT_LE(robin.iteration.history.size(), 10u);
+    }
+    if (name == "asymmetric.toml") {
+      EXPECT_NE(robin.iteration.status, IterationStatus::converged);
+    }
+  }
 }
 
 TEST(RobinVersusMonolithic, Hertz) { expect_matches_monolithic("hertz.toml", 0.5); }
