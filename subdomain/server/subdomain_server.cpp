@@ -196,35 +196,34 @@ std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
   } catch (...) {
     set_error(reply, protocol::INTERNAL, "internal error: unknown exception", state_);
   }
-  if (reply.has_error()) {
-    record.failed = true;
-    record.outcome =
-        protocol::ErrorCode_Name(reply.error().code()) + ": " + reply.error().message();
-  }
-  reply.mutable_version()->set_major(settings_.protocol_major);
-  reply.mutable_version()->set_minor(protocol::protocol_minor);
   record.seconds = seconds_since(start);
-  try {
-    log(record);
-    return reply.SerializeAsString();
-  } catch (...) {
-    return {};  // out of memory while replying: the loop answers with an empty message
-  }
+  return finish(reply, record);
 }
 
 std::string SubdomainServer::reject(std::string_view reason) noexcept {
+  RequestRecord record;
+  protocol::Envelope reply;
   try {
-    RequestRecord record;
-    record.failed = true;
-    record.outcome = "MALFORMED_MESSAGE: " + std::string(reason);
-    protocol::Envelope reply;
     set_error(reply, protocol::MALFORMED_MESSAGE, std::string(reason), state_);
+  } catch (...) {
+    return {};
+  }
+  return finish(reply, record);
+}
+
+std::string SubdomainServer::finish(protocol::Envelope& reply, RequestRecord& record) noexcept {
+  try {
+    if (reply.has_error()) {
+      record.failed = true;
+      record.outcome =
+          protocol::ErrorCode_Name(reply.error().code()) + ": " + reply.error().message();
+    }
     reply.mutable_version()->set_major(settings_.protocol_major);
     reply.mutable_version()->set_minor(protocol::protocol_minor);
     log(record);
     return reply.SerializeAsString();
   } catch (...) {
-    return {};
+    return {};  // out of memory while replying: the client receives an empty message
   }
 }
 

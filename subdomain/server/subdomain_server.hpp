@@ -94,6 +94,8 @@ class SubdomainServer {
                      RequestRecord& record);
   void on_fields(const protocol::Envelope& request, protocol::Envelope& reply);
   void acknowledge(protocol::Envelope& reply) const;
+  /// Sets our version on `reply`, logs `record` and serializes the reply.
+  std::string finish(protocol::Envelope& reply, RequestRecord& record) noexcept;
   void log(const RequestRecord& record) const;
 
   ServerSettings settings_;

@@ -366,6 +366,17 @@ TEST(SubdomainServer, ReplyTypeSentAsRequestIsUnsupported) {
   EXPECT_NE(reply.error().message().find("Acknowledge is a reply"), std::string::npos);
 }
 
+TEST(SubdomainServer, RequestTypeUnknownToThisVersionIsUnsupported) {
+  SubdomainServer server(quiet_settings());
+  // An Envelope whose content is a field this version does not know (number 40, empty bytes),
+  // as a newer minor version could send: tag (40 << 3 | 2) = 322 = varint C2 02, length 0.
+  const std::string bytes = request(8).SerializeAsString() + std::string("\xc2\x02\x00", 3);
+  protocol::Envelope reply;
+  ASSERT_TRUE(reply.ParseFromString(server.handle(bytes)));
+  EXPECT_EQ(reply.request_id(), 8u);
+  expect_error(reply, protocol::UNSUPPORTED, "awaiting_setup");
+}
+
 TEST(SubdomainServer, OtherMajorVersionIsAMismatchNamingBothVersions) {
   SubdomainServer server(quiet_settings());
   const protocol::Envelope reply = exchange(server, hello_request(9, 2));
