@@ -189,6 +189,36 @@ protocol::Envelope shutdown(std::uint64_t id) {
   return envelope;
 }
 
+/// Body 1 of examples/two_blocks.toml, the mesh given as a path on the server's file system.
+protocol::Envelope lower_block_setup(std::uint64_t id) {
+  protocol::Envelope setup = request(id);
+  protocol::SetupBody& body = *setup.mutable_setup_body();
+  body.set_body_name("lower");
+  body.set_mesh_path(lower_geo.string());
+  body.set_mesh_size(0.1);
+  body.set_model(protocol::PLANE_STRAIN);
+  body.set_young_modulus(1000.0);
+  body.set_poisson_ratio(0.3);
+  body.add_dirichlet()->set_boundary("bottom");
+  body.mutable_dirichlet(0)->set_x(0.0);
+  body.mutable_dirichlet(0)->set_y(0.0);
+  body.set_contact_boundary("contact");
+  return setup;
+}
+
+/// The same body, built in this process.
+BodyDefinition lower_block_definition() {
+  BodyDefinition definition;
+  definition.name = "lower";
+  MeshReadOptions options;
+  options.size = 0.1;
+  definition.mesh = read_gmsh_mesh(lower_geo, options);
+  definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
+  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  definition.contact_boundary = "contact";
+  return definition;
+}
+
 TEST(SubdomainProcess, GarbageGetsAnErrorReplyAndShutdownExitsWithZero) {
   ServerProcess server({"--listen", "tcp://127.0.0.1:*", "--name", "garbage"});
   const std::string endpoint = server.endpoint();
@@ -251,35 +281,12 @@ TEST(SubdomainProcess, IpcEndpointServesAContactSolveEqualToADirectSolve) {
   zmq::context_t context;
   zmq::socket_t socket = connect(context, endpoint);
 
-  // Body 1 of examples/two_blocks.toml, the mesh given as a path on the server's file system.
-  protocol::Envelope setup = request(1);
-  protocol::SetupBody& body = *setup.mutable_setup_body();
-  body.set_body_name("lower");
-  body.set_mesh_path(lower_geo.string());
-  body.set_mesh_size(0.1);
-  body.set_model(protocol::PLANE_STRAIN);
-  body.set_young_modulus(1000.0);
-  body.set_poisson_ratio(0.3);
-  body.add_dirichlet()->set_boundary("bottom");
-  body.mutable_dirichlet(0)->set_x(0.0);
-  body.mutable_dirichlet(0)->set_y(0.0);
-  body.set_contact_boundary("contact");
-  const protocol::Envelope interface_reply = exchange(socket, setup);
+  const protocol::Envelope interface_reply = exchange(socket, lower_block_setup(1));
   ASSERT_TRUE(interface_reply.has_interface()) << interface_reply.DebugString();
-
-  BodyDefinition definition;
-  definition.name = "lower";
-  MeshReadOptions options;
-  options.size = 0.1;
-  definition.mesh = read_gmsh_mesh(lower_geo, options);
-  definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
-  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
-  definition.contact_boundary = "contact";
-  BodySolver reference(std::move(definition));
+  BodySolver reference(lower_block_definition());
   const InterfaceDescription interface = reference.contact_boundary();
   ASSERT_EQ(interface_reply.interface().node_ids_size(),
             static_cast<int>(interface.node_ids.size()));
-
   ContactAssignment assignment{interface.node_ids, {}};
   protocol::Envelope assign = request(2);
   for (int node : interface.node_ids) {

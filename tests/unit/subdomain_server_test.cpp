@@ -241,6 +241,35 @@ void expect_fields(const protocol::FieldsReply& message, const BodySolver& refer
   EXPECT_NEAR(message.reaction_resultant(1), total_contact_force, 1e-9 * total_contact_force);
 }
 
+/// A correction (r_i = 1 + x_i) and the fields for `contact_force`, written to a temporary
+/// directory, compared with `reference`.
+void expect_correction_and_fields(SubdomainServer& server, const BodySolver& reference,
+                                  const InterfaceDescription& interface,
+                                  const Eigen::VectorXd& contact_force) {
+  protocol::Envelope correction = request(5);
+  Eigen::VectorXd interface_force(21);
+  for (int i = 0; i < 21; ++i) interface_force[i] = 1.0 + interface.coordinates[i].x();
+  correction.mutable_correction()->mutable_interface_force()->Assign(interface_force.begin(),
+                                                                     interface_force.end());
+  protocol::Envelope reply = exchange(server, correction);
+  ASSERT_TRUE(reply.has_correction_result()) << reply.DebugString();
+  expect_equal_vectors(to_vector(reply.correction_result().normal_trace()),
+                       reference.solve_correction(interface_force));
+
+  const std::filesystem::path directory = std::filesystem::temp_directory_path() /
+                                          ("subdomain_server_test_" + std::to_string(getpid()));
+  protocol::Envelope fields = request(6);
+  fields.mutable_fields()->mutable_contact_force()->Assign(contact_force.begin(),
+                                                           contact_force.end());
+  fields.mutable_fields()->set_write_directory(directory.string());
+  reply = exchange(server, fields);
+  ASSERT_TRUE(reply.has_fields_reply()) << reply.DebugString();
+  expect_fields(reply.fields_reply(), reference, contact_force);
+  EXPECT_EQ(reply.fields_reply().written_file(), (directory / "lower.vtu").string());
+  EXPECT_TRUE(std::filesystem::is_regular_file(directory / "lower.vtu"));
+  std::filesystem::remove_all(directory);
+}
+
 TEST(SubdomainServer, FullRunMatchesADirectlyBuiltBodySolver) {
   SubdomainServer server(quiet_settings());
   BodySolver reference(lower_block_definition());
@@ -275,28 +304,7 @@ TEST(SubdomainServer, FullRunMatchesADirectlyBuiltBodySolver) {
     expect_contact_result(reply.contact_result(), expected, obstacle);
   }
 
-  protocol::Envelope correction = request(5);
-  Eigen::VectorXd interface_force(21);
-  for (int i = 0; i < 21; ++i) interface_force[i] = 1.0 + interface.coordinates[i].x();
-  correction.mutable_correction()->mutable_interface_force()->Assign(interface_force.begin(),
-                                                                     interface_force.end());
-  reply = exchange(server, correction);
-  ASSERT_TRUE(reply.has_correction_result()) << reply.DebugString();
-  expect_equal_vectors(to_vector(reply.correction_result().normal_trace()),
-                       reference.solve_correction(interface_force));
-
-  const std::filesystem::path directory = std::filesystem::temp_directory_path() /
-                                          ("subdomain_server_test_" + std::to_string(getpid()));
-  protocol::Envelope fields = request(6);
-  fields.mutable_fields()->mutable_contact_force()->Assign(expected.contact_force.begin(),
-                                                           expected.contact_force.end());
-  fields.mutable_fields()->set_write_directory(directory.string());
-  reply = exchange(server, fields);
-  ASSERT_TRUE(reply.has_fields_reply()) << reply.DebugString();
-  expect_fields(reply.fields_reply(), reference, expected.contact_force);
-  EXPECT_EQ(reply.fields_reply().written_file(), (directory / "lower.vtu").string());
-  EXPECT_TRUE(std::filesystem::is_regular_file(directory / "lower.vtu"));
-  std::filesystem::remove_all(directory);
+  expect_correction_and_fields(server, reference, interface, expected.contact_force);
 
   protocol::Envelope end_run = request(7);
   end_run.mutable_end_run();
