@@ -13,7 +13,6 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <sstream>
 
 #include "coupling/coupled_run.hpp"
@@ -74,23 +73,39 @@ std::vector<int> children_named(const std::string& name) {
   return pids;
 }
 
-/// True when a TCP connection to host:port is refused (nothing listens there any more).
+/// True when a TCP connection to tcp://HOST:PORT is refused (nothing listens there any more).
 bool tcp_port_closed(const std::string& endpoint) {
-  const std::smatch match = [&] {
-    std::smatch result;
-    std::regex_match(endpoint, result, std::regex(R"(tcp://([0-9.]+):([0-9]+))"));
-    return result;
-  }();
-  if (match.empty()) return false;
+  const std::string prefix = "tcp://";
+  const auto colon = endpoint.rfind(':');
+  if (endpoint.rfind(prefix, 0) != 0 || colon == std::string::npos) return false;
+  const std::string host = endpoint.substr(prefix.size(), colon - prefix.size());
   sockaddr_in address{};
   address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<uint16_t>(std::stoi(match[2].str())));
-  inet_pton(AF_INET, match[1].str().c_str(), &address.sin_addr);
+  address.sin_port = htons(static_cast<uint16_t>(std::stoi(endpoint.substr(colon + 1))));
+  if (inet_pton(AF_INET, host.c_str(), &address.sin_addr) != 1) return false;
   const int socket_descriptor = socket(AF_INET, SOCK_STREAM, 0);
   const int result =
       connect(socket_descriptor, reinterpret_cast<const sockaddr*>(&address), sizeof address);
   close(socket_descriptor);
   return result != 0;
+}
+
+/// (pid, endpoint) of every "... (pid N) listening on ENDPOINT" line of the launcher's log.
+std::vector<std::pair<std::string, std::string>> listening_servers(const std::string& log) {
+  std::vector<std::pair<std::string, std::string>> servers;
+  std::istringstream lines(log);
+  const std::string pid_marker = "(pid ", listening_marker = ") listening on ";
+  for (std::string line; std::getline(lines, line);) {
+    const auto listening = line.find(listening_marker);
+    const auto pid = line.rfind(pid_marker, listening);
+    if (listening == std::string::npos || pid == std::string::npos) continue;
+    std::istringstream endpoint(line.substr(listening + listening_marker.size()));
+    std::string word;
+    endpoint >> word;
+    servers.emplace_back(line.substr(pid + pid_marker.size(), listening - pid - pid_marker.size()),
+                         word);
+  }
+  return servers;
 }
 
 double in_process_resultant_y() {
@@ -121,15 +136,12 @@ TEST(RobinRun, SolvesTwoBlocksAndLeavesNoServerBehind) {
               1e-12 * std::abs(expected));
 
   // The launcher logged "<server> (pid N) listening on ENDPOINT" for both servers.
-  const std::regex listening(R"(\(pid ([0-9]+)\) listening on (\S+))");
-  int servers = 0;
-  for (auto it = std::sregex_iterator(outcome.errors.begin(), outcome.errors.end(), listening);
-       it != std::sregex_iterator(); ++it, ++servers) {
-    const std::string pid = (*it)[1].str(), endpoint = (*it)[2].str();
+  const auto servers = listening_servers(outcome.errors);
+  for (const auto& [pid, endpoint] : servers) {
     EXPECT_FALSE(std::filesystem::exists("/proc/" + pid)) << "server pid " << pid << " remains";
     EXPECT_TRUE(tcp_port_closed(endpoint)) << endpoint << " still accepts connections";
   }
-  EXPECT_EQ(servers, 2) << outcome.errors;
+  EXPECT_EQ(servers.size(), 2u) << outcome.errors;
   EXPECT_TRUE(children_named("robin-subdomain").empty()) << "orphaned servers were reparented here";
   EXPECT_TRUE(std::filesystem::exists(output.path() / "logs" / "server-lower.log"));
   EXPECT_TRUE(std::filesystem::exists(output.path() / "logs" / "server-upper.log"));
