@@ -1,5 +1,6 @@
 #include "coupling/coupled_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <future>
@@ -16,6 +17,12 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+PortTimings difference(const PortTimings& later, const PortTimings& earlier) {
+  return {later.compute_seconds - earlier.compute_seconds,
+          later.round_trip_seconds - earlier.round_trip_seconds,
+          later.bytes_sent - earlier.bytes_sent, later.bytes_received - earlier.bytes_received};
 }
 
 void report_stage(const RunObserver& observer, const std::string& text) {
@@ -80,7 +87,13 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   summary["contact_pairs"] = result.pairing.size();
   summary["excluded_pairs"] = result.pairing.excluded;
   summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
-  double server_compute = 0.0, messaging = 0.0;
+  double server_compute = 0.0;
+  long iteration_bytes = 0;
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    iteration_bytes += result.iteration_port_timings[alpha].bytes_sent +
+                       result.iteration_port_timings[alpha].bytes_received;
+  }
+  const double iterations = std::max<double>(1.0, static_cast<double>(iteration.history.size()));
   for (int alpha = 0; alpha < 2; ++alpha) {
     const PortTimings& timings = result.port_timings[alpha];
     const BodyOutput& output = result.outputs[alpha];
@@ -94,13 +107,17 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
          {"reaction_resultant", {output.reaction_resultant.x(), output.reaction_resultant.y()}},
          {"applied_force", {output.applied_force.x(), output.applied_force.y()}}});
     server_compute += timings.compute_seconds;
-    messaging += timings.round_trip_seconds - timings.compute_seconds;
   }
+  summary["bytes_per_iteration"] = static_cast<double>(iteration_bytes) / iterations;
+  const double messaging = iteration.messaging_seconds();
   summary["timings"] = {{"setup", result.setup_seconds},
                         {"iteration", iteration.wall_seconds},
                         {"server_compute", server_compute},
+                        {"server_compute_critical_path", iteration.critical_compute_seconds},
                         {"coordinator_compute", iteration.coordinator_seconds},
                         {"messaging", messaging},
+                        {"messaging_share_of_iteration",
+                         iteration.wall_seconds > 0 ? messaging / iteration.wall_seconds : 0.0},
                         {"total", result.total_seconds}};
   return summary;
 }
@@ -127,8 +144,12 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   for (int alpha = 0; alpha < 2; ++alpha) ports[alpha]->assign_contact(result.pairing.assignment(alpha));
   result.setup_seconds = seconds_since(start);
 
+  const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
   result.iteration =
       run_robin_iteration(*ports[0], *ports[1], result.pairing.gaps(), options, observer.iteration);
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    result.iteration_port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
+  }
   report_stage(observer, "collecting the fields of both bodies");
   const RobinResult& iteration = result.iteration;
   result.outputs = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {

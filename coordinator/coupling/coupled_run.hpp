@@ -20,7 +20,8 @@ struct CoupledRunResult {
   RobinResult iteration;
   std::array<BodyOutput, 2> outputs;
   std::array<InterfaceDescription, 2> interfaces;
-  std::array<PortTimings, 2> port_timings;
+  std::array<PortTimings, 2> port_timings;            // whole run
+  std::array<PortTimings, 2> iteration_port_timings;  // the iteration alone (no setup, fields)
   double setup_seconds = 0.0;
   double total_seconds = 0.0;
 };

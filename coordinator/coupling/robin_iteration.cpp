@@ -165,6 +165,8 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
     const CorrectionSolveResult correction2 = body2.finish_correction();
     const auto update_start = Clock::now();
     port_seconds += seconds_between(correction_start, update_start);
+    result.critical_compute_seconds += std::max(contact1.seconds, contact2.seconds) +
+                                       std::max(correction1.seconds, correction2.seconds);
     // Step 3: relaxed obstacle updates.
     const Eigen::VectorXd next1 = (1.0 - delta) * obstacle1 +
                                   delta * (correction2.normal_trace - contact2.normal_trace + gaps);

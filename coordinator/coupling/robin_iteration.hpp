@@ -55,7 +55,15 @@ struct RobinResult {
   Eigen::VectorXd contact_force1, contact_force2;
   Eigen::VectorXd correction1, correction2;      // w_N
   double coordinator_seconds = 0.0;  // time in the coordinator's own computations
+  /// Critical path of the bodies' compute: sum over iterations of max(contact1, contact2) +
+  /// max(correction1, correction2), as reported by the bodies.
+  double critical_compute_seconds = 0.0;
   double wall_seconds = 0.0;
+  /// Transport time: wall - coordinator - critical compute (for in-process ports this is the
+  /// serialisation of the two bodies, which run one after the other).
+  double messaging_seconds() const {
+    return wall_seconds - coordinator_seconds - critical_compute_seconds;
+  }
 };
 
 using IterationObserver = std::function<void(const IterationRecord&)>;

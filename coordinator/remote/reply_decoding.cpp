@@ -116,6 +116,7 @@ InterfaceDescription decode_interface(const protocol::InterfaceDescription& mess
   interface.weights.assign(message.weights().begin(), message.weights().end());
   interface.x_fixed.assign(message.x_fixed().begin(), message.x_fixed().end());
   interface.y_fixed.assign(message.y_fixed().begin(), message.y_fixed().end());
+  interface.dof_count = static_cast<int>(message.dof_count());
   return interface;
 }
 
