@@ -1,0 +1,134 @@
+// Bad input through the real executables: every problem ends with a non-zero exit and a message
+// naming the file, the field (and line) and the body; never a crash (exit by signal) or a hang.
+// Each case is a variant of examples/two_blocks.toml written to a temporary directory.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code = -1;  // -1 when killed by a signal
+  std::string output;  // stdout and stderr
+};
+
+CommandResult run_command(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen(("timeout 60 " + command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
+  const int status = pclose(pipe);
+  if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
+  return result;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+class BadInput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = fs::temp_directory_path() /
+                 ("robin_bad_input_" + std::to_string(::getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(directory_);
+    const fs::path meshes = fs::path(ROBIN_EXAMPLES) / "meshes";
+    base_case_ = read_text(fs::path(ROBIN_EXAMPLES) / "two_blocks.toml");
+    base_case_ = std::regex_replace(base_case_, std::regex("meshes/"), meshes.string() + "/");
+  }
+  void TearDown() override { fs::remove_all(directory_); }
+
+  /// Writes the base case with `from` replaced by `to` (which must occur) and returns its path.
+  fs::path write_case(const std::string& from, const std::string& to) {
+    const std::size_t position = base_case_.find(from);
+    EXPECT_NE(position, std::string::npos) << from;
+    std::string text = base_case_;
+    if (position != std::string::npos) text.replace(position, from.size(), to);
+    const fs::path path = directory_ / "case.toml";
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  /// Runs robin-monolithic on the case and checks a clean failure whose message contains
+  /// every fragment.
+  void expect_failure(const fs::path& case_path, const std::vector<std::string>& fragments) {
+    const std::string binary = std::string(ROBIN_BINARY_DIR) + "/bin/robin-monolithic";
+    const CommandResult result = run_command(binary + " " + case_path.string() + " --output " +
+                                             (directory_ / "out").string());
+    EXPECT_EQ(result.exit_code, 1) << result.output;
+    for (const std::string& fragment : fragments) {
+      EXPECT_NE(result.output.find(fragment), std::string::npos)
+          << "missing '" << fragment << "' in:\n"
+          << result.output;
+    }
+  }
+
+  fs::path directory_;
+  std::string base_case_;
+};
+
+TEST_F(BadInput, MissingCaseFile) {
+  expect_failure(directory_ / "nowhere.toml", {"nowhere.toml"});
+}
+
+TEST_F(BadInput, MalformedCaseFileNamesTheLine) {
+  expect_failure(write_case("title = \"symmetric two blocks\"", "title = \"unterminated"),
+                 {"case.toml:4"});
+}
+
+TEST_F(BadInput, UnknownKeyIsAnError) {
+  expect_failure(write_case("young = 1000.0", "youngs = 1000.0"), {"case.toml", "youngs", "lower"});
+}
+
+TEST_F(BadInput, MissingMeshNamesThePathAndBody) {
+  expect_failure(write_case("block_lower.geo", "no_such_mesh.geo"), {"no_such_mesh.geo", "lower"});
+}
+
+TEST_F(BadInput, MalformedMeshNamesTheFile) {
+  const fs::path garbage = directory_ / "garbage.msh";
+  std::ofstream(garbage) << "$MeshFormat\nthis is not a mesh\n";
+  const std::string lower = fs::path(ROBIN_EXAMPLES).string() + "/meshes/block_lower.geo";
+  expect_failure(write_case(lower + "\"\nmesh_size = 0.1", garbage.string() + "\""),
+                 {"garbage.msh", "lower"});
+}
+
+TEST_F(BadInput, UnknownPhysicalGroupNamesTheFieldAndBody) {
+  expect_failure(write_case("boundary = \"bottom\"", "boundary = \"floor\""),
+                 {"case.toml", "floor", "lower", "dirichlet"});
+}
+
+TEST_F(BadInput, IncompressiblePoissonRatio) {
+  expect_failure(write_case("poisson = 0.3", "poisson = 0.5"), {"case.toml", "lower", "oisson"});
+}
+
+TEST_F(BadInput, NonPositiveDefiniteVoigtMatrix) {
+  expect_failure(write_case("young = 1000.0\npoisson = 0.3",
+                            "voigt = [[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]]"),
+                 {"case.toml", "lower", "positive definite"});
+}
+
+TEST_F(BadInput, BodyWithoutEnoughDirichletConditions) {
+  expect_failure(write_case("x = 0.0\ny = 0.0", "y = 0.0"), {"lower", "rigid motion"});
+}
+
+TEST_F(BadInput, GapExpressionThatDoesNotParse) {
+  expect_failure(write_case("[coupling]", "[gap]\nexpression = \"sin(x\"\n\n[coupling]"),
+                 {"case.toml", "gap.expression"});
+}
+
+}  // namespace
