@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config git
-  libeigen3-dev libsuitesparse-dev
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread
   libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
   libspdlog-dev libfmt-dev
   libgmsh-dev gmsh
