@@ -94,7 +94,7 @@ void read_solver(const CheckedTable& root, SolverOptions& solver) {
                                      : *kind == "dense" ? InterfaceOperatorKind::dense
                                                         : InterfaceOperatorKind::factor;
   }
-  solver.body.dense_limit = integer_at_least(*table, "dense_limit", 0, solver.body.dense_limit);
+  solver.body.dense_limit = integer_at_least(*table, "dense_limit", 1, solver.body.dense_limit);
   solver.pairing_tolerance =
       number_above(*table, "pairing_tolerance", 0.0, solver.pairing_tolerance);
 }
