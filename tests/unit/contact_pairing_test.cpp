@@ -1,0 +1,96 @@
+// Node-to-node pairing of two contact boundaries, on hand-built interfaces whose pairs, normals,
+// gaps and weights are known by construction.
+
+#include "coupling/contact_pairing.hpp"
+
+#include <gtest/gtest.h>
+
+#include "numerics/errors.hpp"
+
+namespace robin {
+namespace {
+
+/// A flat interface y = height with nodes at the given x (tags 100 + i), unit weights,
+/// outward normal (0, normal_y).
+InterfaceDescription flat_interface(const std::vector<double>& xs, double height, double normal_y) {
+  InterfaceDescription interface;
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    interface.node_ids.push_back(static_cast<int>(i));
+    interface.node_tags.push_back(100 + i);
+    interface.coordinates.emplace_back(xs[i], height);
+    interface.normals.emplace_back(0.0, normal_y);
+    interface.weights.push_back(1.0 + static_cast<double>(i));
+    interface.x_fixed.push_back(false);
+    interface.y_fixed.push_back(false);
+  }
+  return interface;
+}
+
+TEST(ContactPairing, MatchingFlatInterfacesWithGeometricAndAnalyticGap) {
+  // Body 1 below (outward normal +y), body 2 above at distance 0.1, listed in another order.
+  const InterfaceDescription lower = flat_interface({1.0, 0.0, 0.5}, 0.0, 1.0);
+  InterfaceDescription upper = flat_interface({0.5, 1.0, 0.0}, 0.1, -1.0);
+  const GapFunction parabola("x^2", {}, "test");
+  const ContactPairing pairing =
+      pair_contact_nodes(lower, "lower", upper, "upper", &parabola, 1e-6);
+  ASSERT_EQ(pairing.size(), 3u);
+  EXPECT_TRUE(pairing.excluded.empty());
+  const std::vector<double> expected_x = {0.0, 0.5, 1.0};  // ordered along the zone
+  for (std::size_t i = 0; i < 3; ++i) {
+    const ContactPair& pair = pairing.pairs[i];
+    EXPECT_DOUBLE_EQ(pair.position.x(), expected_x[i]);
+    EXPECT_DOUBLE_EQ(pair.normal.x(), 0.0);
+    EXPECT_DOUBLE_EQ(pair.normal.y(), 1.0);
+    EXPECT_NEAR(pair.gap, 0.1 + expected_x[i] * expected_x[i], 1e-15);
+    EXPECT_DOUBLE_EQ(lower.coordinates[pair.node1].x(), upper.coordinates[pair.node2].x());
+    // Weights: lower node k has 1 + k, upper node k has 1 + k; the pair averages both sides.
+    EXPECT_DOUBLE_EQ(pair.weight, 0.5 * (lower.weights[pair.node1] + upper.weights[pair.node2]));
+  }
+  const ContactAssignment second = pairing.assignment(1);
+  EXPECT_DOUBLE_EQ(second.normals[0].y(), -1.0);
+  EXPECT_EQ(second.node_ids[0], 2);  // upper node at x = 0
+}
+
+TEST(ContactPairing, NonMatchingMeshesNameTheFirstUnmatchedNode) {
+  const InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  const InterfaceDescription upper = flat_interface({0.0, 0.52, 1.0}, 0.0, -1.0);
+  try {
+    pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("body 'lower'"), std::string::npos) << message;
+    EXPECT_NE(message.find("tag 101"), std::string::npos) << message;
+    EXPECT_NE(message.find("(0.5, 0)"), std::string::npos) << message;
+  }
+}
+
+TEST(ContactPairing, ExtraNodeOnTheSecondBodyIsNamed) {
+  const InterfaceDescription lower = flat_interface({0.0, 1.0}, 0.0, 1.0);
+  const InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
+  try {
+    pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("body 'upper'"), std::string::npos) << message;
+    EXPECT_NE(message.find("(0.5, 0)"), std::string::npos) << message;
+  }
+}
+
+TEST(ContactPairing, PairsWithAPrescribedNormalDisplacementAreExcluded) {
+  InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
+  lower.x_fixed[0] = lower.y_fixed[0] = true;  // clamped: normal displacement prescribed
+  upper.y_fixed[2] = true;                     // u_y fixed and the normal is (0, -1)
+  lower.x_fixed[1] = true;                     // only the tangential component: stays in contact
+  const ContactPairing pairing = pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
+  ASSERT_EQ(pairing.size(), 1u);
+  EXPECT_DOUBLE_EQ(pairing.pairs[0].position.x(), 0.5);
+  ASSERT_EQ(pairing.excluded.size(), 2u);
+  EXPECT_NE(pairing.excluded[0].find("body 'lower'"), std::string::npos);
+  EXPECT_NE(pairing.excluded[1].find("body 'upper'"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace robin
