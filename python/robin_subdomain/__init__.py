@@ -1,0 +1,10 @@
+"""robin_subdomain: a reference external subdomain server of robin-contact, in Python.
+
+A second, independent implementation of one elastic body of the Robin domain decomposition
+(proto/robin.proto, docs/protocol.md): its own Gmsh reader, finite elements (P1, P2 triangles
+and Q1 quadrilaterals, plane strain or stress), sparse LU factorization (SuperLU via SciPy),
+dense interface compliance and bound-constrained contact QP. Nothing here calls the C++ code.
+"""
+
+VERSION = "0.1.0"
+SERVER_NAME = "robin-subdomain-py " + VERSION

@@ -1,0 +1,174 @@
+"""One elastic body: assembled stiffness, Dirichlet reduction, a sparse LU factor computed once,
+and the operators of the dual (contact-force) formulation on its assigned contact nodes.
+
+With B the normal trace on the assigned nodes ((B u)_i = u(node_i) . n_i), K the stiffness on
+the free dofs and f the reduced load (f_f - K_fp u_p):
+  e = B K^-1 f + B u_p       free normal trace
+  F = B K^-1 B'              interface compliance, assembled densely
+  u_N = e - F lambda         normal trace under nodal contact forces lambda (K u = f - B' lambda)
+"""
+
+import time
+
+import numpy as np
+import scipy.sparse
+import scipy.sparse.linalg
+
+from . import contact, fem
+from .errors import InputError, SingularBodyError
+
+
+class BodyDefinition:
+    """Plain data: name, mesh, material, body_force (2), dirichlet [(boundary, x or None,
+    y or None)], tractions [(boundary, vector (2) or None, pressure or None)], contact_boundary."""
+
+    def __init__(self, name, mesh, material, body_force=(0.0, 0.0), dirichlet=(), tractions=(),
+                 contact_boundary=""):
+        self.name = name
+        self.mesh = mesh
+        self.material = material
+        self.body_force = np.asarray(body_force, dtype=float)
+        self.dirichlet = list(dirichlet)
+        self.tractions = list(tractions)
+        self.contact_boundary = contact_boundary
+
+
+def prescribed_values(definition):
+    """Per dof: the prescribed value, NaN when free. Conflicting values are an InputError."""
+    mesh = definition.mesh
+    values = np.full(2 * mesh.node_count(), np.nan)
+    source = {}
+    for boundary, x, y in definition.dirichlet:
+        for node in mesh.boundaries[boundary].nodes():
+            for component, value in ((0, x), (1, y)):
+                if value is None:
+                    continue
+                dof = 2 * node + component
+                if not np.isnan(values[dof]) and abs(values[dof] - value) > 1e-14 * (1 + abs(value)):
+                    raise InputError(
+                        "body '%s': Dirichlet conditions on '%s' and '%s' prescribe different "
+                        "values to node tag %d (%s)" % (definition.name, source[dof], boundary,
+                                                        mesh.node_tags[node],
+                                                        "u_x" if component == 0 else "u_y"))
+                values[dof] = value
+                source[dof] = boundary
+    return values
+
+
+def removes_rigid_motions(nodes, prescribed):
+    """True when the prescribed dofs block the rigid modes (1, 0), (0, 1) and the rotation
+    (-(y - yc), x - xc) / scale: the Gram matrix of the modes on those dofs has rank 3."""
+    centre = nodes.mean(axis=0)
+    scale = np.max(np.hypot(*(nodes - centre).T)) or 1.0
+    relative = (nodes - centre) / scale
+    rows = np.zeros((len(prescribed), 3))
+    rows[0::2, 0] = 1.0
+    rows[0::2, 2] = -relative[:, 1]
+    rows[1::2, 1] = 1.0
+    rows[1::2, 2] = relative[:, 0]
+    rows = rows[prescribed]
+    eigenvalues = np.linalg.eigvalsh(rows.T @ rows)
+    return eigenvalues[2] > 0.0 and eigenvalues[0] > 1e-10 * eigenvalues[2]
+
+
+def external_load(definition):
+    """f: body force plus tractions (pressure p: traction -p n, compression positive)."""
+    mesh = definition.mesh
+    load = np.zeros(2 * mesh.node_count())
+    if np.any(definition.body_force != 0.0):
+        load += fem.assemble_body_force(mesh, definition.body_force)
+    for boundary, vector, pressure in definition.tractions:
+        edges = fem.EdgeSet(mesh, boundary, mesh.boundaries[boundary])
+        if pressure is not None:
+            load += fem.assemble_traction(mesh, edges, lambda x, n: -pressure * n)
+        else:
+            constant = np.asarray(vector, dtype=float)
+            load += fem.assemble_traction(mesh, edges,
+                                          lambda x, n: np.broadcast_to(constant, x.shape))
+    return load
+
+
+class Body:
+    """Assembles and factorizes at construction (InputError, SingularBodyError)."""
+
+    def __init__(self, definition):
+        self.definition = definition
+        self.name = definition.name
+        self.mesh = definition.mesh
+        start = time.perf_counter()
+        if self.mesh.node_count() == 0 or self.mesh.element_count() == 0:
+            raise InputError("body '%s': the mesh has no elements" % self.name)
+        self.prescribed = prescribed_values(definition)
+        self.is_prescribed = ~np.isnan(self.prescribed)
+        if not removes_rigid_motions(self.mesh.nodes, self.is_prescribed):
+            raise SingularBodyError(
+                "body '%s': the Dirichlet conditions leave a rigid motion free (translation or "
+                "rotation); fix u_x and u_y on a boundary segment, or enough components on "
+                "several boundaries" % self.name)
+        self.free_dofs = np.flatnonzero(~self.is_prescribed)
+        self.free_index = np.full(len(self.prescribed), -1, dtype=np.int64)
+        self.free_index[self.free_dofs] = np.arange(len(self.free_dofs))
+        self.prescribed_full = np.where(self.is_prescribed, self.prescribed, 0.0)
+        self.full_stiffness = fem.assemble_stiffness(self.mesh, definition.material)
+        self.full_load = external_load(definition)
+        reduced = self.full_stiffness[self.free_dofs][:, self.free_dofs].tocsc()
+        # f_f - K_fp u_p: the free rows of f - K u_p
+        self.reduced_load = (self.full_load - self.full_stiffness @ self.prescribed_full)[
+            self.free_dofs]
+        self.assembly_seconds = time.perf_counter() - start
+        start = time.perf_counter()
+        self.factor = self._factorize(reduced)
+        self.free_solution = self.factor.solve(self.reduced_load)   # K^-1 f
+        self.factorization_seconds = time.perf_counter() - start
+        self.contact = None
+
+    def _factorize(self, reduced):
+        try:
+            # K is SPD: symmetric ordering and diagonal pivots (SuperLU's symmetric mode).
+            return scipy.sparse.linalg.splu(reduced, permc_spec="MMD_AT_PLUS_A",
+                                            diag_pivot_thresh=0.0,
+                                            options={"SymmetricMode": True})
+        except RuntimeError as error:
+            raise SingularBodyError("body '%s': the stiffness matrix is singular (%s)" %
+                                    (self.name, error))
+
+    def free_dof_count(self):
+        return len(self.free_dofs)
+
+    def contact_edges(self):
+        boundary = self.definition.contact_boundary
+        return fem.EdgeSet(self.mesh, boundary, self.mesh.boundaries[boundary])
+
+    def contact_boundary(self):
+        """The contact boundary as the body sees it: dict of node_ids (ascending), node_tags,
+        coordinates (n x 2), normals (n x 2), weights (n), x_fixed, y_fixed."""
+        edges = self.contact_edges()
+        nodes = edges.group.nodes()
+        return {"node_ids": nodes, "node_tags": self.mesh.node_tags[nodes],
+                "coordinates": self.mesh.nodes[nodes],
+                "normals": fem.boundary_node_normals(self.mesh, edges),
+                "weights": fem.boundary_weights(self.mesh, edges)[nodes],
+                "x_fixed": self.is_prescribed[2 * nodes], "y_fixed": self.is_prescribed[2 * nodes + 1]}
+
+    def assign_contact(self, node_ids, normals):
+        """Sets the contact nodes (pair order) and their unit normals; builds e and F."""
+        self.contact = contact.ContactInterface(self, np.asarray(node_ids, dtype=np.int64),
+                                                np.asarray(normals, dtype=float).reshape(-1, 2))
+
+    def displacement(self, contact_force):
+        """Full displacement (2 per node): u_f = K^-1 (f - B' lambda), prescribed values kept."""
+        free_values = self.free_solution.copy()
+        if len(contact_force) and np.max(np.abs(contact_force)) > 0.0:
+            free_values -= self.factor.solve(self.contact.trace.T @ contact_force)
+        full = self.prescribed_full.copy()
+        full[self.free_dofs] = free_values
+        return full
+
+    def reactions(self, displacement):
+        """K u - f at the prescribed dofs, zero at the free ones."""
+        reaction = self.full_stiffness @ displacement - self.full_load
+        reaction[~self.is_prescribed] = 0.0
+        return reaction
+
+    def applied_force(self):
+        return self.full_load.reshape(-1, 2).sum(axis=0)

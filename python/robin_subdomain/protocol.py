@@ -1,0 +1,322 @@
+"""The subdomain server's protocol state machine (proto/robin.proto), free of transport: a
+serialized request Envelope in, a serialized reply Envelope out. One body at a time. The states,
+transitions and error codes are those of the C++ server (subdomain/server/subdomain_server.hpp):
+
+  awaiting_setup       no body
+  awaiting_assignment  body assembled and factorized (SetupBody done); + AssignContact
+  ready                contact nodes assigned; + AssignContact, ContactSolveRequest,
+                       CorrectionRequest, FieldsRequest
+Hello, SetupBody, EndRun and Shutdown are accepted in every state. SetupBody discards the
+previous body first (a failed SetupBody leaves awaiting_setup); a refused AssignContact keeps the
+state and the previous assignment; EndRun -> awaiting_setup; Shutdown keeps the state and sets
+shutdown_requested.
+
+Every reply echoes the request_id and carries version (protocol_major, 0). Failures are Error
+replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH,
+WRONG_STATE, INVALID_ARGUMENT (sizes, unknown/repeated node ids, non-unit normals, non-finite
+values, unusable write_directory), BAD_INPUT (the body definition), SINGULAR_BODY, UNSUPPORTED
+(a reply sent as a request, a request unknown to this version), INTERNAL (anything else).
+"""
+
+import logging
+import math
+import time
+
+import numpy as np
+from google.protobuf.message import DecodeError
+
+from . import SERVER_NAME
+from .body import Body
+from .errors import InputError, RequestError, SingularBodyError
+from .fields import body_fields, write_vtu
+from .mesh import VTK_CELL_TYPE
+from .setup_decoding import decode_setup_body
+
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 1, 0
+AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
+REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction", "fields",
+            "end_run", "shutdown")
+CAPABILITIES = ("contact_solve", "correction_solve", "fields")
+
+
+class _Record:
+    """What the log line of a request says."""
+
+    def __init__(self):
+        self.type = "(unparsed message)"
+        self.body = ""
+        self.iteration = ""
+        self.outcome = "ok"
+        self.failed = False
+
+
+def _checked_vector(values, size, field, body_name):
+    """A per-contact-node vector of a request: its length and finiteness."""
+    if len(values) != size:
+        raise RequestError("INVALID_ARGUMENT",
+                           "%s has %d values for the %d contact nodes of body '%s' (pair order of "
+                           "AssignContact)" % (field, len(values), size, body_name))
+    vector = np.array(values, dtype=float)
+    bad = np.flatnonzero(~np.isfinite(vector))
+    if len(bad):
+        raise RequestError("INVALID_ARGUMENT", "%s[%d] of body '%s' is not a finite number" %
+                           (field, bad[0], body_name))
+    return vector
+
+
+class SubdomainProtocol:
+    def __init__(self, protocol, name="", protocol_major=PROTOCOL_MAJOR, logger=None):
+        self.protocol = protocol          # the robin_pb2 module
+        self.name = name
+        self.protocol_major = protocol_major
+        self.logger = logger or logging.getLogger("robin-subdomain-py")
+        self.state = AWAITING_SETUP
+        self.shutdown_requested = False
+        self.body = None
+        self.interface_positions = {}     # contact boundary node id -> position
+        self.settings = None
+
+    def server_name(self):
+        return SERVER_NAME + (" (%s)" % self.name if self.name else "")
+
+    def handle(self, request_bytes):
+        """The serialized reply to one request. Never raises."""
+        start = time.perf_counter()
+        record = _Record()
+        reply = self.protocol.Envelope()
+        try:
+            request = self.protocol.Envelope()
+            try:
+                request.ParseFromString(request_bytes)
+            except (DecodeError, RuntimeError, ValueError):
+                raise RequestError("MALFORMED_MESSAGE", "the message (%d bytes) is not a "
+                                   "serialized robin.protocol.Envelope" % len(request_bytes))
+            reply.request_id = request.request_id
+            content = request.WhichOneof("content")
+            record.type = self._type_name(request, content)
+            if self.body is not None:
+                record.body = self.body.name
+            self._check_version(request)
+            self._dispatch(request, content, reply, record)
+        except RequestError as error:
+            self._set_error(reply, error.code, str(error))
+        except SingularBodyError as error:
+            self._set_error(reply, "SINGULAR_BODY", str(error))
+        except InputError as error:
+            self._set_error(reply, "BAD_INPUT", str(error))
+        except Exception as error:  # noqa: BLE001 - every failure becomes an INTERNAL reply
+            self._set_error(reply, "INTERNAL", "internal error: %s" % error)
+        return self._finish(reply, record, time.perf_counter() - start)
+
+    def reject(self, reason):
+        """The MALFORMED_MESSAGE reply (request_id 0) to a message the transport could not pass
+        to handle(), e.g. one of several frames."""
+        reply = self.protocol.Envelope()
+        self._set_error(reply, "MALFORMED_MESSAGE", reason)
+        return self._finish(reply, _Record(), 0.0)
+
+    def _type_name(self, request, content):
+        if content is None:
+            return "(no content)"
+        return request.DESCRIPTOR.fields_by_name[content].message_type.name
+
+    def _set_error(self, reply, code, message):
+        reply.error.code = self.protocol.ErrorCode.Value(code)
+        reply.error.message = message
+        reply.error.state = self.state
+
+    def _finish(self, reply, record, seconds):
+        if reply.HasField("error"):
+            record.failed = True
+            record.outcome = "%s: %s" % (self.protocol.ErrorCode.Name(reply.error.code),
+                                         reply.error.message)
+        reply.version.major = self.protocol_major
+        reply.version.minor = PROTOCOL_MINOR
+        body = " body '%s'" % record.body if record.body else ""
+        self.logger.log(logging.WARNING if record.failed else logging.INFO, "%s%s%s: %s (%.3f ms)",
+                        record.type, body, record.iteration, record.outcome, 1e3 * seconds)
+        return reply.SerializeToString()
+
+    def _check_version(self, request):
+        if not request.HasField("version"):
+            raise RequestError("MALFORMED_MESSAGE", "the Envelope carries no version: every "
+                               "message must carry the sender's protocol Version")
+        major = request.version.major
+        if major != self.protocol_major:
+            raise RequestError(
+                "VERSION_MISMATCH",
+                "protocol version mismatch: the request speaks %d.%d, this server %d.%d (the major "
+                "versions must be equal); use a matching coordinator or server" %
+                (major, request.version.minor, self.protocol_major, PROTOCOL_MINOR))
+
+    def _dispatch(self, request, content, reply, record):
+        handlers = {"hello": self._on_hello, "setup_body": self._on_setup_body,
+                    "assign_contact": self._on_assign_contact,
+                    "contact_solve": self._on_contact_solve, "correction": self._on_correction,
+                    "fields": self._on_fields, "end_run": self._on_end_run,
+                    "shutdown": self._on_shutdown}
+        if content in handlers:
+            return handlers[content](request, reply, record)
+        if content is not None:
+            raise RequestError("UNSUPPORTED", "%s is a reply, not a request" %
+                               self._type_name(request, content))
+        if len(request.UnknownFields()) > 0:
+            raise RequestError("UNSUPPORTED", "the request type is unknown to this server "
+                               "(protocol %d.%d); check HelloReply.capabilities" %
+                               (self.protocol_major, PROTOCOL_MINOR))
+        raise RequestError("MALFORMED_MESSAGE", "the Envelope carries no request (no content)")
+
+    def _require_state(self, minimum, request_type):
+        if self.state == AWAITING_SETUP and minimum != AWAITING_SETUP:
+            raise RequestError("WRONG_STATE", "%s before SetupBody: send SetupBody first" %
+                               request_type)
+        if self.state == AWAITING_ASSIGNMENT and minimum == READY:
+            raise RequestError("WRONG_STATE", "%s before AssignContact: send AssignContact for "
+                               "body '%s' first" % (request_type, self.body.name))
+
+    def _acknowledge(self, reply):
+        reply.acknowledge.state = self.state
+
+    def _on_hello(self, request, reply, record):
+        reply.hello_reply.server_name = self.server_name()
+        reply.hello_reply.capabilities.extend(CAPABILITIES)
+        reply.hello_reply.state = self.state
+
+    def _on_end_run(self, request, reply, record):
+        self.body = None
+        self.interface_positions = {}
+        self.state = AWAITING_SETUP
+        self._acknowledge(reply)
+
+    def _on_shutdown(self, request, reply, record):
+        self.shutdown_requested = True
+        self._acknowledge(reply)
+
+    def _on_setup_body(self, request, reply, record):
+        self.body = None                  # a SetupBody starts a new run, whatever its outcome
+        self.interface_positions = {}
+        self.state = AWAITING_SETUP
+        record.body = request.setup_body.body_name
+        definition, settings = decode_setup_body(request.setup_body, self.protocol)
+        body = Body(definition)
+        interface = body.contact_boundary()
+        description = reply.interface
+        description.body_name = body.name
+        description.node_ids.extend(int(node) for node in interface["node_ids"])
+        description.node_tags.extend(int(tag) for tag in interface["node_tags"])
+        description.coordinates.extend(interface["coordinates"].ravel().tolist())
+        description.normals.extend(interface["normals"].ravel().tolist())
+        description.weights.extend(interface["weights"].tolist())
+        description.x_fixed.extend(bool(flag) for flag in interface["x_fixed"])
+        description.y_fixed.extend(bool(flag) for flag in interface["y_fixed"])
+        description.dof_count = body.free_dof_count()
+        description.setup_seconds = body.assembly_seconds + body.factorization_seconds
+        self.interface_positions = {int(node): k for k, node in enumerate(interface["node_ids"])}
+        self.settings = settings
+        self.body = body
+        self.state = AWAITING_ASSIGNMENT
+        record.outcome = "ok, %d nodes, %d free dofs, %d contact boundary nodes" % (
+            body.mesh.node_count(), body.free_dof_count(), len(self.interface_positions))
+
+    def _checked_assignment(self, message):
+        """Node ids and normals of an AssignContact: as many normals as nodes, known and
+        distinct ids, unit normals (to 1e-8)."""
+        name = self.body.name
+
+        def invalid(problem):
+            return RequestError("INVALID_ARGUMENT", "AssignContact for body '%s': %s" %
+                                (name, problem))
+
+        if len(message.normals) != 2 * len(message.node_ids):
+            raise invalid("%d normal values for %d nodes, expected 2 per node" %
+                          (len(message.normals), len(message.node_ids)))
+        used = set()
+        for i, node in enumerate(message.node_ids):
+            if node not in self.interface_positions:
+                raise invalid("node id %d is not a node of the contact boundary (see "
+                              "InterfaceDescription.node_ids)" % node)
+            label = "node id %d (tag %d)" % (node, self.body.mesh.node_tags[node])
+            if node in used:
+                raise invalid(label + " is assigned twice")
+            used.add(node)
+            length = math.hypot(message.normals[2 * i], message.normals[2 * i + 1])
+            if not math.isfinite(length) or abs(length - 1.0) > 1e-8:
+                raise invalid("the normal of %s is not a unit vector" % label)
+        return list(message.node_ids), list(message.normals)
+
+    def _on_assign_contact(self, request, reply, record):
+        self._require_state(AWAITING_ASSIGNMENT, "AssignContact")
+        node_ids, normals = self._checked_assignment(request.assign_contact)
+        self.state = AWAITING_ASSIGNMENT  # until the body accepted the assignment
+        self.body.assign_contact(node_ids, normals)
+        self.state = READY
+        self._acknowledge(reply)
+
+    def _on_contact_solve(self, request, reply, record):
+        message = request.contact_solve
+        record.iteration = " iteration %d" % message.iteration
+        self._require_state(READY, "ContactSolveRequest")
+        interface = self.body.contact
+        obstacle = _checked_vector(message.obstacle, interface.size(),
+                                   "ContactSolveRequest.obstacle", self.body.name)
+        result = interface.solve_contact(obstacle, self.settings.qp_tolerance,
+                                         self.settings.qp_max_iterations)
+        out = reply.contact_result
+        out.normal_trace.extend(result["normal_trace"].tolist())
+        out.contact_force.extend(result["contact_force"].tolist())
+        out.active.extend(bool(flag) for flag in result["active"])
+        out.status = self.protocol.SolveStatus.Value(result["status"])
+        out.qp_iterations = result["iterations"]
+        out.projected_gradient_norm = result["projected_gradient_norm"]
+        out.penetration = result["penetration"]
+        out.complementarity = result["complementarity"]
+        out.compute_seconds = result["seconds"]
+        out.message = result["message"]
+        record.outcome = "%s, %d QP iterations" % (result["status"], result["iterations"])
+        if result["message"]:
+            record.outcome += " (%s)" % result["message"]
+
+    def _on_correction(self, request, reply, record):
+        start = time.perf_counter()
+        message = request.correction
+        record.iteration = " iteration %d" % message.iteration
+        self._require_state(READY, "CorrectionRequest")
+        interface = self.body.contact
+        force = _checked_vector(message.interface_force, interface.size(),
+                                "CorrectionRequest.interface_force", self.body.name)
+        reply.correction_result.normal_trace.extend(interface.solve_correction(force).tolist())
+        reply.correction_result.compute_seconds = time.perf_counter() - start
+
+    def _on_fields(self, request, reply, record):
+        message = request.fields
+        self._require_state(READY, "FieldsRequest")
+        force = _checked_vector(message.contact_force, self.body.contact.size(),
+                                "FieldsRequest.contact_force", self.body.name)
+        fields = body_fields(self.body, force)
+        out = reply.fields_reply
+        mesh = self.body.mesh
+        out.node_coordinates.extend(mesh.nodes.ravel().tolist())
+        out.node_tags.extend(int(tag) for tag in mesh.node_tags)
+        out.cell_offsets.append(0)
+        for block in mesh.blocks:
+            out.cell_types.append(VTK_CELL_TYPE[block.type])
+            out.connectivity.extend(int(node) for node in block.connectivity.ravel())
+            out.cell_offsets.append(len(out.connectivity))
+        for target, source in ((out.point_fields, fields.point_fields),
+                               (out.cell_fields, fields.cell_fields)):
+            for name, components, values in source:
+                field = target.add()
+                field.name = name
+                field.components = components
+                field.values.extend(np.ravel(values).tolist())
+        out.reaction_resultant.extend(fields.reaction_resultant.tolist())
+        out.applied_force.extend(fields.applied_force.tolist())
+        if message.write_directory:
+            try:
+                path = write_vtu(message.write_directory, self.body.name, mesh, fields)
+            except OSError as error:
+                raise RequestError("INVALID_ARGUMENT",
+                                   "FieldsRequest.write_directory: cannot write the fields of "
+                                   "body '%s' to '%s': %s" % (self.body.name,
+                                                              message.write_directory, error))
+            out.written_file = str(path)
