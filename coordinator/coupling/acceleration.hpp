@@ -1,0 +1,70 @@
+#pragma once
+// Convergence acceleration of the Robin obstacle iteration (paper (13), step 3).
+//
+// The iteration is a fixed-point map x -> H(x) on the stacked obstacles x = (g^1, g^2), with
+//   H^1(g) = w^2_N - u^2_N + d,   H^2(g) = w^1_N - u^1_N + d,
+// and residual r(x) = H(x) - x. In the all-active regime the two blocks are independent linear
+// maps (docs: algorithm.md, "Structure worth knowing"), which is why every method can run per
+// body. Methods:
+//   "none"    x_{k+1} = (1 - delta_a) x_k + delta_a H(x_k) per body: exactly the paper's update;
+//   "aitken"  the same with a dynamic factor omega per body (Irons-Tuck / Aitken);
+//   "iqn-ils" Anderson mixing / interface quasi-Newton with inverse least squares, on each
+//             body (per_body, the default) or on the stacked vector.
+// The module is plain arithmetic on vectors: no transport, no logging.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+namespace robin {
+
+struct AccelerationOptions {
+  std::string method = "iqn-ils";  // "none", "aitken" or "iqn-ils"
+  /// delta per body: the step of "none", and the first step (and every restart) of "iqn-ils".
+  double relaxation1 = 0.5, relaxation2 = 0.5;
+  /// "aitken": the first omega of each body, then |omega| is clamped to [minimum, maximum]
+  /// keeping its sign (relaxation1/2 do not apply). The bounds also bound the "aitken" mixing
+  /// of "iqn-ils".
+  double aitken_initial = 0.5, aitken_minimum = 1e-4, aitken_maximum = 1.0;
+  int history_depth = 10;           // "iqn-ils": secant columns kept, newest first
+  double filter_threshold = 1e-10;  // "iqn-ils": drop a column when |R_ii| < threshold ||V||_F
+  /// "iqn-ils": when a quasi-Newton step gives ||r_k|| > growth ||r_{k-1}||, forget the history
+  /// and take a relaxation step.
+  double safeguard_growth = 2.0;
+  /// "iqn-ils": how the least-squares point x^ and its predicted image h^ are mixed,
+  /// x_{k+1} = (1 - beta) x^ + beta h^ per body (acceleration_quasi_newton.hpp):
+  /// "full" (beta = 1, classical IQN-ILS), "relaxation" (beta = relaxation1/2) or "aitken"
+  /// (beta = the secant estimate of the newest column, |beta| in [aitken_minimum,
+  /// aitken_maximum]). "aitken" is the default: with beta = 1 a truncated history stalls on
+  /// bodies of different stiffness, and a good fixed beta needs the compliance ratio.
+  std::string mixing = "aitken";
+  /// "iqn-ils": an independent IQN-ILS on each body's block (true), or one on (g^1, g^2).
+  /// Per body is the default: the blocks are independent maps, and an ill-conditioned block
+  /// then cannot hold back the other (tests/unit/acceleration_test.cpp measures both).
+  bool per_body = true;
+};
+
+/// Post-processes the fixed-point map x -> H(x) for the stacked obstacles x = (g^1, g^2)
+/// (size n1 + n2, body 1 first). An instance keeps the history of one iteration.
+class Acceleration {
+ public:
+  virtual ~Acceleration() = default;
+  /// Given the iterate x_k (the obstacles used in this iteration's contact solves) and
+  /// H(x_k), returns x_{k+1}. Both vectors have the size given at construction.
+  virtual Eigen::VectorXd next(const Eigen::VectorXd& iterate, const Eigen::VectorXd& mapped) = 0;
+  /// One line for logs, e.g. "aitken omega = (0.31, 0.92)", "iqn-ils 4 columns (1 filtered)".
+  virtual std::string state() const = 0;
+  /// Forgets the history: the next step is a first step again.
+  virtual void restart() = 0;
+};
+
+/// The method of `options` for blocks of sizes size1 (body 1) and size2 (body 2). Validates the
+/// options first (throws InputError as validate does).
+std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options, int size1,
+                                                int size2);
+
+/// Throws robin::InputError naming the field when an option is out of range, e.g.
+/// "acceleration.history_depth must be >= 1, got 0".
+void validate(const AccelerationOptions& options);
+
+}  // namespace robin

@@ -1,0 +1,169 @@
+#include "coupling/acceleration_quasi_newton.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <utility>
+
+#include "coupling/acceleration_filtered_qr.hpp"
+
+namespace robin {
+namespace {
+
+int total_size(const std::vector<RelaxationBlock>& blocks) {
+  int size = 0;
+  for (const RelaxationBlock& block : blocks) size += block.size;
+  return size;
+}
+
+}  // namespace
+
+IqnIlsAcceleration::IqnIlsAcceleration(std::vector<RelaxationBlock> blocks,
+                                       QuasiNewtonParameters parameters)
+    : size_(total_size(blocks)),
+      blocks_(blocks),
+      parameters_(parameters),
+      relaxation_(std::move(blocks)) {}
+
+Eigen::VectorXd IqnIlsAcceleration::next(const Eigen::VectorXd& iterate,
+                                         const Eigen::VectorXd& mapped) {
+  assert(iterate.size() == size_ && mapped.size() == size_);
+  // r_k = H(x_k) - x_k
+  const Eigen::VectorXd residual = mapped - iterate;
+  columns_ = 0;
+  filtered_ = 0;
+  if (has_previous_) record_differences(residual, mapped);
+  previous_residual_ = residual;
+  previous_mapped_ = mapped;
+  has_previous_ = true;
+  if (!residual_differences_.empty()) {
+    const Eigen::VectorXd alpha = least_squares_coefficients(residual);
+    if (alpha.size() > 0) {
+      previous_was_quasi_newton_ = true;
+      return quasi_newton_step(iterate, mapped, alpha);
+    }
+  }
+  previous_was_quasi_newton_ = false;
+  return relaxation_.next(iterate, mapped);
+}
+
+void IqnIlsAcceleration::record_differences(const Eigen::VectorXd& residual,
+                                            const Eigen::VectorXd& mapped) {
+  const double growth = residual.norm() / previous_residual_.norm();
+  if (previous_was_quasi_newton_ && growth > parameters_.safeguard_growth) {
+    clear_history();
+    ++safeguard_restarts_;
+    reason_ = "restart: the residual grew " + format_for_state(growth) + "x";
+    return;
+  }
+  // V <- [r_k - r_{k-1}, V],  W <- [x~_k - x~_{k-1}, W]
+  residual_differences_.push_front(residual - previous_residual_);
+  mapped_differences_.push_front(mapped - previous_mapped_);
+  while (static_cast<int>(residual_differences_.size()) > parameters_.history_depth) {
+    residual_differences_.pop_back();
+    mapped_differences_.pop_back();
+  }
+}
+
+Eigen::VectorXd IqnIlsAcceleration::least_squares_coefficients(const Eigen::VectorXd& residual) {
+  const int count = static_cast<int>(residual_differences_.size());
+  Eigen::MatrixXd differences(size_, count);
+  for (int column = 0; column < count; ++column) {
+    differences.col(column) = residual_differences_[column];
+  }
+  const FilteredQr factors = filtered_qr(differences, parameters_.filter_threshold);
+  const int kept = static_cast<int>(factors.kept.size());
+  filtered_ = count - kept;
+  if (filtered_ > 0) {
+    std::deque<Eigen::VectorXd> kept_residual, kept_mapped;
+    for (const int column : factors.kept) {
+      kept_residual.push_back(residual_differences_[column]);
+      kept_mapped.push_back(mapped_differences_[column]);
+    }
+    residual_differences_ = std::move(kept_residual);
+    mapped_differences_ = std::move(kept_mapped);
+  }
+  if (kept == 0) {
+    clear_history();
+    reason_ = "restart: the filter dropped every column";
+    return {};
+  }
+  columns_ = kept;
+  // R alpha = -Q' r_k
+  return factors.r.triangularView<Eigen::Upper>().solve(-(factors.q.transpose() * residual));
+}
+
+Eigen::VectorXd IqnIlsAcceleration::quasi_newton_step(const Eigen::VectorXd& iterate,
+                                                      const Eigen::VectorXd& mapped,
+                                                      const Eigen::VectorXd& alpha) {
+  // h^ = x~_k + W alpha
+  Eigen::VectorXd predicted = mapped;
+  for (Eigen::Index column = 0; column < alpha.size(); ++column) {
+    predicted += alpha(column) * mapped_differences_[column];
+  }
+  mixing_.assign(blocks_.size(), 1.0);
+  if (parameters_.mixing == QuasiNewtonMixing::full) return predicted;
+  // x^ = x_k + (W - V) alpha
+  Eigen::VectorXd combination = iterate;
+  for (Eigen::Index column = 0; column < alpha.size(); ++column) {
+    combination += alpha(column) * (mapped_differences_[column] - residual_differences_[column]);
+  }
+  Eigen::VectorXd result(size_);
+  Eigen::Index start = 0;
+  for (std::size_t index = 0; index < blocks_.size(); ++index) {
+    const int size = blocks_[index].size;
+    const double beta = block_mixing(blocks_[index], start);
+    // x_{k+1} = (1 - beta) x^ + beta h^ on the block
+    result.segment(start, size) =
+        (1.0 - beta) * combination.segment(start, size) + beta * predicted.segment(start, size);
+    mixing_[index] = beta;
+    start += size;
+  }
+  return result;
+}
+
+double IqnIlsAcceleration::block_mixing(const RelaxationBlock& block, Eigen::Index start) const {
+  if (parameters_.mixing == QuasiNewtonMixing::relaxation) return block.relaxation;
+  // beta = -dx'dv / |dv|^2 with dv = V_0, dx = W_0 - V_0 on the block
+  const auto residual_change = residual_differences_.front().segment(start, block.size);
+  const auto mapped_change = mapped_differences_.front().segment(start, block.size);
+  const double denominator = residual_change.squaredNorm();
+  if (!(denominator > 0.0)) return block.relaxation;
+  const double secant = -(mapped_change - residual_change).dot(residual_change) / denominator;
+  const double magnitude =
+      std::clamp(std::abs(secant), parameters_.mixing_minimum, parameters_.mixing_maximum);
+  return std::copysign(magnitude, secant);
+}
+
+void IqnIlsAcceleration::clear_history() {
+  residual_differences_.clear();
+  mapped_differences_.clear();
+}
+
+std::string IqnIlsAcceleration::state() const {
+  if (columns_ == 0) return "iqn-ils relaxation step (" + reason_ + ")";
+  std::string line =
+      "iqn-ils " + std::to_string(columns_) + (columns_ == 1 ? " column" : " columns");
+  if (filtered_ > 0) line += " (" + std::to_string(filtered_) + " filtered)";
+  if (parameters_.mixing == QuasiNewtonMixing::full) return line;
+  line += ", beta = ";
+  if (mixing_.size() > 1) line += "(";
+  for (std::size_t index = 0; index < mixing_.size(); ++index) {
+    if (index > 0) line += ", ";
+    line += format_for_state(mixing_[index]);
+  }
+  if (mixing_.size() > 1) line += ")";
+  return line;
+}
+
+void IqnIlsAcceleration::restart() {
+  clear_history();
+  has_previous_ = false;
+  previous_was_quasi_newton_ = false;
+  columns_ = 0;
+  filtered_ = 0;
+  reason_ = "first step after a restart";
+}
+
+}  // namespace robin
