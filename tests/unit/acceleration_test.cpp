@@ -194,6 +194,133 @@ TEST(Aitken, OmegaIsClampedKeepingItsSign) {
   }
 }
 
+// --- IQN-ILS ---------------------------------------------------------------------------------
+
+QuasiNewtonParameters with_mixing(QuasiNewtonMixing mixing, int history_depth) {
+  QuasiNewtonParameters parameters;
+  parameters.mixing = mixing;
+  parameters.history_depth = history_depth;
+  return parameters;
+}
+
+TEST(IqnIls, FullHistoryReachesTheFixedPointInAtMostNPlusTwoSteps) {
+  // Anderson mixing on a linear map: x_{k+1} = x^_k + beta r(x^_k) with x^_k the GMRES iterate
+  // of (I - M) x = c (Walker & Ni), so x_{n+1} = x* when the grade of r_0 is n (generic).
+  std::mt19937 generator(17);
+  const int size = 10;
+  const Eigen::MatrixXd matrix = random_matrix(size, size, generator);
+  const LinearMap map(0.9 * matrix / matrix.operatorNorm(), random_vector(size, generator));
+  for (const auto mixing : {QuasiNewtonMixing::full, QuasiNewtonMixing::aitken}) {
+    IqnIlsAcceleration acceleration({{size, 0.5}}, with_mixing(mixing, size + 2));
+    const int calls = calls_to_converge(acceleration, map, 1e-10, 100);
+    std::cout << "full-rank n = " << size << ": " << calls
+              << " steps to 1e-10 (theory n + 1 = " << size + 1 << ")\n";
+    EXPECT_LE(calls, size + 2);
+    EXPECT_GE(calls, size);  // GMRES does not end early on generic data
+  }
+}
+
+TEST(IqnIls, RankKPerturbationOfAScalarNeedsKPlusTwoSteps) {
+  // M = m I + U V' (rank k): I - M = (1 - m) I - U V' gives Krylov spaces of dimension at most
+  // k + 1, so GMRES is exact at step k + 1 and x_{k+2} = x*.
+  std::mt19937 generator(23);
+  const int size = 30;
+  for (const int rank : {1, 3, 5}) {
+    const Eigen::MatrixXd perturbation = random_matrix(size, rank, generator) *
+                                         random_matrix(rank, size, generator) / std::sqrt(size);
+    const LinearMap map(-0.5 * Eigen::MatrixXd::Identity(size, size) + perturbation,
+                        random_vector(size, generator));
+    for (const auto mixing : {QuasiNewtonMixing::full, QuasiNewtonMixing::aitken}) {
+      IqnIlsAcceleration acceleration({{size, 0.5}}, with_mixing(mixing, 10));
+      const int calls = calls_to_converge(acceleration, map, 1e-10, 100);
+      std::cout << "rank " << rank << ": " << calls << " steps to 1e-10\n";
+      EXPECT_EQ(calls, rank + 2) << "rank " << rank;
+    }
+  }
+}
+
+TEST(IqnIls, FilterDropsAnExactlyDuplicatedColumn) {
+  // Integer data on the line x_j = x_0 + j s make r_2 - r_1 = r_1 - r_0 exactly.
+  Eigen::Matrix4d matrix;
+  matrix << 1, -2, 0, 1, 0, 3, 1, -1, 2, 0, -1, 0, 1, 1, 0, 2;
+  const Eigen::Vector4d constant(4.0, -1.0, 2.0, 3.0);
+  const Eigen::Vector4d start(1.0, 2.0, -1.0, 0.0), step(0.0, 1.0, 1.0, -1.0);
+  QuasiNewtonParameters parameters = with_mixing(QuasiNewtonMixing::full, 5);
+  parameters.safeguard_growth = std::numeric_limits<double>::infinity();
+  IqnIlsAcceleration acceleration({{4, 0.5}}, parameters);
+  Eigen::VectorXd result;
+  for (int j = 0; j <= 2; ++j) {
+    const Eigen::Vector4d iterate = start + j * step;
+    result = acceleration.next(iterate, matrix * iterate + constant);
+  }
+  EXPECT_EQ(acceleration.columns(), 1);
+  EXPECT_EQ(acceleration.filtered(), 1);
+  EXPECT_EQ(acceleration.state(), "iqn-ils 1 column (1 filtered)");
+  // One column v = (M - I) s, w = M s: alpha = -v'r_2 / v'v, x_3 = H(x_2) + alpha w.
+  const Eigen::Vector4d iterate = start + 2 * step;
+  const Eigen::Vector4d residual = matrix * iterate + constant - iterate;
+  const Eigen::Vector4d column = (matrix - Eigen::Matrix4d::Identity()) * step;
+  const double alpha = -column.dot(residual) / column.dot(column);
+  const Eigen::Vector4d expected = matrix * iterate + constant + alpha * (matrix * step);
+  EXPECT_LT((result - expected).norm(), 1e-12 * expected.norm());
+}
+
+TEST(IqnIls, SafeguardRestartsWithARelaxationStepWhenTheResidualGrows) {
+  const double delta = 0.4;
+  IqnIlsAcceleration acceleration({{3, delta}}, QuasiNewtonParameters{});
+  const Eigen::Vector3d x0(0.0, 0.0, 0.0), h0(1.0, 2.0, -1.0);
+  const Eigen::Vector3d x1(0.5, 0.5, 0.0), h1(1.0, 1.5, -0.5);  // r_1 = (0.5, 1, -0.5)
+  acceleration.next(x0, h0);
+  EXPECT_TRUE(acceleration.relaxation_step());
+  acceleration.next(x1, h1);
+  EXPECT_EQ(acceleration.columns(), 1);
+  // The quasi-Newton step led to x2 with |r_2| = 5 |r_1| > 2 |r_1|.
+  const Eigen::Vector3d x2(0.2, 0.1, 0.3);
+  const Eigen::Vector3d r1 = h1 - x1;
+  const Eigen::Vector3d h2 = x2 + 5.0 * Eigen::Vector3d(-r1(1), r1(0), r1(2));
+  const Eigen::VectorXd x3 = acceleration.next(x2, h2);
+  EXPECT_TRUE(acceleration.relaxation_step());
+  EXPECT_EQ(acceleration.safeguard_restarts(), 1);
+  EXPECT_EQ(acceleration.state(), "iqn-ils relaxation step (restart: the residual grew 5x)");
+  const Eigen::Vector3d relaxed = (1.0 - delta) * x2 + delta * h2;
+  EXPECT_TRUE(x3 == relaxed);
+  // The next step uses the single column from (x2, h2), not the older ones.
+  const Eigen::Vector3d h3 = x3 + Eigen::Vector3d(0.1, -0.2, 0.05);
+  acceleration.next(x3, h3);
+  EXPECT_EQ(acceleration.columns(), 1);
+}
+
+TEST(IqnIls, RestartMakesTheNextStepARelaxationStep) {
+  std::mt19937 generator(29);
+  const LinearMap map(0.5 * random_matrix(6, 6, generator), random_vector(6, generator));
+  IqnIlsAcceleration acceleration({{6, 0.3}}, QuasiNewtonParameters{});
+  Eigen::VectorXd iterate = Eigen::VectorXd::Zero(6);
+  for (int step = 0; step < 3; ++step) iterate = acceleration.next(iterate, map(iterate));
+  EXPECT_FALSE(acceleration.relaxation_step());
+  acceleration.restart();
+  const Eigen::VectorXd mapped = map(iterate);
+  const Eigen::VectorXd next = acceleration.next(iterate, mapped);
+  const Eigen::VectorXd relaxed = (1.0 - 0.3) * iterate + 0.3 * mapped;
+  EXPECT_TRUE(next == relaxed);
+  EXPECT_EQ(acceleration.state(), "iqn-ils relaxation step (first step after a restart)");
+}
+
+TEST(FilteredQr, FactorsIndependentColumnsAndDropsADependentOne) {
+  std::mt19937 generator(31);
+  Eigen::MatrixXd columns = random_matrix(8, 4, generator);
+  columns.col(2) = 2.0 * columns.col(0) - columns.col(1);  // dependent on the earlier two
+  const FilteredQr factors = filtered_qr(columns, 1e-10);
+  ASSERT_EQ(factors.kept, (std::vector<int>{0, 1, 3}));
+  Eigen::MatrixXd kept(8, 3);
+  kept << columns.col(0), columns.col(1), columns.col(3);
+  EXPECT_LT((factors.q * factors.r - kept).norm(), 1e-14 * kept.norm());
+  EXPECT_LT((factors.q.transpose() * factors.q - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+  EXPECT_TRUE(factors.r.isUpperTriangular());
+  // A zero column is dropped even without a threshold (R_jj = 0).
+  columns.col(1).setZero();
+  EXPECT_EQ(filtered_qr(columns, 0.0).kept, (std::vector<int>{0, 2, 3}));
+}
+
 // --- Two bodies with compliance ratio c --------------------------------------------------------
 
 /// The all-active Robin iteration (algorithm.md, "Structure worth knowing"): with interface
@@ -275,6 +402,109 @@ TEST(TwoBodies, QuasiNewtonNeedsTenTimesFewerIterationsThanTheBestRelaxation) {
   EXPECT_LT(per_body, 20);
   EXPECT_LT(joint, 20);
   EXPECT_GE(relaxation, 10 * per_body);
+}
+
+/// Relative error of body 1's block after each of `steps` steps, when body 2's map H^2 carries
+/// random noise of standard deviation `noise` (an inexact or non-smooth second sequence).
+std::vector<double> body1_errors(const LinearMap& map, int size, const AccelerationOptions& options,
+                                 double noise, int steps) {
+  const auto acceleration = make_acceleration(options, size, size);
+  std::mt19937 generator(3);
+  std::normal_distribution<double> normal(0.0, noise);
+  std::vector<double> errors;
+  Eigen::VectorXd iterate = Eigen::VectorXd::Zero(2 * size);
+  for (int step = 0; step < steps; ++step) {
+    Eigen::VectorXd mapped = map(iterate);
+    for (int index = size; index < 2 * size; ++index) mapped(index) += normal(generator);
+    iterate = acceleration->next(iterate, mapped);
+    errors.push_back((iterate - map.fixed_point).head(size).norm() /
+                     map.fixed_point.head(size).norm());
+  }
+  return errors;
+}
+
+int first_below(const std::vector<double>& errors, double tolerance) {
+  for (std::size_t step = 0; step < errors.size(); ++step) {
+    if (errors[step] <= tolerance) return static_cast<int>(step) + 1;
+  }
+  return static_cast<int>(errors.size()) + 1;
+}
+
+TEST(TwoBodies, PerBodyQuasiNewtonIsolatesTheGoodSequenceFromANoisyOne) {
+  // Either sequence alone fixes the solution (algorithm.md), so the good one must not be held
+  // back by the other. Per body, body 1's iterates do not depend on H^2 at all.
+  std::mt19937 generator(7);
+  const int size = 16;
+  const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
+  AccelerationOptions options;
+  const std::vector<double> clean = body1_errors(map, size, options, 0.0, 60);
+  const std::vector<double> noisy = body1_errors(map, size, options, 1e-3, 60);
+  EXPECT_EQ(clean, noisy);
+  options.per_body = false;
+  const std::vector<double> joint = body1_errors(map, size, options, 1e-3, 60);
+  const int per_body_steps = first_below(noisy, 1e-10);
+  const int joint_steps = first_below(joint, 1e-10);
+  std::cout << "body 1 to 1e-10 with noise 1e-3 on H^2: per body " << per_body_steps
+            << " steps, joint " << (joint_steps > 60 ? "not in 60" : std::to_string(joint_steps))
+            << "\n";
+  EXPECT_LT(per_body_steps, 25);
+  EXPECT_GT(joint_steps, 2 * per_body_steps);
+}
+
+TEST(TwoBodies, EveryMethodHandlesABodyWithoutPairs) {
+  // A body with no contact pairs has an empty block; the other block must still converge.
+  std::mt19937 generator(37);
+  const LinearMap map(symmetric_with_spectrum({-0.5, -0.2, 0.3}, generator),
+                      random_vector(3, generator));
+  for (const std::string method : {"none", "aitken", "iqn-ils"}) {
+    for (const bool per_body : {true, false}) {
+      AccelerationOptions options;
+      options.method = method;
+      options.per_body = per_body;
+      const auto acceleration = make_acceleration(options, 0, 3);
+      // "none" with delta = 0.5 contracts at max |1 - 0.5 (1 - mu)| = 0.75: 1e-10 in 81 steps.
+      EXPECT_LE(calls_to_converge(*acceleration, map, 1e-10, 100), 81) << method;
+    }
+  }
+}
+
+// --- Options ----------------------------------------------------------------------------------
+
+/// The message of the InputError thrown by validate(options), or "" when nothing is thrown.
+std::string validation_message(const AccelerationOptions& options) {
+  try {
+    validate(options);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(AccelerationOptions, DefaultsAreValidAndBadValuesNameTheirField) {
+  EXPECT_EQ(validation_message(AccelerationOptions{}), "");
+  const std::vector<std::pair<std::function<void(AccelerationOptions&)>, std::string>> cases = {
+      {[](AccelerationOptions& o) { o.method = "anderson"; }, "acceleration.method"},
+      {[](AccelerationOptions& o) { o.mixing = "half"; }, "acceleration.mixing"},
+      {[](AccelerationOptions& o) { o.relaxation1 = 0.0; }, "acceleration.relaxation1"},
+      {[](AccelerationOptions& o) { o.relaxation2 = 2.5; }, "acceleration.relaxation2"},
+      {[](AccelerationOptions& o) { o.relaxation2 = std::nan(""); }, "acceleration.relaxation2"},
+      {[](AccelerationOptions& o) { o.aitken_minimum = -1.0; }, "acceleration.aitken_minimum"},
+      {[](AccelerationOptions& o) { o.aitken_maximum = 1e-5; }, "acceleration.aitken_maximum"},
+      {[](AccelerationOptions& o) { o.aitken_initial = 1.5; }, "acceleration.aitken_initial"},
+      {[](AccelerationOptions& o) { o.history_depth = 0; }, "acceleration.history_depth"},
+      {[](AccelerationOptions& o) { o.filter_threshold = -1e-3; }, "acceleration.filter_threshold"},
+      {[](AccelerationOptions& o) { o.safeguard_growth = 1.0; }, "acceleration.safeguard_growth"},
+  };
+  for (const auto& [change, field] : cases) {
+    AccelerationOptions options;
+    change(options);
+    const std::string message = validation_message(options);
+    EXPECT_EQ(message.rfind(field + " must be", 0), 0u) << field << ": " << message;
+    EXPECT_THROW(make_acceleration(options, 2, 3), InputError) << field;
+  }
+  AccelerationOptions options;
+  options.history_depth = 0;
+  EXPECT_EQ(validation_message(options), "acceleration.history_depth must be >= 1, got 0");
 }
 
 }  // namespace
