@@ -1,0 +1,177 @@
+"""Contact operators and the bound-constrained QP of the Python subdomain server.
+
+- QP: on random SPD matrices with positive entries (like an interface compliance) the solver's
+  answer equals the KKT point found by enumerating all 2^n active sets; both the primal-dual
+  active set path and the Lawson-Hanson safeguard alone; warm starts change nothing.
+- A block pressed by a prescribed top displacement onto a rigid flat obstacle (roller on its
+  left side): uniform uniaxial strain, so the nodal contact forces are lambda_i = |s_yy| m_i
+  with s_yy = E/(1 - nu^2) (-d/H) (plane strain), to rounding.
+- Consistency: e - F lambda equals the normal trace of the displacement computed with lambda.
+"""
+
+import itertools
+import unittest
+
+import numpy as np
+
+import support
+from robin_subdomain import contact
+from robin_subdomain.body import Body, BodyDefinition
+from robin_subdomain.material import PLANE_STRAIN, isotropic_material
+
+
+def enumerated_solution(matrix, right_hand_side):
+    """The unique KKT point of min 1/2 x'Ax - b'x, x >= 0, by trying every free set."""
+    size = len(right_hand_side)
+    for free_count in range(size + 1):
+        for free in itertools.combinations(range(size), free_count):
+            free = list(free)
+            x = np.zeros(size)
+            if free:
+                x[free] = np.linalg.solve(matrix[np.ix_(free, free)], right_hand_side[free])
+            gradient = matrix @ x - right_hand_side
+            scale = np.abs(right_hand_side).max()
+            if np.all(x >= 0.0) and np.all(gradient[x == 0.0] >= -1e-12 * scale):
+                return x
+    raise AssertionError("no KKT point found")
+
+
+def compliance_like(generator, size):
+    """SPD with positive entries decaying off the diagonal (a discrete Green's function)."""
+    positions = np.sort(generator.uniform(0.0, 1.0, size))
+    matrix = np.exp(-np.abs(positions[:, None] - positions[None, :]) / 0.3)
+    return matrix + 0.05 * np.eye(size)
+
+
+class BoundQp(unittest.TestCase):
+    def test_equals_enumeration(self):
+        generator = np.random.default_rng(20080101)
+        for trial in range(40):
+            size = int(generator.integers(1, 10))
+            matrix = compliance_like(generator, size)
+            right_hand_side = generator.normal(size=size)
+            expected = enumerated_solution(matrix, right_hand_side)
+            result = contact.solve_bound_qp(matrix, right_hand_side, np.zeros(size), 1e-12, 1000,
+                                            contact.estimate_norm(matrix))
+            self.assertEqual(result.status, contact.CONVERGED, result.message)
+            scale = max(np.abs(expected).max(), 1e-300)
+            self.assertLess(np.abs(result.solution - expected).max(), 1e-10 * scale,
+                            "trial %d" % trial)
+            warm = contact.solve_bound_qp(matrix, right_hand_side, expected + 0.1, 1e-12, 1000,
+                                          contact.estimate_norm(matrix))
+            self.assertLess(np.abs(warm.solution - expected).max(), 1e-10 * scale)
+
+    def test_safeguard_alone_equals_enumeration(self):
+        generator = np.random.default_rng(7)
+        for _ in range(20):
+            size = int(generator.integers(2, 10))
+            matrix = compliance_like(generator, size)
+            right_hand_side = generator.normal(size=size)
+            problem = contact._Problem(matrix, right_hand_side, 1e-12,
+                                       contact.estimate_norm(matrix))
+            start = np.abs(generator.normal(size=size)) * (generator.uniform(size=size) < 0.5)
+            x, _, converged = contact._lawson_hanson(problem, start, 1000)
+            self.assertTrue(converged)
+            expected = enumerated_solution(matrix, right_hand_side)
+            self.assertLess(np.abs(x - expected).max(), 1e-10 * max(np.abs(expected).max(), 1e-300))
+
+    def test_cycling_active_set_hands_over_to_the_safeguard(self):
+        # A random SPD matrix (Wishart plus 1e-3 I) on which the primal-dual active set
+        # method revisits an active set from lambda = 0.
+        matrix = np.array([
+            [4.600924183887254, 0.1331167524287453, -0.5172272099346218, -3.7674623189169627,
+             -2.482092598643416],
+            [0.1331167524287453, 6.0460055622578315, 1.2386919165884653, -0.05035902051059699,
+             -4.068208345029607],
+            [-0.5172272099346218, 1.2386919165884653, 2.8019509696738534, 4.113450650659886,
+             2.1776209347169977],
+            [-3.7674623189169627, -0.05035902051059699, 4.113450650659886, 10.187165118328878,
+             7.968392933600425],
+            [-2.482092598643416, -4.068208345029607, 2.1776209347169977, 7.968392933600425,
+             9.732499438539305]])
+        right_hand_side = np.array([2.805894318064536, -1.126174269363369, 1.8871533010114294,
+                                    0.6928099799776283, 1.714355064134923])
+        problem = contact._Problem(matrix, right_hand_side, 1e-12, contact.estimate_norm(matrix))
+        _, _, converged = contact._primal_dual_active_set(problem, np.zeros(5), 50)
+        self.assertFalse(converged)
+        result = contact.solve_bound_qp(matrix, right_hand_side, np.zeros(5), 1e-12, 1000,
+                                        problem.norm)
+        self.assertEqual(result.status, contact.CONVERGED)
+        expected = enumerated_solution(matrix, right_hand_side)
+        self.assertLess(np.abs(result.solution - expected).max(), 1e-12 * np.abs(expected).max())
+
+    def test_all_open_gives_zero_forces(self):
+        matrix = compliance_like(np.random.default_rng(1), 5)
+        result = contact.solve_bound_qp(matrix, -np.ones(5), np.ones(5), 1e-12, 100, 1.0)
+        np.testing.assert_array_equal(result.solution, np.zeros(5))
+        np.testing.assert_allclose(result.gradient, np.ones(5))
+
+
+PLATE_GEO = """
+DefineConstant[ h = 0.25 ];
+Point(1) = {0, 0, 0, h};
+Point(2) = {2, 0, 0, h};
+Point(3) = {2, 1, 0, h};
+Point(4) = {0, 1, 0, h};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 4};
+Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4};
+Plane Surface(1) = {1};
+Physical Curve("contact") = {1};
+Physical Curve("right") = {2};
+Physical Curve("top") = {3};
+Physical Curve("left") = {4};
+Physical Surface("block") = {1};
+"""
+
+
+class BlockOnRigidFlat(unittest.TestCase):
+    YOUNG, POISSON, PUSH, HEIGHT = 1000.0, 0.3, 0.01, 1.0
+
+    def make_body(self, element_order):
+        mesh = support.mesh_from_geo(PLATE_GEO, 0.0, element_order)
+        material = isotropic_material(self.YOUNG, self.POISSON, PLANE_STRAIN, "test")
+        body = Body(BodyDefinition("block", mesh, material, (0.0, 0.0),
+                                   [("left", 0.0, None), ("top", None, -self.PUSH)], [],
+                                   "contact"))
+        interface = body.contact_boundary()
+        body.assign_contact(interface["node_ids"], interface["normals"])
+        return body, interface
+
+    def check(self, element_order):
+        body, interface = self.make_body(element_order)
+        np.testing.assert_allclose(interface["normals"],
+                                   np.tile([0.0, -1.0], (len(interface["normals"]), 1)),
+                                   atol=1e-15)
+        obstacle = np.zeros(len(interface["node_ids"]))            # the rigid flat: u_N <= 0
+        result = body.contact.solve_contact(obstacle, 1e-12, 1000)
+        self.assertEqual(result["status"], contact.CONVERGED)
+        stress = self.YOUNG / (1.0 - self.POISSON ** 2) * self.PUSH / self.HEIGHT
+        expected = stress * interface["weights"]
+        self.assertLess(np.abs(result["contact_force"] - expected).max(), 1e-10 * expected.max())
+        self.assertLess(np.abs(result["normal_trace"]).max(), 1e-12 * self.PUSH)
+        # consistency: e - F lambda is the normal trace of u(lambda)
+        displacement = body.displacement(result["contact_force"]).reshape(-1, 2)
+        trace = np.sum(displacement[interface["node_ids"]] * interface["normals"], axis=1)
+        np.testing.assert_allclose(result["normal_trace"], trace, atol=1e-14 * self.PUSH)
+
+    def test_linear_triangles(self):
+        self.check(1)
+
+    def test_quadratic_triangles(self):
+        self.check(2)
+
+    def test_compliance_is_symmetric_positive_definite(self):
+        body, _ = self.make_body(1)
+        compliance = body.contact.compliance
+        np.testing.assert_array_equal(compliance, compliance.T)
+        self.assertGreater(np.linalg.eigvalsh(compliance)[0], 0.0)
+        norm = contact.estimate_norm(compliance)
+        self.assertLessEqual(norm, np.linalg.norm(compliance, 2) * (1 + 1e-12))
+        self.assertGreater(norm, 0.9 * np.linalg.norm(compliance, 2))
+
+
+if __name__ == "__main__":
+    unittest.main()

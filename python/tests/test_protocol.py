@@ -1,0 +1,125 @@
+"""The protocol state machine of the Python subdomain server, without a socket: states and their
+transitions, the error codes of refused requests, and replies that echo the request id and carry
+version 1.0.
+"""
+
+import unittest
+
+import numpy as np
+
+import support
+from robin_subdomain.proto_module import load_protocol
+from robin_subdomain.protocol import SubdomainProtocol
+
+protocol = load_protocol()
+LOWER_GEO = (support.REPOSITORY / "examples" / "meshes" / "block_lower.geo").read_bytes()
+
+
+def request(request_id=7, major=1, **content):
+    envelope = protocol.Envelope()
+    envelope.request_id = request_id
+    if major is not None:
+        envelope.version.major = major
+    for name, message in content.items():
+        getattr(envelope, name).CopyFrom(message)
+    return envelope.SerializeToString()
+
+
+def setup_body(**changes):
+    message = protocol.SetupBody(body_name="lower", mesh_content=LOWER_GEO, mesh_extension=".geo",
+                                 mesh_size=0.5, model=protocol.PLANE_STRAIN, young_modulus=1000.0,
+                                 poisson_ratio=0.3, contact_boundary="contact")
+    condition = message.dirichlet.add()
+    condition.boundary, condition.x, condition.y = "bottom", 0.0, 0.0
+    for name, value in changes.items():
+        setattr(message, name, value)
+    return message
+
+
+class StateMachine(unittest.TestCase):
+    def setUp(self):
+        self.server = SubdomainProtocol(protocol)
+        self.server.logger.disabled = True
+
+    def ask(self, data):
+        reply = protocol.Envelope()
+        reply.ParseFromString(self.server.handle(data))
+        self.assertEqual((reply.version.major, reply.version.minor), (1, 0))
+        return reply
+
+    def expect_error(self, data, code, state):
+        reply = self.ask(data)
+        self.assertEqual(reply.WhichOneof("content"), "error", reply)
+        self.assertEqual(protocol.ErrorCode.Name(reply.error.code), code, reply.error.message)
+        self.assertEqual(reply.error.state, state)
+        return reply.error.message
+
+    def test_garbage_is_malformed_and_the_server_goes_on(self):
+        self.expect_error(b"\xff\xfe not protobuf", "MALFORMED_MESSAGE", "awaiting_setup")
+        reply = self.ask(request(request_id=11, hello=protocol.Hello()))
+        self.assertEqual(reply.request_id, 11)
+        self.assertEqual(reply.hello_reply.state, "awaiting_setup")
+        self.assertEqual(list(reply.hello_reply.capabilities),
+                         ["contact_solve", "correction_solve", "fields"])
+
+    def test_envelope_checks(self):
+        self.expect_error(request(), "MALFORMED_MESSAGE", "awaiting_setup")
+        self.expect_error(request(major=None, hello=protocol.Hello()), "MALFORMED_MESSAGE",
+                          "awaiting_setup")
+        message = self.expect_error(request(major=2, hello=protocol.Hello()), "VERSION_MISMATCH",
+                                    "awaiting_setup")
+        self.assertIn("2.0", message)
+        self.assertIn("1.0", message)
+        self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
+                          "awaiting_setup")
+        # field 31 of the Envelope: a request type this version does not know
+        self.expect_error(request() + b"\xfa\x01\x00", "UNSUPPORTED", "awaiting_setup")
+
+    def test_states_and_transitions(self):
+        solve = protocol.ContactSolveRequest(obstacle=[0.0])
+        self.expect_error(request(contact_solve=solve), "WRONG_STATE", "awaiting_setup")
+        reply = self.ask(request(setup_body=setup_body()))
+        interface = reply.interface
+        self.assertEqual(interface.body_name, "lower")
+        count = len(interface.node_ids)
+        self.assertEqual(count, 5)  # the transfinite contact edge, h = 0.5
+        np.testing.assert_allclose(np.array(interface.normals).reshape(-1, 2),
+                                   np.tile([0.0, 1.0], (count, 1)), atol=1e-15)
+        self.assertAlmostEqual(sum(interface.weights), 2.0, delta=1e-14)
+        self.expect_error(request(contact_solve=solve), "WRONG_STATE", "awaiting_assignment")
+        bad = protocol.AssignContact(node_ids=[interface.node_ids[0]], normals=[0.0, 2.0])
+        self.expect_error(request(assign_contact=bad), "INVALID_ARGUMENT", "awaiting_assignment")
+        good = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
+        self.assertEqual(self.ask(request(assign_contact=good)).acknowledge.state, "ready")
+        self.expect_error(request(contact_solve=solve), "INVALID_ARGUMENT", "ready")
+        solve = protocol.ContactSolveRequest(obstacle=[1.0] * count)
+        result = self.ask(request(contact_solve=solve)).contact_result
+        self.assertEqual(result.status, protocol.CONVERGED)
+        self.assertEqual(list(result.contact_force), [0.0] * count)  # unloaded body, far obstacle
+        self.assertEqual(self.ask(request(end_run=protocol.EndRun())).acknowledge.state,
+                         "awaiting_setup")
+        self.assertEqual(self.ask(request(shutdown=protocol.Shutdown())).acknowledge.state,
+                         "awaiting_setup")
+        self.assertTrue(self.server.shutdown_requested)
+
+    def test_bad_bodies(self):
+        self.expect_error(request(setup_body=setup_body(poisson_ratio=0.5)), "BAD_INPUT",
+                          "awaiting_setup")
+        message = self.expect_error(request(setup_body=setup_body(contact_boundary="lid")),
+                                    "BAD_INPUT", "awaiting_setup")
+        self.assertIn("bottom, contact, left, right", message)
+        singular = setup_body()
+        singular.ClearField("dirichlet")
+        self.expect_error(request(setup_body=singular), "SINGULAR_BODY", "awaiting_setup")
+        self.expect_error(request(setup_body=setup_body(mesh_content=b"Point(1) = {0, 0, 0;")),
+                          "BAD_INPUT", "awaiting_setup")
+
+    def test_failed_setup_discards_the_previous_body(self):
+        self.ask(request(setup_body=setup_body()))
+        self.assertEqual(self.server.state, "awaiting_assignment")
+        self.expect_error(request(setup_body=setup_body(young_modulus=-1.0)), "BAD_INPUT",
+                          "awaiting_setup")
+
+
+if __name__ == "__main__":
+    unittest.main()

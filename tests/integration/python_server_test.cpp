@@ -1,0 +1,209 @@
+// robin-subdomain-py (python/robin-subdomain-py run by /usr/bin/python3), the independent Python
+// implementation of a subdomain server (its own Gmsh reader, elements, factorization and QP),
+// driven by the coordinator's RemotePort:
+//  - coupled runs of examples/two_blocks.toml and examples/two_blocks_partial.toml with body 1
+//    on the C++ robin-subdomain and body 2 on the Python server, and with both bodies on Python
+//    servers, equal the all-C++ run (InProcessPort: the C++ numerics in this process, which
+//    remote_port_test shows equal to C++ servers to 1e-12) to 1e-6 relative in contact forces,
+//    normal traces and displacement fields, with the same iteration count;
+//  - the process: exactly one "listening on" line with the ephemeral port resolved; garbage
+//    bytes and a multi-frame message get MALFORMED_MESSAGE replies and the server goes on;
+//    Shutdown, SIGTERM and SIGINT end it with exit status 0.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <iostream>
+#include <thread>
+#include <zmq.hpp>
+
+#include "coupling/coupled_run.hpp"
+#include "coupling/in_process_port.hpp"
+#include "remote/remote_port.hpp"
+#include "remote_test_support.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+namespace {
+
+using testing::example;
+using testing::server_options;
+using testing::TemporaryDirectory;
+using testing::vectors_close;
+
+constexpr double tolerance = 1e-6;  // relative, two independent implementations
+
+/// Launch options of the Python server (same command line as robin-subdomain).
+ServerLaunchOptions python_server_options(const std::filesystem::path& log_directory) {
+  ServerLaunchOptions options = server_options(log_directory);
+  options.executable = std::filesystem::path(ROBIN_EXAMPLES) / "../python/robin-subdomain-py";
+  options.command_prefix = {"/usr/bin/python3"};
+  options.startup_timeout_seconds = 60.0;
+  return options;
+}
+
+Eigen::VectorXd point_field(const BodyOutput& output, const std::string& name) {
+  for (const OutputField& field : output.point_fields) {
+    if (field.name == name) {
+      return Eigen::Map<const Eigen::VectorXd>(field.values.data(),
+                                               static_cast<Eigen::Index>(field.values.size()));
+    }
+  }
+  throw std::runtime_error("no point field '" + name + "' in body '" + output.body_name + "'");
+}
+
+/// The all-C++ run of a case, computed once per case.
+const CoupledRunResult& cpp_reference(const std::string& case_file) {
+  static std::map<std::string, CoupledRunResult> references;
+  const auto found = references.find(case_file);
+  if (found != references.end()) return found->second;
+  const CaseDefinition definition = read_case_file(example(case_file));
+  InProcessPort body1, body2;
+  CoupledRunResult result = run_coupled_case(definition, {&body1, &body2}, definition.coupling);
+  body1.end_run();
+  body2.end_run();
+  return references.emplace(case_file, std::move(result)).first->second;
+}
+
+/// Runs `case_file` with body 1 on a C++ or Python server and body 2 on a Python server.
+CoupledRunResult run_with_python(const std::string& case_file, bool python_body1) {
+  const TemporaryDirectory logs("python-server-logs");
+  const CaseDefinition definition = read_case_file(example(case_file));
+  const ServerLaunchOptions python = python_server_options(logs.path());
+  SubdomainServer server1(definition.bodies[0].definition.name,
+                          python_body1 ? python : server_options(logs.path()));
+  SubdomainServer server2(definition.bodies[1].definition.name, python);
+  server1.await_listening();
+  server2.await_listening();
+  RemotePortOptions port_options;
+  port_options.request_timeout_seconds = 60.0;
+  RemotePort body1(server1.endpoint(), definition.bodies[0].definition.name, port_options);
+  RemotePort body2(server2.endpoint(), definition.bodies[1].definition.name, port_options);
+  CoupledRunResult result = run_coupled_case(definition, {&body1, &body2}, definition.coupling);
+  EXPECT_EQ(body2.server_name().rfind("robin-subdomain-py ", 0), 0u) << body2.server_name();
+  body1.end_run();
+  body2.end_run();
+  return result;
+}
+
+void expect_equal_to_cpp(const std::string& case_file, const CoupledRunResult& run) {
+  const CoupledRunResult& reference = cpp_reference(case_file);
+  const RobinResult& a = run.iteration;
+  const RobinResult& b = reference.iteration;
+  ASSERT_EQ(b.status, IterationStatus::converged) << b.message;
+  ASSERT_EQ(a.status, IterationStatus::converged) << a.message;
+  EXPECT_EQ(a.history.size(), b.history.size());
+  EXPECT_GT(b.contact_force1.maxCoeff(), 0.0);  // a real contact state
+  std::cout << case_file << ": " << a.history.size() << " iterations; largest differences to "
+            << "the all-C++ run: contact force "
+            << (a.contact_force1 - b.contact_force1).lpNorm<Eigen::Infinity>() << " (of "
+            << b.contact_force1.lpNorm<Eigen::Infinity>() << "), normal trace "
+            << (a.normal_trace2 - b.normal_trace2).lpNorm<Eigen::Infinity>() << " (of "
+            << b.normal_trace2.lpNorm<Eigen::Infinity>() << ")\n";
+  EXPECT_TRUE(vectors_close(a.contact_force1, b.contact_force1, tolerance));
+  EXPECT_TRUE(vectors_close(a.contact_force2, b.contact_force2, tolerance));
+  EXPECT_TRUE(vectors_close(a.normal_trace1, b.normal_trace1, tolerance));
+  EXPECT_TRUE(vectors_close(a.normal_trace2, b.normal_trace2, tolerance));
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    EXPECT_EQ(run.outputs[alpha].mesh.nodes.size(), reference.outputs[alpha].mesh.nodes.size());
+    EXPECT_TRUE(vectors_close(point_field(run.outputs[alpha], "displacement"),
+                              point_field(reference.outputs[alpha], "displacement"), tolerance))
+        << "body " << alpha + 1;
+    EXPECT_TRUE(vectors_close(run.outputs[alpha].reaction_resultant,
+                              reference.outputs[alpha].reaction_resultant, tolerance))
+        << "body " << alpha + 1;
+  }
+}
+
+TEST(PythonServer, TwoBlocksCppAndPythonEqualsAllCpp) {
+  expect_equal_to_cpp("two_blocks.toml", run_with_python("two_blocks.toml", false));
+}
+
+TEST(PythonServer, TwoBlocksTwoPythonServersEqualsAllCpp) {
+  expect_equal_to_cpp("two_blocks.toml", run_with_python("two_blocks.toml", true));
+}
+
+TEST(PythonServer, PartialContactCppAndPythonEqualsAllCpp) {
+  expect_equal_to_cpp("two_blocks_partial.toml", run_with_python("two_blocks_partial.toml", false));
+}
+
+TEST(PythonServer, PartialContactTwoPythonServersEqualsAllCpp) {
+  expect_equal_to_cpp("two_blocks_partial.toml", run_with_python("two_blocks_partial.toml", true));
+}
+
+/// Sends `frames` on a REQ socket and parses the reply.
+protocol::Envelope exchange(zmq::socket_t& socket, const std::vector<std::string>& frames) {
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const auto flag = k + 1 < frames.size() ? zmq::send_flags::sndmore : zmq::send_flags::none;
+    socket.send(zmq::buffer(frames[k]), flag);
+  }
+  zmq::message_t message;
+  EXPECT_TRUE(socket.recv(message));
+  protocol::Envelope reply;
+  EXPECT_TRUE(reply.ParseFromArray(message.data(), static_cast<int>(message.size())));
+  EXPECT_EQ(reply.version().major(), 1u);
+  return reply;
+}
+
+std::string hello_request(std::uint64_t request_id) {
+  protocol::Envelope request;
+  request.mutable_version()->set_major(1);
+  request.set_request_id(request_id);
+  request.mutable_hello()->set_client_name("python_server_test");
+  return request.SerializeAsString();
+}
+
+/// Waits up to 10 s for the server's exit; its description ("" while it runs).
+std::string await_exit(SubdomainServer& server) {
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    const std::string failure = server.failure();
+    if (!failure.empty()) return failure;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return "";
+}
+
+TEST(PythonServer, GarbageIsMalformedAndTheServerGoesOn) {
+  const TemporaryDirectory logs("python-server-garbage");
+  SubdomainServer server("lower", python_server_options(logs.path()));
+  server.await_listening();
+  EXPECT_EQ(server.endpoint().rfind("tcp://127.0.0.1:", 0), 0u) << server.endpoint();
+  EXPECT_EQ(server.endpoint().find('*'), std::string::npos) << server.endpoint();
+  zmq::context_t context;
+  zmq::socket_t socket(context, zmq::socket_type::req);
+  socket.set(zmq::sockopt::linger, 0);
+  socket.set(zmq::sockopt::rcvtimeo, 20000);
+  socket.connect(server.endpoint());
+  for (const std::vector<std::string>& garbage :
+       {std::vector<std::string>{std::string("\xff\xfe garbage", 10)},
+        std::vector<std::string>{"two", "frames"}}) {
+    const protocol::Envelope reply = exchange(socket, garbage);
+    ASSERT_TRUE(reply.has_error());
+    EXPECT_EQ(reply.error().code(), protocol::MALFORMED_MESSAGE) << reply.error().message();
+    EXPECT_EQ(reply.error().state(), "awaiting_setup");
+  }
+  const protocol::Envelope hello = exchange(socket, {hello_request(42)});
+  EXPECT_EQ(hello.request_id(), 42u);
+  ASSERT_TRUE(hello.has_hello_reply());
+  EXPECT_EQ(hello.hello_reply().state(), "awaiting_setup");
+  EXPECT_EQ(server.failure(), "");
+}
+
+TEST(PythonServer, ShutdownSigtermAndSigintExitWithStatusZero) {
+  const TemporaryDirectory logs("python-server-stop");
+  for (const int signal_number : {0, SIGTERM, SIGINT}) {
+    SubdomainServer server("upper", python_server_options(logs.path()));
+    server.await_listening();
+    if (signal_number == 0) {
+      EXPECT_TRUE(request_server_shutdown(server.endpoint(), 10.0));
+    } else {
+      ASSERT_EQ(kill(server.pid(), signal_number), 0);
+    }
+    const std::string exit = await_exit(server);
+    EXPECT_NE(exit.find("exited with status 0"), std::string::npos)
+        << "signal " << signal_number << ": " << exit;
+  }
+}
+
+}  // namespace
+}  // namespace robin
