@@ -44,7 +44,8 @@ def prescribed_values(definition):
                 if value is None:
                     continue
                 dof = 2 * node + component
-                if not np.isnan(values[dof]) and abs(values[dof] - value) > 1e-14 * (1 + abs(value)):
+                differs = abs(values[dof] - value) > 1e-14 * (1 + abs(value))
+                if not np.isnan(values[dof]) and differs:
                     raise InputError(
                         "body '%s': Dirichlet conditions on '%s' and '%s' prescribe different "
                         "values to node tag %d (%s)" % (definition.name, source[dof], boundary,
@@ -148,7 +149,8 @@ class Body:
                 "coordinates": self.mesh.nodes[nodes],
                 "normals": fem.boundary_node_normals(self.mesh, edges),
                 "weights": fem.boundary_weights(self.mesh, edges)[nodes],
-                "x_fixed": self.is_prescribed[2 * nodes], "y_fixed": self.is_prescribed[2 * nodes + 1]}
+                "x_fixed": self.is_prescribed[2 * nodes],
+                "y_fixed": self.is_prescribed[2 * nodes + 1]}
 
     def assign_contact(self, node_ids, normals):
         """Sets the contact nodes (pair order) and their unit normals; builds e and F."""

@@ -1,5 +1,5 @@
-"""2D meshes from Gmsh files: .msh (ASCII formats 4.1 and 2.2) read here, .geo meshed by the
-`gmsh` command-line tool first.
+"""2D meshes from Gmsh files: .msh (ASCII formats 4.1 and 2.2) read here, other .msh versions
+and binary files converted to ASCII 4.1 by the `gmsh` command-line tool, .geo meshed by it.
 
 The mesh read is what the C++ reader (subdomain/numerics/gmsh_reader.hpp) reads:
   - area elements of every entity in a 2D physical group (of every 2D entity when the file has
@@ -326,9 +326,10 @@ def _boundary_edges(raw, source):
                 if dimension != 1 or entity != curve:
                     continue
                 if gmsh_type not in GMSH_EDGE_TYPES:
-                    raise InputError("%s: boundary '%s': unsupported 1D element %s (Gmsh type %d);"
-                                     " use 2-node or 3-node lines" %
-                                     (source, name, GMSH_NAMES.get(gmsh_type, "unknown"), gmsh_type))
+                    raise InputError(
+                        "%s: boundary '%s': unsupported 1D element %s (Gmsh type %d); use 2-node "
+                        "or 3-node lines" % (source, name, GMSH_NAMES.get(gmsh_type, "unknown"),
+                                             gmsh_type))
                 kind = GMSH_EDGE_TYPES[gmsh_type]
                 entry = edges.setdefault(name, (kind, []))
                 if entry[0] != kind:
@@ -399,7 +400,8 @@ def extract_mesh(raw, source):
     blocks = []
     for kind in ELEMENT_ORDER:
         if kind in areas:
-            connectivity = _orient_counter_clockwise(nodes, used, kind, indices(areas[kind]), source)
+            connectivity = indices(areas[kind])
+            _orient_counter_clockwise(nodes, used, kind, connectivity, source)
             blocks.append(ElementBlock(kind, connectivity))
     boundaries = {name: BoundaryGroup(kind, indices(tags))
                   for name, (kind, tags) in sorted(edges.items())}
@@ -415,34 +417,69 @@ def _format_size(size):
     return repr(float(size))
 
 
+def _run_gmsh(arguments, source, action, input_path):
+    """Runs the gmsh command-line tool; any "Error" line or a failed exit is an InputError."""
+    gmsh = shutil.which("gmsh")
+    if gmsh is None:
+        raise InputError("%s: the gmsh command-line tool is not installed (needed for %s; "
+                         "apt-get install gmsh)" % (source, action))
+    completed = subprocess.run([gmsh] + arguments + ["-v", "2", "-nt", "1"], capture_output=True,
+                               text=True, check=False, stdin=subprocess.DEVNULL, timeout=3600)
+    log = (completed.stdout + "\n" + completed.stderr).splitlines()
+    errors = [line.split(":", 1)[1].strip() for line in log if line.startswith("Error")]
+    errors = [error.replace(str(input_path), source) for error in errors if error]
+    if errors or completed.returncode != 0:
+        problem = "; ".join(dict.fromkeys(errors)) or "gmsh exited with status %d" % (
+            completed.returncode)
+        raise InputError("%s: %s failed: %s" % (source, action, problem))
+
+
 def mesh_geo_file(geo_path, source, size=0.0, element_order=1, recombine=False):
     """Meshes a .geo in 2D with the gmsh command-line tool (`-setnumber h SIZE` when size > 0,
     `-order N`, Mesh.RecombineAll = 1 when recombine) and returns the .msh text (format 4.1)."""
-    gmsh = shutil.which("gmsh")
-    if gmsh is None:
-        raise InputError("%s: the gmsh command-line tool is not installed (needed for .geo "
-                         "meshes; apt-get install gmsh)" % source)
     directory = tempfile.mkdtemp(prefix="robin-subdomain-py-mesh-")
     try:
         output = os.path.join(directory, "mesh.msh")
-        command = [gmsh, str(geo_path), "-2", "-order", str(element_order), "-format", "msh41",
-                   "-o", output, "-v", "2", "-nt", "1"]
+        arguments = [str(geo_path), "-2", "-order", str(element_order), "-format", "msh41",
+                     "-o", output]
         if size > 0.0:
-            command[2:2] = ["-setnumber", "h", _format_size(size)]
+            arguments[1:1] = ["-setnumber", "h", _format_size(size)]
         if recombine:
-            command[2:2] = ["-string", "Mesh.RecombineAll = 1;"]
-        completed = subprocess.run(command, capture_output=True, text=True, check=False,
-                                   stdin=subprocess.DEVNULL, timeout=3600)
-        log = (completed.stdout + "\n" + completed.stderr).splitlines()
-        errors = [line.split(":", 1)[1].strip() for line in log if line.startswith("Error")]
-        errors = [error.replace(str(geo_path), source) for error in errors if error]
-        if errors or completed.returncode != 0 or not os.path.isfile(output):
-            problem = "; ".join(dict.fromkeys(errors)) or "gmsh exited with status %d" % (
-                completed.returncode)
-            raise InputError("%s: meshing failed: %s" % (source, problem))
+            arguments[1:1] = ["-string", "Mesh.RecombineAll = 1;"]
+        _run_gmsh(arguments, source, "meshing", geo_path)
         return pathlib.Path(output).read_text()
     finally:
         shutil.rmtree(directory, ignore_errors=True)
+
+
+def _is_native_msh(content):
+    """True for an ASCII .msh of format 4.1 or 2.2 (read here); other versions and binary
+    files are converted by gmsh first."""
+    head = content[:200].split(b"\n")
+    if len(head) < 2 or head[0].strip() != b"$MeshFormat":
+        return True  # not a .msh at all: the reader reports it
+    words = head[1].split()
+    return len(words) >= 2 and words[0] in (b"4.1", b"2.2") and words[1] == b"0"
+
+
+def read_msh_bytes(content, source):
+    """The mesh of the bytes of a .msh file of any version Gmsh reads, ASCII or binary."""
+    if not _is_native_msh(content):
+        directory = tempfile.mkdtemp(prefix="robin-subdomain-py-msh-")
+        try:
+            original = os.path.join(directory, "original.msh")
+            converted = os.path.join(directory, "converted.msh")
+            pathlib.Path(original).write_bytes(content)
+            _run_gmsh([original, "-0", "-save_all", "-format", "msh41", "-o", converted], source,
+                      "reading", original)
+            content = pathlib.Path(converted).read_bytes()
+        finally:
+            shutil.rmtree(directory, ignore_errors=True)
+    try:
+        text = content.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError("%s: not a Gmsh .msh file (not text)" % source)
+    return read_msh_text(text, source)
 
 
 def read_mesh(path, source, size=0.0, element_order=1, recombine=False):
@@ -455,13 +492,8 @@ def read_mesh(path, source, size=0.0, element_order=1, recombine=False):
     if not path.is_file():
         raise InputError("%s: the file does not exist or is not a regular file" % source)
     if extension == ".geo":
-        text = mesh_geo_file(path, source, size, element_order, recombine)
-    else:
-        try:
-            text = path.read_text()
-        except UnicodeDecodeError:
-            raise InputError("%s: not an ASCII Gmsh .msh file" % source)
-    return read_msh_text(text, source)
+        return read_msh_text(mesh_geo_file(path, source, size, element_order, recombine), source)
+    return read_msh_bytes(path.read_bytes(), source)
 
 
 def read_mesh_content(content, extension, source, size=0.0, element_order=1, recombine=False):
@@ -471,10 +503,7 @@ def read_mesh_content(content, extension, source, size=0.0, element_order=1, rec
         raise InputError("%s: unsupported mesh extension '%s': give .msh or .geo" %
                          (source, extension))
     if lowered == ".msh":
-        try:
-            return read_msh_text(content.decode("utf-8"), source)
-        except UnicodeDecodeError:
-            raise InputError("%s: not an ASCII Gmsh .msh file" % source)
+        return read_msh_bytes(content, source)
     directory = tempfile.mkdtemp(prefix="robin-subdomain-py-geo-")
     try:
         path = pathlib.Path(directory) / "mesh.geo"

@@ -6,9 +6,13 @@
   right side: the nodal displacements are the analytic ones, plane strain and plane stress,
   isotropic and orthotropic (Voigt) materials; reactions balance the applied force.
 - Body force, boundary weights and outward normals of a rectangle: totals and directions.
-- The .msh 2.2 and 4.1 files of the same mesh read alike; rigid motions left free are refused.
+- The .msh 2.2 and 4.1 files of the same mesh read alike (binary and 4.0 files through gmsh);
+  rigid motions left free and conflicting Dirichlet values are refused.
 """
 
+import os
+import subprocess
+import tempfile
 import unittest
 
 import numpy as np
@@ -167,6 +171,25 @@ class MeshesAndConditions(unittest.TestCase):
             np.testing.assert_array_equal(np.sort(a.connectivity, axis=1),
                                           np.sort(b.connectivity, axis=1))
         self.assertEqual(old.node_count(), 12)  # the unit square's 12 nodes, not the stray point
+
+    def test_binary_and_other_versions_read_like_ascii_41(self):
+        with tempfile.TemporaryDirectory() as directory:
+            geo = os.path.join(directory, "rectangle.geo")
+            with open(geo, "w") as stream:
+                stream.write(support.RECTANGLE_GEO)
+            meshes = []
+            for name, options in (("ascii41.msh", ["-format", "msh41"]),
+                                  ("binary41.msh", ["-format", "msh41", "-bin"]),
+                                  ("ascii40.msh", ["-format", "msh40"]),
+                                  ("ascii22.msh", ["-format", "msh22"])):
+                path = os.path.join(directory, name)
+                subprocess.run(["gmsh", geo, "-2", "-o", path, "-v", "0"] + options, check=True)
+                meshes.append(read_mesh(path, name))
+        for other in meshes[1:]:
+            np.testing.assert_array_equal(other.nodes, meshes[0].nodes)
+            np.testing.assert_array_equal(other.blocks[0].connectivity,
+                                          meshes[0].blocks[0].connectivity)
+            self.assertEqual(sorted(other.boundaries), ["bottom", "left", "right", "top"])
 
     def test_free_rotation_is_a_singular_body(self):
         material = isotropic_material(YOUNG, POISSON, PLANE_STRAIN, "test")
