@@ -151,8 +151,13 @@ def _lawson_hanson(problem, x, max_steps):
         best = int(np.argmin(candidates))
         if not candidates[best] < -problem.sign_margin(x):
             return x, step, True
+        previous = free.copy()
         free[best] = True
         x, free = _move_to_face_minimiser(problem, x, free)
+        if np.array_equal(free, previous):
+            # The freed constraint was dropped again at once: no descent left above the
+            # rounding level; the caller's projected-gradient test decides.
+            return x, step, True
     return x, max_steps, False
 
 
