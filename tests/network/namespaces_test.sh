@@ -88,6 +88,21 @@ trap 'exit 130' INT
 trap 'exit 143' TERM
 trap 'exit 129' HUP
 
+# Namespaces of earlier runs of this test that were killed (SIGKILL, e.g. at a CTest timeout)
+# before their cleanup: removed when the run that created them is gone.
+remove_stale_namespaces() {
+  local namespace owner remaining
+  for namespace in $(ip netns list 2> /dev/null | awk '/^robin-test-/ { print $1 }'); do
+    owner=${namespace##*-}
+    if [ "$owner" != $$ ] && ! kill -0 "$owner" 2> /dev/null; then
+      remaining=$(ip netns pids "$namespace" 2> /dev/null || true)
+      # shellcheck disable=SC2086  # one pid per word
+      [ -z "$remaining" ] || kill -KILL $remaining 2> /dev/null || true
+      if ip netns delete "$namespace" 2> /dev/null; then echo "removed stale namespace $namespace"; fi
+    fi
+  done
+}
+
 # --- The network ------------------------------------------------------------------------------
 
 # Creates the namespaces: the coordinator's holds the bridge (and the address .1), each server's
@@ -196,7 +211,7 @@ remote_server_options=(
 
 check_remote_servers_script() {
   local status=0 comparison
-  "$remote_servers" "${remote_server_options[@]}" \
+  timeout 120 "$remote_servers" "${remote_server_options[@]}" \
     --coordinator-binary "$binary_directory/robin-coordinator" \
     --log-dir "$work/script-logs" "$case_file" --output "$work/script" --log-level warn \
     2> "$work/script.stderr" || status=$?
@@ -237,7 +252,7 @@ check_interruption() {
 
 check_bind_failure() {
   local status=0
-  "$remote_servers" --subdomain-binary "$binary_directory/robin-subdomain" \
+  timeout 60 "$remote_servers" --subdomain-binary "$binary_directory/robin-subdomain" \
     --launch "ip netns exec ${server_namespaces[0]}" --listen "tcp://${server_addresses[0]}:5557" \
     --launch "ip netns exec ${server_namespaces[1]}" --listen "tcp://$subnet.9:5557" \
     --log-dir "$work/failure-logs" "$case_file" --output "$work/failure" \
@@ -254,6 +269,7 @@ check_bind_failure() {
 
 "$binary_directory/robin-run" "$case_file" --output "$work/local" --log-level warn \
   2> "$work/robin-run.log" || fail "robin-run exited with status $?"
+remove_stale_namespaces
 create_network
 check_coordinator_across_namespaces
 check_remote_servers_script
