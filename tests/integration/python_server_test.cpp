@@ -1,7 +1,7 @@
 // robin-subdomain-py (python/robin-subdomain-py run by /usr/bin/python3), the independent Python
 // implementation of a subdomain server (its own Gmsh reader, elements, factorization and QP),
 // driven by the coordinator's RemotePort:
-//  - coupled runs of examples/two_blocks.toml and examples/two_blocks_partial.toml with body 1
+//  - coupled runs of examples/two_blocks.toml, two_blocks_partial.toml and hertz.toml with body 1
 //    on the C++ robin-subdomain and body 2 on the Python server, and with both bodies on Python
 //    servers, equal the all-C++ run (InProcessPort: the C++ numerics in this process, which
 //    remote_port_test shows equal to C++ servers to 1e-12) to 1e-6 relative in contact forces,
@@ -125,6 +125,14 @@ TEST(PythonServer, TwoBlocksTwoPythonServersEqualsAllCpp) {
 
 TEST(PythonServer, PartialContactCppAndPythonEqualsAllCpp) {
   expect_equal_to_cpp("two_blocks_partial.toml", run_with_python("two_blocks_partial.toml", false));
+}
+
+TEST(PythonServer, HertzCppAndPythonEqualsAllCpp) {
+  expect_equal_to_cpp("hertz.toml", run_with_python("hertz.toml", false));
+}
+
+TEST(PythonServer, HertzTwoPythonServersEqualsAllCpp) {
+  expect_equal_to_cpp("hertz.toml", run_with_python("hertz.toml", true));
 }
 
 TEST(PythonServer, PartialContactTwoPythonServersEqualsAllCpp) {
