@@ -55,6 +55,9 @@ def parse_arguments(arguments):
 
 
 def make_logger(level, name):
+    for spelled, number in LOG_LEVELS.items():
+        if spelled != "off":
+            logging.addLevelName(number, "warning" if spelled == "warn" else spelled)
     logger = logging.getLogger("robin-subdomain-py")
     handler = logging.StreamHandler(sys.stderr)
     label = "robin-subdomain-py" + (" " + name if name else "")
