@@ -185,7 +185,9 @@ server_tail() {
 # Waits for the "listening on" line of server INDEX and prints the endpoint to connect to.
 await_endpoint() {
   local index=$1 number=$(($1 + 1)) line endpoint host deadline=$((SECONDS + startup_timeout))
-  until line=$(grep -a -m 1 'listening on ' "$log_directory/server-$number.out" 2> /dev/null); do
+  # The line starts with "listening on"; through a terminal (ssh -tt) the server's log lines,
+  # which also contain "listening on", arrive in the same stream.
+  until line=$(grep -a -m 1 '^listening on ' "$log_directory/server-$number.out" 2> /dev/null); do
     if ! kill -0 "${server_pids[index]}" 2> /dev/null; then
       die "server $number (${server_listen[index]}) exited before listening:"$'\n'"$(server_tail "$number")"
     fi

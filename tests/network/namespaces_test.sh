@@ -13,6 +13,9 @@
 #  3. deploy/remote-servers.sh interrupted by SIGTERM while the coordinator runs: exit code 143
 #     and every process it started is gone; a server that cannot bind its address: exit code 1,
 #     a message naming the endpoint, and the other server stopped.
+#  4. Where OpenSSH (server and client) is installed: an sshd in each server namespace and
+#     remote-servers.sh in the coordinator's namespace with `ssh -tt ADDRESS` as the prefix:
+#     same comparison, and the remote servers end when the script does. Left out otherwise.
 # Exit code 77 (skipped for CTest) when network namespaces cannot be created here (not root, no
 # iproute2, no kernel support). The namespaces, their links and every process are removed on
 # any exit. The namespaces hold their own addresses, so nothing is added to the host's network.
@@ -50,6 +53,7 @@ command -v ip > /dev/null || skip "iproute2's ip is missing"
 work=$(mktemp -d -t robin-namespaces.XXXXXX)
 created_namespaces=()
 started_pids=()
+created_privilege_directory=""  # /run/sshd, when the ssh check had to create it
 
 # Stops what this test started, then removes the namespaces (which removes their links) and
 # kills anything still running inside them. Runs on every exit.
@@ -81,6 +85,7 @@ cleanup() {
     done
   fi
   rm -rf "$work"
+  [ -z "$created_privilege_directory" ] || rmdir "$created_privilege_directory" 2> /dev/null || true
   exit "$status"
 }
 trap cleanup EXIT
@@ -265,6 +270,61 @@ check_bind_failure() {
   echo "deploy/remote-servers.sh with an unbindable address: status 1, message names it"
 }
 
+# --- 4. ssh as the prefix (when OpenSSH's server and client are installed) ----------------------
+
+# An sshd in each server namespace (key login for this user, files in the work directory), and
+# remote-servers.sh run inside the coordinator's namespace with `ssh -tt ADDRESS` as the prefix:
+# the servers must answer, and be gone once the script ends (SIGHUP when ssh's terminal closes).
+check_ssh_prefix() {
+  local index config ssh_options=() status=0 comparison
+  if [ ! -x /usr/sbin/sshd ] || ! command -v ssh > /dev/null || ! command -v ssh-keygen > /dev/null; then
+    echo "left out: ssh as the prefix (needs openssh-server and openssh-client)"
+    return 0
+  fi
+  [ -d /run/sshd ] || { mkdir -p /run/sshd && created_privilege_directory=/run/sshd; }
+  ssh-keygen -q -t ed25519 -N '' -f "$work/ssh_host_key"
+  ssh-keygen -q -t ed25519 -N '' -f "$work/ssh_client_key"
+  cp "$work/ssh_client_key.pub" "$work/ssh_authorized_keys"
+  for index in 0 1; do
+    config=$work/sshd_config_$index
+    printf '%s\n' "ListenAddress ${server_addresses[index]}:22" "HostKey $work/ssh_host_key" \
+      "PidFile $work/sshd_$index.pid" "AuthorizedKeysFile $work/ssh_authorized_keys" \
+      "PermitRootLogin prohibit-password" "PasswordAuthentication no" \
+      "KbdInteractiveAuthentication no" "UsePAM no" "StrictModes no" > "$config"
+    ip netns exec "${server_namespaces[index]}" /usr/sbin/sshd -D -e -f "$config" \
+      2> "$work/sshd_$index.log" &
+    started_pids+=($!)
+  done
+  ssh_options=(ssh -tt -i "$work/ssh_client_key" -o BatchMode=yes -o StrictHostKeyChecking=no
+    -o UserKnownHostsFile=/dev/null -o LogLevel=ERROR -o ConnectTimeout=10)
+  for index in 0 1; do  # until each sshd accepts a login
+    for _ in $(seq 50); do
+      ip netns exec "$coordinator_namespace" "${ssh_options[@]}" "$(id -un)@${server_addresses[index]}" \
+        true > /dev/null 2>&1 < /dev/null && break
+      sleep 0.2
+    done
+  done
+  timeout 120 ip netns exec "$coordinator_namespace" "$remote_servers" \
+    --subdomain-binary "$binary_directory/robin-subdomain" \
+    --coordinator-binary "$binary_directory/robin-coordinator" \
+    --launch "${ssh_options[*]} $(id -un)@${server_addresses[0]}" \
+    --listen "tcp://${server_addresses[0]}:5558" \
+    --launch "${ssh_options[*]} $(id -un)@${server_addresses[1]}" \
+    --connect-host "${server_addresses[1]}" --listen "tcp://0.0.0.0:5558" \
+    --log-dir "$work/ssh-logs" "$case_file" --output "$work/ssh" --log-level warn \
+    2> "$work/ssh.stderr" || status=$?
+  [ "$status" -eq 0 ] || fail "remote-servers.sh through ssh exited with status $status"
+  comparison=$(compare_contact "$work/local" "$work/ssh") ||
+    fail "contact.csv of remote-servers.sh through ssh differs from the local run: $comparison"
+  echo "deploy/remote-servers.sh through ssh -tt: $comparison"
+  for _ in $(seq 50); do  # the remote servers end on SIGHUP, shortly after ssh exits
+    pgrep -f "robin-subdomain --listen tcp://[0-9.]*:5558" > /dev/null || break
+    sleep 0.1
+  done
+  ! pgrep -af "robin-subdomain --listen tcp://[0-9.]*:5558" ||
+    fail "servers started through ssh are still running after remote-servers.sh ended"
+}
+
 # --- Main ---------------------------------------------------------------------------------------
 
 "$binary_directory/robin-run" "$case_file" --output "$work/local" --log-level warn \
@@ -275,4 +335,5 @@ check_coordinator_across_namespaces
 check_remote_servers_script
 check_interruption
 check_bind_failure
+check_ssh_prefix
 echo "PASSED: runs across network namespaces"
