@@ -24,124 +24,16 @@ set -euo pipefail
 binary_directory=$(cd "${1:?usage: namespaces_test.sh BINARY_DIRECTORY [SOURCE_DIRECTORY]}" && pwd)
 source_directory=$(cd "${2:-$(dirname "$0")/../..}" && pwd)
 case_file=$source_directory/examples/two_blocks.toml
+
+# shellcheck source=tests/network/network_namespaces.sh
+source "$(dirname "$0")/network_namespaces.sh"
 remote_servers=$source_directory/deploy/remote-servers.sh
-python=/usr/bin/python3
-
-subnet=10.231.77
-coordinator_address=$subnet.1
-server_addresses=("$subnet.2" "$subnet.3")
-coordinator_namespace=robin-test-coordinator-$$
-server_namespaces=("robin-test-server1-$$" "robin-test-server2-$$")
-all_namespaces=("$coordinator_namespace" "${server_namespaces[@]}")
-
-skip() {
-  echo "SKIPPED: $*"
-  exit 77
-}
-fail() {
-  echo "FAILED: $*" >&2
-  exit 1
-}
-
-for tool in robin-run robin-coordinator robin-subdomain; do
-  [ -x "$binary_directory/$tool" ] || fail "$binary_directory/$tool is missing (build it first)"
-done
-[ -x "$python" ] || skip "$python is missing (the comparison of contact.csv needs it)"
-[ "$(id -u)" -eq 0 ] || skip "network namespaces need root (running as uid $(id -u))"
-command -v ip > /dev/null || skip "iproute2's ip is missing"
-
-work=$(mktemp -d -t robin-namespaces.XXXXXX)
-created_namespaces=()
-started_pids=()
 created_privilege_directory=""  # /run/sshd, when the ssh check had to create it
-
-# Stops what this test started, then removes the namespaces (which removes their links) and
-# kills anything still running inside them. Runs on every exit.
-# shellcheck disable=SC2317  # invoked by the EXIT trap
-cleanup() {
-  local status=$? pid namespace remaining
-  trap '' INT TERM HUP
-  for pid in "${started_pids[@]}"; do kill -TERM "$pid" 2> /dev/null || true; done
-  for pid in "${started_pids[@]}"; do
-    for _ in $(seq 50); do kill -0 "$pid" 2> /dev/null || break; sleep 0.1; done
-    kill -KILL "$pid" 2> /dev/null || true
-    wait "$pid" 2> /dev/null || true
-  done
-  for namespace in "${created_namespaces[@]}"; do
-    remaining=$(ip netns pids "$namespace" 2> /dev/null || true)
-    if [ -n "$remaining" ]; then
-      echo "cleanup: killing processes left in $namespace: $remaining" >&2
-      # shellcheck disable=SC2086  # one pid per word
-      kill -KILL $remaining 2> /dev/null || true
-      sleep 0.2
-    fi
-    ip netns delete "$namespace" 2> /dev/null || echo "cleanup: could not delete $namespace" >&2
-  done
-  if [ "$status" -ne 0 ] && [ "$status" -ne 77 ]; then
-    echo "--- logs of the failed test ($work) ---" >&2
-    find "$work" -name '*.log' -o -name '*.out' -o -name '*.stderr' | sort | while read -r file; do
-      echo "== $file" >&2
-      tail -n 20 "$file" >&2
-    done
-  fi
-  rm -rf "$work"
+# shellcheck disable=SC2317  # run by the cleanup
+cleanup_hook() {
   [ -z "$created_privilege_directory" ] || rmdir "$created_privilege_directory" 2> /dev/null || true
-  exit "$status"
 }
-trap cleanup EXIT
-trap 'exit 130' INT
-trap 'exit 143' TERM
-trap 'exit 129' HUP
-
-# Namespaces of earlier runs of this test that were killed (SIGKILL, e.g. at a CTest timeout)
-# before their cleanup: removed when the run that created them is gone.
-remove_stale_namespaces() {
-  local namespace owner remaining
-  for namespace in $(ip netns list 2> /dev/null | awk '/^robin-test-/ { print $1 }'); do
-    owner=${namespace##*-}
-    if [ "$owner" != $$ ] && ! kill -0 "$owner" 2> /dev/null; then
-      remaining=$(ip netns pids "$namespace" 2> /dev/null || true)
-      # shellcheck disable=SC2086  # one pid per word
-      [ -z "$remaining" ] || kill -KILL $remaining 2> /dev/null || true
-      if ip netns delete "$namespace" 2> /dev/null; then echo "removed stale namespace $namespace"; fi
-    fi
-  done
-}
-
-# --- The network ------------------------------------------------------------------------------
-
-# Creates the namespaces: the coordinator's holds the bridge (and the address .1), each server's
-# one end of a veth link whose other end is a port of the bridge.
-create_network() {
-  local index namespace port
-  ip netns add "$coordinator_namespace" 2> "$work/netns.stderr" ||
-    skip "cannot create a network namespace: $(cat "$work/netns.stderr")"
-  created_namespaces+=("$coordinator_namespace")
-  for namespace in "${server_namespaces[@]}"; do
-    ip netns add "$namespace"
-    created_namespaces+=("$namespace")
-  done
-  for namespace in "${all_namespaces[@]}"; do ip -n "$namespace" link set lo up; done
-  ip -n "$coordinator_namespace" link add bridge0 type bridge forward_delay 0
-  ip -n "$coordinator_namespace" address add "$coordinator_address/24" dev bridge0
-  ip -n "$coordinator_namespace" link set bridge0 up
-  for index in 0 1; do
-    namespace=${server_namespaces[index]}
-    port=port$((index + 1))
-    ip link add "$port" netns "$coordinator_namespace" type veth peer name eth0 netns "$namespace"
-    ip -n "$coordinator_namespace" link set "$port" master bridge0 up
-    ip -n "$namespace" address add "${server_addresses[index]}/24" dev eth0
-    ip -n "$namespace" link set eth0 up
-  done
-  echo "network: $coordinator_namespace ($coordinator_address, bridge), ${server_namespaces[0]}" \
-    "(${server_addresses[0]}), ${server_namespaces[1]} (${server_addresses[1]})"
-}
-
-# Prints the pids of the processes running in the server and coordinator namespaces.
-processes_in_namespaces() {
-  local namespace
-  for namespace in "${all_namespaces[@]}"; do ip netns pids "$namespace"; done | tr '\n' ' '
-}
+require_namespace_tools
 
 # --- Servers started by the test ---------------------------------------------------------------
 
@@ -173,10 +65,6 @@ stop_server() {
   for _ in $(seq 100); do kill -0 "$2" 2> /dev/null || break; sleep 0.1; done
   wait "$2" || status=$?
   [ "$status" -eq 0 ] || fail "server $1 exited with status $status after SIGTERM"
-}
-
-compare_contact() {  # REFERENCE_DIRECTORY DIRECTORY
-  "$python" "$source_directory/tests/network/compare_contact.py" "$1/contact.csv" "$2/contact.csv"
 }
 
 # --- 1. Servers bound to their namespaces' addresses, the coordinator in its own --------------
