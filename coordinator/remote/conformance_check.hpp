@@ -1,0 +1,77 @@
+#pragma once
+// robin-coordinator --check-server ENDPOINT: a conformance checker for subdomain servers.
+//
+// check_server() drives the server at an endpoint through every message of the protocol
+// (proto/robin.proto, docs/protocol.md), well-formed and not: malformed bytes, requests out of
+// order, refused bodies and assignments, wrong vector lengths, an oversized message. It judges
+// only what travels on the wire, so that any implementation can be checked, and reports every
+// deviation in plain words naming the message.
+//
+// The body it sets up is built in: the unit square [0, 1]^2 (a .geo script sent as
+// mesh_content), isotropic plane strain, its bottom edge lifted by a prescribed displacement
+// u = (0, lift) and no load, its top edge the contact boundary. Its solution without contact is
+// the rigid translation u = (0, lift), so e_i = lift at every contact node and the expected
+// answers of the free solve and of the fields are known exactly. The numerical checks use only
+// that and identities every correct server satisfies: the Signorini conditions, u_N = e - F
+// lambda with F r the correction's reply, F linear, symmetric and positive definite, the global
+// force balance, and the same answer in a second run.
+//
+// Deadlines: every request has reply_timeout_seconds. A request that gets no reply fails its
+// check; the checker then opens a new connection and sends a Hello. When that is not answered
+// either, the server is considered unresponsive and every remaining check fails at once as
+// "not checked", so a silent server costs about two timeouts, never a hang.
+//
+// The oversized-message rule: a Hello of oversized_message_bytes bytes (its client_name padded)
+// must either be answered (its HelloReply or any Error carrying the request id) or be dropped
+// without a reply (libzmq's ZMQ_MAXMSGSIZE drops it and disconnects the sender); in both cases
+// the server must then answer a Hello on a new connection within the deadline.
+//
+// The checker sends EndRun (it forgets any body the server holds) but never Shutdown, unless
+// include_shutdown is set; then Shutdown is the last request and the server must stop answering.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace robin {
+
+struct ConformanceOptions {
+  double reply_timeout_seconds = 10.0;       // deadline of every request
+  long oversized_message_bytes = 64L << 20;  // size of the oversized-message probe (64 MiB)
+  bool include_shutdown = false;             // finish with Shutdown (the server exits)
+  double tolerance = 1e-8;                   // relative tolerance of the numerical checks
+};
+
+struct ConformanceCheck {
+  std::string name;  // e.g. "contact_solve_before_setup"
+  bool passed = false;
+  std::string explanation;  // why it failed, naming the message; or a note on a pass
+};
+
+struct ConformanceReport {
+  std::string endpoint;
+  std::string server_name;               // HelloReply.server_name, when the server answered a Hello
+  std::vector<ConformanceCheck> checks;  // in the order they ran
+  double seconds = 0.0;                  // wall time of the whole check
+
+  bool conforms() const { return failure_count() == 0 && !checks.empty(); }
+  std::size_t failure_count() const;
+};
+
+/// Runs every check against the server at `endpoint` (tcp://HOST:PORT or ipc://PATH). Never
+/// throws for anything the server does; a bad endpoint fails the checks.
+ConformanceReport check_server(const std::string& endpoint, const ConformanceOptions& options);
+
+/// One line per check, "PASS name" (with " (note)" when there is one) or
+/// "FAIL name: explanation", then a summary line.
+std::string format_report(const ConformanceReport& report);
+
+/// True when the command line asks for a server check (it contains --check-server).
+bool requests_server_check(int argc, const char* const* argv);
+
+/// robin-coordinator --check-server ENDPOINT [--timeout S] [--max-message-size-probe BYTES]
+/// [--tolerance T] [--include-shutdown]: prints the report on standard output. Returns 0 when
+/// the server conforms, 1 when it does not, 2 for a bad command line.
+int server_check_main(int argc, const char* const* argv);
+
+}  // namespace robin

@@ -1,0 +1,484 @@
+// The protocol conformance checker (robin-coordinator --check-server) against the real
+// robin-subdomain, against servers written here that deviate in known ways (a REP socket that
+// answers everything with HelloReply, one that never answers, a proxy to robin-subdomain that
+// corrupts one aspect of its replies or requests), and through the robin-coordinator command
+// line. Each deviation must fail the checks that judge it, with an explanation naming the
+// message, and the checker must keep to its deadlines.
+
+#include "remote/conformance_check.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <zmq.hpp>
+
+#include "protocol_version.hpp"
+#include "remote_test_support.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+namespace {
+
+using protocol::Envelope;
+using robin::testing::seconds_since;
+
+// --- Servers written for the tests -------------------------------------------------------------
+
+struct FakeReply {
+  std::optional<std::string> bytes;  // nullopt: never answer (the socket goes silent)
+  bool then_stop = false;            // close the socket after this reply (like an exiting server)
+};
+using Responder = std::function<FakeReply(const std::vector<std::string>& frames)>;
+
+/// A REP socket on an ephemeral tcp port, served by a thread that asks `responder` for the
+/// reply to every message.
+class FakeServer {
+ public:
+  explicit FakeServer(Responder responder) : responder_(std::move(responder)) {
+    socket_.set(zmq::sockopt::linger, 1000);  // a reply before closing still goes out
+    socket_.bind("tcp://127.0.0.1:*");
+    endpoint_ = socket_.get(zmq::sockopt::last_endpoint);
+    thread_ = std::thread([this] { serve(); });
+  }
+  ~FakeServer() {
+    stop_ = true;
+    thread_.join();
+  }
+  const std::string& endpoint() const { return endpoint_; }
+
+ private:
+  void serve() {
+    while (!stop_) {
+      zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
+      zmq::poll(&item, 1, std::chrono::milliseconds(20));
+      if ((item.revents & ZMQ_POLLIN) == 0) continue;
+      std::vector<std::string> frames;
+      zmq::message_t frame;
+      do {
+        (void)socket_.recv(frame);
+        frames.push_back(frame.to_string());
+      } while (frame.more());
+      const FakeReply reply = responder_(frames);
+      if (!reply.bytes) break;  // silent from now on: the socket stays, nothing is answered
+      (void)socket_.send(zmq::buffer(*reply.bytes), zmq::send_flags::none);
+      if (reply.then_stop) {
+        socket_.close();  // like an exiting server: a new connection finds nobody
+        break;
+      }
+    }
+    while (!stop_) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+
+  Responder responder_;
+  zmq::context_t context_{1};
+  zmq::socket_t socket_{context_, zmq::socket_type::rep};
+  std::string endpoint_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+std::string hello_reply_to(const std::vector<std::string>& frames) {
+  Envelope request, reply;
+  if (frames.size() == 1 && request.ParseFromString(frames[0])) {
+    reply.set_request_id(request.request_id());
+  }
+  reply.mutable_version()->set_major(protocol::protocol_major);
+  reply.mutable_hello_reply()->set_server_name("hello-only test server");
+  for (const char* capability : {"contact_solve", "correction_solve", "fields"}) {
+    reply.mutable_hello_reply()->add_capabilities(capability);
+  }
+  reply.mutable_hello_reply()->set_state("awaiting_setup");
+  return reply.SerializeAsString();
+}
+
+/// Changes a parsed request before it is forwarded, or a parsed reply before it is returned.
+using Mutation = std::function<void(Envelope&)>;
+
+/// A responder that forwards every message to `endpoint` (a REQ socket of the serving thread)
+/// and passes requests and replies through the mutations. `on_shutdown` answers Shutdown
+/// itself when set (robin-subdomain's own Acknowledge to Shutdown can be lost, see the report).
+Responder proxy_to(const std::string& endpoint, Mutation on_request, Mutation on_reply,
+                   std::function<FakeReply(const Envelope&)> on_shutdown = {}) {
+  struct Backend {  // the socket is closed before its context
+    zmq::context_t context{1};
+    std::unique_ptr<zmq::socket_t> socket;
+  };
+  auto backend = std::make_shared<Backend>();
+  return [=](const std::vector<std::string>& frames) -> FakeReply {
+    std::unique_ptr<zmq::socket_t>& socket = backend->socket;
+    if (!socket) {
+      socket = std::make_unique<zmq::socket_t>(backend->context, zmq::socket_type::req);
+      socket->set(zmq::sockopt::linger, 0);
+      socket->set(zmq::sockopt::rcvtimeo, 5000);
+      socket->connect(endpoint);
+    }
+    std::vector<std::string> forwarded = frames;
+    Envelope request;
+    if (frames.size() == 1 && request.ParseFromString(frames[0])) {
+      if (request.has_shutdown() && on_shutdown) return on_shutdown(request);
+      if (on_request) on_request(request);
+      forwarded[0] = request.SerializeAsString();
+    }
+    for (std::size_t i = 0; i < forwarded.size(); ++i) {
+      const auto flags =
+          i + 1 < forwarded.size() ? zmq::send_flags::sndmore : zmq::send_flags::none;
+      (void)socket->send(zmq::buffer(forwarded[i]), flags);
+    }
+    zmq::message_t answer;
+    if (!socket->recv(answer)) return {std::nullopt};
+    Envelope reply;
+    if (!on_reply || !reply.ParseFromArray(answer.data(), static_cast<int>(answer.size()))) {
+      return {answer.to_string()};
+    }
+    on_reply(reply);
+    return {reply.SerializeAsString()};
+  };
+}
+
+// --- Helpers -----------------------------------------------------------------------------------
+
+const ConformanceCheck* find_check(const ConformanceReport& report, const std::string& name) {
+  for (const ConformanceCheck& check : report.checks) {
+    if (check.name == name) return &check;
+  }
+  return nullptr;
+}
+
+::testing::AssertionResult fails_with(const ConformanceReport& report, const std::string& name,
+                                      const std::vector<std::string>& words) {
+  const ConformanceCheck* check = find_check(report, name);
+  if (check == nullptr) return ::testing::AssertionFailure() << "no check named " << name;
+  if (check->passed) return ::testing::AssertionFailure() << name << " passed";
+  for (const std::string& word : words) {
+    if (check->explanation.find(word) == std::string::npos) {
+      return ::testing::AssertionFailure()
+             << name << ": '" << check->explanation << "' does not mention '" << word << "'";
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+::testing::AssertionResult passes(const ConformanceReport& report, const std::string& name) {
+  const ConformanceCheck* check = find_check(report, name);
+  if (check == nullptr) return ::testing::AssertionFailure() << "no check named " << name;
+  if (!check->passed) return ::testing::AssertionFailure() << name << ": " << check->explanation;
+  return ::testing::AssertionSuccess();
+}
+
+/// The names of the failed checks, for messages.
+std::string failed_checks(const ConformanceReport& report) {
+  std::string names;
+  for (const ConformanceCheck& check : report.checks) {
+    if (!check.passed) names += "\n  " + check.name + ": " + check.explanation;
+  }
+  return names;
+}
+
+/// One robin-subdomain for the whole file (every check run starts with EndRun).
+class ConformanceTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    directory_ = std::make_unique<testing::TemporaryDirectory>("conformance");
+    ServerLaunchOptions launch = testing::server_options(directory_->path() / "logs");
+    launch.shutdown_timeout_seconds = 0.5;  // its Acknowledge to Shutdown can be lost
+    server_ = std::make_unique<SubdomainServer>("reference", launch);
+    server_->await_listening();
+  }
+  static void TearDownTestSuite() {
+    server_.reset();
+    directory_.reset();
+  }
+  static const std::string& reference_endpoint() { return server_->endpoint(); }
+
+  static ConformanceOptions quick_options() {
+    ConformanceOptions options;
+    options.reply_timeout_seconds = 5.0;
+    options.oversized_message_bytes = 1L << 20;
+    return options;
+  }
+
+  static std::unique_ptr<testing::TemporaryDirectory> directory_;
+  static std::unique_ptr<SubdomainServer> server_;
+};
+
+std::unique_ptr<testing::TemporaryDirectory> ConformanceTest::directory_;
+std::unique_ptr<SubdomainServer> ConformanceTest::server_;
+
+// --- The reference server ----------------------------------------------------------------------
+
+TEST_F(ConformanceTest, ReferenceServerPassesEveryCheck) {
+  ConformanceOptions options;  // the defaults: 10 s deadlines, a 64 MiB oversized message
+  const auto start = std::chrono::steady_clock::now();
+  const ConformanceReport report = check_server(reference_endpoint(), options);
+  const double seconds = seconds_since(start);
+  EXPECT_TRUE(report.conforms()) << failed_checks(report);
+  EXPECT_GE(report.checks.size(), 40u);
+  EXPECT_NE(report.server_name.find("robin-subdomain"), std::string::npos);
+  for (const char* name :
+       {"hello", "version_mismatch", "garbage_bytes", "empty_envelope",
+        "contact_solve_before_setup", "setup_floating_body", "setup_body", "assign_unknown_node",
+        "contact_solve_wrong_length", "contact_solve_signorini", "correction_linearity",
+        "correction_symmetry", "fields_structure", "end_run", "second_run", "oversized_message",
+        "request_id_echoed", "version_on_every_reply"}) {
+    EXPECT_TRUE(passes(report, name)) << name;
+  }
+  EXPECT_EQ(find_check(report, "shutdown"), nullptr);  // only with include_shutdown
+  EXPECT_LT(seconds, 20.0);
+  std::cout << "reference server: " << report.checks.size() << " checks in " << seconds << " s\n";
+}
+
+TEST_F(ConformanceTest, ServerThatDropsOversizedMessagesConformsAndShutsDown) {
+  // libzmq drops a message above --max-message-size and disconnects its sender: no reply, and
+  // the server answers the next connection. The rule accepts that as well as an answer.
+  testing::TemporaryDirectory directory("conformance-drop");
+  ServerLaunchOptions launch = testing::server_options(directory.path());
+  launch.extra_arguments = {"--max-message-size", "1048576"};
+  SubdomainServer server("small", launch);
+  server.await_listening();
+  ConformanceOptions options = quick_options();
+  options.oversized_message_bytes = 4L << 20;
+  options.include_shutdown = true;
+  const auto start = std::chrono::steady_clock::now();
+  const ConformanceReport report = check_server(server.endpoint(), options);
+  EXPECT_TRUE(report.conforms()) << failed_checks(report);
+  EXPECT_TRUE(passes(report, "oversized_message"));
+  EXPECT_TRUE(passes(report, "shutdown"));
+  EXPECT_LT(seconds_since(start), 10.0);  // the dropped connection is noticed at once
+  std::string fate;
+  for (int wait = 0; wait < 100 && fate.empty(); ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    fate = server.failure();
+  }
+  EXPECT_NE(fate.find("exited with status 0"), std::string::npos) << fate;
+}
+
+// --- Servers that do not conform ----------------------------------------------------------------
+
+TEST_F(ConformanceTest, HelloOnlyServerFailsEveryOtherMessage) {
+  FakeServer fake(
+      [](const std::vector<std::string>& frames) { return FakeReply{hello_reply_to(frames)}; });
+  const auto start = std::chrono::steady_clock::now();
+  const ConformanceReport report = check_server(fake.endpoint(), quick_options());
+  EXPECT_FALSE(report.conforms());
+  EXPECT_TRUE(passes(report, "hello"));
+  EXPECT_TRUE(fails_with(report, "end_run_before_checks",
+                         {"EndRun", "expected Acknowledge", "HelloReply"}));
+  EXPECT_TRUE(fails_with(report, "version_mismatch",
+                         {"Hello with version 2.0", "Error{VERSION_MISMATCH}", "HelloReply"}));
+  EXPECT_TRUE(fails_with(report, "garbage_bytes", {"ff ff ff", "MALFORMED_MESSAGE"}));
+  EXPECT_TRUE(fails_with(report, "contact_solve_before_setup",
+                         {"ContactSolveRequest before SetupBody", "WRONG_STATE", "HelloReply"}));
+  EXPECT_TRUE(fails_with(report, "setup_floating_body", {"SINGULAR_BODY", "HelloReply"}));
+  EXPECT_TRUE(fails_with(report, "setup_body", {"SetupBody", "InterfaceDescription"}));
+  EXPECT_TRUE(fails_with(report, "contact_solve_signorini", {"not checked", "setup_body"}));
+  EXPECT_TRUE(passes(report, "request_id_echoed"));  // it does echo the ids
+  EXPECT_LT(seconds_since(start), 5.0);
+}
+
+TEST_F(ConformanceTest, SilentServerFailsWithinTheDeadlines) {
+  FakeServer fake([](const std::vector<std::string>&) { return FakeReply{std::nullopt}; });
+  ConformanceOptions options = quick_options();
+  options.reply_timeout_seconds = 0.5;
+  const auto start = std::chrono::steady_clock::now();
+  const ConformanceReport report = check_server(fake.endpoint(), options);
+  const double seconds = seconds_since(start);
+  EXPECT_EQ(report.failure_count(), report.checks.size());
+  EXPECT_TRUE(fails_with(report, "hello", {"Hello", "no reply within 0.5 s"}));
+  EXPECT_TRUE(fails_with(report, "setup_body", {"not checked", "did not answer a Hello"}));
+  EXPECT_TRUE(fails_with(report, "request_id_echoed", {"no reply"}));
+  // The first Hello and the Hello on a new connection: two deadlines, then nothing waits.
+  EXPECT_GE(seconds, 1.0);
+  EXPECT_LT(seconds, 2.5);
+}
+
+TEST_F(ConformanceTest, NoServerAtTheEndpointFailsWithinTheDeadlines) {
+  testing::TemporaryDirectory directory("conformance-nobody");
+  ConformanceOptions options = quick_options();
+  options.reply_timeout_seconds = 0.3;
+  const auto start = std::chrono::steady_clock::now();
+  const ConformanceReport report =
+      check_server("ipc://" + (directory.path() / "nobody.sock").string(), options);
+  EXPECT_EQ(report.failure_count(), report.checks.size());
+  EXPECT_TRUE(fails_with(report, "hello", {"could not send within 0.3 s"}));
+  EXPECT_LT(seconds_since(start), 1.5);
+}
+
+struct Deviation {
+  std::string name;
+  Mutation on_request;
+  Mutation on_reply;
+  std::vector<std::pair<std::string, std::vector<std::string>>> failures;  // check, words
+};
+
+std::ostream& operator<<(std::ostream& stream, const Deviation& deviation) {
+  return stream << deviation.name;
+}
+
+class DeviationTest : public ConformanceTest, public ::testing::WithParamInterface<Deviation> {};
+
+TEST_P(DeviationTest, FailsTheChecksThatJudgeIt) {
+  const Deviation& deviation = GetParam();
+  FakeServer proxy(proxy_to(reference_endpoint(), deviation.on_request, deviation.on_reply));
+  ConformanceOptions options = quick_options();
+  options.reply_timeout_seconds = 2.0;  // a reply with a wrong id costs one deadline
+  const ConformanceReport report = check_server(proxy.endpoint(), options);
+  EXPECT_FALSE(report.conforms());
+  EXPECT_TRUE(passes(report, "hello"));
+  EXPECT_TRUE(passes(report, "setup_body"));
+  for (const auto& [name, words] : deviation.failures) {
+    EXPECT_TRUE(fails_with(report, name, words));
+  }
+}
+
+Deviation negated_contact_force() {
+  return {"NegatedContactForce",
+          {},
+          [](Envelope& reply) {
+            if (!reply.has_contact_result()) return;
+            for (double& force : *reply.mutable_contact_result()->mutable_contact_force()) {
+              force = -force;
+            }
+          },
+          {{"contact_solve_signorini", {"ContactSolveRequest", "contact_force", "< 0"}}}};
+}
+
+Deviation ignored_pair_order() {
+  // The server sees the nodes in ascending id order: it applies the obstacles to other nodes.
+  return {"IgnoredPairOrder",
+          [](Envelope& request) {
+            if (!request.has_assign_contact()) return;
+            auto& ids = *request.mutable_assign_contact()->mutable_node_ids();
+            std::sort(ids.begin(), ids.end());
+          },
+          {},
+          {{"fields_pair_order", {"FieldsRequest", "pair index", "pair order of AssignContact"}}}};
+}
+
+Deviation shifted_correction() {
+  // w = F r + 1e-3: not linear, and u_N = e - F lambda no longer holds.
+  return {"ShiftedCorrection",
+          {},
+          [](Envelope& reply) {
+            if (!reply.has_correction_result()) return;
+            for (double& trace : *reply.mutable_correction_result()->mutable_normal_trace()) {
+              trace += 1e-3;
+            }
+          },
+          {{"correction_linearity", {"w(2 r) != 2 w(r)"}},
+           {"contact_solve_equilibrium", {"u_N = e - F lambda"}}}};
+}
+
+Deviation wrong_request_ids() {
+  return {"WrongRequestIds",
+          {},
+          [](Envelope& reply) { reply.set_request_id(reply.request_id() + 1000); },
+          {{"request_id_echoed", {"HelloReply reply to Hello", "expected"}},
+           {"unknown_request_type", {"request_id"}}}};
+}
+
+Deviation errors_without_version() {
+  return {"ErrorsWithoutVersion",
+          {},
+          [](Envelope& reply) {
+            if (reply.has_error()) reply.clear_version();
+          },
+          {{"version_on_every_reply",
+            {"the Error{VERSION_MISMATCH} reply to Hello with version 2.0 carries no Version"}}}};
+}
+
+Deviation no_fields_reactions() {
+  return {"NoReactionResultant",
+          {},
+          [](Envelope& reply) {
+            if (reply.has_fields_reply()) reply.mutable_fields_reply()->clear_reaction_resultant();
+          },
+          {{"fields_equilibrium", {"FieldsRequest", "reaction_resultant"}}}};
+}
+
+INSTANTIATE_TEST_SUITE_P(Conformance, DeviationTest,
+                         ::testing::Values(negated_contact_force(), ignored_pair_order(),
+                                           shifted_correction(), wrong_request_ids(),
+                                           errors_without_version(), no_fields_reactions()),
+                         [](const auto& info) { return info.param.name; });
+
+// --- Shutdown (only with include_shutdown) ------------------------------------------------------
+
+/// Acknowledges Shutdown itself; `stops` says whether it then closes its socket.
+std::function<FakeReply(const Envelope&)> shutdown_answer(bool stops) {
+  return [stops](const Envelope& request) {
+    Envelope reply;
+    reply.set_request_id(request.request_id());
+    reply.mutable_version()->set_major(protocol::protocol_major);
+    reply.mutable_acknowledge()->set_state("awaiting_setup");
+    return FakeReply{reply.SerializeAsString(), stops};
+  };
+}
+
+TEST_F(ConformanceTest, ShutdownMustStopTheServer) {
+  ConformanceOptions options = quick_options();
+  options.include_shutdown = true;
+  {
+    FakeServer stopping(proxy_to(reference_endpoint(), {}, {}, shutdown_answer(true)));
+    const ConformanceReport report = check_server(stopping.endpoint(), options);
+    EXPECT_TRUE(report.conforms()) << failed_checks(report);
+    EXPECT_TRUE(passes(report, "shutdown"));
+  }
+  FakeServer immortal(proxy_to(reference_endpoint(), {}, {}, shutdown_answer(false)));
+  const ConformanceReport report = check_server(immortal.endpoint(), options);
+  EXPECT_TRUE(fails_with(report, "shutdown", {"still answered a Hello", "after its Acknowledge"}));
+}
+
+// --- The command line ---------------------------------------------------------------------------
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;
+};
+
+CommandResult run_command(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer{};
+  while (fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
+    result.output += buffer.data();
+  }
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+TEST_F(ConformanceTest, CommandLinePrintsOneLinePerCheckAndTheExitCode) {
+  const std::string coordinator = testing::tool("robin-coordinator").string();
+  const CommandResult conforming = run_command(
+      coordinator + " --check-server " + reference_endpoint() + " --max-message-size-probe 1024");
+  EXPECT_EQ(conforming.exit_code, 0) << conforming.output;
+  EXPECT_NE(conforming.output.find("\nPASS hello\n"), std::string::npos);
+  EXPECT_NE(conforming.output.find("0 failed"), std::string::npos);
+  EXPECT_NE(conforming.output.find("the server conforms"), std::string::npos);
+
+  testing::TemporaryDirectory directory("conformance-cli");
+  const CommandResult nobody =
+      run_command(coordinator + " --check-server ipc://" +
+                  (directory.path() / "nobody.sock").string() + " --timeout 0.2");
+  EXPECT_EQ(nobody.exit_code, 1) << nobody.output;
+  EXPECT_NE(nobody.output.find("FAIL hello: Hello: could not send within 0.2 s"), std::string::npos)
+      << nobody.output;
+  EXPECT_NE(nobody.output.find("does not conform"), std::string::npos);
+
+  EXPECT_EQ(run_command(coordinator + " --check-server").exit_code, 2);
+  EXPECT_EQ(run_command(coordinator + " --check-server tcp://127.0.0.1:1 --timeout -1").exit_code,
+            2);
+}
+
+}  // namespace
+}  // namespace robin
