@@ -6,10 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "remote/conformance_check.hpp"
 #include "remote/coordinator_application.hpp"
 #include "remote/run_interruption.hpp"
 
 int main(int argc, char** argv) {
+  // --check-server ENDPOINT: the protocol conformance checker, with its own options.
+  if (robin::requests_server_check(argc, argv)) return robin::server_check_main(argc, argv);
   CLI::App app{
       "robin-coordinator: Robin domain decomposition of a two-body contact case on two "
       "robin-subdomain servers"};
@@ -21,6 +24,10 @@ int main(int argc, char** argv) {
                  "the first serves body 1")
       ->required()
       ->allow_extra_args(false);  // one endpoint per --subdomain; the count is checked below
+  std::string check_server;  // handled above; listed here for --help
+  app.add_option("--check-server", check_server,
+                 "instead of a run: check that the server at ENDPOINT conforms to the protocol "
+                 "(CASE and --subdomain are then not needed; --check-server ENDPOINT --help)");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
   if (subdomains.size() != 2) {
     std::cerr << "robin-coordinator: give exactly two --subdomain ENDPOINT options (the first "
