@@ -17,8 +17,11 @@ const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
     "qp_tolerance", "qp_max_iterations", "interface_operator", "dense_limit", "pairing_tolerance"};
 const std::vector<std::string> coupling_keys{
-    "relaxation",      "tolerance",         "max_iterations",   "initial_obstacle",
-    "request_timeout", "divergence_factor", "stagnation_window"};
+    "relaxation",      "tolerance",         "max_iterations",    "initial_obstacle",
+    "request_timeout", "divergence_factor", "stagnation_window", "acceleration",
+    "relaxation1",     "relaxation2",       "aitken_initial",    "aitken_minimum",
+    "aitken_maximum",  "history_depth",     "filter_threshold",  "safeguard_growth",
+    "per_body"};
 
 toml::table parse_toml(const std::filesystem::path& path, const std::string& label) {
   std::error_code error;
@@ -99,6 +102,42 @@ void read_solver(const CheckedTable& root, SolverOptions& solver) {
       number_above(*table, "pairing_tolerance", 0.0, solver.pairing_tolerance);
 }
 
+/// A relaxation factor delta in (0, 2), or nothing when the key is absent.
+std::optional<double> optional_relaxation(const CheckedTable& table, std::string_view key) {
+  const auto value = table.optional_number(key);
+  if (value && !(*value > 0.0 && *value < 2.0)) {
+    table.fail(key, "must be in (0, 2), got " + format_number(*value));
+  }
+  return value;
+}
+
+/// The acceleration keys of [coupling]; the ranges are those of validate(AccelerationOptions).
+void read_acceleration(const CheckedTable& table, CouplingOptions& coupling) {
+  AccelerationOptions& acceleration = coupling.acceleration;
+  acceleration.method = table.optional_choice("acceleration", {"none", "aitken", "iqn-ils"})
+                            .value_or(acceleration.method);
+  coupling.relaxation1 = optional_relaxation(table, "relaxation1");
+  coupling.relaxation2 = optional_relaxation(table, "relaxation2");
+  acceleration.aitken_initial =
+      table.optional_number("aitken_initial").value_or(acceleration.aitken_initial);
+  acceleration.aitken_minimum =
+      number_above(table, "aitken_minimum", 0.0, acceleration.aitken_minimum);
+  acceleration.aitken_maximum =
+      number_above(table, "aitken_maximum", 0.0, acceleration.aitken_maximum);
+  acceleration.history_depth =
+      integer_at_least(table, "history_depth", 1, acceleration.history_depth);
+  acceleration.filter_threshold =
+      number_above(table, "filter_threshold", 0.0, acceleration.filter_threshold);
+  acceleration.safeguard_growth =
+      number_above(table, "safeguard_growth", 1.0, acceleration.safeguard_growth);
+  acceleration.per_body = table.optional_boolean("per_body").value_or(acceleration.per_body);
+  try {
+    validate(effective_acceleration(coupling));
+  } catch (const InputError& error) {
+    table.fail("acceleration", error.what());
+  }
+}
+
 void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
   const auto table = root.optional_table("coupling", coupling_keys);
   if (!table) return;
@@ -116,6 +155,7 @@ void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
       number_above(*table, "divergence_factor", 1.0, coupling.divergence_factor);
   coupling.stagnation_window =
       integer_at_least(*table, "stagnation_window", 1, coupling.stagnation_window);
+  read_acceleration(*table, coupling);
 }
 
 void read_bodies(const CheckedTable& root, const std::filesystem::path& directory,
@@ -159,6 +199,13 @@ std::vector<BoundaryReference> references_of(const BodyDefinition& definition) {
 }
 
 }  // namespace
+
+AccelerationOptions effective_acceleration(const CouplingOptions& options) {
+  AccelerationOptions acceleration = options.acceleration;
+  acceleration.relaxation1 = options.relaxation1.value_or(options.relaxation);
+  acceleration.relaxation2 = options.relaxation2.value_or(options.relaxation);
+  return acceleration;
+}
 
 CaseDefinition read_case_file(const std::filesystem::path& path) {
   const std::string label = path.string();

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "coupling/acceleration.hpp"
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/gmsh_reader.hpp"
@@ -36,12 +37,17 @@ struct BodyCase {
 
 /// Options of the Robin iteration (coordinator); command-line flags override them.
 struct CouplingOptions {
-  double relaxation = 0.5;  // delta of paper (13)
+  double relaxation = 0.5;  // delta of paper (13), for both bodies unless overridden
+  std::optional<double> relaxation1, relaxation2;  // per-body deltas (default: relaxation)
+  /// Acceleration of the obstacle update (method "iqn-ils", "aitken" or "none"; see
+  /// coupling/acceleration.hpp). Its relaxation1/2 are filled from the fields above by
+  /// effective_acceleration().
+  AccelerationOptions acceleration;
   double tolerance = 1e-8;  // on every scaled residual
   int max_iterations = 200;
   std::string initial_obstacle = "gap";   // "gap": g^alpha_0 = d; "zero": g^alpha_0 = 0
   double request_timeout_seconds = 60.0;  // deadline of each request to a server
-  double divergence_factor = 1e3;         // residual growth over its minimum that means divergence
+  double divergence_factor = 1e3;         // obstacle-step growth over its minimum: divergence
   int stagnation_window = 50;  // iterations without residual decrease that mean stagnation
 };
 
@@ -61,6 +67,10 @@ struct CaseDefinition {
   SolverOptions solver;
   CouplingOptions coupling;
 };
+
+/// The acceleration options with the per-body relaxations resolved (relaxation1/2, else
+/// relaxation).
+AccelerationOptions effective_acceleration(const CouplingOptions& options);
 
 /// Parses and validates a case file (without reading meshes): every key, type and range,
 /// the materials, the existence of the mesh files, and the gap expression (parsed and

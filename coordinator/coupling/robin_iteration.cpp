@@ -40,9 +40,9 @@ class ProgressMonitor {
     } else if (record.obstacle_step > first_step_ &&
                record.obstacle_step > options_.divergence_factor * smallest_step_) {
       // The scaled residuals saturate when the iterates blow up; the raw obstacle step does not.
-      text << "the iteration diverged at iteration " << record.iteration
-           << ": the obstacle update " << record.obstacle_step << " grew to more than "
-           << options_.divergence_factor << " times its smallest value " << smallest_step_
+      text << "the iteration diverged at iteration " << record.iteration << ": the obstacle update "
+           << record.obstacle_step << " grew to more than " << options_.divergence_factor
+           << " times its smallest value " << smallest_step_
            << " (the relaxation is too large for these bodies; try a smaller --relaxation)";
     } else if (stagnated() && best() >= no_contraction_level) {
       text << "the iteration diverged: after " << record.iteration
@@ -84,9 +84,9 @@ class ProgressMonitor {
 
 void require_converged(const ContactSolveResult& result, const SubdomainPort& port, int iteration) {
   if (result.status == QpStatus::converged) return;
-  throw PortError(port.describe() + ", step contact solve (iteration " +
-                  std::to_string(iteration) + "): the contact QP returned '" +
-                  to_string(result.status) + "': " + result.message);
+  throw PortError(port.describe() + ", step contact solve (iteration " + std::to_string(iteration) +
+                  "): the contact QP returned '" + to_string(result.status) +
+                  "': " + result.message);
 }
 
 IterationRecord make_record(int iteration, const Eigen::VectorXd& gaps,
@@ -108,8 +108,10 @@ IterationRecord make_record(int iteration, const Eigen::VectorXd& gaps,
   record.correction =
       std::max(maximum_absolute(correction1), maximum_absolute(correction2)) / displacement_scale;
   record.obstacle_change = obstacle_change;
-  record.active1 = static_cast<int>(std::count(contact1.active.begin(), contact1.active.end(), true));
-  record.active2 = static_cast<int>(std::count(contact2.active.begin(), contact2.active.end(), true));
+  record.active1 =
+      static_cast<int>(std::count(contact1.active.begin(), contact1.active.end(), true));
+  record.active2 =
+      static_cast<int>(std::count(contact2.active.begin(), contact2.active.end(), true));
   record.qp_iterations1 = contact1.iterations;
   record.qp_iterations2 = contact2.iterations;
   return record;
@@ -123,10 +125,14 @@ double IterationRecord::largest() const {
 
 std::string to_string(IterationStatus status) {
   switch (status) {
-    case IterationStatus::converged: return "converged";
-    case IterationStatus::max_iterations: return "iteration limit reached";
-    case IterationStatus::diverged: return "diverged";
-    case IterationStatus::stagnated: return "stagnated";
+    case IterationStatus::converged:
+      return "converged";
+    case IterationStatus::max_iterations:
+      return "iteration limit reached";
+    case IterationStatus::diverged:
+      return "diverged";
+    case IterationStatus::stagnated:
+      return "stagnated";
   }
   return "unknown";
 }
@@ -136,7 +142,10 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const IterationObserver& observer) {
   const auto run_start = Clock::now();
   double port_seconds = 0.0;
-  const double delta = options.relaxation;
+  const Eigen::Index size = gaps.size();
+  const std::unique_ptr<Acceleration> acceleration = make_acceleration(
+      effective_acceleration(options), static_cast<int>(size), static_cast<int>(size));
+  Eigen::VectorXd iterate(2 * size), mapped(2 * size);
   RobinResult result;
   Eigen::VectorXd obstacle1 =
       options.initial_obstacle == "zero" ? Eigen::VectorXd::Zero(gaps.size()) : gaps;
@@ -167,11 +176,14 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
     port_seconds += seconds_between(correction_start, update_start);
     result.critical_compute_seconds += std::max(contact1.seconds, contact2.seconds) +
                                        std::max(correction1.seconds, correction2.seconds);
-    // Step 3: relaxed obstacle updates.
-    const Eigen::VectorXd next1 = (1.0 - delta) * obstacle1 +
-                                  delta * (correction2.normal_trace - contact2.normal_trace + gaps);
-    const Eigen::VectorXd next2 = (1.0 - delta) * obstacle2 +
-                                  delta * (correction1.normal_trace - contact1.normal_trace + gaps);
+    // Step 3: the obstacle update x_{k+1} = A(x_k, H(x_k)) on x = (g1, g2), with the map
+    // H = (w2_N - u2_N + d, w1_N - u1_N + d); "none" is the paper's (1 - delta) x + delta H.
+    iterate << obstacle1, obstacle2;
+    mapped << correction2.normal_trace - contact2.normal_trace + gaps,
+        correction1.normal_trace - contact1.normal_trace + gaps;
+    const Eigen::VectorXd next = acceleration->next(iterate, mapped);
+    const Eigen::VectorXd next1 = next.head(size);
+    const Eigen::VectorXd next2 = next.tail(size);
     const double change_scale =
         std::max({maximum_absolute(next1), maximum_absolute(next2), maximum_absolute(gaps),
                   maximum_absolute(contact1.normal_trace), maximum_absolute(contact2.normal_trace),
@@ -179,9 +191,11 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
     const double change =
         std::max(maximum_absolute(next1 - obstacle1), maximum_absolute(next2 - obstacle2)) /
         change_scale;
-    IterationRecord record = make_record(iteration, gaps, contact1, contact2,
-                                         correction1.normal_trace, correction2.normal_trace, change);
+    IterationRecord record =
+        make_record(iteration, gaps, contact1, contact2, correction1.normal_trace,
+                    correction2.normal_trace, change);
     record.obstacle_step = change * change_scale;
+    record.acceleration_state = acceleration->state();
     record.seconds = seconds_between(iteration_start, Clock::now());
     result.history.push_back(record);
     result.obstacle1 = obstacle1;

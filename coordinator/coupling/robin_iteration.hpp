@@ -3,9 +3,10 @@
 // ports. One iteration, with d the initial gaps:
 //   step 1 (both bodies in parallel): u^a = argmin 1/2 u'K^a u - f^a'u s.t. B^a u <= g^a,
 //          returning u^a_N and lambda^a >= 0;
-//   step 2 (both in parallel): w^1_N = F^1 (lambda^2 - lambda^1), w^2_N = F^2 (lambda^1 - lambda^2);
-//   step 3: g^1 <- (1 - delta) g^1 + delta (w^2_N - u^2_N + d),
-//           g^2 <- (1 - delta) g^2 + delta (w^1_N - u^1_N + d).
+//   step 2 (both in parallel): w^1_N = F^1 (lambda^2 - lambda^1), w^2_N = F^2 (lambda^1 -
+//   lambda^2); step 3: g^1 <- (1 - delta) g^1 + delta (w^2_N - u^2_N + d),
+//           g^2 <- (1 - delta) g^2 + delta (w^1_N - u^1_N + d),
+//           or an accelerated update of the same map (CouplingOptions::acceleration).
 // Convergence: every scaled residual of IterationRecord below the tolerance. At the fixed point
 // lambda^1 = lambda^2, w = 0 and the state solves the monolithic problem (Prop. 3.2).
 
@@ -38,8 +39,9 @@ struct IterationRecord {
   double correction = 0.0;       // max(|w1_N|, |w2_N|) / D
   int active1 = 0, active2 = 0;  // closed pairs seen by each body
   int qp_iterations1 = 0, qp_iterations2 = 0;
-  double seconds = 0.0;          // wall time of the iteration
-  double largest() const;        // the largest residual
+  double seconds = 0.0;            // wall time of the iteration
+  std::string acceleration_state;  // e.g. "iqn-ils 4 columns", for progress lines
+  double largest() const;          // the largest residual
 };
 
 enum class IterationStatus { converged, max_iterations, diverged, stagnated };
@@ -53,8 +55,8 @@ struct RobinResult {
   Eigen::VectorXd obstacle1, obstacle2;          // g used in the last contact solves
   Eigen::VectorXd normal_trace1, normal_trace2;  // u_N
   Eigen::VectorXd contact_force1, contact_force2;
-  Eigen::VectorXd correction1, correction2;      // w_N
-  double coordinator_seconds = 0.0;  // time in the coordinator's own computations
+  Eigen::VectorXd correction1, correction2;  // w_N
+  double coordinator_seconds = 0.0;          // time in the coordinator's own computations
   /// Critical path of the bodies' compute: sum over iterations of max(contact1, contact2) +
   /// max(correction1, correction2), as reported by the bodies.
   double critical_compute_seconds = 0.0;

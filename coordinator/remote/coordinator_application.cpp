@@ -83,6 +83,14 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
   app.add_option("--relaxation", settings.relaxation,
                  "relaxation delta of the obstacle update, in (0, 2)")
       ->check(open_interval(0.0, 2.0));
+  app.add_option("--relaxation1", settings.relaxation1, "relaxation delta of body 1's obstacle")
+      ->check(open_interval(0.0, 2.0));
+  app.add_option("--relaxation2", settings.relaxation2, "relaxation delta of body 2's obstacle")
+      ->check(open_interval(0.0, 2.0));
+  app.add_option("--acceleration", settings.acceleration,
+                 "obstacle update: 'iqn-ils' (quasi-Newton, default), 'aitken' or 'none' (the "
+                 "paper's fixed relaxation)")
+      ->check(CLI::IsMember({"iqn-ils", "aitken", "none"}));
   app.add_option("--tolerance", settings.tolerance, "tolerance on every scaled residual")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-iterations", settings.max_iterations, "iteration limit")
@@ -110,7 +118,15 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const
 CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
                                         const CoordinatorSettings& settings) {
   CouplingOptions options = from_case;
-  if (settings.relaxation) options.relaxation = *settings.relaxation;
+  if (settings.relaxation) {
+    // --relaxation sets the shared delta; it overrides per-body values from the case file.
+    options.relaxation = *settings.relaxation;
+    options.relaxation1.reset();
+    options.relaxation2.reset();
+  }
+  if (settings.relaxation1) options.relaxation1 = *settings.relaxation1;
+  if (settings.relaxation2) options.relaxation2 = *settings.relaxation2;
+  if (settings.acceleration) options.acceleration.method = *settings.acceleration;
   if (settings.tolerance) options.tolerance = *settings.tolerance;
   if (settings.max_iterations) options.max_iterations = *settings.max_iterations;
   if (settings.initial_obstacle) options.initial_obstacle = *settings.initial_obstacle;
@@ -134,10 +150,11 @@ std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level
 std::string progress_line(const IterationRecord& record) {
   return fmt::format(
       "iteration {}: obstacle change {:.2e}, penetration {:.2e}, force balance {:.2e}, "
-      "complementarity {:.2e}, correction {:.2e}; active {}/{}, QP iterations {}/{}, {:.3f} s",
+      "complementarity {:.2e}, correction {:.2e}; active {}/{}, QP iterations {}/{}, {:.3f} s; "
+      "{}",
       record.iteration, record.obstacle_change, record.penetration, record.force_balance,
       record.complementarity, record.correction, record.active1, record.active2,
-      record.qp_iterations1, record.qp_iterations2, record.seconds);
+      record.qp_iterations1, record.qp_iterations2, record.seconds, record.acceleration_state);
 }
 
 std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {

@@ -30,6 +30,8 @@ struct CoordinatorSettings {
   std::filesystem::path case_file;
   std::filesystem::path output_directory;
   std::optional<double> relaxation;
+  std::optional<double> relaxation1, relaxation2;
+  std::optional<std::string> acceleration;  // "iqn-ils", "aitken" or "none"
   std::optional<double> tolerance;
   std::optional<int> max_iterations;
   std::optional<std::string> initial_obstacle;  // "gap" or "zero"

@@ -36,23 +36,30 @@ double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& 
   return (value - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>();
 }
 
-void expect_matches_monolithic(const std::string& case_name, double relaxation) {
+/// Runs the case with `method` ("none": the paper's plain relaxation with `relaxation`) and
+/// compares with the monolithic reference; returns the iteration count.
+std::size_t expect_matches_monolithic(const std::string& case_name, const std::string& method,
+                                      double relaxation, double tolerance = 1e-9) {
   const CaseDefinition definition = example(case_name);
   CouplingOptions options = definition.coupling;
+  options.acceleration.method = method;
   options.relaxation = relaxation;
-  options.tolerance = 1e-9;
+  options.tolerance = tolerance;
   options.max_iterations = 5000;
   const CoupledRunResult robin = run_in_process(definition, options);
-  std::printf("%s: plain relaxation delta = %.3g: %s after %zu iterations\n", case_name.c_str(),
-              relaxation, to_string(robin.iteration.status).c_str(), robin.iteration.history.size());
-  ASSERT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
+  std::printf("%s: %s, delta = %.3g: %s after %zu iterations\n", case_name.c_str(), method.c_str(),
+              relaxation, to_string(robin.iteration.status).c_str(),
+              robin.iteration.history.size());
+  const std::size_t iterations = robin.iteration.history.size();
+  EXPECT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
+  if (robin.iteration.status != IterationStatus::converged) return iterations;
 
   const LocalProblem reference = prepare_local_problem(definition);
-  const MonolithicResult monolithic =
-      solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing,
-                       definition.solver.qp);
-  ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
-  ASSERT_EQ(robin.pairing.size(), reference.pairing.size());
+  const MonolithicResult monolithic = solve_monolithic(*reference.bodies[0], *reference.bodies[1],
+                                                       reference.pairing, definition.solver.qp);
+  EXPECT_EQ(monolithic.qp.status, QpStatus::converged);
+  EXPECT_EQ(robin.pairing.size(), reference.pairing.size());
+  if (robin.pairing.size() != reference.pairing.size()) return iterations;
   const RobinResult& state = robin.iteration;
   EXPECT_LE(relative_difference(state.contact_force1, monolithic.contact_force), 1e-7);
   EXPECT_LE(relative_difference(state.contact_force2, monolithic.contact_force), 1e-7);
@@ -73,18 +80,22 @@ void expect_matches_monolithic(const std::string& case_name, double relaxation) 
     const Eigen::VectorXd actual = Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
     EXPECT_LE(relative_difference(actual, expected), 1e-7) << body.name();
   }
+  return iterations;
 }
 
-TEST(RobinVersusMonolithic, SymmetricBlocks) { expect_matches_monolithic("two_blocks.toml", 0.5); }
+// The paper's plain relaxation.
+TEST(RobinVersusMonolithic, SymmetricBlocks) {
+  expect_matches_monolithic("two_blocks.toml", "none", 0.5);
+}
 
 TEST(RobinVersusMonolithic, PartialContactBlocks) {
-  expect_matches_monolithic("two_blocks_partial.toml", 0.5);
+  expect_matches_monolithic("two_blocks_partial.toml", "none", 0.5);
 }
 
 TEST(RobinVersusMonolithic, AsymmetricCantileverOnBlock) {
   // The bending cantilever is far more compliant than the block on smooth modes, so one shared
-  // delta must be small (see docs/method.md); acceleration is the cure (a later issue).
-  expect_matches_monolithic("asymmetric.toml", 0.02);
+  // delta must be small (see docs/method.md).
+  expect_matches_monolithic("asymmetric.toml", "none", 0.02);
 }
 
 TEST(RobinIteration, PlainRelaxationIterationCounts) {
@@ -94,6 +105,7 @@ TEST(RobinIteration, PlainRelaxationIterationCounts) {
   for (const std::string name : {"two_blocks.toml", "two_blocks_partial.toml", "asymmetric.toml"}) {
     const CaseDefinition definition = example(name);
     CouplingOptions options = definition.coupling;
+    options.acceleration.method = "none";
     options.relaxation = 0.5;
     options.max_iterations = 1000;
     const CoupledRunResult robin = run_in_process(definition, options);
@@ -110,18 +122,40 @@ TEST(RobinIteration, PlainRelaxationIterationCounts) {
   }
 }
 
-TEST(RobinVersusMonolithic, Hertz) { expect_matches_monolithic("hertz.toml", 0.5); }
+TEST(RobinVersusMonolithic, Hertz) {
+  expect_matches_monolithic("hertz.toml", "none", 0.5);
+}
+
+// The accelerated methods reach the same answer; the default (Aitken per body) needs far fewer
+// iterations than the best fixed delta on the asymmetric pair (0.02, found by a scan).
+TEST(RobinVersusMonolithic, AcceleratedMethodsOnEveryCase) {
+  for (const std::string name :
+       {"two_blocks.toml", "two_blocks_partial.toml", "asymmetric.toml", "hertz.toml"}) {
+    expect_matches_monolithic(name, "aitken", 0.5);
+    // IQN-ILS stalls near 1e-9 on the asymmetric pair (secant columns of QP noise): 1e-8 here.
+    expect_matches_monolithic(name, "iqn-ils", 0.5, 1e-8);
+  }
+}
+
+TEST(RobinVersusMonolithic, DefaultMethodBeatsTheBestFixedDeltaTenfoldOnTheAsymmetricPair) {
+  const std::string default_method = AccelerationOptions{}.method;
+  const std::size_t accelerated = expect_matches_monolithic("asymmetric.toml", default_method, 0.5);
+  const std::size_t plain = expect_matches_monolithic("asymmetric.toml", "none", 0.02);
+  EXPECT_LE(10 * accelerated, plain);
+}
 
 TEST(RobinIteration, TooLargeRelaxationIsReportedAsDiverging) {
   // Identical bodies: in the all-active regime the error is multiplied by (1 - 2 delta) per
   // iteration, so delta = 1.5 doubles it every iteration.
   const CaseDefinition definition = example("two_blocks.toml");
   CouplingOptions options = definition.coupling;
+  options.acceleration.method = "none";
   options.relaxation = 1.5;
   options.max_iterations = 200;
   const CoupledRunResult robin = run_in_process(definition, options);
-  std::printf("delta = 1.5: %s after %zu iterations: %s\n", to_string(robin.iteration.status).c_str(),
-              robin.iteration.history.size(), robin.iteration.message.c_str());
+  std::printf("delta = 1.5: %s after %zu iterations: %s\n",
+              to_string(robin.iteration.status).c_str(), robin.iteration.history.size(),
+              robin.iteration.message.c_str());
   EXPECT_EQ(robin.iteration.status, IterationStatus::diverged);
   EXPECT_NE(exit_code(robin.iteration.status), 0);
 }
