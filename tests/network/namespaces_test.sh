@@ -215,10 +215,10 @@ check_ssh_prefix() {
 
 # --- Main ---------------------------------------------------------------------------------------
 
-"$binary_directory/robin-run" "$case_file" --output "$work/local" --log-level warn \
-  2> "$work/robin-run.log" || fail "robin-run exited with status $?"
 remove_stale_namespaces
 create_network
+"$binary_directory/robin-run" "$case_file" --output "$work/local" --log-level warn \
+  2> "$work/robin-run.log" || fail "robin-run exited with status $?"
 check_coordinator_across_namespaces
 check_remote_servers_script
 check_interruption
