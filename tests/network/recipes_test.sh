@@ -5,7 +5,8 @@
 #
 #  - shellcheck on every shell script of deploy/ and tests/network/;
 #  - the compose file and the Kubernetes manifests parse (PyYAML) and agree with each other and
-#    with the shipped case (check_manifests.py); `kubectl kustomize` renders them;
+#    with the shipped case (check_manifests.py); `docker compose config` (or docker-compose)
+#    validates the compose file; `kubectl kustomize` renders the manifests;
 #  - the systemd unit passes `systemd-analyze verify` without a message (with ExecStart pointed
 #    at the built robin-subdomain) and its offline security exposure is at most 2.0 ("OK");
 #  - the runtime stage of deploy/Dockerfile installs packages whose dependency closure holds
@@ -50,6 +51,14 @@ check_shell_scripts() {
 
 check_manifests() {
   "$python" tests/network/check_manifests.py "$source_directory"
+}
+
+# The Compose file against the schema of the installed Compose (v2 plugin, else v1); no engine.
+check_compose_schema() {
+  local compose=(docker-compose)
+  if docker compose version > /dev/null 2>&1; then compose=(docker compose); fi
+  ROBIN_UID=1000 ROBIN_GID=1000 "${compose[@]}" -f deploy/compose.yaml config --quiet || return 1
+  echo "${compose[*]} config: valid ($("${compose[@]}" version --short 2> /dev/null || true))"
 }
 
 check_kustomize() {
@@ -120,6 +129,9 @@ if command -v shellcheck > /dev/null; then run_check shellcheck check_shell_scri
 else leave_out shellcheck "shellcheck is not installed (Debian package shellcheck)"; fi
 if "$python" -c 'import yaml' 2> /dev/null; then run_check manifests check_manifests
 else leave_out manifests "$python has no yaml module (Debian package python3-yaml)"; fi
+if docker compose version > /dev/null 2>&1 || command -v docker-compose > /dev/null; then
+  run_check compose-schema check_compose_schema
+else leave_out compose-schema "neither docker compose nor docker-compose is installed"; fi
 if command -v kubectl > /dev/null; then run_check kustomize check_kustomize
 else leave_out kustomize "kubectl is not installed"; fi
 if command -v systemd-analyze > /dev/null; then run_check systemd-unit check_systemd_unit
