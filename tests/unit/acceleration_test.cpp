@@ -437,6 +437,7 @@ TEST(TwoBodies, PerBodyQuasiNewtonIsolatesTheGoodSequenceFromANoisyOne) {
   const int size = 16;
   const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
   AccelerationOptions options;
+  options.method = "iqn-ils";
   const std::vector<double> clean = body1_errors(map, size, options, 0.0, 60);
   const std::vector<double> noisy = body1_errors(map, size, options, 1e-3, 60);
   EXPECT_EQ(clean, noisy);
