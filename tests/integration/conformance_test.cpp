@@ -381,7 +381,7 @@ Deviation wrong_request_ids() {
   return {"WrongRequestIds",
           {},
           [](Envelope& reply) { reply.set_request_id(reply.request_id() + 1000); },
-          {{"request_id_echoed", {"HelloReply reply to Hello", "expected"}},
+          {{"request_id_echoed", {"the HelloReply to Hello carries request_id 1001, expected 1"}},
            {"unknown_request_type", {"request_id"}}}};
 }
 
