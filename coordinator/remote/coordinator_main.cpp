@@ -24,10 +24,11 @@ int main(int argc, char** argv) {
                  "the first serves body 1")
       ->required()
       ->allow_extra_args(false);  // one endpoint per --subdomain; the count is checked below
-  std::string check_server;  // handled above; listed here for --help
+  std::string check_server;       // handled above; listed here for --help
   app.add_option("--check-server", check_server,
                  "instead of a run: check that the server at ENDPOINT conforms to the protocol "
-                 "(CASE and --subdomain are then not needed; --check-server ENDPOINT --help)");
+                 "(CASE and --subdomain are then not needed; --check-server ENDPOINT --help)")
+      ->type_name("ENDPOINT");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
   if (subdomains.size() != 2) {
     std::cerr << "robin-coordinator: give exactly two --subdomain ENDPOINT options (the first "
