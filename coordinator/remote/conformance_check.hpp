@@ -14,7 +14,10 @@
 // answers of the free solve and of the fields are known exactly. The numerical checks use only
 // that and identities every correct server satisfies: the Signorini conditions, u_N = e - F
 // lambda with F r the correction's reply, F linear, symmetric and positive definite, the global
-// force balance, and the same answer in a second run.
+// force balance, and the same answer in a second run. Answers indexed by the pair order cannot
+// reveal a server that uses its own node order instead (they are consistently relabelled), so
+// the pair order is judged through positions: a unit force at pair index k must move the node
+// at x_k most, in the FieldsReply's 'displacement' field (that check needs the field).
 //
 // Deadlines: every request has reply_timeout_seconds. A request that gets no reply fails its
 // check; the checker then opens a new connection and sends a Hello. When that is not answered
