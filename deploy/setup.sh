@@ -12,7 +12,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev libmuparser-dev nlohmann-json3-dev
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-scipy python3-matplotlib python3-zmq python3-protobuf
-  iproute2 procps
+  iproute2 procps shellcheck python3-yaml
 )
 
 missing=()
