@@ -45,7 +45,26 @@ Eigen::VectorXd IqnIlsAcceleration::next(const Eigen::VectorXd& iterate,
     }
   }
   previous_was_quasi_newton_ = false;
+  if (parameters_.mixing == QuasiNewtonMixing::aitken && !mixing_.empty()) {
+    return mixed(iterate, mapped, mixing_);
+  }
   return relaxation_.next(iterate, mapped);
+}
+
+Eigen::VectorXd IqnIlsAcceleration::mixed(const Eigen::VectorXd& point,
+                                          const Eigen::VectorXd& image,
+                                          const std::vector<double>& mixing) const {
+  Eigen::VectorXd result(size_);
+  Eigen::Index start = 0;
+  for (std::size_t index = 0; index < blocks_.size(); ++index) {
+    const int size = blocks_[index].size;
+    const double beta = mixing[index];
+    // (1 - beta) x + beta h on the block
+    result.segment(start, size) =
+        (1.0 - beta) * point.segment(start, size) + beta * image.segment(start, size);
+    start += size;
+  }
+  return result;
 }
 
 void IqnIlsAcceleration::record_differences(const Eigen::VectorXd& residual,
@@ -102,25 +121,23 @@ Eigen::VectorXd IqnIlsAcceleration::quasi_newton_step(const Eigen::VectorXd& ite
   for (Eigen::Index column = 0; column < alpha.size(); ++column) {
     predicted += alpha(column) * mapped_differences_[column];
   }
-  mixing_.assign(blocks_.size(), 1.0);
-  if (parameters_.mixing == QuasiNewtonMixing::full) return predicted;
+  if (parameters_.mixing == QuasiNewtonMixing::full) {
+    mixing_.assign(blocks_.size(), 1.0);
+    return predicted;
+  }
   // x^ = x_k + (W - V) alpha
   Eigen::VectorXd combination = iterate;
   for (Eigen::Index column = 0; column < alpha.size(); ++column) {
     combination += alpha(column) * (mapped_differences_[column] - residual_differences_[column]);
   }
-  Eigen::VectorXd result(size_);
+  mixing_.resize(blocks_.size());
   Eigen::Index start = 0;
   for (std::size_t index = 0; index < blocks_.size(); ++index) {
-    const int size = blocks_[index].size;
-    const double beta = block_mixing(blocks_[index], start);
-    // x_{k+1} = (1 - beta) x^ + beta h^ on the block
-    result.segment(start, size) =
-        (1.0 - beta) * combination.segment(start, size) + beta * predicted.segment(start, size);
-    mixing_[index] = beta;
-    start += size;
+    mixing_[index] = block_mixing(blocks_[index], start);
+    start += blocks_[index].size;
   }
-  return result;
+  // x_{k+1} = (1 - beta) x^ + beta h^ per block
+  return mixed(combination, predicted, mixing_);
 }
 
 double IqnIlsAcceleration::block_mixing(const RelaxationBlock& block, Eigen::Index start) const {
@@ -163,6 +180,7 @@ void IqnIlsAcceleration::restart() {
   previous_was_quasi_newton_ = false;
   columns_ = 0;
   filtered_ = 0;
+  mixing_.clear();
   reason_ = "first step after a restart";
 }
 

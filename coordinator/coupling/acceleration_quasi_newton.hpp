@@ -28,6 +28,9 @@
 //  - safeguard: after a quasi-Newton step with |r_k| > safeguard_growth |r_{k-1}|, the history
 //    is cleared (the pair (r_k, x~_k) starts the next one);
 //  - when the filter drops every column, the history is cleared.
+// With aitken mixing, the relaxation steps of the last two kinds use the last beta_b instead of
+// delta_b: it is the learnt scale of the block, where delta_b may blow the residual up (delta =
+// 0.5 multiplies the stiff sequence's residual by about c / 2).
 // Only differences of (x_k, H(x_k)) pairs are used, so the caller may change the iterate.
 
 #include <deque>
@@ -79,6 +82,9 @@ class IqnIlsAcceleration : public Acceleration {
   Eigen::VectorXd quasi_newton_step(const Eigen::VectorXd& iterate, const Eigen::VectorXd& mapped,
                                     const Eigen::VectorXd& alpha);
   double block_mixing(const RelaxationBlock& block, Eigen::Index start) const;
+  /// (1 - beta_b) point + beta_b image on each block b.
+  Eigen::VectorXd mixed(const Eigen::VectorXd& point, const Eigen::VectorXd& image,
+                        const std::vector<double>& mixing) const;
 
   int size_ = 0;
   std::vector<RelaxationBlock> blocks_;

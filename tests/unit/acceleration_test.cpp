@@ -266,28 +266,34 @@ TEST(IqnIls, FilterDropsAnExactlyDuplicatedColumn) {
 }
 
 TEST(IqnIls, SafeguardRestartsWithARelaxationStepWhenTheResidualGrows) {
+  // Steps: x0 -> relaxation; x1 -> quasi-Newton with the column dv = r1 - r0, dx = x1 - x0;
+  // x2 has |r2| = 5 |r1| > 2 |r1|: the history is cleared and x3 = (1 - b) x2 + b H(x2), with
+  // b = delta for relaxation mixing, and for aitken mixing the last beta,
+  // -dx'dv / |dv|^2 = 0.75 / 1.5 = 0.5.
   const double delta = 0.4;
-  IqnIlsAcceleration acceleration({{3, delta}}, QuasiNewtonParameters{});
-  const Eigen::Vector3d x0(0.0, 0.0, 0.0), h0(1.0, 2.0, -1.0);
-  const Eigen::Vector3d x1(0.5, 0.5, 0.0), h1(1.0, 1.5, -0.5);  // r_1 = (0.5, 1, -0.5)
-  acceleration.next(x0, h0);
-  EXPECT_TRUE(acceleration.relaxation_step());
-  acceleration.next(x1, h1);
-  EXPECT_EQ(acceleration.columns(), 1);
-  // The quasi-Newton step led to x2 with |r_2| = 5 |r_1| > 2 |r_1|.
-  const Eigen::Vector3d x2(0.2, 0.1, 0.3);
+  const Eigen::Vector3d x0(0.0, 0.0, 0.0), h0(1.0, 2.0, -1.0);  // r0 = (1, 2, -1)
+  const Eigen::Vector3d x1(0.5, 0.5, 0.0), h1(1.0, 1.5, -0.5);  // r1 = (0.5, 1, -0.5)
   const Eigen::Vector3d r1 = h1 - x1;
+  const Eigen::Vector3d x2(0.2, 0.1, 0.3);
   const Eigen::Vector3d h2 = x2 + 5.0 * Eigen::Vector3d(-r1(1), r1(0), r1(2));
-  const Eigen::VectorXd x3 = acceleration.next(x2, h2);
-  EXPECT_TRUE(acceleration.relaxation_step());
-  EXPECT_EQ(acceleration.safeguard_restarts(), 1);
-  EXPECT_EQ(acceleration.state(), "iqn-ils relaxation step (restart: the residual grew 5x)");
-  const Eigen::Vector3d relaxed = (1.0 - delta) * x2 + delta * h2;
-  EXPECT_TRUE(x3 == relaxed);
-  // The next step uses the single column from (x2, h2), not the older ones.
-  const Eigen::Vector3d h3 = x3 + Eigen::Vector3d(0.1, -0.2, 0.05);
-  acceleration.next(x3, h3);
-  EXPECT_EQ(acceleration.columns(), 1);
+  for (const auto& [mixing, step] : {std::pair{QuasiNewtonMixing::relaxation, delta},
+                                     std::pair{QuasiNewtonMixing::aitken, 0.5}}) {
+    IqnIlsAcceleration acceleration({{3, delta}}, with_mixing(mixing, 10));
+    acceleration.next(x0, h0);
+    EXPECT_TRUE(acceleration.relaxation_step());
+    acceleration.next(x1, h1);
+    EXPECT_EQ(acceleration.columns(), 1);
+    const Eigen::VectorXd x3 = acceleration.next(x2, h2);
+    EXPECT_TRUE(acceleration.relaxation_step());
+    EXPECT_EQ(acceleration.safeguard_restarts(), 1);
+    EXPECT_EQ(acceleration.state(), "iqn-ils relaxation step (restart: the residual grew 5x)");
+    const Eigen::Vector3d relaxed = (1.0 - step) * x2 + step * h2;
+    EXPECT_LT((x3 - relaxed).norm(), 1e-15 * relaxed.norm()) << "step " << step;
+    // The next step uses the single column from (x2, h2), not the older ones.
+    const Eigen::Vector3d h3 = x3 + Eigen::Vector3d(0.1, -0.2, 0.05);
+    acceleration.next(x3, h3);
+    EXPECT_EQ(acceleration.columns(), 1);
+  }
 }
 
 TEST(IqnIls, RestartMakesTheNextStepARelaxationStep) {
@@ -402,6 +408,28 @@ TEST(TwoBodies, QuasiNewtonNeedsTenTimesFewerIterationsThanTheBestRelaxation) {
   EXPECT_LT(per_body, 20);
   EXPECT_LT(joint, 20);
   EXPECT_GE(relaxation, 10 * per_body);
+}
+
+TEST(TwoBodies, AitkenMixingKeepsAShortHistoryConvergent) {
+  // With beta = 1 the error of x_{k+1} is M times that of x^, and |M| ~ c for body 1: a short
+  // history then loses the stiff modes again. Aitken mixing makes the step a contraction.
+  std::mt19937 generator(7);
+  const int size = 16;
+  const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
+  AccelerationOptions options;
+  options.method = "iqn-ils";
+  for (const int depth : {3, 5}) {
+    options.history_depth = depth;
+    options.mixing = "aitken";
+    const int aitken = two_body_calls(map, size, options, 500);
+    options.mixing = "full";
+    const int full = two_body_calls(map, size, options, 500);
+    std::cout << "c = 100, history depth " << depth << ": aitken mixing " << aitken
+              << " iterations, full mixing " << (full > 500 ? "not in 500" : std::to_string(full))
+              << "\n";
+    EXPECT_LT(aitken, 40);
+    EXPECT_GT(full, 3 * aitken);
+  }
 }
 
 /// Relative error of body 1's block after each of `steps` steps, when body 2's map H^2 carries
