@@ -250,7 +250,9 @@ const PortTimings& RemotePort::timings() const {
 
 bool request_server_shutdown(const std::string& endpoint, double timeout_seconds) noexcept {
   try {
-    RequestChannel channel(endpoint, ChannelOptions{});
+    ChannelOptions options;
+    options.immediate = false;  // keep the acknowledgement even though the server exits at once
+    RequestChannel channel(endpoint, options);
     const Deadline deadline = Deadline::after(timeout_seconds);
     Envelope request;
     request.mutable_shutdown();

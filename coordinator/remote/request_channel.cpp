@@ -51,7 +51,7 @@ RequestChannel::RequestChannel(const std::string& endpoint, ChannelOptions optio
     : sockets_(std::make_unique<Sockets>()), options_(std::move(options)) {
   zmq::socket_t& dealer = sockets_->dealer;
   dealer.set(zmq::sockopt::linger, 0);
-  dealer.set(zmq::sockopt::immediate, 1);
+  dealer.set(zmq::sockopt::immediate, options_.immediate ? 1 : 0);
   dealer.set(zmq::sockopt::sndtimeo, send_backstop_milliseconds);
   dealer.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(options_.max_message_bytes));
   dealer.set(zmq::sockopt::heartbeat_ivl, options_.heartbeat_interval_milliseconds);
@@ -148,21 +148,28 @@ void RequestChannel::wait_for(short events, const Deadline& deadline,
                               const std::string& timeout_problem) {
   for (;;) {
     if (hooks_enabled_ && options_.on_wait) options_.on_wait();
+    // A reply already delivered wins over a connection lost after it (a server that answers a
+    // shutdown and exits at once).
+    if (poll_dealer(events, std::chrono::milliseconds(0))) return;
     check_connection();
     const auto remaining = deadline.at - Clock::now();
     if (remaining <= Clock::duration::zero()) throw ChannelFailure(timeout_problem);
     const auto slice =
         std::min(wait_slice, std::chrono::ceil<std::chrono::milliseconds>(remaining));
-    std::vector<zmq::pollitem_t> items{{sockets_->dealer.handle(), 0, events, 0},
-                                       {sockets_->monitor.handle(), 0, ZMQ_POLLIN, 0}};
-    try {
-      zmq::poll(items, slice);
-    } catch (const zmq::error_t& error) {
-      if (error.num() != EINTR) throw ChannelFailure(std::string("poll failed: ") + error.what());
-      continue;  // a signal: the next round runs on_wait, which may abandon the wait
-    }
-    if ((items[0].revents & events) != 0) return;
+    if (poll_dealer(events, slice)) return;
   }
+}
+
+bool RequestChannel::poll_dealer(short events, std::chrono::milliseconds timeout) {
+  std::vector<zmq::pollitem_t> items{{sockets_->dealer.handle(), 0, events, 0},
+                                     {sockets_->monitor.handle(), 0, ZMQ_POLLIN, 0}};
+  try {
+    zmq::poll(items, timeout);
+  } catch (const zmq::error_t& error) {
+    if (error.num() != EINTR) throw ChannelFailure(std::string("poll failed: ") + error.what());
+    return false;  // a signal: the caller's next round runs on_wait, which may abandon the wait
+  }
+  return (items[0].revents & events) != 0;
 }
 
 void RequestChannel::read_monitor_events() {

@@ -12,6 +12,9 @@
 //                          the coordinator's exit);
 //   ZMQ_IMMEDIATE 1        messages are queued only on completed connections, so a request to a
 //                          server that is not there waits (and times out) instead of vanishing;
+//                          the price: libzmq drops the unread replies of a connection that
+//                          closes, so a request after which the server exits (shutdown) uses
+//                          ChannelOptions::immediate = false;
 //   ZMQ_SNDTIMEO           a backstop: sends happen after the socket polled writable, so they
 //                          never block longer than this;
 //   ZMQ_MAXMSGSIZE         larger inbound messages drop the connection instead of exhausting
@@ -55,6 +58,9 @@ struct ChannelOptions {
   long max_message_bytes = 1L << 30;  // ZMQ_MAXMSGSIZE of inbound messages
   int heartbeat_interval_milliseconds = 1000;
   int heartbeat_timeout_milliseconds = 5000;
+  /// ZMQ_IMMEDIATE (see above). False keeps a reply that arrived just before the server closed
+  /// its end; the send then queues without waiting for the connection.
+  bool immediate = true;
   /// Called at least every 100 ms while waiting; may throw (e.g. RunInterrupted) to abandon the
   /// wait. The exception propagates unchanged.
   std::function<void()> on_wait;
@@ -90,6 +96,8 @@ class RequestChannel {
  private:
   struct Sockets;
   void wait_for(short events, const Deadline& deadline, const std::string& timeout_problem);
+  /// True when the dealer is ready for `events` within `timeout` (false on EINTR).
+  bool poll_dealer(short events, std::chrono::milliseconds timeout);
   void check_connection();
   std::string server_failure_reason() const;
   void read_monitor_events();
