@@ -41,6 +41,17 @@ void InProcessPort::start_correction(const Eigen::VectorXd& interface_force, int
 
 CorrectionSolveResult InProcessPort::finish_correction() { return correction_result_; }
 
+void InProcessPort::start_neumann_solve(const Eigen::VectorXd& contact_force, int /*iteration*/) {
+  const auto start = std::chrono::steady_clock::now();
+  neumann_result_.normal_trace = body().solve_neumann(contact_force);
+  neumann_result_.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  timings_.compute_seconds += neumann_result_.seconds;
+  timings_.round_trip_seconds += neumann_result_.seconds;
+}
+
+CorrectionSolveResult InProcessPort::finish_neumann_solve() { return neumann_result_; }
+
 BodyOutput InProcessPort::fields(const Eigen::VectorXd& contact_force) {
   return make_body_output(body(), contact_force);
 }

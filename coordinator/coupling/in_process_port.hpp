@@ -18,6 +18,8 @@ class InProcessPort final : public SubdomainPort {
   ContactSolveResult finish_contact_solve() override;
   void start_correction(const Eigen::VectorXd& interface_force, int iteration) override;
   CorrectionSolveResult finish_correction() override;
+  void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;
+  CorrectionSolveResult finish_neumann_solve() override;
   BodyOutput fields(const Eigen::VectorXd& contact_force) override;
   void end_run() noexcept override;
   const PortTimings& timings() const override { return timings_; }
@@ -29,6 +31,7 @@ class InProcessPort final : public SubdomainPort {
   MprgpParameters qp_;
   ContactSolveResult contact_result_;
   CorrectionSolveResult correction_result_;
+  CorrectionSolveResult neumann_result_;
   PortTimings timings_;
 };
 

@@ -49,6 +49,12 @@ class SubdomainPort {
   virtual ContactSolveResult finish_contact_solve() = 0;
   virtual void start_correction(const Eigen::VectorXd& interface_force, int iteration) = 0;
   virtual CorrectionSolveResult finish_correction() = 0;
+  /// The Neumann solve of the Dirichlet-Neumann iteration: K u = f - B' lambda for a given
+  /// nodal contact force lambda (pair order; compression positive); returns u_N = B u in
+  /// normal_trace. Protocol 1.1, capability "neumann-solve". The default throws PortError: a
+  /// port without the capability cannot run the Dirichlet-Neumann iteration.
+  virtual void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration);
+  virtual CorrectionSolveResult finish_neumann_solve();
   virtual BodyOutput fields(const Eigen::VectorXd& contact_force) = 0;
   /// Ends the run (the server stays up for the next one). Must not throw.
   virtual void end_run() noexcept = 0;

@@ -255,6 +255,10 @@ Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_fo
   return trace;
 }
 
+Eigen::VectorXd BodySolver::solve_neumann(const Eigen::VectorXd& contact_force) const {
+  return free_trace_ - solve_correction(contact_force);  // e - F lambda
+}
+
 Eigen::VectorXd BodySolver::apply_transpose_trace(const Eigen::VectorXd& contact_force) const {
   return trace_.transpose() * contact_force;
 }

@@ -118,6 +118,10 @@ class BodySolver {
 
   /// Paper step 2: w_N = B K^{-1} B' r for an interface force vector r (force).
   Eigen::VectorXd solve_correction(const Eigen::VectorXd& interface_force) const;
+  /// The Neumann solve of the Dirichlet-Neumann iteration: u_N = B K^{-1} (f - B' lambda)
+  /// = e - F lambda for a nodal contact force lambda (compression positive). Same cost as a
+  /// correction solve (one product with F).
+  Eigen::VectorXd solve_neumann(const Eigen::VectorXd& contact_force) const;
 
   /// Full displacement (2 per node, prescribed values included) under contact forces lambda.
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force) const;
