@@ -6,7 +6,7 @@ void SubdomainPort::start_neumann_solve(const Eigen::VectorXd& /*contact_force*/
                                         int /*iteration*/) {
   throw PortError(describe() +
                   ", step Neumann solve: this subdomain does not offer the Neumann solve "
-                  "(protocol capability \"neumann-solve\", protocol 1.1); the Dirichlet-Neumann "
+                  "(protocol capability \"neumann_solve\", protocol 1.1); the Dirichlet-Neumann "
                   "algorithm needs it");
 }
 

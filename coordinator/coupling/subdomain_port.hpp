@@ -51,7 +51,7 @@ class SubdomainPort {
   virtual CorrectionSolveResult finish_correction() = 0;
   /// The Neumann solve of the Dirichlet-Neumann iteration: K u = f - B' lambda for a given
   /// nodal contact force lambda (pair order; compression positive); returns u_N = B u in
-  /// normal_trace. Protocol 1.1, capability "neumann-solve". The default throws PortError: a
+  /// normal_trace. Protocol 1.1, capability "neumann_solve". The default throws PortError: a
   /// port without the capability cannot run the Dirichlet-Neumann iteration.
   virtual void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration);
   virtual CorrectionSolveResult finish_neumann_solve();
