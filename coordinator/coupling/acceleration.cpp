@@ -1,6 +1,7 @@
 #include "coupling/acceleration.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -19,12 +20,16 @@ void require(bool condition, const std::string& field, const std::string& rule, 
                    format_for_state(value));
 }
 
-std::unique_ptr<Acceleration> per_body(int size1, std::unique_ptr<Acceleration> body1, int size2,
-                                       std::unique_ptr<Acceleration> body2) {
+/// One instance per block, made by `make_block(block index, block size)`, or the instance itself
+/// when there is a single block.
+template <typename MakeBlock>
+std::unique_ptr<Acceleration> per_block(const std::vector<int>& sizes, MakeBlock make_block) {
+  if (sizes.size() == 1) return make_block(0, sizes[0]);
   std::vector<std::unique_ptr<Acceleration>> parts;
-  parts.push_back(std::move(body1));
-  parts.push_back(std::move(body2));
-  return std::make_unique<BlockwiseAcceleration>(std::vector<int>{size1, size2}, std::move(parts));
+  for (std::size_t block = 0; block < sizes.size(); ++block) {
+    parts.push_back(make_block(static_cast<int>(block), sizes[block]));
+  }
+  return std::make_unique<BlockwiseAcceleration>(sizes, std::move(parts));
 }
 
 QuasiNewtonMixing parse_mixing(const std::string& mixing) {
@@ -33,20 +38,27 @@ QuasiNewtonMixing parse_mixing(const std::string& mixing) {
   return QuasiNewtonMixing::aitken;
 }
 
-std::unique_ptr<Acceleration> make_quasi_newton(const AccelerationOptions& options, int size1,
-                                                int size2) {
+/// delta of block `block`: relaxation1 for the first, relaxation2 for the second.
+RelaxationBlock relaxation_block(const AccelerationOptions& options, int block, int size) {
+  return {size, block == 0 ? options.relaxation1 : options.relaxation2};
+}
+
+std::unique_ptr<Acceleration> make_quasi_newton(const AccelerationOptions& options,
+                                                const std::vector<int>& sizes) {
   const QuasiNewtonParameters parameters{options.history_depth,    options.filter_threshold,
                                          options.safeguard_growth, parse_mixing(options.mixing),
                                          options.aitken_minimum,   options.aitken_maximum};
-  const RelaxationBlock body1{size1, options.relaxation1};
-  const RelaxationBlock body2{size2, options.relaxation2};
   if (!options.per_body) {
-    return std::make_unique<IqnIlsAcceleration>(std::vector<RelaxationBlock>{body1, body2},
-                                                parameters);
+    std::vector<RelaxationBlock> blocks;
+    for (std::size_t block = 0; block < sizes.size(); ++block) {
+      blocks.push_back(relaxation_block(options, static_cast<int>(block), sizes[block]));
+    }
+    return std::make_unique<IqnIlsAcceleration>(blocks, parameters);
   }
-  return per_body(
-      size1, std::make_unique<IqnIlsAcceleration>(std::vector<RelaxationBlock>{body1}, parameters),
-      size2, std::make_unique<IqnIlsAcceleration>(std::vector<RelaxationBlock>{body2}, parameters));
+  return per_block(sizes, [&](int block, int size) -> std::unique_ptr<Acceleration> {
+    return std::make_unique<IqnIlsAcceleration>(
+        std::vector<RelaxationBlock>{relaxation_block(options, block, size)}, parameters);
+  });
 }
 
 }  // namespace
@@ -78,20 +90,32 @@ void validate(const AccelerationOptions& options) {
   require(options.safeguard_growth > 1.0, "safeguard_growth", "> 1", options.safeguard_growth);
 }
 
-std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options, int size1,
-                                                int size2) {
+std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options,
+                                                const std::vector<int>& block_sizes) {
   validate(options);
+  if (block_sizes.empty() || block_sizes.size() > 2) {
+    throw std::invalid_argument("make_acceleration: one or two blocks");
+  }
   if (options.method == "none") {
-    return std::make_unique<FixedRelaxation>(
-        std::vector<RelaxationBlock>{{size1, options.relaxation1}, {size2, options.relaxation2}});
+    std::vector<RelaxationBlock> blocks;
+    for (std::size_t block = 0; block < block_sizes.size(); ++block) {
+      blocks.push_back(relaxation_block(options, static_cast<int>(block), block_sizes[block]));
+    }
+    return std::make_unique<FixedRelaxation>(blocks);
   }
   if (options.method == "aitken") {
     const AitkenParameters parameters{options.aitken_initial, options.aitken_minimum,
                                       options.aitken_maximum};
-    return per_body(size1, std::make_unique<AitkenAcceleration>(size1, parameters), size2,
-                    std::make_unique<AitkenAcceleration>(size2, parameters));
+    return per_block(block_sizes, [&](int /*block*/, int size) -> std::unique_ptr<Acceleration> {
+      return std::make_unique<AitkenAcceleration>(size, parameters);
+    });
   }
-  return make_quasi_newton(options, size1, size2);
+  return make_quasi_newton(options, block_sizes);
+}
+
+std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options, int size1,
+                                                int size2) {
+  return make_acceleration(options, std::vector<int>{size1, size2});
 }
 
 }  // namespace robin

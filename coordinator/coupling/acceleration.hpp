@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace robin {
 
@@ -66,6 +67,9 @@ class Acceleration {
 /// options first (throws InputError as validate does).
 std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options, int size1,
                                                 int size2);
+/// The same for one block (single-sequence algorithms: relaxation1 applies) or two blocks.
+std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options,
+                                                const std::vector<int>& block_sizes);
 
 /// Throws robin::InputError naming the field when an option is out of range, e.g.
 /// "acceleration.history_depth must be >= 1, got 0".

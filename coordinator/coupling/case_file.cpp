@@ -21,7 +21,8 @@ const std::vector<std::string> coupling_keys{
     "request_timeout", "divergence_factor", "stagnation_window", "acceleration",
     "relaxation1",     "relaxation2",       "aitken_initial",    "aitken_minimum",
     "aitken_maximum",  "history_depth",     "filter_threshold",  "safeguard_growth",
-    "per_body"};
+    "per_body",        "algorithm",         "alpha",             "contact_body",
+    "stopping"};
 
 toml::table parse_toml(const std::filesystem::path& path, const std::string& label) {
   std::error_code error;
@@ -138,6 +139,23 @@ void read_acceleration(const CheckedTable& table, CouplingOptions& coupling) {
   }
 }
 
+/// The algorithm keys of [coupling] (coupling/coupling_scheme.hpp).
+void read_algorithm(const CheckedTable& table, CouplingOptions& coupling) {
+  coupling.algorithm = table
+                           .optional_choice("algorithm", {"robin", "robin-constant",
+                                                          "dirichlet-neumann", "neumann-neumann"})
+                           .value_or(coupling.algorithm);
+  coupling.alpha = number_above(table, "alpha", 0.0, coupling.alpha);
+  if (coupling.algorithm == "robin-constant" && !(coupling.alpha > 0.0)) {
+    table.fail("algorithm", "\"robin-constant\" needs coupling.alpha > 0 (the constant alpha_S, "
+                            "length per pressure)");
+  }
+  coupling.contact_body = table.optional_choice("contact_body", {"1", "2", "auto"})
+                              .value_or(coupling.contact_body);
+  coupling.stopping = table.optional_choice("stopping", {"either-sequence", "joint"})
+                          .value_or(coupling.stopping);
+}
+
 void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
   const auto table = root.optional_table("coupling", coupling_keys);
   if (!table) return;
@@ -156,6 +174,7 @@ void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
   coupling.stagnation_window =
       integer_at_least(*table, "stagnation_window", 1, coupling.stagnation_window);
   read_acceleration(*table, coupling);
+  read_algorithm(*table, coupling);
 }
 
 void read_bodies(const CheckedTable& root, const std::filesystem::path& directory,

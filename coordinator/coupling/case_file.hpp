@@ -37,6 +37,17 @@ struct BodyCase {
 
 /// Options of the Robin iteration (coordinator); command-line flags override them.
 struct CouplingOptions {
+  /// The coupling algorithm (coupling/coupling_scheme.hpp): "robin" (the paper's (Q_m)),
+  /// "robin-constant", "dirichlet-neumann" or "neumann-neumann".
+  std::string algorithm = "robin";
+  /// "robin-constant": the constant alpha_S of paper (6) (length per pressure; > 0).
+  double alpha = 0.0;
+  /// "dirichlet-neumann": the body that solves the contact problem, "1", "2" or "auto" (the
+  /// more compliant body, measured by one correction solve each).
+  std::string contact_body = "auto";
+  /// "either-sequence": stop also when one obstacle sequence's complete state converged
+  /// ("robin"); "joint": only when the joint state of both sequences did (the paper's test).
+  std::string stopping = "either-sequence";
   double relaxation = 0.5;  // delta of paper (13), for both bodies unless overridden
   std::optional<double> relaxation1, relaxation2;  // per-body deltas (default: relaxation)
   /// Acceleration of the obstacle update (method "iqn-ils", "aitken" or "none"; see

@@ -51,12 +51,18 @@ void write_history_csv(const std::filesystem::path& path, const std::vector<Iter
   if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
   file << std::setprecision(std::numeric_limits<double>::max_digits10);
   file << "iteration,obstacle_change,penetration,force_balance,complementarity,correction,"
-          "active1,active2,qp_iterations1,qp_iterations2,seconds\n";
+          "active1,active2,qp_iterations1,qp_iterations2,seconds,sequence1,sequence2\n";
   for (const IterationRecord& record : history) {
     file << record.iteration << ',' << record.obstacle_change << ',' << record.penetration << ','
          << record.force_balance << ',' << record.complementarity << ',' << record.correction << ','
          << record.active1 << ',' << record.active2 << ',' << record.qp_iterations1 << ','
-         << record.qp_iterations2 << ',' << record.seconds << '\n';
+         << record.qp_iterations2 << ',' << record.seconds;
+    // The complete states of the obstacle sequences ("robin" only; empty otherwise).
+    for (std::size_t k = 0; k < 2; ++k) {
+      file << ',';
+      if (k < record.sequence_residuals.size()) file << record.sequence_residuals[k];
+    }
+    file << '\n';
   }
   if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
 }
@@ -80,6 +86,10 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   summary["status"] = to_string(iteration.status);
   summary["message"] = iteration.message;
   summary["iterations"] = iteration.history.size();
+  summary["algorithm"] = iteration.algorithm;
+  summary["acceleration"] = result.options.acceleration.method;
+  summary["stopping"] = result.options.stopping;
+  summary["completed_by_sequence"] = iteration.completed_by_sequence;
   summary["relaxation"] = result.options.relaxation;
   summary["tolerance"] = result.options.tolerance;
   summary["initial_obstacle"] = result.options.initial_obstacle;
@@ -146,7 +156,8 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
 
   const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
   result.iteration =
-      run_robin_iteration(*ports[0], *ports[1], result.pairing.gaps(), options, observer.iteration);
+      run_robin_iteration(*ports[0], *ports[1], result.pairing.gaps(),
+                          result.pairing.weights(), options, observer.iteration);
   for (int alpha = 0; alpha < 2; ++alpha) {
     result.iteration_port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
   }

@@ -1,12 +1,14 @@
 #include "coupling/robin_iteration.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <sstream>
 
+#include "coupling/coupling_scheme.hpp"
 #include "coupling/monolithic_solver.hpp"
 
 namespace robin {
@@ -29,7 +31,7 @@ class ProgressMonitor {
 
   /// Returns the status that must stop the run, or nothing; fills `message`.
   std::optional<IterationStatus> check(const IterationRecord& record, std::string& message) {
-    const double value = record.largest();
+    const double value = record.progress(options_.stopping == "either-sequence");
     best_history_.push_back(std::min(best(), value));
     if (record.iteration == 1) first_step_ = record.obstacle_step;
     smallest_step_ = std::min(smallest_step_, record.obstacle_step);
@@ -82,45 +84,95 @@ class ProgressMonitor {
   std::vector<double> best_history_;  // smallest largest-residual up to each iteration
 };
 
-void require_converged(const ContactSolveResult& result, const SubdomainPort& port, int iteration) {
-  if (result.status == QpStatus::converged) return;
-  throw PortError(port.describe() + ", step contact solve (iteration " + std::to_string(iteration) +
-                  "): the contact QP returned '" + to_string(result.status) +
-                  "': " + result.message);
-}
-
-IterationRecord make_record(int iteration, const Eigen::VectorXd& gaps,
-                            const ContactSolveResult& contact1, const ContactSolveResult& contact2,
-                            const Eigen::VectorXd& correction1, const Eigen::VectorXd& correction2,
-                            double obstacle_change) {
+/// Scaled residuals of a state (IterationRecord's definitions; obstacle_change is set apart).
+IterationRecord residual_record(int iteration, const Eigen::VectorXd& gaps,
+                                const CouplingState& state) {
   IterationRecord record;
   record.iteration = iteration;
   const InterfaceResiduals residuals =
-      interface_residuals(gaps, contact1.normal_trace, contact2.normal_trace,
-                          contact1.contact_force, contact2.contact_force);
+      interface_residuals(gaps, state.normal_trace1, state.normal_trace2, state.contact_force1,
+                          state.contact_force2);
   const double displacement_scale =
-      std::max({maximum_absolute(gaps), maximum_absolute(contact1.normal_trace),
-                maximum_absolute(contact2.normal_trace), maximum_absolute(correction1),
-                maximum_absolute(correction2), std::numeric_limits<double>::min()});
+      std::max({maximum_absolute(gaps), maximum_absolute(state.normal_trace1),
+                maximum_absolute(state.normal_trace2), maximum_absolute(state.correction1),
+                maximum_absolute(state.correction2), std::numeric_limits<double>::min()});
   record.penetration = residuals.penetration;
   record.force_balance = residuals.force_balance;
   record.complementarity = residuals.complementarity;
-  record.correction =
-      std::max(maximum_absolute(correction1), maximum_absolute(correction2)) / displacement_scale;
-  record.obstacle_change = obstacle_change;
-  record.active1 =
-      static_cast<int>(std::count(contact1.active.begin(), contact1.active.end(), true));
-  record.active2 =
-      static_cast<int>(std::count(contact2.active.begin(), contact2.active.end(), true));
-  record.qp_iterations1 = contact1.iterations;
-  record.qp_iterations2 = contact2.iterations;
+  record.correction = std::max(maximum_absolute(state.correction1),
+                               maximum_absolute(state.correction2)) /
+                      displacement_scale;
   return record;
+}
+
+/// |x_{k+1} - x_k| per block (max norm), and the scale that makes it relative:
+/// max(|x_{k+1}|, |d|, |u1_N|, |u2_N|).
+struct ObstacleChange {
+  std::vector<double> per_block;
+  double scale = 0.0;
+  double relative() const {
+    return *std::max_element(per_block.begin(), per_block.end()) / scale;
+  }
+};
+
+ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::VectorXd& next,
+                               const std::vector<int>& block_sizes, const Eigen::VectorXd& gaps,
+                               const CouplingState& state) {
+  ObstacleChange change;
+  change.scale = std::max({maximum_absolute(next), maximum_absolute(gaps),
+                           maximum_absolute(state.normal_trace1),
+                           maximum_absolute(state.normal_trace2),
+                           std::numeric_limits<double>::min()});
+  Eigen::Index offset = 0;
+  for (const int size : block_sizes) {
+    change.per_block.push_back(maximum_absolute(next.segment(offset, size) -
+                                                iterate.segment(offset, size)));
+    offset += size;
+  }
+  return change;
+}
+
+/// The largest residual of the complete state of obstacle sequence k: its penetration and
+/// complementarity (force balance and correction vanish by construction), the change of its
+/// own obstacle block, and the change of its contact force since the previous iteration,
+/// |lambda_k - lambda_{k-1}| / |lambda_k|. The force change stands in for the force balance of
+/// the joint state: small displacement residuals alone can hide a force error amplified by the
+/// interface stiffness (F^-1 grows like 1/h).
+double completion_residual(const CouplingState& completion, const Eigen::VectorXd& gaps,
+                           double block_change, const Eigen::VectorXd& force,
+                           const Eigen::VectorXd& previous_force) {
+  const IterationRecord record = residual_record(0, gaps, completion);
+  const double force_change =
+      previous_force.size() != force.size()
+          ? std::numeric_limits<double>::infinity()
+          : maximum_absolute(force - previous_force) /
+                std::max(maximum_absolute(force), std::numeric_limits<double>::min());
+  return std::max({record.penetration, record.complementarity, record.force_balance,
+                   record.correction, block_change, force_change});
+}
+
+void store_state(RobinResult& result, const CouplingState& state) {
+  result.obstacle1 = state.obstacle1;
+  result.obstacle2 = state.obstacle2;
+  result.normal_trace1 = state.normal_trace1;
+  result.normal_trace2 = state.normal_trace2;
+  result.contact_force1 = state.contact_force1;
+  result.contact_force2 = state.contact_force2;
+  result.correction1 = state.correction1;
+  result.correction2 = state.correction2;
 }
 
 }  // namespace
 
 double IterationRecord::largest() const {
   return std::max({obstacle_change, penetration, force_balance, complementarity, correction});
+}
+
+double IterationRecord::progress(bool either_sequence) const {
+  double value = largest();
+  if (!either_sequence) return value;
+  for (const double residual : sequence_residuals) value = std::min(value, residual);
+  return value;
 }
 
 std::string to_string(IterationStatus status) {
@@ -140,84 +192,87 @@ std::string to_string(IterationStatus status) {
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd& gaps, const CouplingOptions& options,
                                 const IterationObserver& observer) {
+  return run_robin_iteration(body1, body2, gaps, Eigen::VectorXd::Ones(gaps.size()), options,
+                             observer);
+}
+
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
+                                const CouplingOptions& options, const IterationObserver& observer) {
   const auto run_start = Clock::now();
   double port_seconds = 0.0;
-  const Eigen::Index size = gaps.size();
-  const std::unique_ptr<Acceleration> acceleration = make_acceleration(
-      effective_acceleration(options), static_cast<int>(size), static_cast<int>(size));
-  Eigen::VectorXd iterate(2 * size), mapped(2 * size);
+  const auto setup_start = Clock::now();
+  const std::unique_ptr<CouplingScheme> scheme =
+      make_coupling_scheme(options, body1, body2, gaps, weights);
+  port_seconds += seconds_between(setup_start, Clock::now());
+  const std::vector<int> block_sizes = scheme->block_sizes();
+  const std::unique_ptr<Acceleration> acceleration =
+      make_acceleration(effective_acceleration(options), block_sizes);
+  const bool either_sequence = options.stopping == "either-sequence";
   RobinResult result;
-  Eigen::VectorXd obstacle1 =
-      options.initial_obstacle == "zero" ? Eigen::VectorXd::Zero(gaps.size()) : gaps;
-  Eigen::VectorXd obstacle2 = obstacle1;
+  result.algorithm = scheme->describe();
+  Eigen::VectorXd iterate = scheme->initial_iterate(
+      options.initial_obstacle == "zero" ? Eigen::VectorXd::Zero(gaps.size()) : gaps);
   ProgressMonitor monitor(options);
+  std::array<Eigen::VectorXd, 2> previous_forces;  // each body's lambda one iteration ago
   result.status = IterationStatus::max_iterations;
   result.message = "the iteration limit of " + std::to_string(options.max_iterations) +
                    " iterations was reached before the tolerance " +
                    std::to_string(options.tolerance);
   for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
     const auto iteration_start = Clock::now();
-    // Step 1, both bodies in parallel: u^a = argmin ... s.t. B^a u <= g^a.
-    body1.start_contact_solve(obstacle1, iteration);
-    body2.start_contact_solve(obstacle2, iteration);
-    const ContactSolveResult contact1 = body1.finish_contact_solve();
-    const ContactSolveResult contact2 = body2.finish_contact_solve();
-    require_converged(contact1, body1, iteration);
-    require_converged(contact2, body2, iteration);
-    // Step 2: K^1 w^1 = B^1'(lambda^2 - lambda^1), K^2 w^2 = B^2'(lambda^1 - lambda^2).
-    const Eigen::VectorXd imbalance = contact2.contact_force - contact1.contact_force;
-    const auto correction_start = Clock::now();
-    port_seconds += seconds_between(iteration_start, correction_start);
-    body1.start_correction(imbalance, iteration);
-    body2.start_correction(-imbalance, iteration);
-    const CorrectionSolveResult correction1 = body1.finish_correction();
-    const CorrectionSolveResult correction2 = body2.finish_correction();
+    const CouplingEvaluation evaluation = scheme->evaluate(iterate, iteration);
     const auto update_start = Clock::now();
-    port_seconds += seconds_between(correction_start, update_start);
-    result.critical_compute_seconds += std::max(contact1.seconds, contact2.seconds) +
-                                       std::max(correction1.seconds, correction2.seconds);
-    // Step 3: the obstacle update x_{k+1} = A(x_k, H(x_k)) on x = (g1, g2), with the map
-    // H = (w2_N - u2_N + d, w1_N - u1_N + d); "none" is the paper's (1 - delta) x + delta H.
-    iterate << obstacle1, obstacle2;
-    mapped << correction2.normal_trace - contact2.normal_trace + gaps,
-        correction1.normal_trace - contact1.normal_trace + gaps;
-    const Eigen::VectorXd next = acceleration->next(iterate, mapped);
-    const Eigen::VectorXd next1 = next.head(size);
-    const Eigen::VectorXd next2 = next.tail(size);
-    const double change_scale =
-        std::max({maximum_absolute(next1), maximum_absolute(next2), maximum_absolute(gaps),
-                  maximum_absolute(contact1.normal_trace), maximum_absolute(contact2.normal_trace),
-                  std::numeric_limits<double>::min()});
-    const double change =
-        std::max(maximum_absolute(next1 - obstacle1), maximum_absolute(next2 - obstacle2)) /
-        change_scale;
-    IterationRecord record =
-        make_record(iteration, gaps, contact1, contact2, correction1.normal_trace,
-                    correction2.normal_trace, change);
-    record.obstacle_step = change * change_scale;
+    port_seconds += seconds_between(iteration_start, update_start);
+    result.critical_compute_seconds += evaluation.critical_compute_seconds;
+    // The obstacle update x_{k+1} = A(x_k, H(x_k)); "none" is the paper's (1 - delta) x + delta H.
+    const Eigen::VectorXd next = acceleration->next(iterate, evaluation.mapped);
+    const ObstacleChange change =
+        obstacle_change(iterate, next, block_sizes, gaps, evaluation.state);
+    IterationRecord record = residual_record(iteration, gaps, evaluation.state);
+    record.obstacle_change = change.relative();
+    record.obstacle_step = change.relative() * change.scale;
+    record.active1 = evaluation.active1;
+    record.active2 = evaluation.active2;
+    record.qp_iterations1 = evaluation.qp_iterations1;
+    record.qp_iterations2 = evaluation.qp_iterations2;
+    const std::array<const Eigen::VectorXd*, 2> forces{&evaluation.state.contact_force1,
+                                                       &evaluation.state.contact_force2};
+    for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
+      record.sequence_residuals.push_back(
+          completion_residual(evaluation.completions[k], gaps, change.per_block[k] / change.scale,
+                              *forces[k], previous_forces[k]));
+    }
+    previous_forces = {*forces[0], *forces[1]};
     record.acceleration_state = acceleration->state();
     record.seconds = seconds_between(iteration_start, Clock::now());
     result.history.push_back(record);
-    result.obstacle1 = obstacle1;
-    result.obstacle2 = obstacle2;
-    result.normal_trace1 = contact1.normal_trace;
-    result.normal_trace2 = contact2.normal_trace;
-    result.contact_force1 = contact1.contact_force;
-    result.contact_force2 = contact2.contact_force;
-    result.correction1 = correction1.normal_trace;
-    result.correction2 = correction2.normal_trace;
+    store_state(result, evaluation.state);
     if (observer) observer(record);
     if (record.largest() <= options.tolerance) {
       result.status = IterationStatus::converged;
       result.message = "converged in " + std::to_string(iteration) + " iterations";
       break;
     }
+    const auto finished = std::find_if(
+        record.sequence_residuals.begin(), record.sequence_residuals.end(),
+        [&](double residual) { return either_sequence && residual <= options.tolerance; });
+    if (finished != record.sequence_residuals.end()) {
+      const auto sequence = finished - record.sequence_residuals.begin();
+      store_state(result, evaluation.completions[static_cast<std::size_t>(sequence)]);
+      result.status = IterationStatus::converged;
+      result.completed_by_sequence = static_cast<int>(sequence) + 1;
+      result.message = "converged in " + std::to_string(iteration) +
+                       " iterations (the obstacle sequence of body " +
+                       std::to_string(sequence + 1) +
+                       " reached its fixed point; the other body takes its contact force)";
+      break;
+    }
     if (const auto stop = monitor.check(record, result.message)) {
       result.status = *stop;
       break;
     }
-    obstacle1 = next1;
-    obstacle2 = next2;
+    iterate = next;
   }
   result.wall_seconds = seconds_between(run_start, Clock::now());
   result.coordinator_seconds = result.wall_seconds - port_seconds;

@@ -9,6 +9,9 @@
 //           or an accelerated update of the same map (CouplingOptions::acceleration).
 // Convergence: every scaled residual of IterationRecord below the tolerance. At the fixed point
 // lambda^1 = lambda^2, w = 0 and the state solves the monolithic problem (Prop. 3.2).
+// With stopping "either-sequence" (default) the run also stops when the complete state of one
+// obstacle sequence has all its residuals below the tolerance (coupling_scheme.hpp). The same
+// loop runs the other algorithms of coupling_scheme.hpp.
 
 #include <Eigen/Core>
 #include <functional>
@@ -41,7 +44,13 @@ struct IterationRecord {
   int qp_iterations1 = 0, qp_iterations2 = 0;
   double seconds = 0.0;            // wall time of the iteration
   std::string acceleration_state;  // e.g. "iqn-ils 4 columns", for progress lines
-  double largest() const;          // the largest residual
+  /// "robin": the largest residual of the complete state of each obstacle sequence
+  /// (coupling_scheme.hpp, "Completions"); empty for the other algorithms.
+  std::vector<double> sequence_residuals;
+  double largest() const;  // the largest residual of the joint state
+  /// What the stopping test compares with the tolerance: largest(), or with
+  /// `either_sequence` the smallest of largest() and the sequence residuals.
+  double progress(bool either_sequence) const;
 };
 
 enum class IterationStatus { converged, max_iterations, diverged, stagnated };
@@ -50,12 +59,16 @@ std::string to_string(IterationStatus status);
 struct RobinResult {
   IterationStatus status = IterationStatus::max_iterations;
   std::string message;  // why it stopped, for people
+  std::string algorithm;  // the scheme, e.g. "dirichlet-neumann (contact body 1)"
+  /// 0, or the obstacle sequence (1 or 2) whose complete state was accepted: then the fields
+  /// below hold that state (both contact forces equal, corrections zero).
   std::vector<IterationRecord> history;
   // The state of the last iteration (pair order).
   Eigen::VectorXd obstacle1, obstacle2;          // g used in the last contact solves
   Eigen::VectorXd normal_trace1, normal_trace2;  // u_N
   Eigen::VectorXd contact_force1, contact_force2;
   Eigen::VectorXd correction1, correction2;  // w_N
+  int completed_by_sequence = 0;
   double coordinator_seconds = 0.0;          // time in the coordinator's own computations
   /// Critical path of the bodies' compute: sum over iterations of max(contact1, contact2) +
   /// max(correction1, correction2), as reported by the bodies.
@@ -70,9 +83,15 @@ struct RobinResult {
 
 using IterationObserver = std::function<void(const IterationRecord&)>;
 
-/// Runs the iteration on two ports whose contact has been assigned (pair order of `gaps`).
-/// Throws PortError when a port fails (the message names server, body and step) and
-/// std::runtime_error when a contact solve does not converge.
+/// Runs the coupling algorithm of options.algorithm (coupling_scheme.hpp) on two ports whose
+/// contact has been assigned, with the pairs' initial gaps and boundary weights (pair order).
+/// Throws PortError when a port fails or a contact QP does not converge (the message names
+/// server, body and step), InputError for inconsistent options.
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
+                                const CouplingOptions& options,
+                                const IterationObserver& observer = {});
+/// The same with unit weights (enough for every algorithm but "robin-constant").
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd& gaps, const CouplingOptions& options,
                                 const IterationObserver& observer = {});

@@ -88,9 +88,23 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
   app.add_option("--relaxation2", settings.relaxation2, "relaxation delta of body 2's obstacle")
       ->check(open_interval(0.0, 2.0));
   app.add_option("--acceleration", settings.acceleration,
-                 "obstacle update: 'iqn-ils' (quasi-Newton, default), 'aitken' or 'none' (the "
-                 "paper's fixed relaxation)")
+                 "obstacle update: 'iqn-ils' (quasi-Newton), 'aitken' or 'none' (the "
+                 "paper's fixed relaxation); default from the case file (docs/case-format.md)")
       ->check(CLI::IsMember({"iqn-ils", "aitken", "none"}));
+  app.add_option("--algorithm", settings.algorithm,
+                 "coupling algorithm: 'robin' (the paper's Steklov-Poincare choice, default), "
+                 "'robin-constant' (needs --alpha), 'dirichlet-neumann' or 'neumann-neumann'")
+      ->check(CLI::IsMember({"robin", "robin-constant", "dirichlet-neumann", "neumann-neumann"}));
+  app.add_option("--alpha", settings.alpha,
+                 "'robin-constant': the constant alpha_S (length per pressure)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--contact-body", settings.contact_body,
+                 "'dirichlet-neumann': the body that solves the contact problem: 1, 2 or auto")
+      ->check(CLI::IsMember({"1", "2", "auto"}));
+  app.add_option("--stopping", settings.stopping,
+                 "'either-sequence' (default: stop when one obstacle sequence's complete state "
+                 "converged) or 'joint' (the paper's test on both)")
+      ->check(CLI::IsMember({"either-sequence", "joint"}));
   app.add_option("--tolerance", settings.tolerance, "tolerance on every scaled residual")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-iterations", settings.max_iterations, "iteration limit")
@@ -127,6 +141,10 @@ CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
   if (settings.relaxation1) options.relaxation1 = *settings.relaxation1;
   if (settings.relaxation2) options.relaxation2 = *settings.relaxation2;
   if (settings.acceleration) options.acceleration.method = *settings.acceleration;
+  if (settings.algorithm) options.algorithm = *settings.algorithm;
+  if (settings.alpha) options.alpha = *settings.alpha;
+  if (settings.contact_body) options.contact_body = *settings.contact_body;
+  if (settings.stopping) options.stopping = *settings.stopping;
   if (settings.tolerance) options.tolerance = *settings.tolerance;
   if (settings.max_iterations) options.max_iterations = *settings.max_iterations;
   if (settings.initial_obstacle) options.initial_obstacle = *settings.initial_obstacle;
@@ -148,13 +166,18 @@ std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level
 }
 
 std::string progress_line(const IterationRecord& record) {
+  std::string sequences;
+  if (record.sequence_residuals.size() == 2) {
+    sequences = fmt::format("; sequences {:.2e}/{:.2e}", record.sequence_residuals[0],
+                            record.sequence_residuals[1]);
+  }
   return fmt::format(
       "iteration {}: obstacle change {:.2e}, penetration {:.2e}, force balance {:.2e}, "
       "complementarity {:.2e}, correction {:.2e}; active {}/{}, QP iterations {}/{}, {:.3f} s; "
-      "{}",
+      "{}{}",
       record.iteration, record.obstacle_change, record.penetration, record.force_balance,
       record.complementarity, record.correction, record.active1, record.active2,
-      record.qp_iterations1, record.qp_iterations2, record.seconds, record.acceleration_state);
+      record.qp_iterations1, record.qp_iterations2, record.seconds, record.acceleration_state, sequences);
 }
 
 std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {

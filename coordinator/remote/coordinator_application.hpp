@@ -32,6 +32,10 @@ struct CoordinatorSettings {
   std::optional<double> relaxation;
   std::optional<double> relaxation1, relaxation2;
   std::optional<std::string> acceleration;  // "iqn-ils", "aitken" or "none"
+  std::optional<std::string> algorithm;     // coupling/coupling_scheme.hpp
+  std::optional<double> alpha;              // "robin-constant"
+  std::optional<std::string> contact_body;  // "dirichlet-neumann": "1", "2" or "auto"
+  std::optional<std::string> stopping;      // "either-sequence" or "joint"
   std::optional<double> tolerance;
   std::optional<int> max_iterations;
   std::optional<std::string> initial_obstacle;  // "gap" or "zero"

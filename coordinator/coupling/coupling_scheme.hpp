@@ -1,0 +1,89 @@
+#pragma once
+// The coordinator's algorithm family. A scheme turns the iterate x of one outer iteration into
+// the subdomain requests of that iteration and returns the fixed-point map H(x); the loop in
+// robin_iteration.cpp accelerates x -> H(x) and decides when to stop. Notation (pair order):
+// d the initial gaps, m the boundary weights, e^a = B^a K^a^-1 f^a, F^a = B^a K^a^-1 B^a'.
+//
+//   "robin"              paper (Q_m), the Steklov-Poincare choice. x = (g1, g2), both contact
+//                        solves, both correction solves w1_N = F1 (lambda2 - lambda1),
+//                        w2_N = F2 (lambda1 - lambda2);
+//                        H = (w2_N - u2_N + d, w1_N - u1_N + d).
+//   "robin-constant"     paper (6) with a constant alpha_S (Remark 1): the correction w^b_N is
+//                        replaced by alpha (lambda^a - lambda^b) / m (nodal forces turned into
+//                        pressures); no correction solves.
+//                        H = (alpha (lambda1 - lambda2)/m - u2_N + d,
+//                             alpha (lambda2 - lambda1)/m - u1_N + d).
+//   "dirichlet-neumann"  Bayada-Sabil-Sassi: x = g, the obstacle of the contact body D; D solves
+//                        its contact problem (lambda), then the Neumann body N is loaded by
+//                        lambda: u^N_N = e^N - F^N lambda; H = d - u^N_N. Sequential.
+//   "neumann-neumann"    Bayada-Sabil-Sassi: x = g1, the gap is split, g2 = d - g1; both
+//                        contact solves, then both Neumann corrections by the force jump
+//                        j = lambda1 - lambda2: w^a_N = F^a j; H = g1 + (w1_N + w2_N) / 4
+//                        (the classical quarter: exact in one step for identical bodies with
+//                        delta = 1).
+// Each fixed point solves the monolithic problem (docs/method.md). In the all-active regime
+// the error of the robin blocks is multiplied by I - delta (I + F2 F1^-1) and
+// I - delta (I + F1 F2^-1), that of dirichlet-neumann by I - delta (I + F^N (F^D)^-1).
+//
+// Completions ("robin" only): K2 u2 = f2 - B2' lambda1 has the trace u2_N - w2_N, so every
+// iteration also yields two complete candidate states, one per obstacle sequence:
+// (u1, lambda1; u2_N - w2_N, lambda1) and (u1_N - w1_N, lambda2; u2, lambda2). Either solves the
+// monolithic KKT system when its penetration and complementarity vanish (docs/method.md,
+// "Either sequence alone"); the loop may stop on the first that does.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coupling/case_file.hpp"
+#include "coupling/subdomain_port.hpp"
+
+namespace robin {
+
+/// The interface state of both bodies, pair order. Vectors a scheme does not produce are zero
+/// (corrections of "robin-constant") or, for a body without an obstacle (the Neumann body of
+/// "dirichlet-neumann"), the obstacle it implicitly sees, d - g.
+struct CouplingState {
+  Eigen::VectorXd obstacle1, obstacle2;          // g in the contact solves
+  Eigen::VectorXd normal_trace1, normal_trace2;  // u_N
+  Eigen::VectorXd contact_force1, contact_force2;
+  Eigen::VectorXd correction1, correction2;  // w_N
+};
+
+/// What one outer iteration produced.
+struct CouplingEvaluation {
+  Eigen::VectorXd mapped;  // H(x)
+  CouplingState state;
+  /// Candidate complete states (see the header comment), empty for most schemes; element k
+  /// belongs to obstacle sequence k.
+  std::vector<CouplingState> completions;
+  int active1 = 0, active2 = 0;  // closed pairs seen by each body's contact solve
+  int qp_iterations1 = 0, qp_iterations2 = 0;
+  /// Critical path of the bodies' compute in this iteration (parallel requests count once).
+  double critical_compute_seconds = 0.0;
+};
+
+class CouplingScheme {
+ public:
+  virtual ~CouplingScheme() = default;
+  /// Sizes of the independent blocks of x (accelerated per block).
+  virtual std::vector<int> block_sizes() const = 0;
+  /// For logs and summary.json, e.g. "dirichlet-neumann (contact body 2, Neumann body 1)".
+  virtual std::string describe() const = 0;
+  /// x_0 from the user's initial obstacle g_0 (per pair).
+  virtual Eigen::VectorXd initial_iterate(const Eigen::VectorXd& initial_obstacle) const = 0;
+  /// The subdomain requests of one iteration at x. Throws PortError when a port fails or a
+  /// contact QP does not converge.
+  virtual CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) = 0;
+};
+
+/// The scheme of options.algorithm on two ports whose contact has been assigned, with the
+/// pairs' initial gaps d and boundary weights m (needed by "robin-constant"). Throws InputError
+/// for an unknown algorithm or a missing alpha.
+std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
+                                                     SubdomainPort& body1, SubdomainPort& body2,
+                                                     const Eigen::VectorXd& gaps,
+                                                     const Eigen::VectorXd& weights);
+
+}  // namespace robin
