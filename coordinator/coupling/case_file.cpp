@@ -16,13 +16,27 @@ const std::vector<std::string> root_keys{"title", "gap", "solver", "coupling", "
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
     "qp_tolerance", "qp_max_iterations", "interface_operator", "dense_limit", "pairing_tolerance"};
-const std::vector<std::string> coupling_keys{
-    "relaxation",      "tolerance",         "max_iterations",    "initial_obstacle",
-    "request_timeout", "divergence_factor", "stagnation_window", "acceleration",
-    "relaxation1",     "relaxation2",       "aitken_initial",    "aitken_minimum",
-    "aitken_maximum",  "history_depth",     "filter_threshold",  "safeguard_growth",
-    "per_body",        "algorithm",         "alpha",             "contact_body",
-    "stopping"};
+const std::vector<std::string> coupling_keys{"relaxation",
+                                             "tolerance",
+                                             "max_iterations",
+                                             "initial_obstacle",
+                                             "request_timeout",
+                                             "divergence_factor",
+                                             "stagnation_window",
+                                             "acceleration",
+                                             "relaxation1",
+                                             "relaxation2",
+                                             "aitken_initial",
+                                             "aitken_minimum",
+                                             "aitken_maximum",
+                                             "history_depth",
+                                             "filter_threshold",
+                                             "safeguard_growth",
+                                             "per_body",
+                                             "algorithm",
+                                             "alpha",
+                                             "contact_body",
+                                             "stopping"};
 
 toml::table parse_toml(const std::filesystem::path& path, const std::string& label) {
   std::error_code error;
@@ -147,13 +161,14 @@ void read_algorithm(const CheckedTable& table, CouplingOptions& coupling) {
                            .value_or(coupling.algorithm);
   coupling.alpha = number_above(table, "alpha", 0.0, coupling.alpha);
   if (coupling.algorithm == "robin-constant" && !(coupling.alpha > 0.0)) {
-    table.fail("algorithm", "\"robin-constant\" needs coupling.alpha > 0 (the constant alpha_S, "
-                            "length per pressure)");
+    table.fail("algorithm",
+               "\"robin-constant\" needs coupling.alpha > 0 (the constant alpha_S, "
+               "length per pressure)");
   }
-  coupling.contact_body = table.optional_choice("contact_body", {"1", "2", "auto"})
-                              .value_or(coupling.contact_body);
-  coupling.stopping = table.optional_choice("stopping", {"either-sequence", "joint"})
-                          .value_or(coupling.stopping);
+  coupling.contact_body =
+      table.optional_choice("contact_body", {"1", "2", "auto"}).value_or(coupling.contact_body);
+  coupling.stopping =
+      table.optional_choice("stopping", {"either-sequence", "joint"}).value_or(coupling.stopping);
 }
 
 void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {

@@ -138,8 +138,8 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
     const bool fixed2 = normal_is_prescribed(body2.x_fixed[j], body2.y_fixed[j], pair.normal);
     if (fixed1 || fixed2) {
       pairing.excluded.push_back(
-          describe_node(fixed1 ? name1 : name2,
-                        fixed1 ? body1.node_tags[i] : body2.node_tags[j], point) +
+          describe_node(fixed1 ? name1 : name2, fixed1 ? body1.node_tags[i] : body2.node_tags[j],
+                        point) +
           ": normal displacement prescribed by a Dirichlet condition; pair excluded from contact");
       continue;
     }
@@ -147,9 +147,9 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
   }
   for (std::size_t j = 0; j < body2.node_ids.size(); ++j) {
     if (partner_of_second[j] < 0) {
-      throw InputError("contact pairing: " +
-                       describe_node(name2, body2.node_tags[j], body2.coordinates[j]) +
-                       " has no matching node on body '" + name1 + "'");
+      throw InputError(
+          "contact pairing: " + describe_node(name2, body2.node_tags[j], body2.coordinates[j]) +
+          " has no matching node on body '" + name1 + "'");
     }
   }
   order_along_zone(pairing.pairs);

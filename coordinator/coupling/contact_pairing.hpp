@@ -16,8 +16,8 @@
 namespace robin {
 
 struct ContactPair {
-  int node1 = -1;  // mesh node index in body 1
-  int node2 = -1;  // mesh node index in body 2
+  int node1 = -1;                                      // mesh node index in body 1
+  int node2 = -1;                                      // mesh node index in body 2
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // body-1 node
   Eigen::Vector2d normal = Eigen::Vector2d::Zero();    // n1 (unit, outward from body 1)
   double gap = 0.0;                                    // d_i (length)

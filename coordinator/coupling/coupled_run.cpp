@@ -46,7 +46,8 @@ auto on_both_ports(const std::array<SubdomainPort*, 2>& ports, Request request) 
   return std::array<decltype(first), 2>{std::move(first), std::move(other)};
 }
 
-void write_history_csv(const std::filesystem::path& path, const std::vector<IterationRecord>& history) {
+void write_history_csv(const std::filesystem::path& path,
+                       const std::vector<IterationRecord>& history) {
   std::ofstream file(path);
   if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
   file << std::setprecision(std::numeric_limits<double>::max_digits10);
@@ -93,7 +94,8 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   summary["relaxation"] = result.options.relaxation;
   summary["tolerance"] = result.options.tolerance;
   summary["initial_obstacle"] = result.options.initial_obstacle;
-  if (!iteration.history.empty()) summary["final_residuals"] = residuals_json(iteration.history.back());
+  if (!iteration.history.empty())
+    summary["final_residuals"] = residuals_json(iteration.history.back());
   summary["contact_pairs"] = result.pairing.size();
   summary["excluded_pairs"] = result.pairing.excluded;
   summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
@@ -151,13 +153,13 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   report_stage(observer, std::to_string(result.pairing.size()) + " contact pairs (" +
                              std::to_string(result.pairing.excluded.size()) + " excluded)");
   for (const std::string& line : result.pairing.excluded) report_stage(observer, line);
-  for (int alpha = 0; alpha < 2; ++alpha) ports[alpha]->assign_contact(result.pairing.assignment(alpha));
+  for (int alpha = 0; alpha < 2; ++alpha)
+    ports[alpha]->assign_contact(result.pairing.assignment(alpha));
   result.setup_seconds = seconds_since(start);
 
   const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
   result.iteration =
-      run_robin_iteration(*ports[0], *ports[1], result.pairing.gaps(),
-                          result.pairing.weights(), options, observer.iteration);
+      run_robin_iteration(*ports[0], *ports[1], result.pairing, options, observer.iteration);
   for (int alpha = 0; alpha < 2; ++alpha) {
     result.iteration_port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
   }
@@ -189,10 +191,14 @@ void write_coupled_outputs(const std::filesystem::path& directory, const CaseDef
 
 int exit_code(IterationStatus status) {
   switch (status) {
-    case IterationStatus::converged: return 0;
-    case IterationStatus::max_iterations: return 3;
-    case IterationStatus::diverged: return 4;
-    case IterationStatus::stagnated: return 5;
+    case IterationStatus::converged:
+      return 0;
+    case IterationStatus::max_iterations:
+      return 3;
+    case IterationStatus::diverged:
+      return 4;
+    case IterationStatus::stagnated:
+      return 5;
   }
   return 1;
 }

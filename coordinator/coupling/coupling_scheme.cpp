@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <numeric>
+
+#include <Eigen/Eigenvalues>
 
 #include "numerics/errors.hpp"
 
@@ -64,11 +67,14 @@ class RobinScheme final : public CouplingScheme {
         constant_alpha_(constant_alpha) {}
 
   std::vector<int> block_sizes() const override {
-    return {static_cast<int>(gaps_.size()), static_cast<int>(gaps_.size())};
+    const int size = static_cast<int>(gaps_.size());
+    if (constant_alpha_ > 0.0) return {2 * size};  // H^1 depends on g^2 through lambda^2
+    return {size, size};
   }
   std::string describe() const override {
-    return constant_alpha_ > 0.0 ? "robin-constant (alpha = " + std::to_string(constant_alpha_) + ")"
-                                 : std::string("robin");
+    return constant_alpha_ > 0.0
+               ? "robin-constant (alpha = " + std::to_string(constant_alpha_) + ")"
+               : std::string("robin");
   }
   Eigen::VectorXd initial_iterate(const Eigen::VectorXd& initial_obstacle) const override {
     Eigen::VectorXd iterate(2 * gaps_.size());
@@ -82,7 +88,8 @@ class RobinScheme final : public CouplingScheme {
     CouplingState& state = evaluation.state;
     state.obstacle1 = iterate.head(size);
     state.obstacle2 = iterate.tail(size);
-    const auto contact = contact_solves(body1_, body2_, state.obstacle1, state.obstacle2, iteration);
+    const auto contact =
+        contact_solves(body1_, body2_, state.obstacle1, state.obstacle2, iteration);
     record_contact(evaluation, contact[0], contact[1]);
     state.normal_trace1 = contact[0].normal_trace;
     state.normal_trace2 = contact[1].normal_trace;
@@ -98,8 +105,7 @@ class RobinScheme final : public CouplingScheme {
       const auto correction = correction_solves(body1_, body2_, imbalance, -imbalance, iteration);
       state.correction1 = correction[0].normal_trace;
       state.correction2 = correction[1].normal_trace;
-      evaluation.critical_compute_seconds +=
-          std::max(correction[0].seconds, correction[1].seconds);
+      evaluation.critical_compute_seconds += std::max(correction[0].seconds, correction[1].seconds);
       evaluation.completions = {completion(state, 1), completion(state, 2)};
     }
     // Step 3's map: H = (w2_N - u2_N + d, w1_N - u1_N + d).
@@ -145,6 +151,7 @@ class DirichletNeumannScheme final : public CouplingScheme {
         contact_body_(contact_body) {}
 
   std::vector<int> block_sizes() const override { return {static_cast<int>(gaps_.size())}; }
+  bool shares_contact_force() const override { return true; }
   std::string describe() const override {
     return "dirichlet-neumann (contact body " + std::to_string(contact_body_ + 1) +
            ", Neumann body " + std::to_string(2 - contact_body_) + ")";
@@ -206,7 +213,8 @@ class NeumannNeumannScheme final : public CouplingScheme {
     CouplingState& state = evaluation.state;
     state.obstacle1 = iterate;
     state.obstacle2 = gaps_ - iterate;
-    const auto contact = contact_solves(body1_, body2_, state.obstacle1, state.obstacle2, iteration);
+    const auto contact =
+        contact_solves(body1_, body2_, state.obstacle1, state.obstacle2, iteration);
     record_contact(evaluation, contact[0], contact[1]);
     state.normal_trace1 = contact[0].normal_trace;
     state.normal_trace2 = contact[1].normal_trace;
@@ -228,22 +236,46 @@ class NeumannNeumannScheme final : public CouplingScheme {
   const Eigen::VectorXd gaps_;
 };
 
-/// "auto": the more compliant body takes the obstacle (its sequence is the well-conditioned
-/// one, docs/method.md). Compliance measured as m' F^a m, the normal displacement work of a
-/// uniform unit pressure: one correction solve per body.
-int more_compliant_body(SubdomainPort& body1, SubdomainPort& body2, const Eigen::VectorXd& weights) {
-  const auto response = correction_solves(body1, body2, weights, weights, 0);
-  const double compliance1 = weights.dot(response[0].normal_trace);
-  const double compliance2 = weights.dot(response[1].normal_trace);
+/// "auto": the body that is more compliant at short wavelengths takes the obstacle.
+int more_compliant_body(SubdomainPort& body1, SubdomainPort& body2,
+                        const Eigen::VectorXd& probe_forces) {
+  const auto response = correction_solves(body1, body2, probe_forces, probe_forces, 0);
+  const double compliance1 = probe_forces.dot(response[0].normal_trace);
+  const double compliance2 = probe_forces.dot(response[1].normal_trace);
   return compliance1 >= compliance2 ? 0 : 1;
 }
 
 }  // namespace
 
+Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing) {
+  const std::size_t size = pairing.size();
+  Eigen::VectorXd forces = pairing.weights();
+  if (size < 2) return forces;
+  // Principal direction t of the pair positions; the pairs ranked by t . x alternate in sign.
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const ContactPair& pair : pairing.pairs) mean += pair.position / static_cast<double>(size);
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const ContactPair& pair : pairing.pairs) {
+    scatter += (pair.position - mean) * (pair.position - mean).transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+  const Eigen::Vector2d direction = eigen.eigenvectors().col(1);  // largest eigenvalue
+  std::vector<std::size_t> order(size);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return direction.dot(pairing.pairs[a].position) < direction.dot(pairing.pairs[b].position);
+  });
+  for (std::size_t rank = 1; rank < size; rank += 2) {
+    forces[static_cast<Eigen::Index>(order[rank])] *= -1.0;
+  }
+  return forces;
+}
+
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
                                                      SubdomainPort& body1, SubdomainPort& body2,
                                                      const Eigen::VectorXd& gaps,
-                                                     const Eigen::VectorXd& weights) {
+                                                     const Eigen::VectorXd& weights,
+                                                     const Eigen::VectorXd& probe_forces) {
   if (options.algorithm == "robin") {
     return std::make_unique<RobinScheme>(body1, body2, gaps, weights, 0.0);
   }
@@ -252,22 +284,25 @@ std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& opti
       throw InputError("coupling.alpha must be > 0 for the algorithm \"robin-constant\"");
     }
     if (weights.size() != gaps.size() || (weights.array() <= 0.0).any()) {
-      throw InputError("the algorithm \"robin-constant\" needs a positive boundary weight per pair");
+      throw InputError(
+          "the algorithm \"robin-constant\" needs a positive boundary weight per pair");
     }
     return std::make_unique<RobinScheme>(body1, body2, gaps, weights, options.alpha);
   }
   if (options.algorithm == "dirichlet-neumann") {
-    const int contact_body = options.contact_body == "1"   ? 0
-                             : options.contact_body == "2" ? 1
-                                                           : more_compliant_body(body1, body2, weights);
+    const int contact_body = options.contact_body == "1" ? 0
+                             : options.contact_body == "2"
+                                 ? 1
+                                 : more_compliant_body(body1, body2, probe_forces);
     return std::make_unique<DirichletNeumannScheme>(body1, body2, gaps, contact_body);
   }
   if (options.algorithm == "neumann-neumann") {
     return std::make_unique<NeumannNeumannScheme>(body1, body2, gaps);
   }
-  throw InputError("coupling.algorithm must be \"robin\", \"robin-constant\", "
-                   "\"dirichlet-neumann\" or \"neumann-neumann\", got \"" +
-                   options.algorithm + "\"");
+  throw InputError(
+      "coupling.algorithm must be \"robin\", \"robin-constant\", "
+      "\"dirichlet-neumann\" or \"neumann-neumann\", got \"" +
+      options.algorithm + "\"");
 }
 
 }  // namespace robin

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "coupling/case_file.hpp"
+#include "coupling/contact_pairing.hpp"
 #include "coupling/subdomain_port.hpp"
 
 namespace robin {
@@ -67,8 +68,12 @@ struct CouplingEvaluation {
 class CouplingScheme {
  public:
   virtual ~CouplingScheme() = default;
-  /// Sizes of the independent blocks of x (accelerated per block).
+  /// Sizes of the independent blocks of x (accelerated per block). "robin-constant" has one
+  /// block of both obstacles: its map couples g1 and g2.
   virtual std::vector<int> block_sizes() const = 0;
+  /// True when both bodies carry the same contact force by construction ("dirichlet-neumann"):
+  /// the loop then reports the force change between iterations as the force balance.
+  virtual bool shares_contact_force() const { return false; }
   /// For logs and summary.json, e.g. "dirichlet-neumann (contact body 2, Neumann body 1)".
   virtual std::string describe() const = 0;
   /// x_0 from the user's initial obstacle g_0 (per pair).
@@ -78,12 +83,22 @@ class CouplingScheme {
   virtual CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) = 0;
 };
 
+/// Nodal forces r_i = +-m_i whose sign alternates from pair to pair along the contact zone
+/// (pairs ranked along the principal direction of their positions): the shortest wavelength
+/// the mesh carries.
+Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing);
+
 /// The scheme of options.algorithm on two ports whose contact has been assigned, with the
-/// pairs' initial gaps d and boundary weights m (needed by "robin-constant"). Throws InputError
-/// for an unknown algorithm or a missing alpha.
+/// pairs' initial gaps d, boundary weights m (needed by "robin-constant") and a short-wavelength
+/// probe (for "dirichlet-neumann" with contact_body "auto": the body with the larger r'F^a r,
+/// one correction solve each, takes the obstacle; its sequence is the well-conditioned one,
+/// the error being multiplied by I - delta (I + F^N (F^D)^-1). Short wavelengths decide, as the
+/// few smooth modes, such as a cantilever's bending, are absorbed by the accelerator.)
+/// Throws InputError for an unknown algorithm or a missing alpha.
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
                                                      SubdomainPort& body1, SubdomainPort& body2,
                                                      const Eigen::VectorXd& gaps,
-                                                     const Eigen::VectorXd& weights);
+                                                     const Eigen::VectorXd& weights,
+                                                     const Eigen::VectorXd& probe_forces);
 
 }  // namespace robin

@@ -28,7 +28,9 @@ void InProcessPort::start_contact_solve(const Eigen::VectorXd& obstacle, int /*i
   timings_.round_trip_seconds += contact_result_.seconds;
 }
 
-ContactSolveResult InProcessPort::finish_contact_solve() { return contact_result_; }
+ContactSolveResult InProcessPort::finish_contact_solve() {
+  return contact_result_;
+}
 
 void InProcessPort::start_correction(const Eigen::VectorXd& interface_force, int /*iteration*/) {
   const auto start = std::chrono::steady_clock::now();
@@ -39,7 +41,9 @@ void InProcessPort::start_correction(const Eigen::VectorXd& interface_force, int
   timings_.round_trip_seconds += correction_result_.seconds;
 }
 
-CorrectionSolveResult InProcessPort::finish_correction() { return correction_result_; }
+CorrectionSolveResult InProcessPort::finish_correction() {
+  return correction_result_;
+}
 
 void InProcessPort::start_neumann_solve(const Eigen::VectorXd& contact_force, int /*iteration*/) {
   const auto start = std::chrono::steady_clock::now();
@@ -50,12 +54,16 @@ void InProcessPort::start_neumann_solve(const Eigen::VectorXd& contact_force, in
   timings_.round_trip_seconds += neumann_result_.seconds;
 }
 
-CorrectionSolveResult InProcessPort::finish_neumann_solve() { return neumann_result_; }
+CorrectionSolveResult InProcessPort::finish_neumann_solve() {
+  return neumann_result_;
+}
 
 BodyOutput InProcessPort::fields(const Eigen::VectorXd& contact_force) {
   return make_body_output(body(), contact_force);
 }
 
-void InProcessPort::end_run() noexcept { body_.reset(); }
+void InProcessPort::end_run() noexcept {
+  body_.reset();
+}
 
 }  // namespace robin

@@ -34,12 +34,11 @@ double maximum_absolute(const Eigen::VectorXd& values) {
 }  // namespace
 
 InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::VectorXd& trace1,
-                                       const Eigen::VectorXd& trace2,
-                                       const Eigen::VectorXd& force1,
+                                       const Eigen::VectorXd& trace2, const Eigen::VectorXd& force1,
                                        const Eigen::VectorXd& force2) {
   constexpr double tiny = std::numeric_limits<double>::min();
-  const double displacement_scale = std::max(
-      {maximum_absolute(gap), maximum_absolute(trace1), maximum_absolute(trace2), tiny});
+  const double displacement_scale =
+      std::max({maximum_absolute(gap), maximum_absolute(trace1), maximum_absolute(trace2), tiny});
   const double force_scale = std::max({maximum_absolute(force1), maximum_absolute(force2), tiny});
   InterfaceResiduals residuals;
   for (Eigen::Index i = 0; i < gap.size(); ++i) {
@@ -56,12 +55,13 @@ InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::
 }
 
 MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& body2,
-                                  const ContactPairing& pairing, const MprgpParameters& parameters) {
+                                  const ContactPairing& pairing,
+                                  const MprgpParameters& parameters) {
   const auto start = std::chrono::steady_clock::now();
   const Eigen::Index size = static_cast<Eigen::Index>(pairing.size());
   if (body1.contact_size() != size || body2.contact_size() != size) {
-    throw InputError("monolithic solve: both bodies must be assigned the " +
-                     std::to_string(size) + " contact pairs first");
+    throw InputError("monolithic solve: both bodies must be assigned the " + std::to_string(size) +
+                     " contact pairs first");
   }
   const Eigen::VectorXd gap = pairing.gaps();
   // minimise 1/2 l'(F1 + F2) l - l'(e1 + e2 - d), l >= 0

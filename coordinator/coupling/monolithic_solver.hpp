@@ -13,9 +13,10 @@ namespace robin {
 
 /// Scaled residuals of a two-body contact state; see docs/case-format.md "Residuals".
 struct InterfaceResiduals {
-  double penetration = 0.0;      // max(0, u1_N + u2_N - d) / displacement scale
-  double force_balance = 0.0;    // max |lambda1 - lambda2| / force scale
-  double complementarity = 0.0;  // max |lambda_i (d - u1_N - u2_N)_i| / (force scale * displacement scale)
+  double penetration = 0.0;    // max(0, u1_N + u2_N - d) / displacement scale
+  double force_balance = 0.0;  // max |lambda1 - lambda2| / force scale
+  double complementarity =
+      0.0;  // max |lambda_i (d - u1_N - u2_N)_i| / (force scale * displacement scale)
 };
 
 struct MonolithicResult {
@@ -34,8 +35,7 @@ MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& bod
 /// Residuals of (u1_N, u2_N, lambda1, lambda2) against the gaps d. Displacement scale:
 /// max(max|d|, max|u1_N|, max|u2_N|, tiny); force scale: max(max lambda, tiny).
 InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::VectorXd& trace1,
-                                       const Eigen::VectorXd& trace2,
-                                       const Eigen::VectorXd& force1,
+                                       const Eigen::VectorXd& trace2, const Eigen::VectorXd& force1,
                                        const Eigen::VectorXd& force2);
 
 }  // namespace robin

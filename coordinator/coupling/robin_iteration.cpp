@@ -89,9 +89,8 @@ IterationRecord residual_record(int iteration, const Eigen::VectorXd& gaps,
                                 const CouplingState& state) {
   IterationRecord record;
   record.iteration = iteration;
-  const InterfaceResiduals residuals =
-      interface_residuals(gaps, state.normal_trace1, state.normal_trace2, state.contact_force1,
-                          state.contact_force2);
+  const InterfaceResiduals residuals = interface_residuals(
+      gaps, state.normal_trace1, state.normal_trace2, state.contact_force1, state.contact_force2);
   const double displacement_scale =
       std::max({maximum_absolute(gaps), maximum_absolute(state.normal_trace1),
                 maximum_absolute(state.normal_trace2), maximum_absolute(state.correction1),
@@ -99,9 +98,9 @@ IterationRecord residual_record(int iteration, const Eigen::VectorXd& gaps,
   record.penetration = residuals.penetration;
   record.force_balance = residuals.force_balance;
   record.complementarity = residuals.complementarity;
-  record.correction = std::max(maximum_absolute(state.correction1),
-                               maximum_absolute(state.correction2)) /
-                      displacement_scale;
+  record.correction =
+      std::max(maximum_absolute(state.correction1), maximum_absolute(state.correction2)) /
+      displacement_scale;
   return record;
 }
 
@@ -110,26 +109,30 @@ IterationRecord residual_record(int iteration, const Eigen::VectorXd& gaps,
 struct ObstacleChange {
   std::vector<double> per_block;
   double scale = 0.0;
-  double relative() const {
-    return *std::max_element(per_block.begin(), per_block.end()) / scale;
-  }
+  double relative() const { return *std::max_element(per_block.begin(), per_block.end()) / scale; }
 };
 
 ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::VectorXd& next,
                                const std::vector<int>& block_sizes, const Eigen::VectorXd& gaps,
                                const CouplingState& state) {
   ObstacleChange change;
-  change.scale = std::max({maximum_absolute(next), maximum_absolute(gaps),
-                           maximum_absolute(state.normal_trace1),
-                           maximum_absolute(state.normal_trace2),
-                           std::numeric_limits<double>::min()});
+  change.scale = std::max(
+      {maximum_absolute(next), maximum_absolute(gaps), maximum_absolute(state.normal_trace1),
+       maximum_absolute(state.normal_trace2), std::numeric_limits<double>::min()});
   Eigen::Index offset = 0;
   for (const int size : block_sizes) {
-    change.per_block.push_back(maximum_absolute(next.segment(offset, size) -
-                                                iterate.segment(offset, size)));
+    change.per_block.push_back(
+        maximum_absolute(next.segment(offset, size) - iterate.segment(offset, size)));
     offset += size;
   }
   return change;
+}
+
+/// |lambda_k - lambda_{k-1}| / |lambda_k| (max norms); 1 without a previous value.
+double relative_change(const Eigen::VectorXd& force, const Eigen::VectorXd& previous_force) {
+  if (previous_force.size() != force.size()) return 1.0;  // no previous value: all changed
+  return maximum_absolute(force - previous_force) /
+         std::max(maximum_absolute(force), std::numeric_limits<double>::min());
 }
 
 /// The largest residual of the complete state of obstacle sequence k: its penetration and
@@ -142,11 +145,7 @@ double completion_residual(const CouplingState& completion, const Eigen::VectorX
                            double block_change, const Eigen::VectorXd& force,
                            const Eigen::VectorXd& previous_force) {
   const IterationRecord record = residual_record(0, gaps, completion);
-  const double force_change =
-      previous_force.size() != force.size()
-          ? std::numeric_limits<double>::infinity()
-          : maximum_absolute(force - previous_force) /
-                std::max(maximum_absolute(force), std::numeric_limits<double>::min());
+  const double force_change = relative_change(force, previous_force);
   return std::max({record.penetration, record.complementarity, record.force_balance,
                    record.correction, block_change, force_change});
 }
@@ -189,6 +188,12 @@ std::string to_string(IterationStatus status) {
   return "unknown";
 }
 
+/// The loop behind every run_robin_iteration overload.
+RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
+                              const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
+                              const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
+                              const IterationObserver& observer);
+
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd& gaps, const CouplingOptions& options,
                                 const IterationObserver& observer) {
@@ -197,13 +202,29 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
 }
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const ContactPairing& pairing, const CouplingOptions& options,
+                                const IterationObserver& observer) {
+  return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
+                           short_wavelength_forces(pairing), options, observer);
+}
+
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                                 const CouplingOptions& options, const IterationObserver& observer) {
+  Eigen::VectorXd probe = weights;  // without positions: alternate in pair order
+  for (Eigen::Index i = 1; i < probe.size(); i += 2) probe[i] = -probe[i];
+  return run_coupling_loop(body1, body2, gaps, weights, probe, options, observer);
+}
+
+RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
+                              const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
+                              const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
+                              const IterationObserver& observer) {
   const auto run_start = Clock::now();
   double port_seconds = 0.0;
   const auto setup_start = Clock::now();
   const std::unique_ptr<CouplingScheme> scheme =
-      make_coupling_scheme(options, body1, body2, gaps, weights);
+      make_coupling_scheme(options, body1, body2, gaps, weights, probe_forces);
   port_seconds += seconds_between(setup_start, Clock::now());
   const std::vector<int> block_sizes = scheme->block_sizes();
   const std::unique_ptr<Acceleration> acceleration =
@@ -230,6 +251,9 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
     const ObstacleChange change =
         obstacle_change(iterate, next, block_sizes, gaps, evaluation.state);
     IterationRecord record = residual_record(iteration, gaps, evaluation.state);
+    if (scheme->shares_contact_force()) {
+      record.force_balance = relative_change(evaluation.state.contact_force1, previous_forces[0]);
+    }
     record.obstacle_change = change.relative();
     record.obstacle_step = change.relative() * change.scale;
     record.active1 = evaluation.active1;
@@ -239,9 +263,9 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
     const std::array<const Eigen::VectorXd*, 2> forces{&evaluation.state.contact_force1,
                                                        &evaluation.state.contact_force2};
     for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
-      record.sequence_residuals.push_back(
-          completion_residual(evaluation.completions[k], gaps, change.per_block[k] / change.scale,
-                              *forces[k], previous_forces[k]));
+      record.sequence_residuals.push_back(completion_residual(evaluation.completions[k], gaps,
+                                                              change.per_block[k] / change.scale,
+                                                              *forces[k], previous_forces[k]));
     }
     previous_forces = {*forces[0], *forces[1]};
     record.acceleration_state = acceleration->state();

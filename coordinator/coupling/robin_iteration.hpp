@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "coupling/case_file.hpp"
+#include "coupling/contact_pairing.hpp"
 #include "coupling/subdomain_port.hpp"
 
 namespace robin {
@@ -37,7 +38,8 @@ struct IterationRecord {
   double obstacle_change = 0.0;  // |g_new - g_old| / max(|g_new|, D), both bodies, max norm
   double obstacle_step = 0.0;    // |g_new - g_old| (length), unscaled: watched for divergence
   double penetration = 0.0;      // max(0, u1_N + u2_N - d) / D
-  double force_balance = 0.0;    // |lambda1 - lambda2| / F
+  double force_balance = 0.0;    // |lambda1 - lambda2| / F (for "dirichlet-neumann", whose
+                                 // bodies share lambda: |lambda_k - lambda_{k-1}| / F)
   double complementarity = 0.0;  // |lambda (d - u1_N - u2_N)| / (F D), lambda = mean
   double correction = 0.0;       // max(|w1_N|, |w2_N|) / D
   int active1 = 0, active2 = 0;  // closed pairs seen by each body
@@ -58,7 +60,7 @@ std::string to_string(IterationStatus status);
 
 struct RobinResult {
   IterationStatus status = IterationStatus::max_iterations;
-  std::string message;  // why it stopped, for people
+  std::string message;    // why it stopped, for people
   std::string algorithm;  // the scheme, e.g. "dirichlet-neumann (contact body 1)"
   /// 0, or the obstacle sequence (1 or 2) whose complete state was accepted: then the fields
   /// below hold that state (both contact forces equal, corrections zero).
@@ -69,7 +71,7 @@ struct RobinResult {
   Eigen::VectorXd contact_force1, contact_force2;
   Eigen::VectorXd correction1, correction2;  // w_N
   int completed_by_sequence = 0;
-  double coordinator_seconds = 0.0;          // time in the coordinator's own computations
+  double coordinator_seconds = 0.0;  // time in the coordinator's own computations
   /// Critical path of the bodies' compute: sum over iterations of max(contact1, contact2) +
   /// max(correction1, correction2), as reported by the bodies.
   double critical_compute_seconds = 0.0;
@@ -90,6 +92,10 @@ using IterationObserver = std::function<void(const IterationRecord&)>;
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                                 const CouplingOptions& options,
+                                const IterationObserver& observer = {});
+/// The same for a pairing (gaps, weights and the probe of short_wavelength_forces).
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const ContactPairing& pairing, const CouplingOptions& options,
                                 const IterationObserver& observer = {});
 /// The same with unit weights (enough for every algorithm but "robin-constant").
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,

@@ -31,8 +31,8 @@ struct CorrectionSolveResult {
 
 /// Time spent by a port, for the summary's split of the wall time.
 struct PortTimings {
-  double compute_seconds = 0.0;    // reported by the body (server compute)
-  double round_trip_seconds = 0.0; // request sent to reply decoded (remote); = compute in process
+  double compute_seconds = 0.0;     // reported by the body (server compute)
+  double round_trip_seconds = 0.0;  // request sent to reply decoded (remote); = compute in process
   long bytes_sent = 0;
   long bytes_received = 0;
 };

@@ -177,7 +177,8 @@ std::string progress_line(const IterationRecord& record) {
       "{}{}",
       record.iteration, record.obstacle_change, record.penetration, record.force_balance,
       record.complementarity, record.correction, record.active1, record.active2,
-      record.qp_iterations1, record.qp_iterations2, record.seconds, record.acceleration_state, sequences);
+      record.qp_iterations1, record.qp_iterations2, record.seconds, record.acceleration_state,
+      sequences);
 }
 
 std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {

@@ -1,0 +1,93 @@
+// The coordinator's algorithm family (coupling/coupling_scheme.hpp) on in-process ports: every
+// algorithm converges to the monolithic reference (contact forces and normal traces to 1e-7
+// relative) on two shipped cases, and the iteration counts are recorded in the test log. The
+// same algorithms over real servers are tested in tests/integration.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "coupling/coupled_run.hpp"
+#include "coupling/in_process_port.hpp"
+#include "coupling/local_problem.hpp"
+#include "coupling/monolithic_solver.hpp"
+
+namespace robin {
+namespace {
+
+CaseDefinition example(const std::string& name) {
+  return read_case_file(std::filesystem::path(ROBIN_EXAMPLES) / name);
+}
+
+double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& reference) {
+  return (value - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>();
+}
+
+MonolithicResult monolithic_reference(const CaseDefinition& definition) {
+  const LocalProblem reference = prepare_local_problem(definition);
+  return solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing,
+                          definition.solver.qp);
+}
+
+/// Runs `case_name` with `options` changed by `configure` and checks the answer against the
+/// monolithic reference; returns the run for further checks.
+template <typename Configure>
+CoupledRunResult expect_monolithic_answer(const std::string& case_name, Configure configure) {
+  const CaseDefinition definition = example(case_name);
+  CouplingOptions options = definition.coupling;
+  options.tolerance = 1e-8;
+  options.max_iterations = 3000;
+  configure(options);
+  InProcessPort port1, port2;
+  const CoupledRunResult run = run_coupled_case(definition, {&port1, &port2}, options);
+  const RobinResult& state = run.iteration;
+  std::printf("%s: %s, acceleration %s: %s after %zu iterations\n", case_name.c_str(),
+              state.algorithm.c_str(), options.acceleration.method.c_str(),
+              to_string(state.status).c_str(), state.history.size());
+  EXPECT_EQ(state.status, IterationStatus::converged) << state.message;
+  if (state.status != IterationStatus::converged) return run;
+  const MonolithicResult monolithic = monolithic_reference(definition);
+  EXPECT_LE(relative_difference(state.contact_force1, monolithic.contact_force), 1e-7);
+  EXPECT_LE(relative_difference(state.contact_force2, monolithic.contact_force), 1e-7);
+  EXPECT_LE(relative_difference(state.normal_trace1, monolithic.normal_trace1), 1e-7);
+  EXPECT_LE(relative_difference(state.normal_trace2, monolithic.normal_trace2), 1e-7);
+  return run;
+}
+
+const char* const cases[] = {"two_blocks_partial.toml", "asymmetric.toml"};
+
+TEST(AlgorithmFamily, DirichletNeumannWithEitherContactBody) {
+  for (const char* case_name : cases) {
+    for (const char* contact_body : {"1", "2", "auto"}) {
+      expect_monolithic_answer(case_name, [&](CouplingOptions& options) {
+        options.algorithm = "dirichlet-neumann";
+        options.contact_body = contact_body;
+        options.acceleration.method = "iqn-ils";
+      });
+    }
+  }
+}
+
+TEST(AlgorithmFamily, NeumannNeumann) {
+  for (const char* case_name : cases) {
+    expect_monolithic_answer(case_name, [](CouplingOptions& options) {
+      options.algorithm = "neumann-neumann";
+      options.acceleration.method = "iqn-ils";
+    });
+  }
+}
+
+TEST(AlgorithmFamily, RobinWithConstantAlpha) {
+  for (const char* case_name : cases) {
+    for (const double alpha : {3e-5, 1e-4}) {
+      expect_monolithic_answer(case_name, [&](CouplingOptions& options) {
+        options.algorithm = "robin-constant";
+        options.acceleration.method = "iqn-ils";
+        options.alpha = alpha;
+      });
+    }
+  }
+}
+
+}  // namespace
+}  // namespace robin
