@@ -5,6 +5,7 @@
 namespace robin::protocol {
 
 inline constexpr unsigned protocol_major = 1;
-inline constexpr unsigned protocol_minor = 0;
+/// 1.1 adds NeumannSolveRequest (optional, capability "neumann_solve").
+inline constexpr unsigned protocol_minor = 1;
 
 }  // namespace robin::protocol

@@ -160,6 +160,13 @@ Envelope correction_request(const Eigen::VectorXd& force) {
   return envelope;
 }
 
+Envelope neumann_solve_request(const Eigen::VectorXd& force) {
+  Envelope envelope;
+  envelope.mutable_neumann_solve()->set_iteration(1);
+  envelope.mutable_neumann_solve()->mutable_contact_force()->Assign(force.begin(), force.end());
+  return envelope;
+}
+
 Envelope fields_request(const Eigen::VectorXd& force) {
   Envelope envelope;
   envelope.mutable_fields()->mutable_contact_force()->Assign(force.begin(), force.end());
@@ -330,6 +337,21 @@ std::string read_correction(const Exchange& exchange, long count, Eigen::VectorX
     return problem;
   }
   const protocol::CorrectionResult& result = exchange.reply->correction_result();
+  if (result.normal_trace_size() != count) {
+    return "normal_trace has " + std::to_string(result.normal_trace_size()) + " values for " +
+           std::to_string(count) + " contact nodes";
+  }
+  if (!all_finite(result.normal_trace())) return "normal_trace contains a non-finite value";
+  trace = to_vector(result.normal_trace());
+  return "";
+}
+
+std::string read_neumann_solution(const Exchange& exchange, long count, Eigen::VectorXd& trace) {
+  if (const std::string problem = expect_content(exchange, Envelope::kNeumannResult);
+      !problem.empty()) {
+    return problem;
+  }
+  const protocol::NeumannSolveResult& result = exchange.reply->neumann_result();
   if (result.normal_trace_size() != count) {
     return "normal_trace has " + std::to_string(result.normal_trace_size()) + " values for " +
            std::to_string(count) + " contact nodes";

@@ -49,6 +49,8 @@ protocol::Envelope assign_request(const std::vector<ContactNode>& nodes,
                                   double normal_length = 1.0);
 protocol::Envelope contact_solve_request(const Eigen::VectorXd& obstacle, unsigned iteration = 1);
 protocol::Envelope correction_request(const Eigen::VectorXd& force);
+/// NeumannSolveRequest (protocol 1.1) with the contact force lambda.
+protocol::Envelope neumann_solve_request(const Eigen::VectorXd& force);
 protocol::Envelope fields_request(const Eigen::VectorXd& force);
 protocol::Envelope end_run_request();
 
@@ -80,6 +82,9 @@ std::vector<std::string> signorini_problems(const ContactSolution& solution,
                                             const Eigen::VectorXd& obstacle, double tolerance);
 /// A CorrectionResult of `count` finite values.
 std::string read_correction(const Exchange& exchange, long count, Eigen::VectorXd& trace);
+
+/// A NeumannSolveResult of `count` finite values.
+std::string read_neumann_solution(const Exchange& exchange, long count, Eigen::VectorXd& trace);
 
 /// The FieldsReply's mesh: (x, y) per node, node_tags for every node or none, cell blocks of
 /// VTK types 5, 22, 9 with consistent offsets and indices, field sizes, 2 or no values in

@@ -6,10 +6,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 #include "protocol_version.hpp"
 #include "remote/conformance_body.hpp"
@@ -24,6 +27,7 @@ using namespace conformance;
 using protocol::Envelope;
 
 const std::vector<std::string> core_capabilities = {"contact_solve", "correction_solve", "fields"};
+constexpr const char* neumann_solve_capability = "neumann_solve";  // optional, protocol 1.1
 const std::vector<std::string> state_names = {"awaiting_setup", "awaiting_assignment", "ready"};
 
 // --- The checks -------------------------------------------------------------------------------
@@ -39,6 +43,7 @@ class ServerChecks {
     run_setup_checks();
     run_assignment_checks();
     run_solve_checks();
+    run_neumann_solve_checks();
     run_run_control_checks();
     session_.run("oversized_message", [this] { return oversized_message(); });
     if (session_.options().include_shutdown) {
@@ -54,7 +59,10 @@ class ServerChecks {
   void run_setup_checks();
   void run_assignment_checks();
   void run_solve_checks();
+  void run_neumann_solve_checks();
   void run_run_control_checks();
+  /// Runs a check of the optional Neumann solve, only when the server announced it.
+  void run_if_neumann(const std::string& name, const std::function<std::string()>& check);
 
   std::string hello();
   std::string version_mismatch();
@@ -70,6 +78,11 @@ class ServerChecks {
   std::string contact_solve_equilibrium();
   std::string correction_linearity();
   std::string correction_symmetry();
+  std::string neumann_solve_free();
+  std::string neumann_solve_equation();
+  std::string neumann_solve_contact_consistency();
+  std::string neumann(const Eigen::VectorXd& force, const std::string& what,
+                      Eigen::VectorXd& trace);
   std::string fields_structure();
   std::string fields_equilibrium();
   std::string fields_pair_order();
@@ -93,9 +106,12 @@ class ServerChecks {
   double tolerance_;
   std::vector<ContactNode> nodes_;  // the contact nodes in pair order, after a SetupBody
   bool assigned_ = false;
-  std::optional<ContactSolution> partial_;  // the partial-contact solution
-  Eigen::VectorXd first_force_;             // r1 of 'correction_linearity'
-  Eigen::VectorXd first_response_;          // its reply w(r1)
+  std::optional<ContactSolution> partial_;     // the partial-contact solution
+  std::optional<Eigen::VectorXd> free_trace_;  // e: u_N of the far-obstacle contact solve
+  bool capabilities_known_ = false;            // a HelloReply to 'hello' arrived
+  bool neumann_offered_ = false;               // HelloReply.capabilities has "neumann_solve"
+  Eigen::VectorXd first_force_;                // r1 of 'correction_linearity'
+  Eigen::VectorXd first_response_;             // its reply w(r1)
 };
 
 const std::vector<ContactNode>& ServerChecks::require_interface() const {
@@ -193,6 +209,9 @@ std::string ServerChecks::hello() {
                          "' (it offers: " + join(offered, ", ") + ")");
     }
   }
+  capabilities_known_ = true;
+  neumann_offered_ =
+      std::find(offered.begin(), offered.end(), neumann_solve_capability) != offered.end();
   if (std::find(state_names.begin(), state_names.end(), reply.state()) == state_names.end()) {
     problems.push_back("HelloReply.state '" + reply.state() + "' is not a state name (" +
                        join(state_names, ", ") + ")");
@@ -257,6 +276,9 @@ void ServerChecks::run_state_checks() {
   session_.run("fields_before_setup", [wrong_state] {
     return wrong_state(fields_request(Eigen::VectorXd::Zero(1)), "FieldsRequest");
   });
+  run_if_neumann("neumann_solve_before_setup", [wrong_state] {
+    return wrong_state(neumann_solve_request(Eigen::VectorXd::Zero(1)), "NeumannSolveRequest");
+  });
 }
 
 void ServerChecks::run_setup_checks() {
@@ -320,6 +342,12 @@ void ServerChecks::run_assignment_checks() {
   session_.run("contact_solve_before_assignment", [this] {
     return refused(contact_solve_request(obstacle_of(require_interface(), false)),
                    "ContactSolveRequest before AssignContact", {protocol::WRONG_STATE},
+                   "awaiting_assignment");
+  });
+  run_if_neumann("neumann_solve_before_assignment", [this] {
+    require_interface();
+    return refused(neumann_solve_request(Eigen::VectorXd::Zero(contact_count())),
+                   "NeumannSolveRequest before AssignContact", {protocol::WRONG_STATE},
                    "awaiting_assignment");
   });
   const auto invalid = [this](Envelope request, const std::string& what) {
@@ -419,7 +447,9 @@ std::string ServerChecks::contact_solve_free() {
                          " (the body translates rigidly with its lifted bottom edge)");
     }
   }
-  return problems.empty() ? "" : what + ": " + summarize(problems);
+  if (!problems.empty()) return what + ": " + summarize(problems);
+  free_trace_ = solution.normal_trace;
+  return "";
 }
 
 std::string ServerChecks::solve_partial(const std::string& what, ContactSolution& solution) {
@@ -511,6 +541,129 @@ std::string ServerChecks::correction_symmetry() {
            ": the correction operator F is not positive definite (sign of B' r?)";
   }
   return "";
+}
+
+// The Neumann solve (protocol 1.1, optional): K u = f - B' lambda, u_N = B u = e - F lambda.
+
+void ServerChecks::run_if_neumann(const std::string& name,
+                                  const std::function<std::string()>& check) {
+  if (neumann_offered_) session_.run(name, check);
+}
+
+void ServerChecks::run_neumann_solve_checks() {
+  if (!capabilities_known_) {
+    session_.run("neumann_solve_capability", []() -> std::string {
+      throw NotChecked("needs HelloReply.capabilities (see 'hello')");
+    });
+    return;
+  }
+  if (!neumann_offered_) {
+    session_.record_note("neumann_solve_capability",
+                         "not announced: the optional Neumann solve of protocol 1.1 is not "
+                         "checked, except that its request must be refused as UNSUPPORTED");
+    session_.run("neumann_solve_unsupported", [this] {
+      require_assignment();
+      return refused(neumann_solve_request(Eigen::VectorXd::Zero(contact_count())),
+                     "NeumannSolveRequest to a server that does not announce 'neumann_solve'",
+                     {protocol::UNSUPPORTED}, "ready");
+    });
+    return;
+  }
+  session_.record_note("neumann_solve_capability", "announced: checked");
+  const auto invalid = [this](const Eigen::VectorXd& force, const std::string& what) {
+    return refused(neumann_solve_request(force), "NeumannSolveRequest with " + what,
+                   {protocol::INVALID_ARGUMENT}, "ready");
+  };
+  run_if_neumann("neumann_solve_wrong_length", [this, invalid] {
+    require_assignment();
+    return invalid(Eigen::VectorXd::Ones(contact_count() + 1), "n_c + 1 contact_force values");
+  });
+  run_if_neumann("neumann_solve_non_finite", [this, invalid] {
+    require_assignment();
+    const double quiet_nan = std::numeric_limits<double>::quiet_NaN();
+    const double infinity = std::numeric_limits<double>::infinity();
+    for (const auto& [value, name] : {std::pair{quiet_nan, "NaN"}, std::pair{-infinity, "-inf"}}) {
+      Eigen::VectorXd force = Eigen::VectorXd::Ones(contact_count());
+      force(contact_count() / 2) = value;
+      if (const std::string problem = invalid(force, std::string(name) + " in contact_force[" +
+                                                         std::to_string(contact_count() / 2) + "]");
+          !problem.empty()) {
+        return problem;
+      }
+    }
+    return std::string();
+  });
+  run_if_neumann("neumann_solve_free", [this] { return neumann_solve_free(); });
+  run_if_neumann("neumann_solve_equation", [this] { return neumann_solve_equation(); });
+  run_if_neumann("neumann_solve_contact_consistency",
+                 [this] { return neumann_solve_contact_consistency(); });
+}
+
+std::string ServerChecks::neumann(const Eigen::VectorXd& force, const std::string& what,
+                                  Eigen::VectorXd& trace) {
+  return in_context(what,
+                    read_neumann_solution(session_.request(neumann_solve_request(force), what),
+                                          contact_count(), trace));
+}
+
+/// lambda = 0: the body's own loads only, u_N = e = lift (the rigid translation).
+std::string ServerChecks::neumann_solve_free() {
+  require_assignment();
+  Eigen::VectorXd trace;
+  const std::string what = "NeumannSolveRequest with lambda = 0";
+  if (const std::string problem = neumann(Eigen::VectorXd::Zero(contact_count()), what, trace);
+      !problem.empty()) {
+    return problem;
+  }
+  const double difference = (trace.array() - lift).abs().maxCoeff();
+  if (difference <= tolerance_ * lift) return "";
+  return what + ": normal_trace differs from e = " + number(lift) +
+         " (the body translates rigidly with its lifted bottom edge) by up to " +
+         number(difference);
+}
+
+/// u_N(lambda) = e - F lambda, with e the normal trace of the far-obstacle contact solve and
+/// F lambda the CorrectionResult for r = lambda: the same operator in the sign convention of
+/// the contact solve (force -lambda_i n_i on the body).
+std::string ServerChecks::neumann_solve_equation() {
+  require_assignment();
+  if (!free_trace_) throw NotChecked("needs e from 'contact_solve_free'");
+  Eigen::VectorXd force(contact_count());
+  for (long i = 0; i < contact_count(); ++i) {
+    force(i) = force_reference / static_cast<double>(contact_count()) *
+               (1.0 + 0.5 * std::cos(1.3 * static_cast<double>(i)));
+  }
+  Eigen::VectorXd response, trace;
+  std::string problem = correction(force, "CorrectionRequest with r = lambda", response);
+  if (problem.empty()) problem = neumann(force, "NeumannSolveRequest with lambda", trace);
+  if (!problem.empty()) return problem;
+  const Eigen::VectorXd expected = *free_trace_ - response;
+  const double scale = std::max(free_trace_->cwiseAbs().maxCoeff(), response.cwiseAbs().maxCoeff());
+  const double difference = (trace - expected).cwiseAbs().maxCoeff();
+  if (difference <= tolerance_ * scale) return "";
+  const double flipped = (trace - (*free_trace_ + response)).cwiseAbs().maxCoeff();
+  return "NeumannSolveResult.normal_trace violates u_N = e - F lambda (e from the contact solve "
+         "with far obstacles, F lambda the CorrectionResult for r = lambda): max difference " +
+         number(difference) + " (length) for a scale " + number(scale) +
+         (flipped <= tolerance_ * scale ? "; it equals e + F lambda: the sign of B' lambda is "
+                                          "wrong (the force on the body is -lambda_i n_i)"
+                                        : "");
+}
+
+/// The partial-contact lambda: the Neumann solve reproduces the contact solve's normal trace.
+std::string ServerChecks::neumann_solve_contact_consistency() {
+  const ContactSolution& solution = require_partial_solution();
+  Eigen::VectorXd trace;
+  if (const std::string problem = neumann(
+          solution.contact_force, "NeumannSolveRequest with the partial-contact lambda", trace);
+      !problem.empty()) {
+    return problem;
+  }
+  const double difference = (trace - solution.normal_trace).cwiseAbs().maxCoeff();
+  if (difference <= tolerance_ * lift) return "";
+  return "NeumannSolveRequest with the partial-contact lambda: normal_trace differs from the "
+         "contact solve's u_N for that lambda by up to " +
+         number(difference) + " (length) > " + number(tolerance_ * lift);
 }
 
 /// The fields for lambda = 0: the mesh structure, and the rigid translation u = (0, lift).

@@ -19,6 +19,14 @@
 // the pair order is judged through positions: a unit force at pair index k must move the node
 // at x_k most, in the FieldsReply's 'displacement' field (that check needs the field).
 //
+// The optional Neumann solve (protocol 1.1, capability "neumann_solve") is checked only when
+// HelloReply.capabilities announces it: WRONG_STATE before SetupBody and AssignContact,
+// INVALID_ARGUMENT for a wrong length, a NaN and an infinity, u_N = e = lift for lambda = 0,
+// u_N = e - F lambda with e the far-obstacle contact solve's u_N and F lambda the
+// CorrectionResult for r = lambda, and the contact solve's u_N for its own lambda. Its absence
+// is no deviation (the check 'neumann_solve_capability' passes with a note); the request must
+// then be refused as UNSUPPORTED.
+//
 // Deadlines: every request has reply_timeout_seconds. A request that gets no reply fails its
 // check; the checker then opens a new connection and sends a Hello. When that is not answered
 // either, the server is considered unresponsive and every remaining check fails at once as

@@ -234,6 +234,10 @@ void Session::record(const std::string& name, const std::string& problem) {
   report_.checks.push_back({name, problem.empty(), problem});
 }
 
+void Session::record_note(const std::string& name, const std::string& note) {
+  report_.checks.push_back({name, true, note});
+}
+
 bool Session::answers_hello_within(double seconds) {
   std::unique_ptr<ProbeConnection> probe;
   if (!transport_->connect(endpoint_, probe, true).empty()) return false;

@@ -77,6 +77,8 @@ class Session {
   /// at once. After a request without a reply, the recovery Hello described above.
   void run(const std::string& name, const std::function<std::string()>& check);
   void record(const std::string& name, const std::string& problem);
+  /// Records a passed check with a note (e.g. why a group of optional checks did not run).
+  void record_note(const std::string& name, const std::string& note);
 
   /// Whether a Hello on a connection of its own gets any reply within `seconds` (not counted
   /// among the replies judged by the reply-wide rules).

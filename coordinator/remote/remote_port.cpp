@@ -17,6 +17,7 @@ namespace {
 using protocol::Envelope;
 
 const std::vector<std::string> required_capabilities{"contact_solve", "correction_solve", "fields"};
+constexpr const char* neumann_solve_capability = "neumann_solve";  // optional, protocol 1.1
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -31,7 +32,8 @@ std::string version_text(unsigned major, unsigned minor) {
   return std::to_string(major) + "." + std::to_string(minor);
 }
 
-std::string join(const google::protobuf::RepeatedPtrField<std::string>& items) {
+template <typename Names>
+std::string join_names(const Names& items) {
   std::string text;
   for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;
   return text.empty() ? "nothing" : text;
@@ -132,6 +134,7 @@ void RemotePort::handshake() {
       "robin-coordinator (protocol " +
       version_text(protocol::protocol_major, protocol::protocol_minor) + ")");
   request.mutable_hello()->add_capabilities("fields");
+  request.mutable_hello()->add_capabilities(neumann_solve_capability);
   const double timeout =
       std::min(options_.request_timeout_seconds, options_.handshake_timeout_limit);
   const Envelope reply = exchange(request, "handshake", timeout, Envelope::kHelloReply);
@@ -139,12 +142,15 @@ void RemotePort::handshake() {
   for (const std::string& capability : required_capabilities) {
     const auto& offered = hello.capabilities();
     if (std::find(offered.begin(), offered.end(), capability) == offered.end()) {
-      fail("handshake",
-           "the server does not offer '" + capability + "' (it offers " + join(offered) + ")");
+      fail("handshake", "the server does not offer '" + capability + "' (it offers " +
+                            join_names(offered) + ")");
     }
   }
   server_name_ = hello.server_name();
-  spdlog::debug("{}: {} (state {})", describe(), server_name_, hello.state());
+  capabilities_.assign(hello.capabilities().begin(), hello.capabilities().end());
+  spdlog::debug("{}: {} (protocol {}, state {}, offers {})", describe(), server_name_,
+                version_text(reply.version().major(), reply.version().minor()), hello.state(),
+                join_names(hello.capabilities()));
 }
 
 InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions& solver) {
@@ -208,6 +214,39 @@ CorrectionSolveResult RemotePort::finish_correction() {
   try {
     CorrectionSolveResult result =
         decode_correction_result(reply.correction_result(), contact_size_);
+    timings_.compute_seconds += result.seconds;
+    return result;
+  } catch (const MalformedReply& malformed) {
+    fail(step, std::string("malformed reply: ") + malformed.what());
+  }
+}
+
+bool RemotePort::offers(const std::string& capability) const {
+  return std::find(capabilities_.begin(), capabilities_.end(), capability) != capabilities_.end();
+}
+
+void RemotePort::start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) {
+  const std::string step = "Neumann solve (iteration " + std::to_string(iteration) + ")";
+  if (server_name_.empty()) fail(step, "no handshake yet: call setup() first");
+  if (!offers(neumann_solve_capability)) {
+    fail(step, "the server ('" + server_name_ +
+                   "') lacks capability neumann_solve (protocol 1.1), which the "
+                   "Dirichlet-Neumann algorithm needs; it offers " +
+                   join_names(capabilities_) +
+                   ". Use a robin-subdomain of protocol 1.1 or later, or a Robin algorithm");
+  }
+  Envelope request;
+  protocol::NeumannSolveRequest& solve = *request.mutable_neumann_solve();
+  solve.set_iteration(static_cast<std::uint32_t>(iteration));
+  append(contact_force, *solve.mutable_contact_force());
+  send_request(request, step, options_.request_timeout_seconds);
+}
+
+CorrectionSolveResult RemotePort::finish_neumann_solve() {
+  const std::string step = pending_ ? pending_->step : "Neumann solve";
+  const Envelope reply = finish_request(Envelope::kNeumannResult);
+  try {
+    CorrectionSolveResult result = decode_neumann_result(reply.neumann_result(), contact_size_);
     timings_.compute_seconds += result.seconds;
     return result;
   } catch (const MalformedReply& malformed) {

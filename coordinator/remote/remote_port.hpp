@@ -9,9 +9,15 @@
 // where <problem> is e.g. "no reply within 60 s", "the connection to the server was lost (the
 // server stopped or crashed)" or "server error WRONG_STATE: <the server's message>".
 //
+// Capabilities: the handshake requires the core "contact_solve", "correction_solve" and
+// "fields". The optional "neumann_solve" (protocol 1.1) is needed only by
+// start_neumann_solve: a server that did not announce it (a protocol 1.0 server) serves the
+// Robin iteration as before, and start_neumann_solve throws a PortError naming server, body and
+// step, sending nothing. A server of minor version 0 is compatible (same major).
+//
 // Timings: compute_seconds adds the server-reported times of setup (assembly and
-// factorization), contact solves and corrections; round_trip_seconds adds, for the same
-// requests, the time from sending the request to the decoded reply; bytes count every
+// factorization), contact solves, corrections and Neumann solves; round_trip_seconds adds, for
+// the same requests, the time from sending the request to the decoded reply; bytes count every
 // message's payload in both directions.
 //
 // Not thread-safe: one thread at a time (the coupled run may move a port between threads).
@@ -19,6 +25,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "coupling/subdomain_port.hpp"
 #include "remote/request_channel.hpp"
@@ -47,6 +54,9 @@ class RemotePort final : public SubdomainPort {
   ContactSolveResult finish_contact_solve() override;
   void start_correction(const Eigen::VectorXd& interface_force, int iteration) override;
   CorrectionSolveResult finish_correction() override;
+  /// NeumannSolveRequest (protocol 1.1): u_N for the contact force lambda (pair order).
+  void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;
+  CorrectionSolveResult finish_neumann_solve() override;
   BodyOutput fields(const Eigen::VectorXd& contact_force) override;
   void end_run() noexcept override;
   const PortTimings& timings() const override;
@@ -54,6 +64,10 @@ class RemotePort final : public SubdomainPort {
   const std::string& endpoint() const { return endpoint_; }
   /// What the server said about itself in the handshake ("robin-subdomain 0.1.0").
   const std::string& server_name() const { return server_name_; }
+  /// HelloReply.capabilities of the handshake (empty before setup()).
+  const std::vector<std::string>& server_capabilities() const { return capabilities_; }
+  /// Whether the handshake announced `capability`.
+  bool offers(const std::string& capability) const;
 
  private:
   struct Pending;
@@ -71,6 +85,7 @@ class RemotePort final : public SubdomainPort {
   std::unique_ptr<RequestChannel> channel_;
   std::unique_ptr<Pending> pending_;
   std::string server_name_;
+  std::vector<std::string> capabilities_;
   long contact_size_ = 0;
   bool set_up_ = false;
   PortTimings timings_;

@@ -150,6 +150,12 @@ CorrectionSolveResult decode_correction_result(const protocol::CorrectionResult&
   return {to_vector(message.normal_trace()), message.compute_seconds()};
 }
 
+CorrectionSolveResult decode_neumann_result(const protocol::NeumannSolveResult& message,
+                                            long contact_size) {
+  expect_size(message.normal_trace(), contact_size, "normal_trace");
+  return {to_vector(message.normal_trace()), message.compute_seconds()};
+}
+
 BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string& body_name) {
   BodyOutput output;
   output.body_name = body_name;

@@ -29,6 +29,10 @@ ContactSolveResult decode_contact_result(const protocol::ContactSolveResult& mes
 CorrectionSolveResult decode_correction_result(const protocol::CorrectionResult& message,
                                                long contact_size);
 
+/// A Neumann solve result u_N (protocol 1.1) for `contact_size` contact nodes.
+CorrectionSolveResult decode_neumann_result(const protocol::NeumannSolveResult& message,
+                                            long contact_size);
+
 /// The body's mesh (nodes, tags, element blocks from the VTK cell types 5, 22, 9) and fields.
 /// The mesh has no boundary groups (they are not needed for output). Stress fields get the
 /// component names xx, yy, xy.

@@ -101,7 +101,7 @@ void encode_material(const Material& material, const std::string& context,
     if (!young) {
       throw InputError(context +
                        ": material: an out-of-plane stress factor with a non-isotropic "
-                       "stiffness cannot be sent in protocol 1.0 (give young and poisson)");
+                       "stiffness cannot be sent in protocol 1 (give young and poisson)");
     }
     message.set_young_modulus(*young);
     message.set_poisson_ratio(nu);

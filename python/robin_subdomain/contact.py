@@ -250,3 +250,10 @@ class ContactInterface:
     def solve_correction(self, interface_force):
         """Step 2: w_N = B K^-1 B' r = F r."""
         return self.compliance @ interface_force
+
+    def solve_neumann(self, contact_force):
+        """The Neumann solve (protocol 1.1): u_N = B u with K u = f - B' lambda, u = u_p on the
+        prescribed dofs. One solve with the body's factor, not e - F lambda (so that it is an
+        independent check of F and e)."""
+        load = self.body.reduced_load - self.trace.T @ contact_force
+        return self.trace @ self.body.factor.solve(load) + self.prescribed_trace

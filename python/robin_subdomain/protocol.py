@@ -5,13 +5,16 @@ transitions and error codes are those of the C++ server (subdomain/server/subdom
   awaiting_setup       no body
   awaiting_assignment  body assembled and factorized (SetupBody done); + AssignContact
   ready                contact nodes assigned; + AssignContact, ContactSolveRequest,
-                       CorrectionRequest, FieldsRequest
+                       CorrectionRequest, NeumannSolveRequest, FieldsRequest
 Hello, SetupBody, EndRun and Shutdown are accepted in every state. SetupBody discards the
 previous body first (a failed SetupBody leaves awaiting_setup); a refused AssignContact keeps the
 state and the previous assignment; EndRun -> awaiting_setup; Shutdown keeps the state and sets
 shutdown_requested.
 
-Every reply echoes the request_id and carries version (protocol_major, 0). Failures are Error
+Protocol 1.1: besides the core capabilities the server announces the optional "neumann_solve"
+(NeumannSolveRequest: u_N = B K^-1 (f - B' lambda) for a given contact force lambda).
+
+Every reply echoes the request_id and carries version (protocol_major, 1). Failures are Error
 replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH,
 WRONG_STATE, INVALID_ARGUMENT (sizes, unknown/repeated node ids, non-unit normals, non-finite
 values, unusable write_directory), BAD_INPUT (the body definition), SINGULAR_BODY, UNSUPPORTED
@@ -32,11 +35,11 @@ from .fields import body_fields, write_vtu
 from .mesh import VTK_CELL_TYPE
 from .setup_decoding import decode_setup_body
 
-PROTOCOL_MAJOR, PROTOCOL_MINOR = 1, 0
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 1, 1
 AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
-REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction", "fields",
-            "end_run", "shutdown")
-CAPABILITIES = ("contact_solve", "correction_solve", "fields")
+REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction",
+            "neumann_solve", "fields", "end_run", "shutdown")
+CAPABILITIES = ("contact_solve", "correction_solve", "fields", "neumann_solve")
 
 
 class _Record:
@@ -153,8 +156,8 @@ class SubdomainProtocol:
         handlers = {"hello": self._on_hello, "setup_body": self._on_setup_body,
                     "assign_contact": self._on_assign_contact,
                     "contact_solve": self._on_contact_solve, "correction": self._on_correction,
-                    "fields": self._on_fields, "end_run": self._on_end_run,
-                    "shutdown": self._on_shutdown}
+                    "neumann_solve": self._on_neumann_solve, "fields": self._on_fields,
+                    "end_run": self._on_end_run, "shutdown": self._on_shutdown}
         if content in handlers:
             return handlers[content](request, reply, record)
         if content is not None:
@@ -286,6 +289,21 @@ class SubdomainProtocol:
                                 "CorrectionRequest.interface_force", self.body.name)
         reply.correction_result.normal_trace.extend(interface.solve_correction(force).tolist())
         reply.correction_result.compute_seconds = time.perf_counter() - start
+
+    def _on_neumann_solve(self, request, reply, record):
+        """Protocol 1.1: K u = f - B' lambda for the given lambda; replies u_N = B u."""
+        start = time.perf_counter()
+        message = request.neumann_solve
+        record.iteration = " iteration %d" % message.iteration
+        self._require_state(READY, "NeumannSolveRequest")
+        interface = self.body.contact
+        force = _checked_vector(message.contact_force, interface.size(),
+                                "NeumannSolveRequest.contact_force", self.body.name)
+        trace = interface.solve_neumann(force)
+        reply.neumann_result.normal_trace.extend(trace.tolist())
+        reply.neumann_result.compute_seconds = time.perf_counter() - start
+        record.outcome = "ok, max |lambda| %.3e, max |u_N| %.3e" % (
+            np.max(np.abs(force), initial=0.0), np.max(np.abs(trace), initial=0.0))
 
     def _on_fields(self, request, reply, record):
         message = request.fields

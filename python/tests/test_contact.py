@@ -7,6 +7,9 @@
   left side): uniform uniaxial strain, so the nodal contact forces are lambda_i = |s_yy| m_i
   with s_yy = E/(1 - nu^2) (-d/H) (plane strain), to rounding.
 - Consistency: e - F lambda equals the normal trace of the displacement computed with lambda.
+- The Neumann solve (protocol 1.1): under the analytic contact forces of the block on the flat
+  the bottom does not move (u_N = 0); under other forces it equals e - F lambda and the normal
+  trace of the full displacement.
 """
 
 import itertools
@@ -162,6 +165,24 @@ class BlockOnRigidFlat(unittest.TestCase):
 
     def test_quadratic_triangles(self):
         self.check(2)
+
+    def test_neumann_solve(self):
+        for element_order in (1, 2):
+            body, interface = self.make_body(element_order)
+            stress = self.YOUNG / (1.0 - self.POISSON ** 2) * self.PUSH / self.HEIGHT
+            analytic = stress * interface["weights"]
+            resting = body.contact.solve_neumann(analytic)
+            self.assertLess(np.abs(resting).max(), 1e-12 * self.PUSH)
+            count = len(analytic)
+            force = analytic * (1.0 + 0.5 * np.cos(1.7 * np.arange(count)))
+            trace = body.contact.solve_neumann(force)
+            dual = body.contact.free_trace - body.contact.compliance @ force  # e - F lambda
+            displacement = body.displacement(force).reshape(-1, 2)
+            traced = np.sum(displacement[interface["node_ids"]] * interface["normals"], axis=1)
+            scale = np.abs(trace).max()
+            self.assertGreater(scale, 1e-3 * self.PUSH)  # the forces do move the bottom
+            self.assertLess(np.abs(trace - dual).max(), 1e-12 * scale)
+            self.assertLess(np.abs(trace - traced).max(), 1e-12 * scale)
 
     def test_compliance_is_symmetric_positive_definite(self):
         body, _ = self.make_body(1)

@@ -1,6 +1,7 @@
 """The protocol state machine of the Python subdomain server, without a socket: states and their
 transitions, the error codes of refused requests, and replies that echo the request id and carry
-version 1.0.
+version 1.1. The Neumann solve of 1.1 through the protocol: its refusals, and its answer equal to
+e - F lambda assembled from the server's own contact-solve and correction replies.
 """
 
 import unittest
@@ -44,7 +45,7 @@ class StateMachine(unittest.TestCase):
     def ask(self, data):
         reply = protocol.Envelope()
         reply.ParseFromString(self.server.handle(data))
-        self.assertEqual((reply.version.major, reply.version.minor), (1, 0))
+        self.assertEqual((reply.version.major, reply.version.minor), (1, 1))
         return reply
 
     def expect_error(self, data, code, state):
@@ -60,7 +61,7 @@ class StateMachine(unittest.TestCase):
         self.assertEqual(reply.request_id, 11)
         self.assertEqual(reply.hello_reply.state, "awaiting_setup")
         self.assertEqual(list(reply.hello_reply.capabilities),
-                         ["contact_solve", "correction_solve", "fields"])
+                         ["contact_solve", "correction_solve", "fields", "neumann_solve"])
 
     def test_envelope_checks(self):
         self.expect_error(request(), "MALFORMED_MESSAGE", "awaiting_setup")
@@ -69,7 +70,7 @@ class StateMachine(unittest.TestCase):
         message = self.expect_error(request(major=2, hello=protocol.Hello()), "VERSION_MISMATCH",
                                     "awaiting_setup")
         self.assertIn("2.0", message)
-        self.assertIn("1.0", message)
+        self.assertIn("1.1", message)
         self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
                           "awaiting_setup")
         # field 31 of the Envelope: a request type this version does not know
@@ -101,6 +102,42 @@ class StateMachine(unittest.TestCase):
         self.assertEqual(self.ask(request(shutdown=protocol.Shutdown())).acknowledge.state,
                          "awaiting_setup")
         self.assertTrue(self.server.shutdown_requested)
+
+    def test_neumann_solve(self):
+        neumann = protocol.NeumannSolveRequest(iteration=3, contact_force=[0.0])
+        self.expect_error(request(neumann_solve=neumann), "WRONG_STATE", "awaiting_setup")
+        loaded = setup_body()
+        loaded.body_force.extend([0.0, -5.0])
+        interface = self.ask(request(setup_body=loaded)).interface
+        count = len(interface.node_ids)
+        self.expect_error(request(neumann_solve=neumann), "WRONG_STATE", "awaiting_assignment")
+        assign = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
+        self.ask(request(assign_contact=assign))
+        message = self.expect_error(request(neumann_solve=neumann), "INVALID_ARGUMENT", "ready")
+        self.assertIn("NeumannSolveRequest.contact_force has 1 values for the %d" % count,
+                      message)
+        for bad in (float("nan"), float("inf")):
+            neumann = protocol.NeumannSolveRequest(contact_force=[1.0] * (count - 1) + [bad])
+            message = self.expect_error(request(neumann_solve=neumann), "INVALID_ARGUMENT",
+                                        "ready")
+            self.assertIn("contact_force[%d] of body 'lower' is not a finite number" % (count - 1),
+                          message)
+        # e: the normal trace with every obstacle far; F lambda: the correction for r = lambda
+        far = protocol.ContactSolveRequest(obstacle=[1e3] * count)
+        free = self.ask(request(contact_solve=far)).contact_result
+        self.assertEqual(list(free.contact_force), [0.0] * count)
+        force = 1.0 + np.cos(np.arange(count))
+        correction = protocol.CorrectionRequest(interface_force=force)
+        response = np.array(self.ask(request(correction=correction)).correction_result.normal_trace)
+        neumann = protocol.NeumannSolveRequest(iteration=4, contact_force=force)
+        reply = self.ask(request(request_id=99, neumann_solve=neumann))
+        self.assertEqual(reply.request_id, 99)
+        trace = np.array(reply.neumann_result.normal_trace)
+        expected = np.array(free.normal_trace) - response
+        self.assertGreater(np.abs(response).max(), 1e-3 * np.abs(expected).max())
+        scale = max(np.abs(free.normal_trace).max(), np.abs(response).max())
+        np.testing.assert_allclose(trace, expected, rtol=0, atol=1e-10 * scale)
+        self.assertEqual(self.server.state, "ready")
 
     def test_bad_bodies(self):
         self.expect_error(request(setup_body=setup_body(poisson_ratio=0.5)), "BAD_INPUT",

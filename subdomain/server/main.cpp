@@ -54,8 +54,16 @@ void add_options(CLI::App& app, CommandLine& command_line) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--name", command_line.server.name, "label for the logs and HelloReply");
-  // Testing only: announce and accept another protocol major version.
+  // Testing only: announce and accept another protocol major version, announce another minor.
   app.add_option("--protocol-major", command_line.server.protocol_major)->group("");
+  app.add_option("--protocol-minor", command_line.server.protocol_minor)->group("");
+  app.add_option("--without-capability", command_line.server.withheld_capabilities,
+                 "TESTING ONLY: neither announce nor serve the optional capability NAME (it "
+                 "then answers its request with UNSUPPORTED, like a protocol 1.0 server); "
+                 "repeatable")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"neumann_solve"}))
+      ->group("Testing only");
 }
 
 }  // namespace

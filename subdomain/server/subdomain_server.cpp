@@ -35,6 +35,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+constexpr const char* neumann_solve_capability = "neumann_solve";  // protocol 1.1
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -57,6 +59,7 @@ bool is_request(protocol::Envelope::ContentCase content) {
     case Envelope::kAssignContact:
     case Envelope::kContactSolve:
     case Envelope::kCorrection:
+    case Envelope::kNeumannSolve:
     case Envelope::kFields:
     case Envelope::kEndRun:
     case Envelope::kShutdown:
@@ -64,6 +67,11 @@ bool is_request(protocol::Envelope::ContentCase content) {
     default:
       return false;
   }
+}
+
+/// max_i |v_i|, 0 for an empty vector.
+double largest_magnitude(const Eigen::VectorXd& vector) {
+  return vector.size() == 0 ? 0.0 : vector.cwiseAbs().maxCoeff();
 }
 
 /// Checks a per-contact-node vector of the request: its length and finiteness.
@@ -219,7 +227,7 @@ std::string SubdomainServer::finish(protocol::Envelope& reply, RequestRecord& re
           protocol::ErrorCode_Name(reply.error().code()) + ": " + reply.error().message();
     }
     reply.mutable_version()->set_major(settings_.protocol_major);
-    reply.mutable_version()->set_minor(protocol::protocol_minor);
+    reply.mutable_version()->set_minor(settings_.protocol_minor);
     log(record);
     return reply.SerializeAsString();
   } catch (...) {
@@ -238,7 +246,7 @@ void SubdomainServer::check_version(const protocol::Envelope& request) const {
     throw RequestError(protocol::VERSION_MISMATCH,
                        "protocol version mismatch: the request speaks " +
                            version_text(major, request.version().minor()) + ", this server " +
-                           version_text(settings_.protocol_major, protocol::protocol_minor) +
+                           version_text(settings_.protocol_major, settings_.protocol_minor) +
                            " (the major versions must be equal); use a matching coordinator "
                            "or server");
   }
@@ -258,6 +266,8 @@ void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Enve
       return on_contact_solve(request, reply, record);
     case Envelope::kCorrection:
       return on_correction(request, reply, record);
+    case Envelope::kNeumannSolve:
+      return on_neumann_solve(request, reply, record);
     case Envelope::kFields:
       return on_fields(request, reply);
     case Envelope::kEndRun:
@@ -279,7 +289,7 @@ void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Enve
   if (!request.GetReflection()->GetUnknownFields(request).empty()) {
     throw RequestError(protocol::UNSUPPORTED,
                        "the request type is unknown to this server (protocol " +
-                           version_text(settings_.protocol_major, protocol::protocol_minor) +
+                           version_text(settings_.protocol_major, settings_.protocol_minor) +
                            "); check HelloReply.capabilities");
   }
   throw RequestError(protocol::MALFORMED_MESSAGE, "the Envelope carries no request (no content)");
@@ -304,6 +314,7 @@ void SubdomainServer::on_hello(protocol::Envelope& reply) {
   for (const char* capability : {"contact_solve", "correction_solve", "fields"}) {
     hello.add_capabilities(capability);
   }
+  if (offers(neumann_solve_capability)) hello.add_capabilities(neumann_solve_capability);
   hello.set_state(to_string(state_));
 }
 
@@ -370,6 +381,29 @@ void SubdomainServer::on_correction(const protocol::Envelope& request, protocol:
   result.set_compute_seconds(seconds_since(start));
 }
 
+/// Since protocol 1.1: K u = f - B' lambda with the given lambda, u_N = B u = e - F lambda.
+void SubdomainServer::on_neumann_solve(const protocol::Envelope& request, protocol::Envelope& reply,
+                                       RequestRecord& record) {
+  const auto start = Clock::now();
+  const protocol::NeumannSolveRequest& message = request.neumann_solve();
+  record.iteration = " iteration " + std::to_string(message.iteration());
+  if (!offers(neumann_solve_capability)) {
+    throw RequestError(protocol::UNSUPPORTED,
+                       "NeumannSolveRequest is not served: this server withholds the capability "
+                       "'neumann_solve' (started with --without-capability neumann_solve)");
+  }
+  require_state(ServerState::ready, "NeumannSolveRequest");
+  const Eigen::VectorXd contact_force =
+      checked_vector(message.contact_force(), body_->contact_size(),
+                     "NeumannSolveRequest.contact_force", body_->name());
+  const Eigen::VectorXd trace = body_->solve_neumann(contact_force);  // u_N = e - F lambda
+  protocol::NeumannSolveResult& result = *reply.mutable_neumann_result();
+  result.mutable_normal_trace()->Assign(trace.begin(), trace.end());
+  result.set_compute_seconds(seconds_since(start));
+  record.outcome = fmt::format("ok, max |lambda| {:.3e}, max |u_N| {:.3e}",
+                               largest_magnitude(contact_force), largest_magnitude(trace));
+}
+
 void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Envelope& reply) {
   const protocol::FieldsRequest& message = request.fields();
   require_state(ServerState::ready, "FieldsRequest");
@@ -381,6 +415,11 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   if (!message.write_directory().empty()) {
     fields.set_written_file(write_fields_file(message.write_directory(), output));
   }
+}
+
+bool SubdomainServer::offers(const std::string& name) const {
+  const auto& withheld = settings_.withheld_capabilities;
+  return std::find(withheld.begin(), withheld.end(), name) == withheld.end();
 }
 
 void SubdomainServer::acknowledge(protocol::Envelope& reply) const {

@@ -6,7 +6,7 @@
 //   awaiting_setup       no body
 //   awaiting_assignment  body assembled and factorized (SetupBody done); + AssignContact
 //   ready                contact nodes assigned; + AssignContact, ContactSolveRequest,
-//                        CorrectionRequest, FieldsRequest
+//                        CorrectionRequest, NeumannSolveRequest, FieldsRequest
 // Transitions: SetupBody -> awaiting_assignment (the previous body is discarded first, so a
 // failed SetupBody leaves awaiting_setup); AssignContact -> ready (a refused assignment keeps
 // the state and the previous assignment); EndRun -> awaiting_setup; Shutdown -> unchanged, and
@@ -22,9 +22,14 @@
 //                      values, a write_directory where the fields cannot be written
 //   BAD_INPUT          the body definition is unusable (robin::InputError while setting up)
 //   SINGULAR_BODY      the Dirichlet conditions leave a rigid motion free (SingularBodyError)
-//   UNSUPPORTED        a reply type sent as a request, or a request unknown to this version
+//   UNSUPPORTED        a reply type sent as a request, a request unknown to this version, or
+//                      a NeumannSolveRequest when "neumann_solve" is withheld (testing only)
 //   INTERNAL           any other exception
 // The state after the request is in Acknowledge.state, HelloReply.state and Error.state.
+//
+// Capabilities (HelloReply.capabilities): the core "contact_solve", "correction_solve",
+// "fields", and since protocol 1.1 the optional "neumann_solve" (NeumannSolveRequest:
+// u_N = B K^{-1} (f - B' lambda) = e - F lambda for a given contact force lambda).
 
 #include <memory>
 #include <string>
@@ -53,6 +58,11 @@ struct ServerSettings {
   std::string name;  // optional label, appended to HelloReply.server_name and the logs
   /// The major version announced and accepted (tests set another one to provoke a mismatch).
   unsigned protocol_major = protocol::protocol_major;
+  /// The minor version announced (tests set 0 to play a protocol 1.0 server).
+  unsigned protocol_minor = protocol::protocol_minor;
+  /// Optional capabilities neither announced nor served (testing only: with "neumann_solve"
+  /// the server answers NeumannSolveRequest with UNSUPPORTED, like a protocol 1.0 server).
+  std::vector<std::string> withheld_capabilities;
   /// Where requests are logged; null means subdomain_logger().
   std::shared_ptr<spdlog::logger> logger;
 };
@@ -92,7 +102,11 @@ class SubdomainServer {
                         RequestRecord& record);
   void on_correction(const protocol::Envelope& request, protocol::Envelope& reply,
                      RequestRecord& record);
+  void on_neumann_solve(const protocol::Envelope& request, protocol::Envelope& reply,
+                        RequestRecord& record);
   void on_fields(const protocol::Envelope& request, protocol::Envelope& reply);
+  /// Whether the optional capability `name` is announced and served.
+  bool offers(const std::string& name) const;
   void acknowledge(protocol::Envelope& reply) const;
   /// Sets our version on `reply`, logs `record` and serializes the reply.
   std::string finish(protocol::Envelope& reply, RequestRecord& record) noexcept;

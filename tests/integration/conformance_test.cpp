@@ -3,7 +3,9 @@
 // answers everything with HelloReply, one that never answers, a proxy to robin-subdomain that
 // corrupts one aspect of its replies or requests), and through the robin-coordinator command
 // line. Each deviation must fail the checks that judge it, with an explanation naming the
-// message, and the checker must keep to its deadlines.
+// message, and the checker must keep to its deadlines. The optional Neumann solve (protocol
+// 1.1) is checked when announced; a server without it (robin-subdomain --protocol-minor 0
+// --without-capability neumann_solve, as a 1.0 server) conforms.
 
 #include "remote/conformance_check.hpp"
 
@@ -22,6 +24,7 @@
 #include <zmq.hpp>
 
 #include "protocol_version.hpp"
+#include "remote/conformance_body.hpp"
 #include "remote_test_support.hpp"
 #include "robin.pb.h"
 
@@ -223,14 +226,36 @@ TEST_F(ConformanceTest, ReferenceServerPassesEveryCheck) {
   EXPECT_TRUE(report.conforms()) << failed_checks(report);
   EXPECT_GE(report.checks.size(), 40u);
   EXPECT_NE(report.server_name.find("robin-subdomain"), std::string::npos);
-  for (const char* name :
-       {"hello", "version_mismatch", "garbage_bytes", "empty_envelope",
-        "contact_solve_before_setup", "setup_floating_body", "setup_body", "assign_unknown_node",
-        "contact_solve_wrong_length", "contact_solve_signorini", "correction_linearity",
-        "correction_symmetry", "fields_structure", "end_run", "second_run", "oversized_message",
-        "request_id_echoed", "version_on_every_reply"}) {
+  for (const char* name : {"hello",
+                           "version_mismatch",
+                           "garbage_bytes",
+                           "empty_envelope",
+                           "contact_solve_before_setup",
+                           "setup_floating_body",
+                           "setup_body",
+                           "assign_unknown_node",
+                           "contact_solve_wrong_length",
+                           "contact_solve_signorini",
+                           "correction_linearity",
+                           "correction_symmetry",
+                           "fields_structure",
+                           "end_run",
+                           "second_run",
+                           "oversized_message",
+                           "request_id_echoed",
+                           "version_on_every_reply",
+                           "neumann_solve_capability",
+                           "neumann_solve_before_setup",
+                           "neumann_solve_before_assignment",
+                           "neumann_solve_wrong_length",
+                           "neumann_solve_non_finite",
+                           "neumann_solve_free",
+                           "neumann_solve_equation",
+                           "neumann_solve_contact_consistency"}) {
     EXPECT_TRUE(passes(report, name)) << name;
   }
+  EXPECT_EQ(find_check(report, "neumann_solve_capability")->explanation, "announced: checked");
+  EXPECT_EQ(find_check(report, "neumann_solve_unsupported"), nullptr);
   EXPECT_EQ(find_check(report, "shutdown"), nullptr);  // only with include_shutdown
   EXPECT_LT(seconds, 20.0);
   std::cout << "reference server: " << report.checks.size() << " checks in " << seconds << " s\n";
@@ -259,6 +284,27 @@ TEST_F(ConformanceTest, ServerThatDropsOversizedMessagesConformsAndShutsDown) {
     fate = server.failure();
   }
   EXPECT_NE(fate.find("exited with status 0"), std::string::npos) << fate;
+}
+
+TEST_F(ConformanceTest, ServerWithoutTheOptionalNeumannSolveConforms) {
+  // As a protocol 1.0 server: minor version 0, no "neumann_solve", its request UNSUPPORTED.
+  testing::TemporaryDirectory directory("conformance-1.0");
+  ServerLaunchOptions launch = testing::server_options(directory.path());
+  launch.extra_arguments = {"--protocol-minor", "0", "--without-capability", "neumann_solve"};
+  SubdomainServer server("old", launch);
+  server.await_listening();
+  const ConformanceReport report = check_server(server.endpoint(), quick_options());
+  EXPECT_TRUE(report.conforms()) << failed_checks(report);
+  EXPECT_TRUE(passes(report, "neumann_solve_unsupported"));
+  const ConformanceCheck* note = find_check(report, "neumann_solve_capability");
+  ASSERT_NE(note, nullptr);
+  EXPECT_TRUE(note->passed);
+  EXPECT_NE(note->explanation.find("not announced"), std::string::npos) << note->explanation;
+  for (const char* name : {"neumann_solve_before_setup", "neumann_solve_equation"}) {
+    EXPECT_EQ(find_check(report, name), nullptr) << name;
+  }
+  EXPECT_NE(format_report(report).find("PASS neumann_solve_capability (not announced"),
+            std::string::npos);
 }
 
 // --- Servers that do not conform ----------------------------------------------------------------
@@ -377,6 +423,34 @@ Deviation shifted_correction() {
            {"contact_solve_equilibrium", {"u_N = e - F lambda"}}}};
 }
 
+Deviation negated_neumann_force() {
+  // The server loads the body with +lambda n instead of -lambda n: u_N = e + F lambda.
+  return {"NegatedNeumannForce",
+          [](Envelope& request) {
+            if (!request.has_neumann_solve()) return;
+            for (double& force : *request.mutable_neumann_solve()->mutable_contact_force()) {
+              force = -force;
+            }
+          },
+          {},
+          {{"neumann_solve_equation", {"u_N = e - F lambda", "it equals e + F lambda"}},
+           {"neumann_solve_contact_consistency", {"contact solve's u_N"}}}};
+}
+
+Deviation neumann_without_loads() {
+  // The server answers the correction's -F lambda, forgetting its own loads (e).
+  return {"NeumannWithoutLoads",
+          {},
+          [](Envelope& reply) {
+            if (!reply.has_neumann_result()) return;
+            for (double& trace : *reply.mutable_neumann_result()->mutable_normal_trace()) {
+              trace -= conformance::lift;
+            }
+          },
+          {{"neumann_solve_free", {"NeumannSolveRequest with lambda = 0", "e = 0.01"}},
+           {"neumann_solve_equation", {"u_N = e - F lambda"}}}};
+}
+
 Deviation wrong_request_ids() {
   return {"WrongRequestIds",
           {},
@@ -406,7 +480,8 @@ Deviation no_fields_reactions() {
 
 INSTANTIATE_TEST_SUITE_P(Conformance, DeviationTest,
                          ::testing::Values(negated_contact_force(), ignored_pair_order(),
-                                           shifted_correction(), wrong_request_ids(),
+                                           shifted_correction(), negated_neumann_force(),
+                                           neumann_without_loads(), wrong_request_ids(),
                                            errors_without_version(), no_fields_reactions()),
                          [](const auto& info) { return info.param.name; });
 

@@ -6,6 +6,11 @@
 //    servers, equal the all-C++ run (InProcessPort: the C++ numerics in this process, which
 //    remote_port_test shows equal to C++ servers to 1e-12) to 1e-6 relative in contact forces,
 //    normal traces and displacement fields, with the same iteration count;
+//  - the Neumann solve of protocol 1.1 (u_N for a given contact force, computed by the Python
+//    server with one solve of its own factor) equals the C++ server's (e - F lambda) to 1e-9
+//    relative on both bodies of two_blocks.toml;
+//  - the conformance checker (robin-coordinator --check-server) passes on the Python server,
+//    its Neumann-solve checks included;
 //  - the process: exactly one "listening on" line with the ephemeral port resolved; garbage
 //    bytes and a multi-frame message get MALFORMED_MESSAGE replies and the server goes on;
 //    Shutdown, SIGTERM and SIGINT end it with exit status 0.
@@ -13,12 +18,14 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <iostream>
 #include <thread>
 #include <zmq.hpp>
 
 #include "coupling/coupled_run.hpp"
 #include "coupling/in_process_port.hpp"
+#include "remote/conformance_check.hpp"
 #include "remote/remote_port.hpp"
 #include "remote_test_support.hpp"
 #include "robin.pb.h"
@@ -137,6 +144,98 @@ TEST(PythonServer, HertzTwoPythonServersEqualsAllCpp) {
 
 TEST(PythonServer, PartialContactTwoPythonServersEqualsAllCpp) {
   expect_equal_to_cpp("two_blocks_partial.toml", run_with_python("two_blocks_partial.toml", true));
+}
+
+/// Every contact node of `boundary` by descending x, with `sign` times the normal that
+/// `normals_from` (the same body on another server) gives at the same position.
+ContactAssignment assignment_by_position(const InterfaceDescription& boundary,
+                                         const InterfaceDescription& normals_from, double sign) {
+  std::vector<std::size_t> order(boundary.node_ids.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return boundary.coordinates[a].x() > boundary.coordinates[b].x();
+  });
+  ContactAssignment assignment;
+  for (const std::size_t k : order) {
+    std::size_t nearest = 0;
+    for (std::size_t j = 0; j < normals_from.coordinates.size(); ++j) {
+      if ((normals_from.coordinates[j] - boundary.coordinates[k]).norm() <
+          (normals_from.coordinates[nearest] - boundary.coordinates[k]).norm()) {
+        nearest = j;
+      }
+    }
+    EXPECT_LT((normals_from.coordinates[nearest] - boundary.coordinates[k]).norm(), 1e-12);
+    assignment.node_ids.push_back(boundary.node_ids[k]);
+    assignment.normals.push_back(sign * normals_from.normals[nearest]);
+  }
+  return assignment;
+}
+
+TEST(PythonServer, NeumannSolveEqualsTheCppServers) {
+  const TemporaryDirectory logs("python-server-neumann");
+  const CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  SubdomainServer cpp_server("cpp", server_options(logs.path()));
+  SubdomainServer python_server("python", python_server_options(logs.path()));
+  cpp_server.await_listening();
+  python_server.await_listening();
+  RemotePortOptions options;
+  options.request_timeout_seconds = 60.0;
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    const BodyCase& body = definition.bodies[alpha];
+    RemotePort cpp(cpp_server.endpoint(), body.definition.name, options);
+    RemotePort python(python_server.endpoint(), body.definition.name, options);
+    const InterfaceDescription cpp_boundary = cpp.setup(body, definition.solver);
+    const InterfaceDescription python_boundary = python.setup(body, definition.solver);
+    ASSERT_EQ(cpp_boundary.node_ids.size(), python_boundary.node_ids.size());
+    EXPECT_TRUE(python.offers("neumann_solve")) << python.server_name();
+    const double sign = alpha == 0 ? 1.0 : -1.0;  // body 2 receives n2 = -n1
+    const ContactAssignment cpp_assignment =
+        assignment_by_position(cpp_boundary, cpp_boundary, sign);
+    const ContactAssignment python_assignment =
+        assignment_by_position(python_boundary, cpp_boundary, sign);
+    cpp.assign_contact(cpp_assignment);
+    python.assign_contact(python_assignment);
+    Eigen::VectorXd force(static_cast<Eigen::Index>(cpp_assignment.node_ids.size()));
+    for (Eigen::Index i = 0; i < force.size(); ++i) {  // by position: both use descending x
+      force[i] = 1.0 + 0.5 * std::cos(1.3 * static_cast<double>(i));
+    }
+    cpp.start_neumann_solve(force, 1);
+    python.start_neumann_solve(force, 1);
+    const Eigen::VectorXd cpp_trace = cpp.finish_neumann_solve().normal_trace;
+    const Eigen::VectorXd python_trace = python.finish_neumann_solve().normal_trace;
+    std::cout << body.definition.name << ": max |u_N| " << cpp_trace.lpNorm<Eigen::Infinity>()
+              << ", Python - C++ " << (python_trace - cpp_trace).lpNorm<Eigen::Infinity>() << "\n";
+    EXPECT_GT(cpp_trace.lpNorm<Eigen::Infinity>(), 1e-4);
+    EXPECT_TRUE(vectors_close(python_trace, cpp_trace, 1e-9)) << body.definition.name;
+    cpp.end_run();
+    python.end_run();
+  }
+}
+
+TEST(PythonServer, PassesTheConformanceCheckIncludingTheNeumannSolve) {
+  const TemporaryDirectory logs("python-server-conformance");
+  SubdomainServer server("conformance", python_server_options(logs.path()));
+  server.await_listening();
+  ConformanceOptions options;
+  options.reply_timeout_seconds = 30.0;
+  options.oversized_message_bytes = 1L << 20;
+  const ConformanceReport report = check_server(server.endpoint(), options);
+  std::string failed;
+  for (const ConformanceCheck& check : report.checks) {
+    if (!check.passed) failed += "\n  " + check.name + ": " + check.explanation;
+  }
+  EXPECT_TRUE(report.conforms()) << failed;
+  EXPECT_EQ(report.server_name.rfind("robin-subdomain-py ", 0), 0u) << report.server_name;
+  for (const char* name :
+       {"neumann_solve_before_setup", "neumann_solve_before_assignment",
+        "neumann_solve_wrong_length", "neumann_solve_non_finite", "neumann_solve_free",
+        "neumann_solve_equation", "neumann_solve_contact_consistency"}) {
+    const auto found =
+        std::find_if(report.checks.begin(), report.checks.end(),
+                     [&](const ConformanceCheck& check) { return check.name == name; });
+    ASSERT_NE(found, report.checks.end()) << name;
+    EXPECT_TRUE(found->passed) << name << ": " << found->explanation;
+  }
 }
 
 /// Sends `frames` on a REQ socket and parses the reply.

@@ -203,7 +203,7 @@ TEST(RemotePort, ServerOfAnotherMajorVersionIsRefused) {
     std::cout << message << "\n";
     EXPECT_NE(message.find("server " + server.endpoint()), std::string::npos) << message;
     EXPECT_NE(message.find("speaks protocol 2."), std::string::npos) << message;
-    EXPECT_NE(message.find("speaks 1.0"), std::string::npos) << message;
+    EXPECT_NE(message.find("this coordinator speaks 1.1"), std::string::npos) << message;
   }
 }
 

@@ -1,7 +1,9 @@
 // SubdomainServer::handle, in process: a whole run (Hello, SetupBody, AssignContact, contact
 // and correction solves, fields, EndRun, a second run) compared with a BodySolver built
 // directly from the same body definition, the equilibrium of the returned fields, and every
-// error reply of the state machine.
+// error reply of the state machine. The Neumann solve of protocol 1.1 (NeumannSolveRequest)
+// against the normal trace of BodySolver::displacement, its refusals, and a server that
+// withholds it (as a protocol 1.0 server would not know it).
 
 #include "server/subdomain_server.hpp"
 
@@ -103,6 +105,14 @@ protocol::Envelope assign_all_request(std::uint64_t id, const InterfaceDescripti
     envelope.mutable_assign_contact()->add_normals(0.0);
     envelope.mutable_assign_contact()->add_normals(1.0);
   }
+  return envelope;
+}
+
+/// NeumannSolveRequest (protocol 1.1) with the contact force `force`.
+protocol::Envelope neumann_solve_request(std::uint64_t id, const Eigen::VectorXd& force) {
+  protocol::Envelope envelope = request(id);
+  envelope.mutable_neumann_solve()->set_iteration(static_cast<unsigned>(id));
+  envelope.mutable_neumann_solve()->mutable_contact_force()->Assign(force.begin(), force.end());
   return envelope;
 }
 
@@ -281,7 +291,10 @@ TEST(SubdomainServer, FullRunMatchesADirectlyBuiltBodySolver) {
   ASSERT_TRUE(reply.has_hello_reply()) << reply.DebugString();
   EXPECT_EQ(reply.hello_reply().state(), "awaiting_setup");
   EXPECT_NE(reply.hello_reply().server_name().find("unit test"), std::string::npos);
-  EXPECT_EQ(reply.hello_reply().capabilities_size(), 3);
+  EXPECT_EQ(
+      std::vector<std::string>(reply.hello_reply().capabilities().begin(),
+                               reply.hello_reply().capabilities().end()),
+      (std::vector<std::string>{"contact_solve", "correction_solve", "fields", "neumann_solve"}));
 
   reply = exchange(server, setup_request(2, lower_block_setup()));
   ASSERT_TRUE(reply.has_interface()) << reply.DebugString();
@@ -390,7 +403,7 @@ TEST(SubdomainServer, OtherMajorVersionIsAMismatchNamingBothVersions) {
   const protocol::Envelope reply = exchange(server, hello_request(9, 2));
   expect_error(reply, protocol::VERSION_MISMATCH, "awaiting_setup");
   EXPECT_NE(reply.error().message().find("2.0"), std::string::npos) << reply.error().message();
-  EXPECT_NE(reply.error().message().find("1.0"), std::string::npos) << reply.error().message();
+  EXPECT_NE(reply.error().message().find("1.1"), std::string::npos) << reply.error().message();
   EXPECT_TRUE(exchange(server, hello_request(10)).has_hello_reply());  // still serving
 }
 
@@ -447,6 +460,79 @@ TEST_F(ReadyServer, CorrectionAndFieldsOfWrongLengthAreInvalid) {
   protocol::Envelope fields = request(4);
   fields.mutable_fields()->add_contact_force(1.0);
   expect_error(exchange(server, fields), protocol::INVALID_ARGUMENT, "ready");
+}
+
+TEST_F(ReadyServer, NeumannSolveIsTheNormalTraceOfTheDisplacement) {
+  Eigen::VectorXd force(21);  // compressive, varying along the edge (x in [-1, 1])
+  for (int i = 0; i < 21; ++i) force[i] = 2.0 + interface.coordinates[i].x();
+  const protocol::Envelope reply = exchange(server, neumann_solve_request(3, force));
+  ASSERT_TRUE(reply.has_neumann_result()) << reply.DebugString();
+  EXPECT_GE(reply.neumann_result().compute_seconds(), 0.0);
+  EXPECT_EQ(server.state(), ServerState::ready);
+  reference.assign_contact(assign_all(interface));
+  const Eigen::VectorXd displacement = reference.displacement(force);
+  Eigen::VectorXd expected(21);  // u(node_i) . (0, 1)
+  for (int i = 0; i < 21; ++i) expected[i] = displacement[2 * interface.node_ids[i] + 1];
+  EXPECT_LT(expected.maxCoeff(), 0.0);  // the clamped, unloaded block is pushed down
+  expect_equal_vectors(to_vector(reply.neumann_result().normal_trace()), expected);
+}
+
+TEST_F(ReadyServer, NeumannSolveOfWrongLengthOrNonFiniteIsInvalidAndTheStateIsKept) {
+  protocol::Envelope reply = exchange(server, neumann_solve_request(3, Eigen::VectorXd::Ones(22)));
+  expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
+  EXPECT_NE(reply.error().message().find("NeumannSolveRequest.contact_force has 22 values for the "
+                                         "21 contact nodes of body 'lower'"),
+            std::string::npos)
+      << reply.error().message();
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity()}) {
+    Eigen::VectorXd force = Eigen::VectorXd::Ones(21);
+    force[6] = bad;
+    reply = exchange(server, neumann_solve_request(4, force));
+    expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
+    EXPECT_NE(reply.error().message().find("NeumannSolveRequest.contact_force[6] of body 'lower' "
+                                           "is not a finite number"),
+              std::string::npos)
+        << reply.error().message();
+  }
+  EXPECT_TRUE(
+      exchange(server, neumann_solve_request(5, Eigen::VectorXd::Ones(21))).has_neumann_result());
+}
+
+TEST(SubdomainServer, NeumannSolveBeforeSetupOrAssignmentIsWrongState) {
+  SubdomainServer server(quiet_settings());
+  protocol::Envelope reply = exchange(server, neumann_solve_request(1, Eigen::VectorXd::Zero(21)));
+  expect_error(reply, protocol::WRONG_STATE, "awaiting_setup");
+  EXPECT_EQ(reply.error().message(), "NeumannSolveRequest before SetupBody: send SetupBody first");
+  ASSERT_TRUE(exchange(server, setup_request(2, lower_block_setup())).has_interface());
+  reply = exchange(server, neumann_solve_request(3, Eigen::VectorXd::Zero(21)));
+  expect_error(reply, protocol::WRONG_STATE, "awaiting_assignment");
+  EXPECT_NE(reply.error().message().find("NeumannSolveRequest before AssignContact"),
+            std::string::npos);
+}
+
+TEST(SubdomainServer, WithheldNeumannCapabilityIsNeitherAnnouncedNorServed) {
+  ServerSettings settings = quiet_settings();
+  settings.protocol_minor = 0;  // as a protocol 1.0 server
+  settings.withheld_capabilities = {"neumann_solve"};
+  SubdomainServer server(settings);
+  const auto handle = [&server](const protocol::Envelope& envelope) {
+    protocol::Envelope reply;
+    EXPECT_TRUE(reply.ParseFromString(server.handle(envelope.SerializeAsString())));
+    EXPECT_EQ(reply.version().major(), protocol::protocol_major);
+    EXPECT_EQ(reply.version().minor(), 0u);
+    return reply;
+  };
+  const protocol::Envelope hello = handle(hello_request(1));
+  ASSERT_TRUE(hello.has_hello_reply());
+  EXPECT_EQ(hello.hello_reply().capabilities_size(), 3);
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  ASSERT_TRUE(handle(setup_request(2, lower_block_setup())).has_interface());
+  ASSERT_TRUE(handle(assign_all_request(3, interface)).has_acknowledge());
+  const protocol::Envelope reply = handle(neumann_solve_request(4, Eigen::VectorXd::Ones(21)));
+  expect_error(reply, protocol::UNSUPPORTED, "ready");
+  EXPECT_NE(reply.error().message().find("'neumann_solve'"), std::string::npos);
+  EXPECT_TRUE(handle(contact_solve_request(5, Eigen::VectorXd::Ones(21))).has_contact_result());
 }
 
 TEST_F(ReadyServer, BadAssignmentsAreInvalidAndKeepThePreviousAssignment) {
