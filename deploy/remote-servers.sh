@@ -27,6 +27,11 @@
 #   --log-dir DIR           server output and logs (server-N.out, server-N.log), on this host.
 #                           Default: DIR/logs for the coordinator's --output DIR.
 #   --server-log-level L    --log-level of the servers (default info).
+#   --server-arguments WORDS
+#                           more options for every server, split into words, e.g. CurveZMQ's
+#                           "--curve-secret-key /etc/robin-contact/server.secret --curve-allow
+#                           /etc/robin-contact/allowed" (paths as seen by the server; see
+#                           docs/security.md). Default: none.
 #   --startup-timeout S     seconds to wait for each "listening on" line (default 60).
 #   --grace S               seconds between SIGTERM and SIGKILL when stopping (default 5).
 #
@@ -68,6 +73,7 @@ subdomain_binary=$(default_binary robin-subdomain "${ROBIN_SUBDOMAIN:-}")
 coordinator_binary=$(default_binary robin-coordinator "${ROBIN_COORDINATOR:-}")
 log_directory=""
 server_log_level=info
+server_arguments=""
 startup_timeout=60
 grace=5
 server_listen=()   # per server: the endpoint it binds
@@ -91,6 +97,7 @@ while [ $# -gt 0 ]; do
     --coordinator-binary) require_value "$1" $#; coordinator_binary=$2; shift 2 ;;
     --log-dir) require_value "$1" $#; log_directory=$2; shift 2 ;;
     --server-log-level) require_value "$1" $#; server_log_level=$2; shift 2 ;;
+    --server-arguments) require_value "$1" $#; server_arguments=$2; shift 2 ;;
     --startup-timeout) require_value "$1" $#; startup_timeout=$2; shift 2 ;;
     --grace) require_value "$1" $#; grace=$2; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "$0" | sed -e '$d' -e 's/^# \{0,1\}//'; exit 0 ;;
@@ -165,10 +172,11 @@ trap 'log "interrupted (SIGHUP)"; exit 129' HUP
 # Starts server INDEX through its prefix, its standard output in server-N.out (where the
 # "listening on" line arrives) and its standard error in server-N.log.
 start_server() {
-  local index=$1 number=$(($1 + 1)) prefix_words=()
+  local index=$1 number=$(($1 + 1)) prefix_words=() extra_words=()
   read -r -a prefix_words <<< "${server_launch[index]}"
+  read -r -a extra_words <<< "$server_arguments"
   "${prefix_words[@]}" "$subdomain_binary" --listen "${server_listen[index]}" \
-    --name "server-$number" --log-level "$server_log_level" \
+    --name "server-$number" --log-level "$server_log_level" "${extra_words[@]}" \
     > "$log_directory/server-$number.out" 2> "$log_directory/server-$number.log" < /dev/null &
   server_pids+=($!)
   log "server $number: ${server_launch[index]:+${server_launch[index]} }$subdomain_binary" \

@@ -17,6 +17,7 @@
 #include "protocol_version.hpp"
 #include "remote/conformance_body.hpp"
 #include "remote/conformance_session.hpp"
+#include "remote/curve_options.hpp"
 #include "remote/request_channel.hpp"
 #include "robin.pb.h"
 
@@ -817,7 +818,9 @@ std::string ServerChecks::oversized_message() {
   const std::string what = "a Hello of " + std::to_string(size) + " bytes";
   std::string outcome;
   try {
-    RequestChannel channel(session_.endpoint(), ChannelOptions{});
+    ChannelOptions channel_options;
+    channel_options.curve = session_.options().curve;
+    RequestChannel channel(session_.endpoint(), channel_options);
     Envelope request = hello_request();
     request.mutable_hello()->set_client_name(std::string(static_cast<std::size_t>(size), 'x'));
     const Deadline deadline = Deadline::after(session_.options().reply_timeout_seconds);
@@ -922,11 +925,25 @@ int server_check_main(int argc, const char* const* argv) {
       ->capture_default_str();
   app.add_flag("--include-shutdown", options.include_shutdown,
                "finish with a Shutdown request (the server must exit)");
-  app.footer("Exit codes: 0 the server conforms, 1 it does not, 2 bad command line.");
+  CurveClientSettings curve;
+  add_curve_client_options(app, curve, "(one server)");
+  app.footer(
+      "Exit codes: 0 the server conforms, 1 it does not (or a key file is unusable), 2 bad "
+      "command line.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     return app.exit(error) == 0 ? 0 : 2;
+  }
+  if (const std::string problem = curve_options_problem(curve, 1); !problem.empty()) {
+    std::cerr << "robin-coordinator --check-server: " << problem << "\n";
+    return 2;
+  }
+  try {
+    options.curve = load_curve_client_keys(curve, 1).front();
+  } catch (const std::exception& error) {
+    std::cerr << "robin-coordinator --check-server: " << error.what() << "\n";
+    return 1;
   }
   const ConformanceReport report = check_server(endpoint, options);
   std::cout << format_report(report) << std::flush;

@@ -41,8 +41,11 @@
 // include_shutdown is set; then Shutdown is the last request and the server must stop answering.
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "curve_keys.hpp"
 
 namespace robin {
 
@@ -51,6 +54,7 @@ struct ConformanceOptions {
   long oversized_message_bytes = 64L << 20;  // size of the oversized-message probe (64 MiB)
   bool include_shutdown = false;             // finish with Shutdown (the server exits)
   double tolerance = 1e-8;                   // relative tolerance of the numerical checks
+  std::optional<CurveClientKeys> curve;      // CurveZMQ client keys; unset: no security
 };
 
 struct ConformanceCheck {
@@ -81,7 +85,8 @@ std::string format_report(const ConformanceReport& report);
 bool requests_server_check(int argc, const char* const* argv);
 
 /// robin-coordinator --check-server ENDPOINT [--timeout S] [--max-message-size-probe BYTES]
-/// [--tolerance T] [--include-shutdown]: prints the report on standard output. Returns 0 when
+/// [--tolerance T] [--include-shutdown] [--curve-secret-key FILE --curve-server-key FILE]:
+/// prints the report on standard output. Returns 0 when
 /// the server conforms, 1 when it does not, 2 for a bad command line.
 int server_check_main(int argc, const char* const* argv);
 

@@ -80,11 +80,18 @@ class ProbeConnection {
   /// time out). Without it, a reply that arrives just before the server closes the connection
   /// is still delivered: with ZMQ_IMMEDIATE libzmq discards the unread messages of a lost
   /// connection, which loses the Acknowledge of a server that exits after Shutdown.
-  ProbeConnection(zmq::context_t& context, const std::string& endpoint, bool immediate)
-      : socket_(context, zmq::socket_type::dealer) {
+  /// `curve`: a CurveZMQ client with these keys (unset: no transport security).
+  ProbeConnection(zmq::context_t& context, const std::string& endpoint, bool immediate,
+                  const std::optional<CurveClientKeys>& curve)
+      : socket_(context, zmq::socket_type::dealer), curve_(curve.has_value()) {
     socket_.set(zmq::sockopt::linger, 0);
     socket_.set(zmq::sockopt::immediate, immediate ? 1 : 0);
     socket_.set(zmq::sockopt::maxmsgsize, std::int64_t{1} << 30);
+    if (curve) {
+      socket_.set(zmq::sockopt::curve_serverkey, curve->server_public_key);
+      socket_.set(zmq::sockopt::curve_publickey, curve->client.public_key);
+      socket_.set(zmq::sockopt::curve_secretkey, curve->client.secret_key);
+    }
     socket_.connect(endpoint);  // throws zmq::error_t for a malformed endpoint
   }
 
@@ -92,7 +99,11 @@ class ProbeConnection {
   std::string send(const std::vector<std::string>& frames, const Deadline& deadline) {
     if (!wait_for(ZMQ_POLLOUT, deadline)) {
       return "could not send within " + number(deadline.seconds) +
-             " s: no connection to the server (is it running at that endpoint?)";
+             " s: no connection to the server (is it running at that endpoint?" +
+             (curve_ ? " with CurveZMQ: is --curve-server-key its public key, and this "
+                       "client's public key on its allow-list?"
+                     : "") +
+             ")";
     }
     bool sent = socket_.send(zmq::message_t(), zmq::send_flags::sndmore).has_value();
     for (std::size_t i = 0; sent && i < frames.size(); ++i) {
@@ -136,6 +147,7 @@ class ProbeConnection {
   }
 
   zmq::socket_t socket_;
+  bool curve_ = false;
 };
 
 }  // namespace
@@ -152,12 +164,13 @@ struct Session::Transport {
   zmq::context_t context{1};
   std::unique_ptr<ProbeConnection> connection;
   bool immediate = true;  // for the next connection
+  std::optional<CurveClientKeys> curve;
 
   /// Opens a connection into `connection`; returns the problem, or "".
   std::string connect(const std::string& endpoint, std::unique_ptr<ProbeConnection>& connection,
                       bool immediate) {
     try {
-      connection = std::make_unique<ProbeConnection>(context, endpoint, immediate);
+      connection = std::make_unique<ProbeConnection>(context, endpoint, immediate, curve);
       return "";
     } catch (const zmq::error_t& error) {
       return "cannot connect to '" + endpoint + "': " + error.what() +
@@ -171,7 +184,9 @@ Session::Session(const std::string& endpoint, const ConformanceOptions& options,
     : endpoint_(endpoint),
       options_(options),
       report_(report),
-      transport_(std::make_unique<Transport>()) {}
+      transport_(std::make_unique<Transport>()) {
+  transport_->curve = options.curve;
+}
 
 Session::~Session() = default;
 

@@ -1,6 +1,10 @@
 // robin-coordinator CASE --subdomain ENDPOINT --subdomain ENDPOINT --output DIR [options]
 // Runs the Robin domain decomposition of a case on two running robin-subdomain servers; the
-// first --subdomain serves body 1, the second body 2. Exit codes: coordinator_application.hpp.
+// first --subdomain serves body 1, the second body 2. With --curve-secret-key and
+// --curve-server-key the connections use CurveZMQ (curve_options.hpp, docs/security.md).
+// Exit codes: coordinator_application.hpp.
+
+#include <spdlog/spdlog.h>
 
 #include <iostream>
 #include <string>
@@ -8,6 +12,7 @@
 
 #include "remote/conformance_check.hpp"
 #include "remote/coordinator_application.hpp"
+#include "remote/curve_options.hpp"
 #include "remote/run_interruption.hpp"
 
 int main(int argc, char** argv) {
@@ -24,7 +29,9 @@ int main(int argc, char** argv) {
                  "the first serves body 1")
       ->required()
       ->allow_extra_args(false);  // one endpoint per --subdomain; the count is checked below
-  std::string check_server;       // handled above; listed here for --help
+  robin::CurveClientSettings curve;
+  robin::add_curve_client_options(app, curve, "--subdomain");
+  std::string check_server;  // handled above; listed here for --help
   app.add_option("--check-server", check_server,
                  "instead of a run: check that the server at ENDPOINT conforms to the protocol "
                  "(CASE and --subdomain are then not needed; --check-server ENDPOINT --help)")
@@ -36,11 +43,26 @@ int main(int argc, char** argv) {
               << subdomains.size() << "\nRun with --help for more information.\n";
     return 2;
   }
-  robin::make_coordinator_logger(settings.log_level);
+  if (const std::string problem = robin::curve_options_problem(curve, subdomains.size());
+      !problem.empty()) {
+    std::cerr << "robin-coordinator: " << problem << "\nRun with --help for more information.\n";
+    return 2;
+  }
+  const auto log = robin::make_coordinator_logger(settings.log_level);
   robin::install_stop_signal_handlers();
+  std::vector<std::optional<robin::CurveClientKeys>> curve_keys;
+  try {
+    curve_keys = robin::load_curve_client_keys(curve, subdomains.size());
+  } catch (const std::exception& error) {
+    log->error("{}", error.what());
+    return 1;
+  }
   const auto definition = robin::load_case(settings);
   if (!definition) return 1;
   std::array<robin::ChannelOptions, 2> channels;
-  for (auto& channel : channels) channel.on_wait = robin::throw_if_stop_requested;
+  for (std::size_t index = 0; index < channels.size(); ++index) {
+    channels[index].on_wait = robin::throw_if_stop_requested;
+    channels[index].curve = curve_keys[index];
+  }
   return robin::run_coordinator(*definition, settings, {subdomains[0], subdomains[1]}, channels);
 }

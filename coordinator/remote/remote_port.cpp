@@ -287,10 +287,12 @@ const PortTimings& RemotePort::timings() const {
   return timings_;
 }
 
-bool request_server_shutdown(const std::string& endpoint, double timeout_seconds) noexcept {
+bool request_server_shutdown(const std::string& endpoint, double timeout_seconds,
+                             const std::optional<CurveClientKeys>& curve) noexcept {
   try {
     ChannelOptions options;
     options.immediate = false;  // keep the acknowledgement even though the server exits at once
+    options.curve = curve;
     RequestChannel channel(endpoint, options);
     const Deadline deadline = Deadline::after(timeout_seconds);
     Envelope request;

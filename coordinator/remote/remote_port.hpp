@@ -24,6 +24,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -91,8 +92,9 @@ class RemotePort final : public SubdomainPort {
   PortTimings timings_;
 };
 
-/// Asks the server at `endpoint` to stop (Shutdown request) on a fresh connection; true when
-/// it acknowledged within `timeout_seconds`. Never throws.
-bool request_server_shutdown(const std::string& endpoint, double timeout_seconds) noexcept;
+/// Asks the server at `endpoint` to stop (Shutdown request) on a fresh connection (a CurveZMQ
+/// one with `curve`); true when it acknowledged within `timeout_seconds`. Never throws.
+bool request_server_shutdown(const std::string& endpoint, double timeout_seconds,
+                             const std::optional<CurveClientKeys>& curve = std::nullopt) noexcept;
 
 }  // namespace robin

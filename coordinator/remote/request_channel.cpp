@@ -27,6 +27,20 @@ std::string format_seconds(double seconds) {
   return text.str();
 }
 
+/// "not on its allow-list" style explanation of a ZAP status code (RFC 27).
+std::string zap_status_meaning(std::uint32_t status_code) {
+  switch (status_code) {
+    case 300:
+      return "a temporary error in the server's authentication";
+    case 400:
+      return "the server does not admit this client";
+    case 500:
+      return "an internal error in the server's authentication";
+    default:
+      return "status " + std::to_string(status_code);
+  }
+}
+
 std::string next_monitor_address() {
   static std::atomic<unsigned long> counter{0};
   return "inproc://robin-channel-monitor-" + std::to_string(counter++);
@@ -57,10 +71,20 @@ RequestChannel::RequestChannel(const std::string& endpoint, ChannelOptions optio
   dealer.set(zmq::sockopt::heartbeat_ivl, options_.heartbeat_interval_milliseconds);
   dealer.set(zmq::sockopt::heartbeat_timeout, options_.heartbeat_timeout_milliseconds);
   dealer.set(zmq::sockopt::heartbeat_ttl, 2 * options_.heartbeat_timeout_milliseconds);
+  if (options_.curve) {
+    if (!curve_available()) {
+      throw ChannelFailure("this libzmq is built without CURVE (zmq_has(\"curve\") is false)");
+    }
+    dealer.set(zmq::sockopt::curve_serverkey, options_.curve->server_public_key);
+    dealer.set(zmq::sockopt::curve_publickey, options_.curve->client.public_key);
+    dealer.set(zmq::sockopt::curve_secretkey, options_.curve->client.secret_key);
+  }
   const std::string monitor_address = next_monitor_address();
-  if (zmq_socket_monitor(
-          dealer.handle(), monitor_address.c_str(),
-          ZMQ_EVENT_CONNECTED | ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_DISCONNECTED) != 0) {
+  constexpr int monitored_events = ZMQ_EVENT_CONNECTED | ZMQ_EVENT_HANDSHAKE_SUCCEEDED |
+                                   ZMQ_EVENT_DISCONNECTED | ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL |
+                                   ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
+                                   ZMQ_EVENT_HANDSHAKE_FAILED_AUTH;
+  if (zmq_socket_monitor(dealer.handle(), monitor_address.c_str(), monitored_events) != 0) {
     throw ChannelFailure(std::string("cannot monitor the connection: ") + zmq_strerror(errno));
   }
   sockets_->monitor.set(zmq::sockopt::linger, 0);
@@ -126,7 +150,9 @@ bool RequestChannel::connection_lost() {
 void RequestChannel::check_connection() {
   const std::string reason = server_failure_reason();
   if (!reason.empty()) throw ChannelFailure(reason);
-  if (!connection_lost()) return;
+  const bool lost = connection_lost();
+  if (!handshake_failure_.empty()) throw ChannelFailure(handshake_failure_);
+  if (!lost) return;
   // The process behind a lost connection is usually exiting: give its fate a moment to show.
   const auto give_up = Clock::now() + lost_connection_grace;
   for (std::string late_reason; Clock::now() < give_up;
@@ -178,7 +204,11 @@ void RequestChannel::read_monitor_events() {
     zmq::message_t event;
     if (!sockets_->monitor.recv(event, zmq::recv_flags::dontwait)) return;
     std::uint16_t number = 0;
-    if (event.size() >= sizeof number) std::memcpy(&number, event.data(), sizeof number);
+    std::uint32_t value = 0;
+    if (event.size() >= sizeof number + sizeof value) {
+      std::memcpy(&number, event.data(), sizeof number);
+      std::memcpy(&value, static_cast<const char*>(event.data()) + sizeof number, sizeof value);
+    }
     while (event.more()) {
       if (!sockets_->monitor.recv(event, zmq::recv_flags::dontwait)) break;
     }
@@ -187,8 +217,47 @@ void RequestChannel::read_monitor_events() {
     } else if (number == ZMQ_EVENT_DISCONNECTED && connected_) {
       connected_ = false;
       lost_ = true;
+    } else if (handshake_failure_.empty() || number == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
+      handshake_failure_ = handshake_failure(number, value);
     }
   }
+}
+
+std::string RequestChannel::handshake_failure(unsigned event, std::uint32_t value) const {
+  const bool curve = options_.curve.has_value();
+  const std::string mechanism = curve ? "CurveZMQ" : "unencrypted (no CurveZMQ)";
+  if (event == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
+    std::string text = "authentication refused by the server (" + zap_status_meaning(value) +
+                       ", ZAP status " + std::to_string(value) + ")";
+    if (curve && value == 400) {
+      text += ": this coordinator's public key " + options_.curve->client.public_key +
+              " is not on the server's allow-list (robin-subdomain --curve-allow)";
+    }
+    return text;
+  }
+  if (event == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL &&
+      value == ZMQ_PROTOCOL_ERROR_ZMTP_MECHANISM_MISMATCH) {
+    return "the security handshake failed: the server and this coordinator use different "
+           "security mechanisms (this coordinator: " +
+           mechanism + "); " +
+           (curve ? "the server runs without --curve-secret-key"
+                  : "the server requires CurveZMQ: give --curve-secret-key and "
+                    "--curve-server-key");
+  }
+  if (event == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL) {
+    std::ostringstream code;
+    code << std::hex << value;
+    return "the security handshake failed (" + mechanism + ", ZMTP protocol error 0x" + code.str() +
+           ")";
+  }
+  if (curve) {
+    return "the CurveZMQ handshake failed: the server closed the connection during it (is "
+           "--curve-server-key this server's public key, and does the server run with "
+           "--curve-secret-key?)";
+  }
+  return "the connection handshake failed: the peer closed the connection during the ZeroMQ "
+         "handshake (is it a robin-subdomain server? if it requires CurveZMQ, give "
+         "--curve-secret-key and --curve-server-key)";
 }
 
 }  // namespace robin

@@ -24,13 +24,27 @@
 // A socket monitor reports disconnects: a connection lost after it was established fails the
 // pending and every later request at once, instead of at the deadline (a server that crashed or
 // was killed lost the body's state, so there is nothing to resume).
+//
+// CurveZMQ (ChannelOptions::curve, docs/security.md): the dealer is a CURVE client with the
+// coordinator's key pair and the server's public key. The monitor also reports failed security
+// handshakes, which fail the pending and every later request at once with a message that says
+// why: ZMQ_EVENT_HANDSHAKE_FAILED_AUTH (the server's ZAP handler refused this client's public
+// key: status 400; libzmq does not reconnect after it, so without the event a request would
+// wait until its deadline), ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL (e.g. one side uses CURVE and
+// the other not) and ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL (the server closed the connection
+// during the handshake: a CURVE server does that to a client that encrypted its HELLO for
+// another server key). A handshake failure takes precedence over the lost connection that
+// follows it.
 
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+
+#include "curve_keys.hpp"
 
 namespace robin::protocol {
 class Envelope;
@@ -61,6 +75,8 @@ struct ChannelOptions {
   /// ZMQ_IMMEDIATE (see above). False keeps a reply that arrived just before the server closed
   /// its end; the send then queues without waiting for the connection.
   bool immediate = true;
+  /// CurveZMQ client keys; unset: no transport security (ZMTP's NULL mechanism).
+  std::optional<CurveClientKeys> curve;
   /// Called at least every 100 ms while waiting; may throw (e.g. RunInterrupted) to abandon the
   /// wait. The exception propagates unchanged.
   std::function<void()> on_wait;
@@ -101,12 +117,15 @@ class RequestChannel {
   void check_connection();
   std::string server_failure_reason() const;
   void read_monitor_events();
+  /// The message for a failed handshake (monitor event `event` with value `value`).
+  std::string handshake_failure(unsigned event, std::uint32_t value) const;
 
   std::unique_ptr<Sockets> sockets_;
   ChannelOptions options_;
   std::uint64_t next_request_id_ = 1;
   bool connected_ = false;
   bool lost_ = false;
+  std::string handshake_failure_;  // why the security handshake failed, or ""
   bool hooks_enabled_ = true;
   long bytes_sent_ = 0;
   long bytes_received_ = 0;

@@ -109,7 +109,8 @@ void SubdomainServer::request_shutdown() noexcept {
   if (stopping_) return;
   stopping_ = true;
   if (!endpoint_.empty() && process_->running()) {
-    shutdown_acknowledged_ = request_server_shutdown(endpoint_, options_.shutdown_timeout_seconds);
+    shutdown_acknowledged_ = request_server_shutdown(endpoint_, options_.shutdown_timeout_seconds,
+                                                     options_.curve_client);
   }
 }
 

@@ -12,9 +12,11 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "curve_keys.hpp"
 #include "remote/child_process.hpp"
 
 namespace robin {
@@ -29,6 +31,9 @@ struct ServerLaunchOptions {
   double grace_seconds = 3.0;                // before SIGTERM, and again before SIGKILL
   std::vector<std::string> extra_arguments;  // appended to the server's command line
   std::vector<std::string> command_prefix;   // see child_process.hpp; empty: run directly
+  /// The coordinator's keys for the Shutdown request when the servers use CurveZMQ (their
+  /// --curve-secret-key and --curve-allow in extra_arguments).
+  std::optional<CurveClientKeys> curve_client;
 };
 
 /// `name` next to the running executable (/proc/self/exe), e.g. build/bin/robin-subdomain.

@@ -1,8 +1,10 @@
 // robin-subdomain: serves one elastic body of a robin-contact run over ZeroMQ
 // (proto/robin.proto). Prints exactly one line on stdout, "listening on ENDPOINT", once bound
 // (wildcards and ephemeral ports resolved); logs go to stderr.
-// Exit codes: 0 after Shutdown, SIGINT or SIGTERM; 1 when the endpoint cannot be bound or the
-// transport fails; CLI11's codes for bad command lines.
+// With --curve-secret-key and --curve-allow the transport is CurveZMQ (docs/security.md).
+// Exit codes: 0 after Shutdown, SIGINT or SIGTERM; 1 when the endpoint cannot be bound, the
+// transport fails, or the CURVE options or key files are unusable; CLI11's codes for bad
+// command lines.
 
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -10,8 +12,10 @@
 #include <atomic>
 #include <csignal>
 #include <cstdint>
+#include <filesystem>
 #include <iostream>
 
+#include "curve_keys.hpp"
 #include "protocol_version.hpp"
 #include "server/server_logging.hpp"
 #include "server/server_loop.hpp"
@@ -38,6 +42,8 @@ struct CommandLine {
   robin::ServerLoopOptions loop;
   robin::ServerSettings server;
   std::string log_level = "info";
+  std::filesystem::path curve_secret_key;  // empty: no CURVE
+  std::filesystem::path curve_allow;
 };
 
 void add_options(CLI::App& app, CommandLine& command_line) {
@@ -54,6 +60,14 @@ void add_options(CLI::App& app, CommandLine& command_line) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--name", command_line.server.name, "label for the logs and HelloReply");
+  app.add_option("--curve-secret-key", command_line.curve_secret_key,
+                 "the server's key pair (a robin-keygen .secret file): encrypts the transport "
+                 "with CurveZMQ and admits only the clients of --curve-allow")
+      ->type_name("FILE");
+  app.add_option("--curve-allow", command_line.curve_allow,
+                 "allow-list of client public keys for CurveZMQ: one Z85 key per line (bare or "
+                 "public-key = \"...\", i.e. concatenated .public files), '#' comments")
+      ->type_name("FILE");
   // Testing only: announce and accept another protocol major version, announce another minor.
   app.add_option("--protocol-major", command_line.server.protocol_major)->group("");
   app.add_option("--protocol-minor", command_line.server.protocol_minor)->group("");
@@ -64,6 +78,35 @@ void add_options(CLI::App& app, CommandLine& command_line) {
       ->type_name("NAME")
       ->check(CLI::IsMember({"neumann_solve"}))
       ->group("Testing only");
+}
+
+/// The CURVE settings of the command line; throws std::runtime_error or KeyFileError naming the
+/// option or the file when they are incomplete or unusable.
+std::optional<robin::CurveServerOptions> curve_options(const CommandLine& command_line) {
+  const bool has_key = !command_line.curve_secret_key.empty();
+  const bool has_allow_list = !command_line.curve_allow.empty();
+  if (!has_key && !has_allow_list) return std::nullopt;
+  if (!has_allow_list) {
+    throw std::runtime_error(
+        "--curve-secret-key needs --curve-allow FILE: without an allow-list of client public "
+        "keys the server would admit every client (refusing to start)");
+  }
+  if (!has_key) {
+    throw std::runtime_error(
+        "--curve-allow needs --curve-secret-key FILE (the server's key pair, from "
+        "robin-keygen)");
+  }
+  if (!robin::curve_available()) {
+    throw std::runtime_error("this libzmq is built without CURVE (zmq_has(\"curve\") is false)");
+  }
+  robin::CurveServerOptions curve;
+  curve.key_pair = robin::read_curve_secret_key_file(command_line.curve_secret_key);
+  curve.allowed_client_keys = robin::read_curve_allow_list(command_line.curve_allow);
+  curve.allow_list = command_line.curve_allow.string();
+  const std::string warning =
+      robin::secret_key_file_permission_warning(command_line.curve_secret_key);
+  if (!warning.empty()) robin::subdomain_logger()->warn("{}", warning);
+  return curve;
 }
 
 }  // namespace
@@ -77,6 +120,12 @@ int main(int argc, char** argv) {
   const auto logger = robin::subdomain_logger();
   logger->set_level(spdlog::level::from_str(command_line.log_level));
   install_signal_handlers();
+  try {
+    command_line.loop.curve = curve_options(command_line);
+  } catch (const std::exception& error) {
+    logger->error("{}", error.what());
+    return 1;
+  }
   robin::SubdomainServer server(command_line.server);
   try {
     const std::string reason = robin::run_server_loop(

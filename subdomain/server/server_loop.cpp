@@ -8,6 +8,7 @@
 #include <zmq.hpp>
 
 #include "server/server_logging.hpp"
+#include "server/zap_handler.hpp"
 
 namespace robin {
 namespace {
@@ -51,6 +52,10 @@ class ReplySocket {
     socket.set(zmq::sockopt::linger, 0);
     socket.set(zmq::sockopt::maxmsgsize, options_.max_message_size);
     socket.set(zmq::sockopt::sndtimeo, static_cast<int>(options_.send_timeout.count()));
+    if (options_.curve) {
+      socket.set(zmq::sockopt::curve_server, 1);
+      socket.set(zmq::sockopt::curve_secretkey, options_.curve->key_pair.secret_key);
+    }
     socket.bind(endpoint);
     return socket;
   }
@@ -113,9 +118,19 @@ std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& op
                             const std::function<void(const std::string&)>& on_listening) {
   const auto logger = subdomain_logger();
   zmq::context_t context(1);
+  // Bound before the socket: without a ZAP handler, libzmq admits every CURVE client.
+  std::optional<ZapHandler> authentication;
+  if (options.curve) {
+    authentication.emplace(context, options.curve->allowed_client_keys, options.curve->allow_list);
+  }
   ReplySocket socket(context, options);
-  logger->info("{} listening on {} (max message size {} bytes)", server.server_name(),
-               socket.endpoint(), options.max_message_size);
+  logger->info("{} listening on {} (max message size {} bytes, {})", server.server_name(),
+               socket.endpoint(), options.max_message_size,
+               options.curve ? "CurveZMQ with public key " + options.curve->key_pair.public_key +
+                                   ", admitting the " +
+                                   std::to_string(options.curve->allowed_client_keys.size()) +
+                                   " client key(s) of " + options.curve->allow_list
+                             : std::string("no transport security"));
   on_listening(socket.endpoint());
   while (!stop.load()) {
     if (!wait_for_request(socket.socket(), options.poll_interval)) continue;

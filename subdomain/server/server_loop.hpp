@@ -12,17 +12,32 @@
 //    loop goes on.
 // Each message must be one frame (one serialized Envelope); a multi-frame message gets a
 // MALFORMED_MESSAGE reply.
+//
+// With `curve` set, the socket is a CurveZMQ server (ZMQ_CURVE_SERVER with the server's secret
+// key): traffic is encrypted and only clients whose public key is on the allow-list are
+// admitted, by the ZAP handler (zap_handler.hpp) started in the socket's context before the
+// socket binds. Without it the transport has no security (ZMTP's NULL mechanism).
 
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "curve_keys.hpp"
 #include "server/subdomain_server.hpp"
 
 namespace robin {
+
+/// CurveZMQ on the server's socket (docs/security.md).
+struct CurveServerOptions {
+  CurveKeyPair key_pair;  // the server's (robin-subdomain --curve-secret-key)
+  std::vector<std::string> allowed_client_keys;  // Z85 public keys (--curve-allow)
+  std::string allow_list;                        // the allow-list's file, named in the log
+};
 
 struct ServerLoopOptions {
   std::string endpoint;
@@ -30,6 +45,8 @@ struct ServerLoopOptions {
   std::chrono::milliseconds send_timeout{10000};
   /// How often the stop flag is checked while no request arrives.
   std::chrono::milliseconds poll_interval{200};
+  /// Unset: no transport security.
+  std::optional<CurveServerOptions> curve;
 };
 
 /// The endpoint cannot be bound (address in use, malformed endpoint, ...). Names the endpoint.

@@ -25,30 +25,9 @@ namespace robin {
 namespace {
 
 using testing::example;
+using testing::ProcessOutcome;
+using testing::run_tool;
 using testing::TemporaryDirectory;
-using testing::tool;
-
-struct ProcessOutcome {
-  std::string exit;    // ChildProcess::exit_description()
-  std::string errors;  // the process's standard error
-};
-
-/// Runs `executable arguments...` to completion (at most `timeout_seconds`).
-ProcessOutcome run_tool(const std::string& executable, const std::vector<std::string>& arguments,
-                        const std::filesystem::path& directory, double timeout_seconds) {
-  ChildProcessOptions options;
-  options.executable = tool(executable);
-  options.arguments = arguments;
-  options.log_file = directory / (executable + ".stderr");
-  ChildProcess process(options);
-  while (process.read_line(ChildProcess::Clock::time_point::max())) {
-  }
-  EXPECT_TRUE(process.wait_for_exit(timeout_seconds)) << executable << " did not finish";
-  ProcessOutcome outcome{process.exit_description(), {}};
-  std::ifstream file(options.log_file);
-  outcome.errors.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-  return outcome;
-}
 
 /// The processes whose parent is this process and whose command name is `name`.
 std::vector<int> children_named(const std::string& name) {

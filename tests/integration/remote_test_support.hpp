@@ -8,8 +8,12 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
 
+#include "remote/child_process.hpp"
 #include "remote/server_launcher.hpp"
 
 namespace robin::testing {
@@ -64,6 +68,34 @@ inline ::testing::AssertionResult vectors_close(const Eigen::VectorXd& a, const 
   if (difference <= tolerance * scale) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure()
          << "max difference " << difference << " > " << tolerance << " x " << scale;
+}
+
+/// What a finished tool process left behind.
+struct ProcessOutcome {
+  std::string exit;    // ChildProcess::exit_description(), e.g. "exited with status 0"
+  std::string errors;  // its standard error
+  std::string output;  // its standard output
+};
+
+/// Runs build/bin/`executable` `arguments`... to completion (at most `timeout_seconds`), its
+/// standard error in `directory`/`executable`.stderr.
+inline ProcessOutcome run_tool(const std::string& executable,
+                               const std::vector<std::string>& arguments,
+                               const std::filesystem::path& directory, double timeout_seconds) {
+  ChildProcessOptions options;
+  options.executable = tool(executable);
+  options.arguments = arguments;
+  options.log_file = directory / (executable + ".stderr");
+  ChildProcess process(options);
+  ProcessOutcome outcome;
+  while (const auto line = process.read_line(ChildProcess::Clock::time_point::max())) {
+    outcome.output += *line + "\n";
+  }
+  EXPECT_TRUE(process.wait_for_exit(timeout_seconds)) << executable << " did not finish";
+  outcome.exit = process.exit_description();
+  std::ifstream file(options.log_file);
+  outcome.errors.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+  return outcome;
 }
 
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
