@@ -4,11 +4,21 @@
 // runs the coordinator against them and stops them. SIGINT/SIGTERM stop everything cleanly.
 // --curve encrypts the local connections with CurveZMQ, with keys made for this run only
 // (curve_options.hpp); without it the loopback connections are not encrypted.
+// Servers on other hosts: --server-command "ssh HOST" (or "srun -N1 -n1 ...", "ip netns exec
+// NS") puts words before the server's command line, --server-listen the address it binds, and
+// --server-executable its path there; each is given once for both servers or once per body
+// (body order). The prefix must pass the server's standard output through (its "listening on
+// ENDPOINT" line gives the endpoint the coordinator connects to) and forward SIGTERM.
 // Exit codes: coordinator_application.hpp.
 
 #include <spdlog/spdlog.h>
 
+#include <array>
+#include <cstdio>
 #include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "remote/coordinator_application.hpp"
 #include "remote/curve_options.hpp"
@@ -17,9 +27,47 @@
 
 namespace {
 
+/// Where and how the servers are started (the --server-* options).
+struct ServerPlacement {
+  std::vector<std::string> commands;   // command prefixes, split at spaces
+  std::vector<std::string> listens;    // bind endpoints
+  std::vector<std::string> executables;
+};
+
+/// Splits a command prefix at runs of spaces ("ssh -p 2222 node1").
+std::vector<std::string> split_words(const std::string& text) {
+  std::vector<std::string> words;
+  std::istringstream stream(text);
+  for (std::string word; stream >> word;) words.push_back(word);
+  return words;
+}
+
+/// The value of a once-or-per-body option for body `index` (empty: not given).
+std::string per_body(const std::vector<std::string>& values, int index) {
+  if (values.empty()) return "";
+  return values.size() == 1 ? values[0] : values[static_cast<std::size_t>(index)];
+}
+
+std::array<robin::ServerLaunchOptions, 2> placed(const robin::ServerLaunchOptions& launch,
+                                                 const ServerPlacement& placement) {
+  std::array<robin::ServerLaunchOptions, 2> options{launch, launch};
+  for (int index = 0; index < 2; ++index) {
+    options[index].command_prefix = split_words(per_body(placement.commands, index));
+    if (const std::string listen = per_body(placement.listens, index); !listen.empty()) {
+      options[index].listen = listen;
+    }
+    if (const std::string executable = per_body(placement.executables, index);
+        !executable.empty()) {
+      options[index].executable = executable;
+    }
+  }
+  return options;
+}
+
 /// Starts the servers, runs the case against them and stops them; returns the exit code.
 int run_with_local_servers(const robin::CaseDefinition& definition,
-                           const robin::CoordinatorSettings& settings, bool curve) {
+                           const robin::CoordinatorSettings& settings, bool curve,
+                           const ServerPlacement& placement) {
   robin::ServerLaunchOptions launch;
   launch.log_directory = settings.output_directory / "logs";
   launch.log_level = settings.log_level;
@@ -35,7 +83,8 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
     }
     launch.executable = robin::sibling_executable("robin-subdomain");
     robin::LocalServers servers(
-        {definition.bodies[0].definition.name, definition.bodies[1].definition.name}, launch);
+        {definition.bodies[0].definition.name, definition.bodies[1].definition.name},
+        placed(launch, placement));
     servers.await_listening(robin::throw_if_stop_requested);
     if (keys) keys->remove_files();  // read by the servers; the coordinator's are in memory
     std::array<robin::ChannelOptions, 2> channels;
@@ -68,10 +117,30 @@ int main(int argc, char** argv) {
   app.add_flag("--curve", curve,
                "encrypt the connections to the local servers with CurveZMQ, with keys made for "
                "this run (off by default: the connections stay on this machine's loopback)");
+  ServerPlacement placement;
+  app.add_option("--server-command", placement.commands,
+                 "words put before each server's command line to start it elsewhere, e.g. "
+                 "\"ssh node1\" or \"srun -N1 -n1\"; once for both or once per body")
+      ->type_name("WORDS");
+  app.add_option("--server-listen", placement.listens,
+                 "endpoint each server binds (default tcp://127.0.0.1:*), e.g. "
+                 "tcp://10.0.0.2:5555 for a server on another host; once or per body")
+      ->type_name("ENDPOINT");
+  app.add_option("--server-executable", placement.executables,
+                 "robin-subdomain's path where the servers run (default: next to robin-run); "
+                 "once or per body")
+      ->type_name("PATH");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
+  for (const auto* values : {&placement.commands, &placement.listens, &placement.executables}) {
+    if (values->size() > 2) {
+      std::fprintf(stderr, "robin-run: --server-command, --server-listen and --server-executable "
+                           "are given once for both servers or twice (body order)\n");
+      return 2;
+    }
+  }
   robin::make_coordinator_logger(settings.log_level);
   robin::install_stop_signal_handlers();
   const auto definition = robin::load_case(settings);
   if (!definition) return 1;
-  return run_with_local_servers(*definition, settings, curve);
+  return run_with_local_servers(*definition, settings, curve, placement);
 }

@@ -120,9 +120,13 @@ void SubdomainServer::finish_stop() noexcept {
 }
 
 LocalServers::LocalServers(const std::array<std::string, 2>& bodies,
-                           const ServerLaunchOptions& options) {
+                           const ServerLaunchOptions& options)
+    : LocalServers(bodies, std::array<ServerLaunchOptions, 2>{options, options}) {}
+
+LocalServers::LocalServers(const std::array<std::string, 2>& bodies,
+                           const std::array<ServerLaunchOptions, 2>& options) {
   for (int index = 0; index < 2; ++index) {
-    servers_[index] = std::make_unique<SubdomainServer>(bodies[index], options);
+    servers_[index] = std::make_unique<SubdomainServer>(bodies[index], options[index]);
   }
 }
 

@@ -81,6 +81,9 @@ class SubdomainServer {
 class LocalServers {
  public:
   LocalServers(const std::array<std::string, 2>& bodies, const ServerLaunchOptions& options);
+  /// One set of options per body (e.g. another command prefix and listen address per host).
+  LocalServers(const std::array<std::string, 2>& bodies,
+               const std::array<ServerLaunchOptions, 2>& options);
   ~LocalServers();
   /// Waits until both listen (see SubdomainServer::await_listening).
   void await_listening(const std::function<void()>& on_wait = {});

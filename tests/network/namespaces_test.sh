@@ -13,6 +13,9 @@
 #  3. deploy/remote-servers.sh interrupted by SIGTERM while the coordinator runs: exit code 143
 #     and every process it started is gone; a server that cannot bind its address: exit code 1,
 #     a message naming the endpoint, and the other server stopped.
+#  3b. robin-run itself in the coordinator namespace, starting the servers through
+#     --server-command "ip netns exec NS" with --server-listen on their own addresses: same
+#     comparison, and no server process is left in the namespaces.
 #  4. Where OpenSSH (server and client) is installed: an sshd in each server namespace and
 #     remote-servers.sh in the coordinator's namespace with `ssh -tt ADDRESS` as the prefix:
 #     same comparison, and the remote servers end when the script does. Left out otherwise.
@@ -158,6 +161,27 @@ check_bind_failure() {
   echo "deploy/remote-servers.sh with an unbindable address: status 1, message names it"
 }
 
+# --- 3b. robin-run with --server-command ------------------------------------------------------
+
+check_robin_run_server_command() {
+  local status=0 comparison
+  timeout 120 ip netns exec "$coordinator_namespace" "$binary_directory/robin-run" "$case_file" \
+    --output "$work/robin-run-prefix" --log-level info \
+    --server-command "ip netns exec ${server_namespaces[0]}" \
+    --server-command "ip netns exec ${server_namespaces[1]}" \
+    --server-listen "tcp://${server_addresses[0]}:5559" \
+    --server-listen "tcp://${server_addresses[1]}:5559" \
+    2> "$work/robin-run-prefix.stderr" || status=$?
+  [ "$status" -eq 0 ] || fail "robin-run --server-command exited with status $status: $(tail -5 "$work/robin-run-prefix.stderr")"
+  comparison=$(compare_contact "$work/local" "$work/robin-run-prefix") ||
+    fail "contact.csv of robin-run --server-command differs from the local run: $comparison"
+  grep -q "listening on tcp://${server_addresses[1]}:5559" "$work/robin-run-prefix.stderr" ||
+    fail "robin-run did not report server 2 on its namespace's address"
+  echo "robin-run --server-command 'ip netns exec NS': $comparison"
+  [ -z "$(processes_in_namespaces)" ] ||
+    fail "processes left in the namespaces after robin-run: $(processes_in_namespaces)"
+}
+
 # --- 4. ssh as the prefix (when OpenSSH's server and client are installed) ----------------------
 
 # An sshd in each server namespace (key login for this user, files in the work directory), and
@@ -223,5 +247,6 @@ check_coordinator_across_namespaces
 check_remote_servers_script
 check_interruption
 check_bind_failure
+check_robin_run_server_command
 check_ssh_prefix
 echo "PASSED: runs across network namespaces"
