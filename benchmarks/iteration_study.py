@@ -31,20 +31,22 @@ MAX_ITERATIONS = 1000
 
 
 def case_grid():
-    """(name, template, description, young modulus factors for body 1 and body 2)."""
+    """(name, template, description, young modulus factors for body 1 and body 2, coarsest
+    mesh size h or None for the template's)."""
     return [
-        ("symmetric", "two_blocks.toml", "two equal blocks, full contact", (1, 1)),
+        ("symmetric", "two_blocks.toml", "two equal blocks, full contact", (1, 1), None),
         ("asymmetric", "asymmetric.toml",
-         "cantilever (E = 1000, clamped at one end) on a block (E = 100, clamped below)", (1, 1)),
+         "cantilever (E = 1000, clamped at one end) on a block (E = 100, clamped below)", (1, 1),
+         None),
         ("ratio10-stiff-lower", "two_blocks_partial.toml",
-         "partial contact, lower block 10x stiffer", (10, 1)),
+         "partial contact, lower block 10x stiffer", (10, 1), 0.1),
         ("ratio10-stiff-upper", "two_blocks_partial.toml",
-         "partial contact, upper block 10x stiffer", (1, 10)),
+         "partial contact, upper block 10x stiffer", (1, 10), 0.1),
         ("ratio100-stiff-lower", "two_blocks_partial.toml",
-         "partial contact, lower block 100x stiffer", (100, 1)),
+         "partial contact, lower block 100x stiffer", (100, 1), 0.1),
         ("ratio100-stiff-upper", "two_blocks_partial.toml",
-         "partial contact, upper block 100x stiffer", (1, 100)),
-        ("hertz", "hertz.toml", "Hertz: cylinder on a flat, displacement-driven", (1, 1)),
+         "partial contact, upper block 100x stiffer", (1, 100), 0.1),
+        ("hertz", "hertz.toml", "Hertz: cylinder on a flat, displacement-driven", (1, 1), None),
     ]
 
 
@@ -63,15 +65,17 @@ def methods():
     ]
 
 
-def write_case(template, directory, level, young_factors):
-    """The template with every mesh_size divided by 2^level, the Young moduli multiplied by the
-    factors (body order) and absolute mesh paths. Returns (path, coarse mesh size, max E)."""
+def write_case(template, directory, level, young_factors, base_size=None):
+    """The template with every mesh_size (or base_size) divided by 2^level, the Young moduli
+    multiplied by the factors (body order) and absolute mesh paths. Returns (path, mesh size,
+    max E)."""
     with open(os.path.join(EXAMPLES, template)) as file:
         text = file.read()
-    sizes = [float(value) for value in re.findall(r"^mesh_size\s*=\s*([0-9.eE+-]+)", text, re.M)]
+    sizes = [base_size or float(value)
+             for value in re.findall(r"^mesh_size\s*=\s*([0-9.eE+-]+)", text, re.M)]
     text = re.sub(r"^(mesh_size\s*=\s*)([0-9.eE+-]+)",
-                  lambda match: match.group(1) + repr(float(match.group(2)) / 2 ** level), text,
-                  flags=re.M)
+                  lambda match: match.group(1) + repr(
+                      (base_size or float(match.group(2))) / 2 ** level), text, flags=re.M)
     text = re.sub(r'^(mesh\s*=\s*")([^"]+)"',
                   lambda match: match.group(1) + os.path.abspath(
                       os.path.join(EXAMPLES, match.group(2))) + '"', text, flags=re.M)
@@ -125,15 +129,19 @@ def read_history(directory):
     return history
 
 
-def study_case(build, output, case, levels):
-    name, template, description, factors = case
+def study_case(build, output, case, levels, reuse):
+    """Every method on every level of `case`. With `reuse`, a run whose summary.json exists is
+    read, not repeated (to resume an interrupted study)."""
+    name, template, description, factors, base_size = case
     results = []
     for level in range(levels):
         directory = os.path.join(output, "runs", name, "level%d" % level)
-        case_path, size, young_max = write_case(template, directory, level, factors)
+        case_path, size, young_max = write_case(template, directory, level, factors, base_size)
         monolithic_dir = os.path.join(directory, "monolithic")
-        code, _ = run([os.path.join(build, "bin", "robin-monolithic"), case_path, "--output",
-                       monolithic_dir], os.path.join(directory, "monolithic.log"))
+        code = 0
+        if not (reuse and os.path.exists(os.path.join(monolithic_dir, "summary.json"))):
+            code, _ = run([os.path.join(build, "bin", "robin-monolithic"), case_path, "--output",
+                           monolithic_dir], os.path.join(directory, "monolithic.log"))
         if code != 0:
             sys.exit("robin-monolithic failed on %s level %d (see %s)" % (name, level, directory))
         reference, _ = read_contact_forces(monolithic_dir)
@@ -146,7 +154,9 @@ def study_case(build, output, case, levels):
             command = [os.path.join(build, "bin", "robin-run"), case_path, "--output", run_dir,
                        "--tolerance", repr(TOLERANCE), "--max-iterations", str(MAX_ITERATIONS),
                        "--log-level", "warn"] + arguments
-            code, seconds = run(command, os.path.join(directory, slug + ".log"))
+            code, seconds = 0, None
+            if not (reuse and os.path.exists(os.path.join(run_dir, "summary.json"))):
+                code, seconds = run(command, os.path.join(directory, slug + ".log"))
             record = {"case": name, "description": description, "level": level, "h": size,
                       "dofs": dofs, "method": method, "exit_code": code, "seconds": seconds}
             summary_path = os.path.join(run_dir, "summary.json")
@@ -168,9 +178,9 @@ def study_case(build, output, case, levels):
 
 def fixed_delta_scan(build, output, case, deltas):
     """Iterations of the plain iteration with one delta for both bodies on the coarsest mesh."""
-    name, template, _, factors = case
+    name, template, _, factors, base_size = case
     directory = os.path.join(output, "runs", name, "delta-scan")
-    case_path, _, _ = write_case(template, directory, 0, factors)
+    case_path, _, _ = write_case(template, directory, 0, factors, base_size)
     counts = {}
     for delta in deltas:
         run_dir = os.path.join(directory, "delta-%g" % delta)
@@ -274,6 +284,8 @@ def main():
     parser.add_argument("--levels", type=int, default=4)
     parser.add_argument("--docs", help="write DOCS/iteration-study.md and DOCS/images/*.png")
     parser.add_argument("--cases", help="comma-separated subset of the case names")
+    parser.add_argument("--reuse", action="store_true",
+                        help="read runs that already have a summary.json instead of repeating them")
     arguments = parser.parse_args()
     selected = case_grid()
     if arguments.cases:
@@ -282,7 +294,8 @@ def main():
     results, scans = [], {}
     start = time.monotonic()
     for case in selected:
-        results += study_case(arguments.build, arguments.output, case, arguments.levels)
+        results += study_case(arguments.build, arguments.output, case, arguments.levels,
+                              arguments.reuse)
         if case[0] in ("asymmetric", "ratio100-stiff-lower", "ratio100-stiff-upper"):
             scans[case[0]] = fixed_delta_scan(arguments.build, arguments.output, case,
                                               [0.5, 0.2, 0.1, 0.05, 0.02, 0.01])
