@@ -29,8 +29,8 @@ namespace {
 
 /// Where and how the servers are started (the --server-* options).
 struct ServerPlacement {
-  std::vector<std::string> commands;   // command prefixes, split at spaces
-  std::vector<std::string> listens;    // bind endpoints
+  std::vector<std::string> commands;  // command prefixes, split at spaces
+  std::vector<std::string> listens;   // bind endpoints
   std::vector<std::string> executables;
 };
 
@@ -133,8 +133,9 @@ int main(int argc, char** argv) {
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
   for (const auto* values : {&placement.commands, &placement.listens, &placement.executables}) {
     if (values->size() > 2) {
-      std::fprintf(stderr, "robin-run: --server-command, --server-listen and --server-executable "
-                           "are given once for both servers or twice (body order)\n");
+      std::fprintf(stderr,
+                   "robin-run: --server-command, --server-listen and --server-executable "
+                   "are given once for both servers or twice (body order)\n");
       return 2;
     }
   }

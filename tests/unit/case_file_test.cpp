@@ -318,6 +318,22 @@ TEST(CaseFile, MissingOptionalTablesGiveTheDocumentedDefaults) {
                      isotropic_stiffness(2000.0, 0.0, PlaneModel::plane_strain));
 }
 
+TEST(CaseFile, AlgorithmKeys) {
+  const std::string text = replaced(base_case(), "relaxation = 0.5",
+                                    "relaxation = 0.5\nalgorithm = \"robin-constant\"\nalpha = "
+                                    "2.5e-5\ncontact_body = \"2\"\nstopping = \"joint\"");
+  const CouplingOptions coupling = read_case_file(write_case(text)).coupling;
+  EXPECT_EQ(coupling.algorithm, "robin-constant");
+  EXPECT_EQ(coupling.alpha, 2.5e-5);
+  EXPECT_EQ(coupling.contact_body, "2");
+  EXPECT_EQ(coupling.stopping, "joint");
+  const CouplingOptions defaults = read_case_file(write_case(base_case())).coupling;
+  EXPECT_EQ(defaults.algorithm, "robin");
+  EXPECT_EQ(defaults.contact_body, "auto");
+  EXPECT_EQ(defaults.stopping, "either-sequence");
+  EXPECT_EQ(defaults.acceleration.method, "iqn-ils");
+}
+
 TEST(CaseFile, GeoOptionsAndFixComponents) {
   std::string text =
       replaced(base_case(), "mesh_size = 0.5", "recombine = true\nelement_order = 1");
@@ -704,6 +720,37 @@ std::vector<ErrorCase> error_cases() {
        "stagnation_window",
        1,
        {"case.toml:{line}: coupling.stagnation_window: must be >= 1"}},
+      {"UnknownAlgorithm",
+       "relaxation = 0.5",
+       "algorithm = \"robin-neumann\"",
+       "algorithm",
+       1,
+       {"case.toml:{line}: coupling.algorithm: 'robin-neumann' is not one of: robin, "
+        "robin-constant, dirichlet-neumann, neumann-neumann"}},
+      {"RobinConstantWithoutAlpha",
+       "relaxation = 0.5",
+       "algorithm = \"robin-constant\"",
+       "algorithm",
+       1,
+       {"case.toml:{line}: coupling.algorithm: \"robin-constant\" needs coupling.alpha > 0"}},
+      {"NegativeAlpha",
+       "relaxation = 0.5",
+       "alpha = -1.0",
+       "alpha",
+       1,
+       {"case.toml:{line}: coupling.alpha: must be > 0"}},
+      {"UnknownContactBody",
+       "relaxation = 0.5",
+       "contact_body = \"3\"",
+       "contact_body",
+       1,
+       {"case.toml:{line}: coupling.contact_body: '3' is not one of: 1, 2, auto"}},
+      {"UnknownStopping",
+       "relaxation = 0.5",
+       "stopping = \"first\"",
+       "stopping",
+       1,
+       {"case.toml:{line}: coupling.stopping: 'first' is not one of: either-sequence, joint"}},
       {"UnknownInterfaceOperator",
        "\"auto\"",
        "\"sparse\"",
