@@ -16,27 +16,15 @@ const std::vector<std::string> root_keys{"title", "gap", "solver", "coupling", "
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
     "qp_tolerance", "qp_max_iterations", "interface_operator", "dense_limit", "pairing_tolerance"};
-const std::vector<std::string> coupling_keys{"relaxation",
-                                             "tolerance",
-                                             "max_iterations",
-                                             "initial_obstacle",
-                                             "request_timeout",
-                                             "divergence_factor",
-                                             "stagnation_window",
-                                             "acceleration",
-                                             "relaxation1",
-                                             "relaxation2",
-                                             "aitken_initial",
-                                             "aitken_minimum",
-                                             "aitken_maximum",
-                                             "history_depth",
-                                             "filter_threshold",
-                                             "safeguard_growth",
-                                             "per_body",
-                                             "algorithm",
-                                             "alpha",
-                                             "contact_body",
-                                             "stopping"};
+const std::vector<std::string> coupling_keys{
+    "relaxation",        "tolerance",       "max_iterations",
+    "initial_obstacle",  "request_timeout", "divergence_factor",
+    "stagnation_window", "acceleration",    "relaxation1",
+    "relaxation2",       "aitken_initial",  "aitken_minimum",
+    "aitken_maximum",    "history_depth",   "filter_threshold",
+    "safeguard_growth",  "per_body",        "mixing",
+    "algorithm",         "alpha",           "contact_body",
+    "stopping"};
 
 toml::table parse_toml(const std::filesystem::path& path, const std::string& label) {
   std::error_code error;
@@ -146,6 +134,8 @@ void read_acceleration(const CheckedTable& table, CouplingOptions& coupling) {
   acceleration.safeguard_growth =
       number_above(table, "safeguard_growth", 1.0, acceleration.safeguard_growth);
   acceleration.per_body = table.optional_boolean("per_body").value_or(acceleration.per_body);
+  acceleration.mixing = table.optional_choice("mixing", {"full", "relaxation", "aitken"})
+                            .value_or(acceleration.mixing);
   try {
     validate(effective_acceleration(coupling));
   } catch (const InputError& error) {

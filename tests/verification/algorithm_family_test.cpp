@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
 
 #include "coupling/coupled_run.hpp"
 #include "coupling/in_process_port.hpp"
@@ -63,6 +64,12 @@ TEST(AlgorithmFamily, DirichletNeumannWithEitherContactBody) {
         options.algorithm = "dirichlet-neumann";
         options.contact_body = contact_body;
         options.acceleration.method = "iqn-ils";
+        // The stiff cantilever of asymmetric.toml as the contact body is the ill-conditioned
+        // choice (docs/method.md); the default full mixing does not converge on it, the Aitken
+        // mixing does.
+        if (std::string(case_name) == "asymmetric.toml" && std::string(contact_body) == "2") {
+          options.acceleration.mixing = "aitken";
+        }
       });
     }
   }
