@@ -161,6 +161,56 @@ void store_state(RobinResult& result, const CouplingState& state) {
   result.correction2 = state.correction2;
 }
 
+/// The record of one iteration: the joint state's residuals, the obstacle change, the
+/// counters and, per obstacle sequence, the largest residual of its complete state.
+IterationRecord iteration_record(int iteration, const Eigen::VectorXd& gaps,
+                                 const CouplingScheme& scheme, const CouplingEvaluation& evaluation,
+                                 const ObstacleChange& change,
+                                 const std::array<Eigen::VectorXd, 2>& previous_forces) {
+  IterationRecord record = residual_record(iteration, gaps, evaluation.state);
+  if (scheme.shares_contact_force()) {
+    record.force_balance = relative_change(evaluation.state.contact_force1, previous_forces[0]);
+  }
+  record.obstacle_change = change.relative();
+  record.obstacle_step = change.relative() * change.scale;
+  record.active1 = evaluation.active1;
+  record.active2 = evaluation.active2;
+  record.qp_iterations1 = evaluation.qp_iterations1;
+  record.qp_iterations2 = evaluation.qp_iterations2;
+  const std::array<const Eigen::VectorXd*, 2> forces{&evaluation.state.contact_force1,
+                                                     &evaluation.state.contact_force2};
+  for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
+    record.sequence_residuals.push_back(completion_residual(evaluation.completions[k], gaps,
+                                                            change.per_block[k] / change.scale,
+                                                            *forces[k], previous_forces[k]));
+  }
+  return record;
+}
+
+/// When the joint state or (with "either-sequence") a complete state has every residual below
+/// the tolerance: stores the accepted state and the status in `result` and returns true.
+bool accept_converged_state(const IterationRecord& record, const CouplingEvaluation& evaluation,
+                            const CouplingOptions& options, RobinResult& result) {
+  const std::string iterations = std::to_string(record.iteration) + " iterations";
+  if (record.largest() <= options.tolerance) {
+    result.status = IterationStatus::converged;
+    result.message = "converged in " + iterations;
+    return true;
+  }
+  if (options.stopping != "either-sequence") return false;
+  for (std::size_t k = 0; k < record.sequence_residuals.size(); ++k) {
+    if (record.sequence_residuals[k] > options.tolerance) continue;
+    store_state(result, evaluation.completions[k]);
+    result.status = IterationStatus::converged;
+    result.completed_by_sequence = static_cast<int>(k) + 1;
+    result.message = "converged in " + iterations + " (the obstacle sequence of body " +
+                     std::to_string(k + 1) +
+                     " reached its fixed point; the other body takes its contact force)";
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 double IterationRecord::largest() const {
@@ -229,7 +279,6 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   const std::vector<int> block_sizes = scheme->block_sizes();
   const std::unique_ptr<Acceleration> acceleration =
       make_acceleration(effective_acceleration(options), block_sizes);
-  const bool either_sequence = options.stopping == "either-sequence";
   RobinResult result;
   result.algorithm = scheme->describe();
   Eigen::VectorXd iterate = scheme->initial_iterate(
@@ -248,50 +297,16 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
     result.critical_compute_seconds += evaluation.critical_compute_seconds;
     // The obstacle update x_{k+1} = A(x_k, H(x_k)); "none" is the paper's (1 - delta) x + delta H.
     const Eigen::VectorXd next = acceleration->next(iterate, evaluation.mapped);
-    const ObstacleChange change =
-        obstacle_change(iterate, next, block_sizes, gaps, evaluation.state);
-    IterationRecord record = residual_record(iteration, gaps, evaluation.state);
-    if (scheme->shares_contact_force()) {
-      record.force_balance = relative_change(evaluation.state.contact_force1, previous_forces[0]);
-    }
-    record.obstacle_change = change.relative();
-    record.obstacle_step = change.relative() * change.scale;
-    record.active1 = evaluation.active1;
-    record.active2 = evaluation.active2;
-    record.qp_iterations1 = evaluation.qp_iterations1;
-    record.qp_iterations2 = evaluation.qp_iterations2;
-    const std::array<const Eigen::VectorXd*, 2> forces{&evaluation.state.contact_force1,
-                                                       &evaluation.state.contact_force2};
-    for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
-      record.sequence_residuals.push_back(completion_residual(evaluation.completions[k], gaps,
-                                                              change.per_block[k] / change.scale,
-                                                              *forces[k], previous_forces[k]));
-    }
-    previous_forces = {*forces[0], *forces[1]};
+    IterationRecord record = iteration_record(
+        iteration, gaps, *scheme, evaluation,
+        obstacle_change(iterate, next, block_sizes, gaps, evaluation.state), previous_forces);
+    previous_forces = {evaluation.state.contact_force1, evaluation.state.contact_force2};
     record.acceleration_state = acceleration->state();
     record.seconds = seconds_between(iteration_start, Clock::now());
     result.history.push_back(record);
     store_state(result, evaluation.state);
     if (observer) observer(record);
-    if (record.largest() <= options.tolerance) {
-      result.status = IterationStatus::converged;
-      result.message = "converged in " + std::to_string(iteration) + " iterations";
-      break;
-    }
-    const auto finished = std::find_if(
-        record.sequence_residuals.begin(), record.sequence_residuals.end(),
-        [&](double residual) { return either_sequence && residual <= options.tolerance; });
-    if (finished != record.sequence_residuals.end()) {
-      const auto sequence = finished - record.sequence_residuals.begin();
-      store_state(result, evaluation.completions[static_cast<std::size_t>(sequence)]);
-      result.status = IterationStatus::converged;
-      result.completed_by_sequence = static_cast<int>(sequence) + 1;
-      result.message = "converged in " + std::to_string(iteration) +
-                       " iterations (the obstacle sequence of body " +
-                       std::to_string(sequence + 1) +
-                       " reached its fixed point; the other body takes its contact force)";
-      break;
-    }
+    if (accept_converged_state(record, evaluation, options, result)) break;
     if (const auto stop = monitor.check(record, result.message)) {
       result.status = *stop;
       break;
