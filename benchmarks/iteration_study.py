@@ -176,7 +176,7 @@ def study_case(build, output, case, levels, reuse):
     return results
 
 
-def fixed_delta_scan(build, output, case, deltas):
+def fixed_delta_scan(build, output, case, deltas, reuse):
     """Iterations of the plain iteration with one delta for both bodies on the coarsest mesh,
     with the default (either-sequence) stopping, as the accelerated runs."""
     name, template, _, factors, base_size = case
@@ -185,10 +185,11 @@ def fixed_delta_scan(build, output, case, deltas):
     counts = {}
     for delta in deltas:
         run_dir = os.path.join(directory, "delta-%g" % delta)
-        run([os.path.join(build, "bin", "robin-run"), case_path, "--output", run_dir,
-             "--tolerance", repr(TOLERANCE), "--max-iterations", "5000", "--acceleration", "none",
-             "--relaxation", repr(delta), "--log-level", "warn"],
-            os.path.join(directory, "delta-%g.log" % delta))
+        if not (reuse and os.path.exists(os.path.join(run_dir, "summary.json"))):
+            run([os.path.join(build, "bin", "robin-run"), case_path, "--output", run_dir,
+                 "--tolerance", repr(TOLERANCE), "--max-iterations", "5000", "--acceleration",
+                 "none", "--relaxation", repr(delta), "--log-level", "warn"],
+                os.path.join(directory, "delta-%g.log" % delta))
         with open(os.path.join(run_dir, "summary.json")) as file:
             summary = json.load(file)
         counts[delta] = summary["iterations"] if summary["converged"] else None
@@ -300,7 +301,8 @@ def main():
                               arguments.reuse)
         if case[0] in ("asymmetric", "ratio100-stiff-lower", "ratio100-stiff-upper"):
             scans[case[0]] = fixed_delta_scan(arguments.build, arguments.output, case,
-                                              [0.5, 0.2, 0.1, 0.05, 0.02, 0.01])
+                                              [0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.02, 0.01],
+                                              arguments.reuse)
     elapsed = time.monotonic() - start
     os.makedirs(arguments.output, exist_ok=True)
     with open(os.path.join(arguments.output, "study.json"), "w") as file:
