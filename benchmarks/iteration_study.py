@@ -213,15 +213,16 @@ def plot(results, docs):
     for case in cases:
         figure, (left, right) = pyplot.subplots(1, 2, figsize=(12, 4.5))
         finest = max(record["level"] for record in results if record["case"] == case)
-        for method in method_names:
+        for color, method in enumerate(method_names):
             rows = [r for r in results if r["case"] == case and r["method"] == method]
             points = [(1.0 / r["h"], r["iterations"]) for r in rows
                       if r.get("status") == "converged"]
             if points:
-                left.plot(*zip(*points), marker="o", label=method)
+                left.plot(*zip(*points), marker="o", label=method, color="C%d" % color)
             for r in rows:
                 if r["level"] == finest and r["history"]:
-                    right.semilogy(range(1, len(r["history"]) + 1), r["history"], label=method)
+                    right.semilogy(range(1, len(r["history"]) + 1), r["history"], label=method,
+                                   color="C%d" % color)
         left.set_xscale("log", base=2)
         left.set_yscale("log")
         left.set_xlabel("1/h")
@@ -289,9 +290,19 @@ def main():
     parser.add_argument("--levels", type=int, default=4)
     parser.add_argument("--docs", help="write DOCS/iteration-study.md and DOCS/images/*.png")
     parser.add_argument("--cases", help="comma-separated subset of the case names")
+    parser.add_argument("--plot-only", action="store_true",
+                        help="redraw the plots and tables from OUTPUT/study.json")
     parser.add_argument("--reuse", action="store_true",
                         help="read runs that already have a summary.json instead of repeating them")
     arguments = parser.parse_args()
+    if arguments.plot_only:
+        with open(os.path.join(arguments.output, "study.json")) as file:
+            stored = json.load(file)
+        scans = {k: {float(d): n for d, n in v.items()} for k, v in stored["delta_scans"].items()}
+        write_tables(stored["results"], scans, os.path.join(arguments.output, "tables.md"))
+        if arguments.docs:
+            plot(stored["results"], arguments.docs)
+        return
     selected = case_grid()
     if arguments.cases:
         wanted = arguments.cases.split(",")
