@@ -45,14 +45,21 @@ std::array<CorrectionSolveResult, 2> correction_solves(SubdomainPort& body1, Sub
   return {body1.finish_correction(), body2.finish_correction()};
 }
 
-/// Fills the counters of `evaluation` from the two contact solves.
-void record_contact(CouplingEvaluation& evaluation, const ContactSolveResult& contact1,
-                    const ContactSolveResult& contact2) {
-  evaluation.active1 = count_active(contact1);
-  evaluation.active2 = count_active(contact2);
-  evaluation.qp_iterations1 = contact1.iterations;
-  evaluation.qp_iterations2 = contact2.iterations;
-  evaluation.critical_compute_seconds += std::max(contact1.seconds, contact2.seconds);
+/// Step 1 on both bodies at the obstacles already in evaluation.state; fills the state's
+/// traces and forces and the evaluation's counters.
+void solve_both_contacts(SubdomainPort& body1, SubdomainPort& body2, int iteration,
+                         CouplingEvaluation& evaluation) {
+  CouplingState& state = evaluation.state;
+  const auto contact = contact_solves(body1, body2, state.obstacle1, state.obstacle2, iteration);
+  state.normal_trace1 = contact[0].normal_trace;
+  state.normal_trace2 = contact[1].normal_trace;
+  state.contact_force1 = contact[0].contact_force;
+  state.contact_force2 = contact[1].contact_force;
+  evaluation.active1 = count_active(contact[0]);
+  evaluation.active2 = count_active(contact[1]);
+  evaluation.qp_iterations1 = contact[0].iterations;
+  evaluation.qp_iterations2 = contact[1].iterations;
+  evaluation.critical_compute_seconds += std::max(contact[0].seconds, contact[1].seconds);
 }
 
 /// "robin" and "robin-constant" (alpha > 0): two obstacle sequences.
@@ -88,13 +95,7 @@ class RobinScheme final : public CouplingScheme {
     CouplingState& state = evaluation.state;
     state.obstacle1 = iterate.head(size);
     state.obstacle2 = iterate.tail(size);
-    const auto contact =
-        contact_solves(body1_, body2_, state.obstacle1, state.obstacle2, iteration);
-    record_contact(evaluation, contact[0], contact[1]);
-    state.normal_trace1 = contact[0].normal_trace;
-    state.normal_trace2 = contact[1].normal_trace;
-    state.contact_force1 = contact[0].contact_force;
-    state.contact_force2 = contact[1].contact_force;
+    solve_both_contacts(body1_, body2_, iteration, evaluation);
     // Step 2: K^1 w^1 = B^1'(lambda^2 - lambda^1), K^2 w^2 = B^2'(lambda^1 - lambda^2), or the
     // constant-alpha stand-in alpha (lambda^b - lambda^a) / m for w^a_N.
     const Eigen::VectorXd imbalance = state.contact_force2 - state.contact_force1;
@@ -213,13 +214,7 @@ class NeumannNeumannScheme final : public CouplingScheme {
     CouplingState& state = evaluation.state;
     state.obstacle1 = iterate;
     state.obstacle2 = gaps_ - iterate;
-    const auto contact =
-        contact_solves(body1_, body2_, state.obstacle1, state.obstacle2, iteration);
-    record_contact(evaluation, contact[0], contact[1]);
-    state.normal_trace1 = contact[0].normal_trace;
-    state.normal_trace2 = contact[1].normal_trace;
-    state.contact_force1 = contact[0].contact_force;
-    state.contact_force2 = contact[1].contact_force;
+    solve_both_contacts(body1_, body2_, iteration, evaluation);
     // Both bodies loaded by the force jump j = lambda1 - lambda2 along their outward normal.
     const Eigen::VectorXd jump = state.contact_force1 - state.contact_force2;
     const auto correction = correction_solves(body1_, body2_, jump, jump, iteration);

@@ -331,19 +331,26 @@ std::vector<std::string> signorini_problems(const ContactSolution& solution,
   return problems;
 }
 
+/// Checks a reply's normal_trace (one finite value per contact node) and copies it to `trace`;
+/// returns the problem in plain words, or "".
+std::string read_normal_trace(const google::protobuf::RepeatedField<double>& values, long count,
+                              Eigen::VectorXd& trace) {
+  if (values.size() != count) {
+    return "normal_trace has " + std::to_string(values.size()) + " values for " +
+           std::to_string(count) + " contact nodes";
+  }
+  if (!all_finite(values)) return "normal_trace contains a non-finite value";
+  trace = to_vector(values);
+  return "";
+}
+
 std::string read_correction(const Exchange& exchange, long count, Eigen::VectorXd& trace) {
   if (const std::string problem = expect_content(exchange, Envelope::kCorrectionResult);
       !problem.empty()) {
     return problem;
   }
   const protocol::CorrectionResult& result = exchange.reply->correction_result();
-  if (result.normal_trace_size() != count) {
-    return "normal_trace has " + std::to_string(result.normal_trace_size()) + " values for " +
-           std::to_string(count) + " contact nodes";
-  }
-  if (!all_finite(result.normal_trace())) return "normal_trace contains a non-finite value";
-  trace = to_vector(result.normal_trace());
-  return "";
+  return read_normal_trace(result.normal_trace(), count, trace);
 }
 
 std::string read_neumann_solution(const Exchange& exchange, long count, Eigen::VectorXd& trace) {
@@ -352,13 +359,7 @@ std::string read_neumann_solution(const Exchange& exchange, long count, Eigen::V
     return problem;
   }
   const protocol::NeumannSolveResult& result = exchange.reply->neumann_result();
-  if (result.normal_trace_size() != count) {
-    return "normal_trace has " + std::to_string(result.normal_trace_size()) + " values for " +
-           std::to_string(count) + " contact nodes";
-  }
-  if (!all_finite(result.normal_trace())) return "normal_trace contains a non-finite value";
-  trace = to_vector(result.normal_trace());
-  return "";
+  return read_normal_trace(result.normal_trace(), count, trace);
 }
 
 std::vector<std::string> fields_structure_problems(const protocol::FieldsReply& fields) {
