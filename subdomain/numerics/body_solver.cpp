@@ -125,9 +125,21 @@ void BodySolver::assemble() {
   timings_.assembly_seconds = seconds_since(start);
 
   start = std::chrono::steady_clock::now();
-  factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name());
+  factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name(), trailing_unknowns());
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
   timings_.factorization_seconds = seconds_since(start);
+}
+
+std::vector<int> BodySolver::trailing_unknowns() const {
+  std::vector<int> unknowns;
+  if (!options_.contact_unknowns_last) return unknowns;
+  for (int node : definition_.mesh.boundary(definition_.contact_boundary).nodes()) {
+    for (int dof : {2 * node, 2 * node + 1}) {
+      if (!dofs_->is_prescribed(dof)) unknowns.push_back(dofs_->free_index(dof));
+    }
+  }
+  if (static_cast<long>(unknowns.size()) > 2L * options_.dense_limit) unknowns.clear();
+  return unknowns;
 }
 
 InterfaceDescription BodySolver::contact_boundary() const {
@@ -199,7 +211,9 @@ void BodySolver::build_interface_operator() {
       options_.interface_operator == InterfaceOperatorKind::dense ||
       (options_.interface_operator == InterfaceOperatorKind::automatic &&
        contact_size() <= options_.dense_limit);
-  if (dense) {
+  if (dense && factor_->has_trailing_block()) {
+    compliance_ = std::make_unique<DenseOperator>(factor_->trailing_congruence(trace_));
+  } else if (dense) {
     compliance_ = std::make_unique<DenseOperator>(assemble_dense_compliance(trace_, *factor_));
   } else {
     compliance_ = std::make_unique<FactorComplianceOperator>(trace_, *factor_);

@@ -55,6 +55,10 @@ enum class InterfaceOperatorKind {
 struct BodySolverOptions {
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
   int dense_limit = 3000;
+  /// Eliminate the free dofs of the contact boundary last in the Cholesky factor (when there
+  /// are at most 2 dense_limit of them), so a dense F comes from the factor's trailing block in
+  /// O(m^2 n_c) instead of n_c solves with the whole factor (see numerics/cholesky.hpp).
+  bool contact_unknowns_last = true;
 };
 
 struct ContactSolveResult {
@@ -137,6 +141,8 @@ class BodySolver {
  private:
   void assemble();
   void build_interface_operator();
+  /// Free dofs of the contact boundary nodes, to be eliminated last (empty when disabled).
+  std::vector<int> trailing_unknowns() const;
   Eigen::VectorXd apply_transpose_trace(const Eigen::VectorXd& contact_force) const;  // B' lambda
 
   BodyDefinition definition_;

@@ -24,11 +24,116 @@ constexpr Eigen::Index solve_block_columns = 64;
 /// means cond(K) > 1e13, a stiffness with a rigid motion that rounding made "positive".
 constexpr double minimum_pivot_ratio = 1e-13;
 
-/// Eigen's supernodal LL' keeps the cholmod_factor protected; this exposes it read-only.
+/// Eigen's supernodal LL' keeps the cholmod_factor protected; this exposes it read-only and
+/// adds the symbolic analysis with a given elimination order (cholmod_analyze_p).
 class SupernodalCholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
  public:
   const cholmod_factor* factor() const { return m_cholmodFactor; }
+
+  /// analyzePattern() with `ordering` (ordering[k] = unknown eliminated k-th) instead of
+  /// CHOLMOD's own choice; CHOLMOD may still postorder it (the final order is factor()->Perm).
+  void analyze_pattern_ordered(const SparseMatrix& matrix, std::vector<int>& ordering) {
+    cholmod_common& common = cholmod();
+    if (m_cholmodFactor != nullptr) cholmod_free_factor(&m_cholmodFactor, &common);
+    cholmod_sparse view = Eigen::viewAsCholmod(matrix.selfadjointView<Eigen::Lower>());
+    const int method_count = common.nmethods;
+    const int first_method = common.method[0].ordering;
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_GIVEN;
+    m_cholmodFactor = cholmod_analyze_p(&view, ordering.data(), nullptr, 0, &common);
+    common.nmethods = method_count;
+    common.method[0].ordering = first_method;
+    m_isInitialized = true;
+    m_info = Eigen::Success;
+    m_analysisIsOk = true;
+    m_factorizationIsOk = false;
+  }
 };
+
+/// Lower triangle of the matrix restricted to the unknowns j with new_index[j] >= 0, renumbered
+/// to new_index[j].
+SparseMatrix lower_sub_block(const SparseMatrix& matrix, const std::vector<int>& new_index,
+                             int size) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int column = 0; column < matrix.outerSize(); ++column) {
+    if (new_index[column] < 0) continue;
+    for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
+      const int row = static_cast<int>(entry.row());
+      if (row >= column && new_index[row] >= 0) {
+        entries.emplace_back(new_index[row], new_index[column], entry.value());
+      }
+    }
+  }
+  SparseMatrix block(size, size);
+  block.setFromTriplets(entries.begin(), entries.end());
+  return block;
+}
+
+/// Elimination order: CHOLMOD's fill-reducing order (AMD, or METIS when AMD fills too much) of
+/// the matrix without the trailing unknowns, then the trailing unknowns in the given order.
+std::vector<int> ordering_with_trailing(const SparseMatrix& matrix,
+                                        const std::vector<int>& trailing, cholmod_common& common,
+                                        const std::string& body_name) {
+  const int size = static_cast<int>(matrix.rows());
+  std::vector<int> new_index(static_cast<std::size_t>(size), 0);
+  for (int unknown : trailing) {
+    if (unknown < 0 || unknown >= size || new_index[unknown] < 0) {
+      throw std::invalid_argument("body '" + body_name + "': trailing unknown " +
+                                  std::to_string(unknown) + " is out of range or repeated");
+    }
+    new_index[unknown] = -1;
+  }
+  std::vector<int> leading;
+  for (int unknown = 0; unknown < size; ++unknown) {
+    if (new_index[unknown] < 0) continue;
+    new_index[unknown] = static_cast<int>(leading.size());
+    leading.push_back(unknown);
+  }
+  std::vector<int> ordering;
+  ordering.reserve(static_cast<std::size_t>(size));
+  if (!leading.empty()) {
+    const SparseMatrix block = lower_sub_block(matrix, new_index, static_cast<int>(leading.size()));
+    cholmod_sparse view = Eigen::viewAsCholmod(block.selfadjointView<Eigen::Lower>());
+    const int supernodal = common.supernodal;
+    common.supernodal = CHOLMOD_SIMPLICIAL;  // only the permutation is wanted
+    cholmod_factor* symbolic = cholmod_analyze(&view, &common);
+    common.supernodal = supernodal;
+    if (symbolic == nullptr || common.status < CHOLMOD_OK) {
+      throw std::runtime_error("body '" + body_name + "': CHOLMOD ordering failed (status " +
+                               std::to_string(common.status) + ")");
+    }
+    const auto* permutation = static_cast<const int*>(symbolic->Perm);
+    for (std::size_t k = 0; k < leading.size(); ++k) ordering.push_back(leading[permutation[k]]);
+    cholmod_free_factor(&symbolic, &common);
+  }
+  ordering.insert(ordering.end(), trailing.begin(), trailing.end());
+  return ordering;
+}
+
+/// The trailing block L(first:, first:) of a supernodal LL' factor, dense lower triangular.
+/// Supernode s holds columns super[s] .. super[s+1]-1 as a column-major block of nrows rows
+/// (row indices s[pi[s]] ...), starting at x[px[s]]; its first ncols rows are its own columns.
+Eigen::MatrixXd trailing_factor_block(const cholmod_factor& factor, int first) {
+  const int size = static_cast<int>(factor.n);
+  const auto* super = static_cast<const int*>(factor.super);
+  const auto* pi = static_cast<const int*>(factor.pi);
+  const auto* px = static_cast<const int*>(factor.px);
+  const auto* rows = static_cast<const int*>(factor.s);
+  const auto* values = static_cast<const double*>(factor.x);
+  Eigen::MatrixXd block = Eigen::MatrixXd::Zero(size - first, size - first);
+  for (std::size_t s = 0; s < factor.nsuper; ++s) {
+    if (super[s + 1] <= first) continue;
+    const int row_count = pi[s + 1] - pi[s];
+    for (int column = std::max(super[s], first); column < super[s + 1]; ++column) {
+      const int local = column - super[s];
+      const double* entries = values + px[s] + static_cast<long>(local) * row_count;
+      for (int r = local; r < row_count; ++r) {
+        block(rows[pi[s] + r] - first, column - first) = entries[r];
+      }
+    }
+  }
+  return block;
+}
 
 /// Pivots d_j = L_jj^2 of a supernodal factor: column j of supernode s is stored in
 /// x[px[s] + j * nrows + ...], the supernode block being column-major with nrows rows.
@@ -69,18 +174,28 @@ struct CholeskyFactor::Implementation {
   SupernodalCholesky cholesky;
   std::string body_name;
   int size = 0;
+  int trailing_count = 0;
+  bool has_trailing_block = false;
+  std::vector<int> position;  // position[j] = step at which unknown j is eliminated
 
-  void factorize(const SparseMatrix& matrix);
+  void factorize(const SparseMatrix& matrix, const std::vector<int>& trailing);
   void check_pivots() const;
+  void locate_trailing(const std::vector<int>& trailing);
 };
 
-void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix) {
+void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
+                                               const std::vector<int>& trailing) {
   cholmod_common& common = cholesky.cholmod();
   common.print = 0;                // CHOLMOD prints nothing, not even warnings
   common.error_handler = nullptr;  // failures are read from common.status instead
   common.supernodal = CHOLMOD_SUPERNODAL;
-  // The fill-reducing ordering is CHOLMOD's default choice (AMD, METIS when worthwhile).
-  cholesky.analyzePattern(matrix);
+  if (trailing.empty()) {
+    // The fill-reducing ordering is CHOLMOD's default choice (AMD, METIS when worthwhile).
+    cholesky.analyzePattern(matrix);
+  } else {
+    std::vector<int> ordering = ordering_with_trailing(matrix, trailing, common, body_name);
+    cholesky.analyze_pattern_ordered(matrix, ordering);
+  }
   if (cholesky.factor() == nullptr || common.status < CHOLMOD_OK) {
     throw std::runtime_error("body '" + body_name + "': CHOLMOD analysis failed (status " +
                              std::to_string(common.status) + ", e.g. out of memory)");
@@ -101,6 +216,19 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix) {
     throw_singular(body_name, detail);
   }
   check_pivots();
+  locate_trailing(trailing);
+}
+
+void CholeskyFactor::Implementation::locate_trailing(const std::vector<int>& trailing) {
+  const cholmod_factor& factor = *cholesky.factor();
+  trailing_count = static_cast<int>(trailing.size());
+  position.assign(factor.n, 0);
+  const auto* permutation = static_cast<const int*>(factor.Perm);
+  for (int k = 0; k < size; ++k) position[permutation[k]] = k;
+  has_trailing_block = !trailing.empty() && factor.is_super &&
+                       std::all_of(trailing.begin(), trailing.end(), [&](int unknown) {
+                         return position[unknown] >= size - trailing_count;
+                       });
 }
 
 void CholeskyFactor::Implementation::check_pivots() const {
@@ -120,7 +248,8 @@ void CholeskyFactor::Implementation::check_pivots() const {
   }
 }
 
-CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name)
+CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
+                               const std::vector<int>& trailing_unknowns)
     : implementation_(std::make_unique<Implementation>()) {
   implementation_->body_name = body_name;
   if (matrix.rows() != matrix.cols()) {
@@ -133,7 +262,7 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& bo
                      "': the stiffness matrix is empty (every degree of freedom is prescribed)");
   }
   implementation_->size = static_cast<int>(matrix.rows());
-  implementation_->factorize(matrix);
+  implementation_->factorize(matrix, trailing_unknowns);
 }
 
 CholeskyFactor::~CholeskyFactor() = default;
@@ -196,6 +325,43 @@ long CholeskyFactor::factor_nonzeros() const {
     total += row_count * column_count - column_count * (column_count - 1) / 2;
   }
   return total;
+}
+
+}  // namespace robin
+
+namespace robin {
+
+bool CholeskyFactor::has_trailing_block() const { return implementation_->has_trailing_block; }
+
+Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) const {
+  const Implementation& factor = *implementation_;
+  if (!factor.has_trailing_block) {
+    throw std::logic_error("body '" + factor.body_name + "': the factor has no trailing block");
+  }
+  if (trace.cols() != size()) {
+    throw std::invalid_argument("body '" + factor.body_name + "': a trace with " +
+                                std::to_string(trace.cols()) + " columns for a factor of size " +
+                                std::to_string(size()));
+  }
+  const int first = size() - factor.trailing_count;
+  // Y = (P B')_T, then Y <- L_TT^{-1} Y and B K^{-1} B' = Y' Y
+  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(factor.trailing_count, trace.rows());
+  for (int column = 0; column < trace.outerSize(); ++column) {
+    for (SparseMatrix::InnerIterator entry(trace, column); entry; ++entry) {
+      const int step = factor.position[column] - first;
+      if (step < 0) {
+        throw std::invalid_argument("body '" + factor.body_name + "': the trace reads unknown " +
+                                    std::to_string(column) + ", not a trailing unknown");
+      }
+      reduced(step, entry.row()) += entry.value();
+    }
+  }
+  const Eigen::MatrixXd block = trailing_factor_block(*factor.cholesky.factor(), first);
+  block.triangularView<Eigen::Lower>().solveInPlace(reduced);
+  Eigen::MatrixXd congruence = Eigen::MatrixXd::Zero(trace.rows(), trace.rows());
+  congruence.selfadjointView<Eigen::Lower>().rankUpdate(reduced.transpose());
+  congruence.triangularView<Eigen::StrictlyUpper>() = congruence.transpose();
+  return congruence;
 }
 
 }  // namespace robin

@@ -1,10 +1,18 @@
 #pragma once
 // Sparse Cholesky factor of a body's stiffness (CHOLMOD supernodal, through Eigen's
 // CholmodSupport), computed once and reused for every solve.
+//
+// Trailing unknowns. The factor may be asked to eliminate a chosen set T of unknowns last
+// (the free dofs of the contact boundary): P K P' = L L' with T in the last m positions.
+// Then for any B whose columns lie in T, L^{-1} P B' is zero above the last block, so
+//   B K^{-1} B' = Y' Y,  Y = L_TT^{-1} (P B')_T,
+// with L_TT the trailing m x m block of L (L_TT L_TT' is the Schur complement of K on T).
+// This costs O(m^2 n_c) dense work instead of n_c solves with the whole factor.
 
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "numerics/elasticity.hpp"
 
@@ -16,7 +24,11 @@ class CholeskyFactor {
   /// Throws SingularBodyError naming `body_name` when the matrix is not positive definite or
   /// numerically singular (pivot ratio min L_jj^2 / max L_jj^2 < 1e-13, i.e. cond > 1e13);
   /// InputError when it is empty or not square. Solves are not thread-safe (CHOLMOD workspace).
-  CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name);
+  /// `trailing_unknowns` (indices into the matrix, distinct) are eliminated last: the rest
+  /// in CHOLMOD's fill-reducing order of the matrix without them (AMD or METIS), then these
+  /// in the given order. Empty: CHOLMOD's order of the whole matrix.
+  CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
+                 const std::vector<int>& trailing_unknowns = {});
   ~CholeskyFactor();
   CholeskyFactor(const CholeskyFactor&) = delete;
   CholeskyFactor& operator=(const CholeskyFactor&) = delete;
@@ -29,6 +41,14 @@ class CholeskyFactor {
   /// Number of entries stored in the lower triangle of the supernodal factor L (including the
   /// explicit zeros of supernode amalgamation).
   long factor_nonzeros() const;
+  /// True when the trailing unknowns requested at construction occupy the last positions of
+  /// the final (postordered) elimination order, so trailing_congruence() is available.
+  bool has_trailing_block() const;
+  /// B K^{-1} B' (symmetric, n_c x n_c) for a sparse B (n_c x size()) whose nonzero columns are
+  /// all trailing unknowns, from the trailing block of L (see the file comment). Throws
+  /// std::logic_error without a trailing block, std::invalid_argument when B has a nonzero
+  /// outside the trailing unknowns.
+  Eigen::MatrixXd trailing_congruence(const SparseMatrix& trace) const;
   /// Number of right-hand sides solved so far: +1 per vector solve, +columns per matrix solve
   /// (each right-hand side costs one forward and one backward triangular solve).
   long solve_count() const { return solve_count_; }

@@ -4,7 +4,8 @@
 // prescribed values included) taken with the assigned normals, u_N,i = u(node_i) . n_i.
 // Bodies: both blocks of examples/two_blocks.toml (the lower one clamped, the upper one with a
 // prescribed top displacement), with a body force and a traction added so that every kind of
-// load enters f; the dense and the factor form of F; the contact nodes in reversed order and,
+// load enters f; the dense F (from the factor's trailing block, or by blocked solves) and F
+// applied through the factor; the contact nodes in reversed order and,
 // for the upper block, with flipped normals (as body 2 receives n2 = -n1).
 
 #include <gtest/gtest.h>
@@ -72,10 +73,12 @@ TEST(NeumannSolve, EqualsTheNormalTraceOfTheDisplacement) {
   const CaseDefinition definition = two_blocks();
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodyDefinition body_definition = loaded_body(definition.bodies[alpha]);
-    for (const InterfaceOperatorKind kind :
-         {InterfaceOperatorKind::dense, InterfaceOperatorKind::factor}) {
+    for (const auto& [kind, contact_last] :
+         {std::pair{InterfaceOperatorKind::dense, true}, std::pair{InterfaceOperatorKind::dense, false},
+          std::pair{InterfaceOperatorKind::factor, true}}) {
       BodySolverOptions options;
       options.interface_operator = kind;
+      options.contact_unknowns_last = contact_last;
       BodySolver body(body_definition, options);
       const ContactAssignment assignment =
           reversed_assignment(body.contact_boundary(), alpha == 0 ? 1.0 : -1.0);
@@ -83,7 +86,9 @@ TEST(NeumannSolve, EqualsTheNormalTraceOfTheDisplacement) {
       const Eigen::VectorXd force = varying_force(body.contact_size());
       const std::string label =
           body.name() +
-          (kind == InterfaceOperatorKind::dense ? " (dense F)" : " (F through the factor)");
+          (kind == InterfaceOperatorKind::factor ? " (F through the factor)"
+           : contact_last                        ? " (dense F from the trailing block)"
+                                                 : " (dense F by blocked solves)");
 
       const Eigen::VectorXd trace = body.solve_neumann(force);
       const Eigen::VectorXd expected = normal_trace(body.displacement(force), assignment);
