@@ -30,11 +30,14 @@ MonolithicResult monolithic_reference(const CaseDefinition& definition) {
                           definition.solver.qp);
 }
 
-/// Runs `case_name` with `options` changed by `configure` and checks the answer against the
-/// monolithic reference; returns the run for further checks.
+/// Runs `case_name` with `options` changed by `configure` (and the contact QPs' relative
+/// tolerance set to `qp_tolerance` when given) and checks the answer against the monolithic
+/// reference; returns the run for further checks.
 template <typename Configure>
-CoupledRunResult expect_monolithic_answer(const std::string& case_name, Configure configure) {
-  const CaseDefinition definition = example(case_name);
+CoupledRunResult expect_monolithic_answer(const std::string& case_name, Configure configure,
+                                          double qp_tolerance = 0.0) {
+  CaseDefinition definition = example(case_name);
+  if (qp_tolerance > 0.0) definition.solver.qp.relative_tolerance = qp_tolerance;
   CouplingOptions options = definition.coupling;
   options.tolerance = 1e-8;
   options.max_iterations = 3000;
@@ -87,11 +90,19 @@ TEST(AlgorithmFamily, NeumannNeumann) {
 TEST(AlgorithmFamily, RobinWithConstantAlpha) {
   for (const char* case_name : cases) {
     for (const double alpha : {3e-5, 1e-4}) {
-      expect_monolithic_answer(case_name, [&](CouplingOptions& options) {
-        options.algorithm = "robin-constant";
-        options.acceleration.method = "iqn-ils";
-        options.alpha = alpha;
-      });
+      // The constant-alpha variant resolves the force balance only to about the QP tolerance
+      // times the condition number of the active compliance: with the default 1e-12 the
+      // asymmetric pair at alpha = 3e-5 stalls at |lambda1 - lambda2| / |lambda| = 1.7e-8
+      // (reported as stagnation, the run exits non-zero). A tighter QP tolerance removes the
+      // floor; the coupling tolerance and the 1e-7 comparison stay as they are.
+      expect_monolithic_answer(
+          case_name,
+          [&](CouplingOptions& options) {
+            options.algorithm = "robin-constant";
+            options.acceleration.method = "iqn-ils";
+            options.alpha = alpha;
+          },
+          1e-14);
     }
   }
 }
