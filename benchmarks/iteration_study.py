@@ -46,7 +46,7 @@ def case_grid():
          "partial contact, lower block 100x stiffer", (100, 1), 0.1),
         ("ratio100-stiff-upper", "two_blocks_partial.toml",
          "partial contact, upper block 100x stiffer", (1, 100), 0.1),
-        ("hertz", "hertz.toml", "Hertz: cylinder on a flat, displacement-driven", (1, 1), 0.2),
+        ("hertz", "hertz.toml", "Hertz: cylinder on a flat, displacement-driven", (1, 1), 0.1),
     ]
 
 
@@ -95,6 +95,17 @@ def write_case(template, directory, level, young_factors, base_size=None):
     return path, min(sizes) / 2 ** level, max(youngs)
 
 
+def reference_case(case_path):
+    """The case with the contact QP solved to 1e-14 instead of the default 1e-12: the
+    monolithic reference's own error (QP tolerance times the condition of the active compliance)
+    reaches 2e-8 on the finest asymmetric mesh with the default, which would blur the force
+    errors of the coupled runs. The templates have no [solver] table."""
+    path = os.path.join(os.path.dirname(case_path), "reference.toml")
+    with open(case_path) as source, open(path, "w") as target:
+        target.write(source.read() + "\n[solver]\nqp_tolerance = 1e-14\n")
+    return path
+
+
 def read_contact_forces(directory):
     with open(os.path.join(directory, "contact.csv")) as file:
         rows = list(csv.DictReader(file))
@@ -140,8 +151,9 @@ def study_case(build, output, case, levels, reuse):
         monolithic_dir = os.path.join(directory, "monolithic")
         code = 0
         if not (reuse and os.path.exists(os.path.join(monolithic_dir, "summary.json"))):
-            code, _ = run([os.path.join(build, "bin", "robin-monolithic"), case_path, "--output",
-                           monolithic_dir], os.path.join(directory, "monolithic.log"))
+            code, _ = run([os.path.join(build, "bin", "robin-monolithic"),
+                           reference_case(case_path), "--output", monolithic_dir],
+                          os.path.join(directory, "monolithic.log"))
         if code != 0:
             sys.exit("robin-monolithic failed on %s level %d (see %s)" % (name, level, directory))
         reference, _ = read_contact_forces(monolithic_dir)

@@ -104,17 +104,18 @@ IterationRecord residual_record(int iteration, const Eigen::VectorXd& gaps,
   return record;
 }
 
-/// |x_{k+1} - x_k| per block (max norm), and the scale that makes it relative:
-/// max(|x_{k+1}|, |d|, |u1_N|, |u2_N|).
+/// Per block (max norms): the step |x_{k+1} - x_k| and the fixed-point residual |H(x_k) - x_k|,
+/// and the scale that makes them relative: max(|x_{k+1}|, |d|, |u1_N|, |u2_N|).
 struct ObstacleChange {
   std::vector<double> per_block;
+  std::vector<double> residual_per_block;
   double scale = 0.0;
   double relative() const { return *std::max_element(per_block.begin(), per_block.end()) / scale; }
 };
 
-ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::VectorXd& next,
-                               const std::vector<int>& block_sizes, const Eigen::VectorXd& gaps,
-                               const CouplingState& state) {
+ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::VectorXd& mapped,
+                               const Eigen::VectorXd& next, const std::vector<int>& block_sizes,
+                               const Eigen::VectorXd& gaps, const CouplingState& state) {
   ObstacleChange change;
   change.scale = std::max(
       {maximum_absolute(next), maximum_absolute(gaps), maximum_absolute(state.normal_trace1),
@@ -123,37 +124,52 @@ ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::Vect
   for (const int size : block_sizes) {
     change.per_block.push_back(
         maximum_absolute(next.segment(offset, size) - iterate.segment(offset, size)));
+    change.residual_per_block.push_back(
+        maximum_absolute(mapped.segment(offset, size) - iterate.segment(offset, size)));
     offset += size;
   }
   return change;
 }
 
 /// The contact forces lambda_k of one body over the iterations, for an estimate of the distance
-/// of lambda_k to the limit lambda*: with D_k = |lambda_k - lambda_{k-1}| (max norm) and the
-/// observed contraction rho = D_k / D_{k-1}, a sequence converging linearly with ratio rho has
-/// |lambda_k - lambda*| <= rho / (1 - rho) D_k <= D_k / (1 - rho). The plain change D_k alone
-/// underestimates the error by 1 / (1 - rho), tenfold for a slow rho = 0.9 (Aitken relaxation).
+/// of lambda_k to the limit lambda*. With D_k = |lambda_k - lambda_{k-1}| (max norm):
+///  - contraction: with rho = D_k / D_{k-1}, a sequence converging linearly with ratio rho has
+///    |lambda_k - lambda*| <= rho / (1 - rho) D_k <= D_k / (1 - rho);
+///  - step length: D_k was caused by the obstacle step s = |x_k - x_{k-1}| of the body's block,
+///    while the obstacle is still r = |H(x_k) - x_k| from its fixed point; an accelerator that
+///    takes a short step (an Aitken factor near 0) makes D_k small far from the solution, so D_k
+///    is scaled by r / s when r > s (lambda is Lipschitz in the obstacle, D_k / s estimates it).
+/// The bare change D_k would underestimate the error tenfold for rho = 0.9, and arbitrarily after
+/// a short step.
 class ForceSequence {
  public:
-  /// D_k / (1 - rho) / |lambda_k|, rho capped at maximum_contraction (0 without D_{k-1});
-  /// 1 without a previous value.
-  double relative_error_estimate(const Eigen::VectorXd& force) const {
+  /// D_k / (1 - rho) max(1, r / s) / |lambda_k|, rho capped at maximum_contraction (0 without
+  /// D_{k-1}); 1 without a previous value.
+  double relative_error_estimate(const Eigen::VectorXd& force, double obstacle_residual) const {
     if (previous_.size() != force.size()) return 1.0;  // no previous value: all changed
     const double change = maximum_absolute(force - previous_);
     const double contraction =
         previous_change_ > 0.0 ? std::min(change / previous_change_, maximum_contraction) : 0.0;
-    return change / (1.0 - contraction) /
-           std::max(maximum_absolute(force), std::numeric_limits<double>::min());
+    const double step_shortfall =
+        obstacle_residual > step_ ? obstacle_residual / std::max(step_, tiny) : 1.0;
+    return std::min(change / (1.0 - contraction) * step_shortfall /
+                        std::max(maximum_absolute(force), tiny),
+                    1.0);
   }
-  void push(const Eigen::VectorXd& force) {
+  /// Records lambda_k and the obstacle step |x_{k+1} - x_k| of the body's block that leads to
+  /// lambda_{k+1}.
+  void push(const Eigen::VectorXd& force, double obstacle_step) {
     previous_change_ = previous_.size() == force.size() ? maximum_absolute(force - previous_) : 0.0;
     previous_ = force;
+    step_ = obstacle_step;
   }
 
  private:
   static constexpr double maximum_contraction = 0.99;
+  static constexpr double tiny = std::numeric_limits<double>::min();
   Eigen::VectorXd previous_;
   double previous_change_ = 0.0;
+  double step_ = 0.0;
 };
 
 /// The largest residual of the complete state of obstacle sequence k: its penetration and
@@ -163,10 +179,10 @@ class ForceSequence {
 /// residuals alone can hide a force error amplified by the interface stiffness (F^-1 grows
 /// like 1/h).
 double completion_residual(const CouplingState& completion, const Eigen::VectorXd& gaps,
-                           double block_change, const Eigen::VectorXd& force,
-                           const ForceSequence& forces) {
+                           double block_change, double obstacle_residual,
+                           const Eigen::VectorXd& force, const ForceSequence& forces) {
   const IterationRecord record = residual_record(0, gaps, completion);
-  const double force_change = forces.relative_error_estimate(force);
+  const double force_change = forces.relative_error_estimate(force, obstacle_residual);
   return std::max({record.penetration, record.complementarity, record.force_balance,
                    record.correction, block_change, force_change});
 }
@@ -190,8 +206,9 @@ IterationRecord iteration_record(int iteration, const Eigen::VectorXd& gaps,
                                  const std::array<ForceSequence, 2>& force_sequences) {
   IterationRecord record = residual_record(iteration, gaps, evaluation.state);
   if (scheme.shares_contact_force()) {
-    record.force_balance =
-        force_sequences[0].relative_error_estimate(evaluation.state.contact_force1);
+    record.force_balance = force_sequences[0].relative_error_estimate(
+        evaluation.state.contact_force1, *std::max_element(change.residual_per_block.begin(),
+                                                           change.residual_per_block.end()));
   }
   record.obstacle_change = change.relative();
   record.obstacle_step = change.relative() * change.scale;
@@ -202,9 +219,9 @@ IterationRecord iteration_record(int iteration, const Eigen::VectorXd& gaps,
   const std::array<const Eigen::VectorXd*, 2> forces{&evaluation.state.contact_force1,
                                                      &evaluation.state.contact_force2};
   for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
-    record.sequence_residuals.push_back(completion_residual(evaluation.completions[k], gaps,
-                                                            change.per_block[k] / change.scale,
-                                                            *forces[k], force_sequences[k]));
+    record.sequence_residuals.push_back(completion_residual(
+        evaluation.completions[k], gaps, change.per_block[k] / change.scale,
+        change.residual_per_block[k], *forces[k], force_sequences[k]));
   }
   return record;
 }
@@ -319,11 +336,12 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
     result.critical_compute_seconds += evaluation.critical_compute_seconds;
     // The obstacle update x_{k+1} = A(x_k, H(x_k)); "none" is the paper's (1 - delta) x + delta H.
     const Eigen::VectorXd next = acceleration->next(iterate, evaluation.mapped);
-    IterationRecord record = iteration_record(
-        iteration, gaps, *scheme, evaluation,
-        obstacle_change(iterate, next, block_sizes, gaps, evaluation.state), force_sequences);
-    force_sequences[0].push(evaluation.state.contact_force1);
-    force_sequences[1].push(evaluation.state.contact_force2);
+    const ObstacleChange change =
+        obstacle_change(iterate, evaluation.mapped, next, block_sizes, gaps, evaluation.state);
+    IterationRecord record =
+        iteration_record(iteration, gaps, *scheme, evaluation, change, force_sequences);
+    force_sequences[0].push(evaluation.state.contact_force1, change.per_block.front());
+    force_sequences[1].push(evaluation.state.contact_force2, change.per_block.back());
     record.acceleration_state = acceleration->state();
     record.seconds = seconds_between(iteration_start, Clock::now());
     result.history.push_back(record);
