@@ -132,29 +132,30 @@ ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::Vect
 }
 
 /// The contact forces lambda_k of one body over the iterations, for an estimate of the distance
-/// of lambda_k to the limit lambda*. With D_k = |lambda_k - lambda_{k-1}| (max norm):
+/// of lambda_k to the limit lambda*. With D_k = |lambda_k - lambda_{k-1}| (max norm), the larger
+/// of two estimates:
 ///  - contraction: with rho = D_k / D_{k-1}, a sequence converging linearly with ratio rho has
 ///    |lambda_k - lambda*| <= rho / (1 - rho) D_k <= D_k / (1 - rho);
 ///  - step length: D_k was caused by the obstacle step s = |x_k - x_{k-1}| of the body's block,
 ///    while the obstacle is still r = |H(x_k) - x_k| from its fixed point; an accelerator that
-///    takes a short step (an Aitken factor near 0) makes D_k small far from the solution, so D_k
-///    is scaled by r / s when r > s (lambda is Lipschitz in the obstacle, D_k / s estimates it).
-/// The bare change D_k would underestimate the error tenfold for rho = 0.9, and arbitrarily after
-/// a short step.
+///    takes a short step (an Aitken factor near 0) makes D_k small far from the solution, so
+///    D_k r / s (lambda is Lipschitz in the obstacle, D_k / s estimates the constant).
+/// For the plain relaxation s = delta r_{k-1} and the contraction estimate is the sharper one;
+/// after an erratic short step the step estimate is. The bare change D_k underestimated the
+/// error tenfold for rho = 0.9, and arbitrarily after a short step.
 class ForceSequence {
  public:
-  /// D_k / (1 - rho) max(1, r / s) / |lambda_k|, rho capped at maximum_contraction (0 without
-  /// D_{k-1}); 1 without a previous value.
+  /// max(D_k / (1 - rho), D_k r / s) / |lambda_k| (rho capped at maximum_contraction, 0 without
+  /// D_{k-1}), at most 1; 1 without a previous value.
   double relative_error_estimate(const Eigen::VectorXd& force, double obstacle_residual) const {
     if (previous_.size() != force.size()) return 1.0;  // no previous value: all changed
     const double change = maximum_absolute(force - previous_);
     const double contraction =
         previous_change_ > 0.0 ? std::min(change / previous_change_, maximum_contraction) : 0.0;
-    const double step_shortfall =
-        obstacle_residual > step_ ? obstacle_residual / std::max(step_, tiny) : 1.0;
-    return std::min(change / (1.0 - contraction) * step_shortfall /
-                        std::max(maximum_absolute(force), tiny),
-                    1.0);
+    const double step_estimate =
+        obstacle_residual > step_ ? change * (obstacle_residual / std::max(step_, tiny)) : change;
+    const double estimate = std::max(change / (1.0 - contraction), step_estimate);
+    return std::min(estimate / std::max(maximum_absolute(force), tiny), 1.0);
   }
   /// Records lambda_k and the obstacle step |x_{k+1} - x_k| of the body's block that leads to
   /// lambda_{k+1}.
