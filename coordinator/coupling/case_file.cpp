@@ -16,15 +16,29 @@ const std::vector<std::string> root_keys{"title", "gap", "solver", "coupling", "
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
     "qp_tolerance", "qp_max_iterations", "interface_operator", "dense_limit", "pairing_tolerance"};
-const std::vector<std::string> coupling_keys{
-    "relaxation",        "tolerance",       "max_iterations",
-    "initial_obstacle",  "request_timeout", "divergence_factor",
-    "stagnation_window", "acceleration",    "relaxation1",
-    "relaxation2",       "aitken_initial",  "aitken_minimum",
-    "aitken_maximum",    "history_depth",   "filter_threshold",
-    "safeguard_growth",  "per_body",        "mixing",
-    "algorithm",         "alpha",           "contact_body",
-    "stopping"};
+const std::vector<std::string> coupling_keys{"relaxation",
+                                             "tolerance",
+                                             "max_iterations",
+                                             "initial_obstacle",
+                                             "request_timeout",
+                                             "setup_timeout",
+                                             "divergence_factor",
+                                             "stagnation_window",
+                                             "acceleration",
+                                             "relaxation1",
+                                             "relaxation2",
+                                             "aitken_initial",
+                                             "aitken_minimum",
+                                             "aitken_maximum",
+                                             "history_depth",
+                                             "filter_threshold",
+                                             "safeguard_growth",
+                                             "per_body",
+                                             "mixing",
+                                             "algorithm",
+                                             "alpha",
+                                             "contact_body",
+                                             "stopping"};
 
 toml::table parse_toml(const std::filesystem::path& path, const std::string& label) {
   std::error_code error;
@@ -174,6 +188,8 @@ void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
                                   .value_or(coupling.initial_obstacle);
   coupling.request_timeout_seconds =
       number_above(*table, "request_timeout", 0.0, coupling.request_timeout_seconds);
+  coupling.setup_timeout_seconds =
+      number_above(*table, "setup_timeout", 0.0, coupling.setup_timeout_seconds);
   coupling.divergence_factor =
       number_above(*table, "divergence_factor", 1.0, coupling.divergence_factor);
   coupling.stagnation_window =

@@ -57,9 +57,12 @@ struct CouplingOptions {
   double tolerance = 1e-8;  // on every scaled residual
   int max_iterations = 200;
   std::string initial_obstacle = "gap";   // "gap": g^alpha_0 = d; "zero": g^alpha_0 = 0
-  double request_timeout_seconds = 60.0;  // deadline of each request to a server
-  double divergence_factor = 1e3;         // obstacle-step growth over its minimum: divergence
-  int stagnation_window = 50;  // iterations without residual decrease that mean stagnation
+  double request_timeout_seconds = 60.0;  // deadline of each interface-sized request
+  /// Deadline of the mesh-sized requests (setup: meshing, assembly, factorization and the
+  /// interface operator; fields), which grow with the body while the others do not.
+  double setup_timeout_seconds = 3600.0;
+  double divergence_factor = 1e3;  // obstacle-step growth over its minimum: divergence
+  int stagnation_window = 50;      // iterations without residual decrease that mean stagnation
 };
 
 struct SolverOptions {

@@ -29,20 +29,40 @@ void report_stage(const RunObserver& observer, const std::string& text) {
   if (observer.stage) observer.stage(text);
 }
 
-/// Calls `request(port, alpha)` on both ports concurrently and returns both results; the
-/// first exception (body 1 first) is rethrown after both have finished.
+std::string message_of(const std::exception_ptr& failure) {
+  try {
+    std::rethrow_exception(failure);
+  } catch (const std::exception& error) {
+    return error.what();
+  } catch (...) {
+    return "unknown error";
+  }
+}
+
+/// Calls `request(port, alpha)` on both ports concurrently and returns both results. After both
+/// have finished, a failure of one body is rethrown as it is; failures of both bodies become
+/// one PortError carrying both messages (each names its server, body and step).
 template <typename Request>
 auto on_both_ports(const std::array<SubdomainPort*, 2>& ports, Request request) {
   auto second = std::async(std::launch::async, [&] { return request(*ports[1], 1); });
-  std::exception_ptr failure;
-  decltype(request(*ports[0], 0)) first{};
+  std::array<std::exception_ptr, 2> failures;
+  decltype(request(*ports[0], 0)) first{}, other{};
   try {
     first = request(*ports[0], 0);
   } catch (...) {
-    failure = std::current_exception();
+    failures[0] = std::current_exception();
   }
-  auto other = second.get();  // rethrows body 2's failure if body 1 succeeded
-  if (failure) std::rethrow_exception(failure);
+  try {
+    other = second.get();
+  } catch (...) {
+    failures[1] = std::current_exception();
+  }
+  if (failures[0] && failures[1]) {
+    throw PortError(message_of(failures[0]) + "\n  and " + message_of(failures[1]));
+  }
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
   return std::array<decltype(first), 2>{std::move(first), std::move(other)};
 }
 
@@ -61,7 +81,7 @@ void write_history_csv(const std::filesystem::path& path,
     // The complete states of the obstacle sequences ("robin" only; empty otherwise).
     for (std::size_t k = 0; k < 2; ++k) {
       file << ',';
-      if (k < record.sequence_residuals.size()) file << record.sequence_residuals[k];
+      if (k < record.sequences.size()) file << record.sequences[k].largest();
     }
     file << '\n';
   }
@@ -74,6 +94,21 @@ nlohmann::json residuals_json(const IterationRecord& record) {
           {"force_balance", record.force_balance},
           {"complementarity", record.complementarity},
           {"correction", record.correction}};
+}
+
+/// The residuals of the state the run reports (RobinResult::completed_by_sequence): an accepted
+/// complete state has no force imbalance and no correction by construction, and carries the
+/// estimated error of its contact force instead.
+nlohmann::json final_residuals_json(const RobinResult& iteration) {
+  const IterationRecord& last = iteration.history.back();
+  if (iteration.completed_by_sequence == 0) return residuals_json(last);
+  const SequenceResiduals& accepted = last.sequences[iteration.completed_by_sequence - 1];
+  return {{"obstacle_change", accepted.obstacle_change},
+          {"penetration", accepted.penetration},
+          {"force_balance", 0.0},
+          {"complementarity", accepted.complementarity},
+          {"correction", 0.0},
+          {"force_error_estimate", accepted.force_error}};
 }
 
 nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunResult& result) {
@@ -94,8 +129,10 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   summary["relaxation"] = result.options.relaxation;
   summary["tolerance"] = result.options.tolerance;
   summary["initial_obstacle"] = result.options.initial_obstacle;
-  if (!iteration.history.empty())
-    summary["final_residuals"] = residuals_json(iteration.history.back());
+  if (!iteration.history.empty()) {
+    summary["final_residuals"] = final_residuals_json(iteration);
+    summary["joint_state_residuals"] = residuals_json(iteration.history.back());
+  }
   summary["contact_pairs"] = result.pairing.size();
   summary["excluded_pairs"] = result.pairing.excluded;
   summary["contact_force_resultant"] = {resultant.x(), resultant.y()};

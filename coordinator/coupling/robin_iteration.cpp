@@ -173,19 +173,19 @@ class ForceSequence {
   double step_ = 0.0;
 };
 
-/// The largest residual of the complete state of obstacle sequence k: its penetration and
-/// complementarity (force balance and correction vanish by construction), the change of its
-/// own obstacle block, and the estimated relative error of its contact force (ForceSequence).
-/// The force estimate stands in for the force balance of the joint state: small displacement
-/// residuals alone can hide a force error amplified by the interface stiffness (F^-1 grows
-/// like 1/h).
-double completion_residual(const CouplingState& completion, const Eigen::VectorXd& gaps,
-                           double block_change, double obstacle_residual,
-                           const Eigen::VectorXd& force, const ForceSequence& forces) {
+/// The residuals of the complete state of obstacle sequence k: its penetration and
+/// complementarity, the change of its own obstacle block, and the estimated relative error of
+/// its contact force (ForceSequence).
+SequenceResiduals completion_residuals(const CouplingState& completion, const Eigen::VectorXd& gaps,
+                                       double block_change, double obstacle_residual,
+                                       const Eigen::VectorXd& force, const ForceSequence& forces) {
   const IterationRecord record = residual_record(0, gaps, completion);
-  const double force_change = forces.relative_error_estimate(force, obstacle_residual);
-  return std::max({record.penetration, record.complementarity, record.force_balance,
-                   record.correction, block_change, force_change});
+  SequenceResiduals residuals;
+  residuals.obstacle_change = block_change;
+  residuals.penetration = record.penetration;
+  residuals.complementarity = record.complementarity;
+  residuals.force_error = forces.relative_error_estimate(force, obstacle_residual);
+  return residuals;
 }
 
 void store_state(RobinResult& result, const CouplingState& state) {
@@ -208,8 +208,8 @@ IterationRecord iteration_record(int iteration, const Eigen::VectorXd& gaps,
   IterationRecord record = residual_record(iteration, gaps, evaluation.state);
   if (scheme.shares_contact_force()) {
     record.force_balance = force_sequences[0].relative_error_estimate(
-        evaluation.state.contact_force1, *std::max_element(change.residual_per_block.begin(),
-                                                           change.residual_per_block.end()));
+        evaluation.state.contact_force1,
+        *std::max_element(change.residual_per_block.begin(), change.residual_per_block.end()));
   }
   record.obstacle_change = change.relative();
   record.obstacle_step = change.relative() * change.scale;
@@ -220,9 +220,9 @@ IterationRecord iteration_record(int iteration, const Eigen::VectorXd& gaps,
   const std::array<const Eigen::VectorXd*, 2> forces{&evaluation.state.contact_force1,
                                                      &evaluation.state.contact_force2};
   for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
-    record.sequence_residuals.push_back(completion_residual(
-        evaluation.completions[k], gaps, change.per_block[k] / change.scale,
-        change.residual_per_block[k], *forces[k], force_sequences[k]));
+    record.sequences.push_back(
+        completion_residuals(evaluation.completions[k], gaps, change.per_block[k] / change.scale,
+                             change.residual_per_block[k], *forces[k], force_sequences[k]));
   }
   return record;
 }
@@ -238,8 +238,8 @@ bool accept_converged_state(const IterationRecord& record, const CouplingEvaluat
     return true;
   }
   if (options.stopping != "either-sequence") return false;
-  for (std::size_t k = 0; k < record.sequence_residuals.size(); ++k) {
-    if (record.sequence_residuals[k] > options.tolerance) continue;
+  for (std::size_t k = 0; k < record.sequences.size(); ++k) {
+    if (record.sequences[k].largest() > options.tolerance) continue;
     store_state(result, evaluation.completions[k]);
     result.status = IterationStatus::converged;
     result.completed_by_sequence = static_cast<int>(k) + 1;
@@ -253,6 +253,10 @@ bool accept_converged_state(const IterationRecord& record, const CouplingEvaluat
 
 }  // namespace
 
+double SequenceResiduals::largest() const {
+  return std::max({obstacle_change, penetration, complementarity, force_error});
+}
+
 double IterationRecord::largest() const {
   return std::max({obstacle_change, penetration, force_balance, complementarity, correction});
 }
@@ -260,8 +264,15 @@ double IterationRecord::largest() const {
 double IterationRecord::progress(bool either_sequence) const {
   double value = largest();
   if (!either_sequence) return value;
-  for (const double residual : sequence_residuals) value = std::min(value, residual);
+  for (const SequenceResiduals& sequence : sequences) value = std::min(value, sequence.largest());
   return value;
+}
+
+double RobinResult::final_largest_residual() const {
+  if (history.empty()) return 0.0;
+  if (completed_by_sequence > 0)
+    return history.back().sequences[completed_by_sequence - 1].largest();
+  return history.back().largest();
 }
 
 std::string to_string(IterationStatus status) {

@@ -24,6 +24,19 @@
 
 namespace robin {
 
+/// Residuals of the complete state of one obstacle sequence (coupling_scheme.hpp,
+/// "Completions"), scaled as in IterationRecord. Its force balance and correction vanish by
+/// construction; force_error stands in for them: the estimated relative distance of the
+/// sequence's contact force to its limit (robin_iteration.cpp, ForceSequence), since small
+/// displacement residuals alone can hide a force error amplified by the interface stiffness.
+struct SequenceResiduals {
+  double obstacle_change = 0.0;  // change of the sequence's own obstacle block
+  double penetration = 0.0;
+  double complementarity = 0.0;
+  double force_error = 0.0;
+  double largest() const;
+};
+
 /// Residuals of one iteration, all dimensionless: displacement-like quantities are divided by
 /// the displacement scale D = max(|d|, |u1_N|, |u2_N|) (and |w_N| for the correction), forces by
 /// F = max(|lambda1|, |lambda2|).
@@ -46,9 +59,9 @@ struct IterationRecord {
   int qp_iterations1 = 0, qp_iterations2 = 0;
   double seconds = 0.0;            // wall time of the iteration
   std::string acceleration_state;  // e.g. "iqn-ils 4 columns", for progress lines
-  /// "robin": the largest residual of the complete state of each obstacle sequence
+  /// "robin": the residuals of the complete state of each obstacle sequence
   /// (coupling_scheme.hpp, "Completions"); empty for the other algorithms.
-  std::vector<double> sequence_residuals;
+  std::vector<SequenceResiduals> sequences;
   double largest() const;  // the largest residual of the joint state
   /// What the stopping test compares with the tolerance: largest(), or with
   /// `either_sequence` the smallest of largest() and the sequence residuals.
@@ -62,15 +75,19 @@ struct RobinResult {
   IterationStatus status = IterationStatus::max_iterations;
   std::string message;    // why it stopped, for people
   std::string algorithm;  // the scheme, e.g. "dirichlet-neumann (contact body 1)"
-  /// 0, or the obstacle sequence (1 or 2) whose complete state was accepted: then the fields
-  /// below hold that state (both contact forces equal, corrections zero).
   std::vector<IterationRecord> history;
   // The state of the last iteration (pair order).
   Eigen::VectorXd obstacle1, obstacle2;          // g used in the last contact solves
   Eigen::VectorXd normal_trace1, normal_trace2;  // u_N
   Eigen::VectorXd contact_force1, contact_force2;
   Eigen::VectorXd correction1, correction2;  // w_N
+  /// 0, or the obstacle sequence (1 or 2) whose complete state was accepted: then the fields
+  /// above hold that state (both contact forces equal, corrections zero) and its residuals are
+  /// history.back().sequences[completed_by_sequence - 1], not those of the joint state.
   int completed_by_sequence = 0;
+  /// The largest scaled residual of the state in the fields above: that of the accepted
+  /// complete state, or of the last joint state.
+  double final_largest_residual() const;
   double coordinator_seconds = 0.0;  // time in the coordinator's own computations
   /// Critical path of the bodies' compute: sum over iterations of max(contact1, contact2) +
   /// max(correction1, correction2), as reported by the bodies.

@@ -3,6 +3,8 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+
 #include "coupling/coupled_run.hpp"
 #include "remote/remote_port.hpp"
 #include "remote/run_interruption.hpp"
@@ -29,6 +31,18 @@ CLI::Validator open_interval(double low, double high) {
       "in (" + fmt::format("{}", low) + ", " + fmt::format("{}", high) + ")");
 }
 
+/// Accepts finite numbers > 0 (CLI11's PositiveNumber prints its range as 300 digits).
+CLI::Validator positive() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+        if (value > 0.0 && std::isfinite(value)) return "";
+        return "must be a finite number > 0, got " + text;
+      },
+      "> 0");
+}
+
 std::shared_ptr<spdlog::logger> coordinator_logger() {
   auto log = spdlog::get("coordinator");
   return log ? log : make_coordinator_logger("info");
@@ -48,7 +62,7 @@ RunObserver make_observer(const std::shared_ptr<spdlog::logger>& log) {
 int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& settings,
                    spdlog::logger& log) {
   const RobinResult& iteration = result.iteration;
-  const double largest = iteration.history.empty() ? 0.0 : iteration.history.back().largest();
+  const double largest = iteration.final_largest_residual();
   const std::string outcome = to_string(iteration.status) + " after " +
                               std::to_string(iteration.history.size()) +
                               " iterations (largest residual " + fmt::format("{:.2e}", largest) +
@@ -97,7 +111,7 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
       ->check(CLI::IsMember({"robin", "robin-constant", "dirichlet-neumann", "neumann-neumann"}));
   app.add_option("--alpha", settings.alpha,
                  "'robin-constant': the constant alpha_S (length per pressure)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   app.add_option("--contact-body", settings.contact_body,
                  "'dirichlet-neumann': the body that solves the contact problem: 1, 2 or auto")
       ->check(CLI::IsMember({"1", "2", "auto"}));
@@ -106,15 +120,19 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
                  "converged) or 'joint' (the paper's test on both)")
       ->check(CLI::IsMember({"either-sequence", "joint"}));
   app.add_option("--tolerance", settings.tolerance, "tolerance on every scaled residual")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--max-iterations", settings.max_iterations, "iteration limit")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
+  app.add_option("--max-iterations", settings.max_iterations, "iteration limit")->check(positive());
   app.add_option("--initial-obstacle", settings.initial_obstacle,
                  "initial obstacles: 'gap' (g0 = d) or 'zero' (g0 = 0)")
       ->check(CLI::IsMember({"gap", "zero"}));
   app.add_option("--timeout", settings.timeout_seconds,
-                 "deadline of each request to a server, in seconds")
-      ->check(CLI::PositiveNumber);
+                 "deadline of each interface-sized request to a server (contact solve, "
+                 "correction, handshake), in seconds; default from the case file, 60")
+      ->check(positive());
+  app.add_option("--setup-timeout", settings.setup_timeout_seconds,
+                 "deadline of the mesh-sized requests (body setup: meshing, assembly, "
+                 "factorization; fields), in seconds; default from the case file, 3600")
+      ->check(positive());
   app.add_option("--log-level", settings.log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.footer(exit_code_footer);
@@ -149,6 +167,8 @@ CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
   if (settings.max_iterations) options.max_iterations = *settings.max_iterations;
   if (settings.initial_obstacle) options.initial_obstacle = *settings.initial_obstacle;
   if (settings.timeout_seconds) options.request_timeout_seconds = *settings.timeout_seconds;
+  if (settings.setup_timeout_seconds)
+    options.setup_timeout_seconds = *settings.setup_timeout_seconds;
   return options;
 }
 
@@ -167,9 +187,9 @@ std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level
 
 std::string progress_line(const IterationRecord& record) {
   std::string sequences;
-  if (record.sequence_residuals.size() == 2) {
-    sequences = fmt::format("; sequences {:.2e}/{:.2e}", record.sequence_residuals[0],
-                            record.sequence_residuals[1]);
+  if (record.sequences.size() == 2) {
+    sequences = fmt::format("; sequences {:.2e}/{:.2e}", record.sequences[0].largest(),
+                            record.sequences[1].largest());
   }
   return fmt::format(
       "iteration {}: obstacle change {:.2e}, penetration {:.2e}, force balance {:.2e}, "
@@ -211,6 +231,7 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     for (int alpha = 0; alpha < 2; ++alpha) {
       RemotePortOptions port_options;
       port_options.request_timeout_seconds = options.request_timeout_seconds;
+      port_options.setup_timeout_seconds = options.setup_timeout_seconds;
       port_options.channel = channels[alpha];
       const std::string& body = definition.bodies[alpha].definition.name;
       ports[alpha] = std::make_unique<RemotePort>(endpoints[alpha], body, port_options);

@@ -39,12 +39,13 @@ struct CoordinatorSettings {
   std::optional<double> tolerance;
   std::optional<int> max_iterations;
   std::optional<std::string> initial_obstacle;  // "gap" or "zero"
-  std::optional<double> timeout_seconds;        // deadline of each request to a server
+  std::optional<double> timeout_seconds;        // deadline of each interface-sized request
+  std::optional<double> setup_timeout_seconds;  // deadline of the setup and fields requests
   std::string log_level = "info";
 };
 
 /// Adds CASE, --output, --relaxation, --tolerance, --max-iterations, --initial-obstacle,
-/// --timeout and --log-level to `app`, and the exit codes to its footer.
+/// --timeout, --setup-timeout and --log-level to `app`, and the exit codes to its footer.
 void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings);
 
 /// Parses the command line; nullopt to go on, otherwise the exit code (0 after --help, 2 for

@@ -159,7 +159,7 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   Envelope request;
   *request.mutable_setup_body() = encode_setup_body(body, solver);
   const Envelope reply =
-      exchange(request, "setup", options_.request_timeout_seconds, Envelope::kInterface);
+      exchange(request, "setup", options_.setup_timeout_seconds, Envelope::kInterface);
   timings_.compute_seconds += reply.interface().setup_seconds();
   try {
     InterfaceDescription interface = decode_interface(reply.interface());
@@ -258,7 +258,7 @@ BodyOutput RemotePort::fields(const Eigen::VectorXd& contact_force) {
   Envelope request;
   append(contact_force, *request.mutable_fields()->mutable_contact_force());
   const Envelope reply =
-      exchange(request, "fields", options_.request_timeout_seconds, Envelope::kFieldsReply);
+      exchange(request, "fields", options_.setup_timeout_seconds, Envelope::kFieldsReply);
   try {
     return decode_fields(reply.fields_reply(), body_label_);
   } catch (const MalformedReply& malformed) {

@@ -3,8 +3,10 @@
 // over ZeroMQ (see request_channel.hpp for the transport and its socket options).
 //
 // setup() performs the handshake (Hello; the reply's major version must equal ours; the
-// handshake's deadline is min(request timeout, 10 s)) and then SetupBody. Each later request
-// has the full request timeout as its deadline. Every failure is a PortError of the form
+// handshake's deadline is min(request timeout, 10 s)) and then SetupBody, whose deadline is the
+// setup timeout, as is that of FieldsRequest: both grow with the body (meshing, assembly,
+// factorization; the whole fields). Every other request is interface-sized and has the request
+// timeout as its deadline. Every failure is a PortError of the form
 //   server tcp://127.0.0.1:5555 (body 'upper'), step contact solve (iteration 7): <problem>
 // where <problem> is e.g. "no reply within 60 s", "the connection to the server was lost (the
 // server stopped or crashed)" or "server error WRONG_STATE: <the server's message>".
@@ -35,6 +37,7 @@ namespace robin {
 
 struct RemotePortOptions {
   double request_timeout_seconds = 60.0;  // CouplingOptions.request_timeout_seconds
+  double setup_timeout_seconds = 3600.0;  // CouplingOptions.setup_timeout_seconds
   double handshake_timeout_limit = 10.0;  // the handshake waits min(request timeout, this)
   double end_run_timeout_seconds = 2.0;   // EndRun is best effort
   /// Transport settings and the hooks run while waiting (cancellation, child-process checks).

@@ -2,6 +2,8 @@
 
 #include <google/protobuf/repeated_field.h>
 
+#include <cmath>
+
 namespace robin {
 
 namespace {
@@ -14,8 +16,31 @@ void expect_size(const Repeated& values, long expected, const std::string& what)
   }
 }
 
+/// Throws MalformedReply naming `what` and the first entry that is NaN or infinite.
+void expect_finite(const google::protobuf::RepeatedField<double>& values, const std::string& what) {
+  for (int i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      throw MalformedReply(what + "[" + std::to_string(i) + "] is " + std::to_string(values[i]) +
+                           ", not a finite number");
+    }
+  }
+}
+
 Eigen::VectorXd to_vector(const google::protobuf::RepeatedField<double>& values) {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
+}
+
+/// Contact forces are compressive, lambda >= 0; a negative entry beyond round-off (1e-12 of the
+/// largest) is a sign-convention error of the server (docs/protocol.md, "Signs").
+void expect_compressive(const Eigen::VectorXd& force) {
+  const double round_off = 1e-12 * (force.size() == 0 ? 0.0 : force.cwiseAbs().maxCoeff());
+  for (Eigen::Index i = 0; i < force.size(); ++i) {
+    if (force[i] < -round_off) {
+      throw MalformedReply("contact_force[" + std::to_string(i) +
+                           "] = " + std::to_string(force[i]) +
+                           " is negative (contact forces are compressive: lambda >= 0)");
+    }
+  }
 }
 
 std::vector<Eigen::Vector2d> to_points(const google::protobuf::RepeatedField<double>& values) {
@@ -108,6 +133,9 @@ InterfaceDescription decode_interface(const protocol::InterfaceDescription& mess
   expect_size(message.weights(), count, "weights");
   expect_size(message.x_fixed(), count, "x_fixed");
   expect_size(message.y_fixed(), count, "y_fixed");
+  expect_finite(message.coordinates(), "coordinates");
+  expect_finite(message.normals(), "normals");
+  expect_finite(message.weights(), "weights");
   InterfaceDescription interface;
   interface.node_ids.assign(message.node_ids().begin(), message.node_ids().end());
   interface.node_tags.assign(message.node_tags().begin(), message.node_tags().end());
@@ -128,8 +156,11 @@ ContactSolveResult decode_contact_result(const protocol::ContactSolveResult& mes
   if (result.status == QpStatus::breakdown) return result;  // values are not usable
   expect_size(message.normal_trace(), contact_size, "normal_trace");
   expect_size(message.contact_force(), contact_size, "contact_force");
+  expect_finite(message.normal_trace(), "normal_trace");
+  expect_finite(message.contact_force(), "contact_force");
   result.normal_trace = to_vector(message.normal_trace());
   result.contact_force = to_vector(message.contact_force());
+  expect_compressive(result.contact_force);
   if (message.active_size() == 0) {
     for (long i = 0; i < contact_size; ++i) result.active.push_back(result.contact_force[i] > 0);
   } else {
@@ -147,12 +178,14 @@ ContactSolveResult decode_contact_result(const protocol::ContactSolveResult& mes
 CorrectionSolveResult decode_correction_result(const protocol::CorrectionResult& message,
                                                long contact_size) {
   expect_size(message.normal_trace(), contact_size, "normal_trace");
+  expect_finite(message.normal_trace(), "normal_trace");
   return {to_vector(message.normal_trace()), message.compute_seconds()};
 }
 
 CorrectionSolveResult decode_neumann_result(const protocol::NeumannSolveResult& message,
                                             long contact_size) {
   expect_size(message.normal_trace(), contact_size, "normal_trace");
+  expect_finite(message.normal_trace(), "normal_trace");
   return {to_vector(message.normal_trace()), message.compute_seconds()};
 }
 

@@ -1,7 +1,9 @@
 #pragma once
 // Decoding of the servers' replies into the coordinator's types (part of robin_remote's
-// protocol module). Every function checks the sizes and indices it relies on and throws
-// MalformedReply saying what is inconsistent; the port adds server, body and step.
+// protocol module). Every function checks the sizes and indices it relies on, that the
+// interface vectors are finite and that contact forces are compressive (lambda >= 0), and throws
+// MalformedReply saying what is inconsistent; the port adds server, body and step (a NaN from a
+// third-party server is named where it arrives, not found later as a diverged iteration).
 
 #include <stdexcept>
 #include <string>

@@ -8,8 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "numerics/errors.hpp"
 #include "remote/reply_decoding.hpp"
@@ -151,6 +153,38 @@ TEST(ContactDecoding, SizesAreChecked) {
   EXPECT_EQ(result.active, (std::vector<bool>{false, true}));  // lambda_i > 0 without flags
   EXPECT_EQ(result.status, QpStatus::converged);
   EXPECT_THROW(decode_contact_result(message, 3), MalformedReply);
+}
+
+/// The message of the MalformedReply that decoding `message` throws, or "" when it decodes.
+template <typename Decode>
+std::string malformed_message(Decode decode) {
+  try {
+    decode();
+  } catch (const MalformedReply& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(ContactDecoding, NonFiniteValuesAndTensileForcesAreRefused) {
+  protocol::ContactSolveResult message;
+  message.set_status(protocol::CONVERGED);
+  for (double value : {0.1, std::nan("")}) message.add_normal_trace(value);
+  for (double value : {0.0, 3.0}) message.add_contact_force(value);
+  const auto decode = [&] { decode_contact_result(message, 2); };
+  EXPECT_NE(malformed_message(decode).find("normal_trace[1]"), std::string::npos)
+      << malformed_message(decode);
+  message.set_normal_trace(1, 0.2);
+  message.set_contact_force(0, -1e-3);  // beyond round-off of the largest force 3
+  EXPECT_NE(malformed_message(decode).find("contact_force[0]"), std::string::npos);
+  EXPECT_NE(malformed_message(decode).find("compressive"), std::string::npos);
+  message.set_contact_force(0, -1e-13);  // round-off: accepted
+  EXPECT_EQ(malformed_message(decode), "");
+
+  protocol::CorrectionResult correction;
+  correction.add_normal_trace(std::numeric_limits<double>::infinity());
+  EXPECT_NE(malformed_message([&] { decode_correction_result(correction, 1); }).find("finite"),
+            std::string::npos);
 }
 
 }  // namespace

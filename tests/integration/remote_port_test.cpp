@@ -7,18 +7,25 @@
 //    the server and the step well before the 5 s request deadline;
 //  - a server that never replies fails the handshake after the 2 s deadline, naming the
 //    endpoint and "handshake";
+//  - when neither server answers, the error names both servers and bodies;
+//  - a server that answers the handshake but not SetupBody fails the setup at the setup
+//    timeout (3 s), not at the shorter request timeout (1 s);
 //  - a server speaking protocol 2.x is refused with both versions in the message.
 
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <array>
 #include <iostream>
+#include <thread>
 #include <zmq.hpp>
 
 #include "coupling/coupled_run.hpp"
 #include "coupling/in_process_port.hpp"
+#include "protocol_version.hpp"
 #include "remote/remote_port.hpp"
 #include "remote_test_support.hpp"
+#include "robin.pb.h"
 
 namespace robin {
 namespace {
@@ -185,6 +192,110 @@ TEST(RemotePort, SilentServerFailsTheHandshakeAtTheDeadline) {
   }
   zmq::message_t request;
   EXPECT_TRUE(silent.recv(request, zmq::recv_flags::dontwait)) << "the Hello never arrived";
+}
+
+TEST(RemotePort, FailureOfBothServersNamesBoth) {
+  // Two bound REP sockets that never reply: both handshakes fail at the 1 s deadline.
+  zmq::context_t context;
+  std::array<zmq::socket_t, 2> silent{zmq::socket_t(context, zmq::socket_type::rep),
+                                      zmq::socket_t(context, zmq::socket_type::rep)};
+  std::array<std::string, 2> endpoints;
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    silent[alpha].set(zmq::sockopt::linger, 0);
+    silent[alpha].bind("tcp://127.0.0.1:*");
+    endpoints[alpha] = silent[alpha].get(zmq::sockopt::last_endpoint);
+  }
+  const CaseDefinition definition = two_blocks();
+  RemotePort body1(endpoints[0], "lower", port_options(1.0));
+  RemotePort body2(endpoints[1], "upper", port_options(1.0));
+  try {
+    run_coupled_case(definition, {&body1, &body2}, definition.coupling);
+    FAIL() << "the run succeeded without servers";
+  } catch (const PortError& error) {
+    const std::string message = error.what();
+    std::cout << message << "\n";
+    for (int alpha = 0; alpha < 2; ++alpha) {
+      EXPECT_NE(message.find("server " + endpoints[alpha]), std::string::npos) << message;
+    }
+    EXPECT_NE(message.find("body 'lower'"), std::string::npos) << message;
+    EXPECT_NE(message.find("body 'upper'"), std::string::npos) << message;
+  }
+}
+
+/// A REP server that answers the first request (a Hello) with a valid HelloReply and then
+/// receives the next request (SetupBody) without ever answering it.
+class HandshakeOnlyServer {
+ public:
+  HandshakeOnlyServer() : socket_(context_, zmq::socket_type::rep) {
+    socket_.set(zmq::sockopt::linger, 0);
+    socket_.set(zmq::sockopt::rcvtimeo, 10000);
+    socket_.bind("tcp://127.0.0.1:*");
+    endpoint_ = socket_.get(zmq::sockopt::last_endpoint);
+    thread_ = std::thread([this] { serve(); });
+  }
+  ~HandshakeOnlyServer() {
+    if (thread_.joinable()) thread_.join();
+  }
+  const std::string& endpoint() const { return endpoint_; }
+  /// Waits for the server thread (it ends once SetupBody arrived, or after 10 s without it);
+  /// true when a SetupBody request arrived.
+  bool setup_arrived() {
+    thread_.join();
+    return setup_arrived_;
+  }
+
+ private:
+  void serve() {
+    zmq::message_t message;
+    if (!socket_.recv(message)) return;
+    protocol::Envelope hello;
+    hello.ParseFromArray(message.data(), static_cast<int>(message.size()));
+    protocol::Envelope reply;
+    reply.mutable_version()->set_major(protocol::protocol_major);
+    reply.mutable_version()->set_minor(protocol::protocol_minor);
+    reply.set_request_id(hello.request_id());
+    for (const char* capability : {"contact_solve", "correction_solve", "fields"})
+      reply.mutable_hello_reply()->add_capabilities(capability);
+    reply.mutable_hello_reply()->set_server_name("handshake only");
+    const std::string bytes = reply.SerializeAsString();
+    socket_.send(zmq::buffer(bytes));
+    zmq::message_t setup;
+    if (socket_.recv(setup)) {
+      protocol::Envelope request;
+      setup_arrived_ = request.ParseFromArray(setup.data(), static_cast<int>(setup.size())) &&
+                       request.has_setup_body();
+    }
+  }
+
+  zmq::context_t context_;
+  zmq::socket_t socket_;
+  std::string endpoint_;
+  std::thread thread_;
+  bool setup_arrived_ = false;
+};
+
+TEST(RemotePort, SetupHasItsOwnDeadline) {
+  const CaseDefinition definition = two_blocks();
+  HandshakeOnlyServer server;
+  RemotePortOptions options = port_options(1.0);
+  options.setup_timeout_seconds = 3.0;
+  RemotePort port(server.endpoint(), "lower", options);
+  const auto start = std::chrono::steady_clock::now();
+  std::string message;
+  try {
+    port.setup(definition.bodies[0], definition.solver);
+    ADD_FAILURE() << "setup succeeded against a server that never answers it";
+  } catch (const PortError& error) {
+    message = error.what();
+  }
+  const double elapsed = seconds_since(start);
+  std::cout << "failed after " << elapsed << " s: " << message << "\n";
+  EXPECT_NE(message.find("server " + server.endpoint()), std::string::npos) << message;
+  EXPECT_NE(message.find("step setup"), std::string::npos) << message;
+  EXPECT_NE(message.find("no reply within 3 s"), std::string::npos) << message;
+  EXPECT_GE(elapsed, 3.0 - 0.05);
+  EXPECT_LT(elapsed, 3.0 + 1.0);
+  EXPECT_TRUE(server.setup_arrived()) << "the handshake did not lead to a SetupBody request";
 }
 
 TEST(RemotePort, ServerOfAnotherMajorVersionIsRefused) {

@@ -204,6 +204,7 @@ TEST(CaseFile, FullCaseReadsEveryKey) {
   EXPECT_EQ(coupling.max_iterations, 321);
   EXPECT_EQ(coupling.initial_obstacle, "zero");
   EXPECT_EQ(coupling.request_timeout_seconds, 12.5);
+  EXPECT_EQ(coupling.setup_timeout_seconds, 90.5);
   EXPECT_EQ(coupling.divergence_factor, 500.0);
   EXPECT_EQ(coupling.stagnation_window, 17);
 }
@@ -301,6 +302,7 @@ TEST(CaseFile, MissingOptionalTablesGiveTheDocumentedDefaults) {
   EXPECT_EQ(definition.coupling.max_iterations, 200);
   EXPECT_EQ(definition.coupling.initial_obstacle, "gap");
   EXPECT_EQ(definition.coupling.request_timeout_seconds, 60.0);
+  EXPECT_EQ(definition.coupling.setup_timeout_seconds, 3600.0);
   EXPECT_EQ(definition.coupling.divergence_factor, 1e3);
   EXPECT_EQ(definition.coupling.stagnation_window, 50);
 
@@ -708,6 +710,12 @@ std::vector<ErrorCase> error_cases() {
        "request_timeout",
        1,
        {"case.toml:{line}: coupling.request_timeout: must be > 0"}},
+      {"NegativeSetupTimeout",
+       "relaxation = 0.5",
+       "setup_timeout = -5.0",
+       "setup_timeout",
+       1,
+       {"case.toml:{line}: coupling.setup_timeout: must be > 0"}},
       {"DivergenceFactorOne",
        "relaxation = 0.5",
        "divergence_factor = 1.0",
