@@ -3,6 +3,12 @@
 // symmetric blocks, the asymmetric cantilever-on-block pair and the Hertz case. Also records the
 // iteration counts of the paper's plain relaxation and checks that a too-large delta is reported
 // as diverging.
+//
+// The paper's plain relaxation ("none") runs with the paper's test on the joint state
+// (stopping "joint"), so lambda1 = lambda2 and w -> 0 are properties of the computed iterates.
+// The accelerated methods keep the default either-sequence stopping, whose accepted complete
+// state has lambda1 = lambda2 and w = 0 by construction (coupling_scheme.hpp): for them the
+// comparison with the monolithic answer is what is tested.
 
 #include <gtest/gtest.h>
 
@@ -36,8 +42,8 @@ double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& 
   return (value - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>();
 }
 
-/// Runs the case with `method` ("none": the paper's plain relaxation with `relaxation`) and
-/// compares with the monolithic reference; returns the iteration count.
+/// Runs the case with `method` ("none": the paper's plain relaxation with `relaxation` and its
+/// joint stopping test) and compares with the monolithic reference; returns the iteration count.
 std::size_t expect_matches_monolithic(const CaseDefinition& definition,
                                       const std::string& case_name, const std::string& method,
                                       double relaxation, double tolerance = 1e-9,
@@ -47,6 +53,7 @@ std::size_t expect_matches_monolithic(const CaseDefinition& definition,
   options.relaxation = relaxation;
   options.tolerance = tolerance;
   options.max_iterations = 5000;
+  if (method == "none") options.stopping = "joint";
   const CoupledRunResult robin = run_in_process(definition, options);
   std::printf("%s: %s, delta = %.3g: %s after %zu iterations\n", case_name.c_str(), method.c_str(),
               relaxation, to_string(robin.iteration.status).c_str(),
@@ -54,12 +61,15 @@ std::size_t expect_matches_monolithic(const CaseDefinition& definition,
   const std::size_t iterations = robin.iteration.history.size();
   EXPECT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
   if (robin.iteration.status != IterationStatus::converged) return iterations;
+  if (options.stopping == "joint") {
+    EXPECT_EQ(robin.iteration.completed_by_sequence, 0);
+  }
 
   const LocalProblem reference = prepare_local_problem(definition);
   MprgpParameters reference_qp = definition.solver.qp;
   if (reference_qp_tolerance > 0.0) reference_qp.relative_tolerance = reference_qp_tolerance;
-  const MonolithicResult monolithic = solve_monolithic(*reference.bodies[0], *reference.bodies[1],
-                                                       reference.pairing, reference_qp);
+  const MonolithicResult monolithic =
+      solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing, reference_qp);
   EXPECT_EQ(monolithic.qp.status, QpStatus::converged);
   EXPECT_EQ(robin.pairing.size(), reference.pairing.size());
   if (robin.pairing.size() != reference.pairing.size()) return iterations;
@@ -115,6 +125,7 @@ TEST(RobinIteration, PlainRelaxationIterationCounts) {
     CouplingOptions options = definition.coupling;
     options.acceleration.method = "none";
     options.relaxation = 0.5;
+    options.stopping = "joint";  // the paper's test
     options.max_iterations = 1000;
     const CoupledRunResult robin = run_in_process(definition, options);
     std::printf("plain relaxation delta = 0.5 on %s: %s, %zu iterations (%s)\n", name.c_str(),
