@@ -19,6 +19,13 @@ std::string format_point(const Eigen::Vector2d& point) {
   return stream.str();
 }
 
+std::string format_length(double length) {
+  std::ostringstream stream;
+  stream.precision(6);
+  stream << length;
+  return stream.str();
+}
+
 /// Shortest distance between two distinct contact nodes of one side: the length scale of the
 /// matching tolerance.
 double shortest_spacing(const std::vector<Eigen::Vector2d>& points) {
@@ -82,6 +89,49 @@ std::string describe_node(const std::string& body, std::size_t tag, const Eigen:
 
 }  // namespace
 
+std::string overlap_warning(const ContactPairing& pairing) {
+  int overlapping = 0;
+  const ContactPair* deepest = nullptr;
+  for (const ContactPair& pair : pairing.pairs) {
+    if (pair.gap >= 0.0) continue;
+    ++overlapping;
+    if (deepest == nullptr || pair.gap < deepest->gap) deepest = &pair;
+  }
+  if (deepest == nullptr) return "";
+  std::ostringstream text;
+  text << overlapping << " of " << pairing.size()
+       << " contact pairs overlap initially (negative gap; the largest overlap is " << -deepest->gap
+       << " at " << format_point(deepest->position)
+       << "): the bodies are pushed apart, as in an interference fit; if that is not intended, "
+          "check the meshes and the [gap] expression";
+  return text.str();
+}
+
+ExcludedPairClearance excluded_pair_clearance(const ContactPairing& pairing,
+                                              const PairDisplacement& displacement_of,
+                                              double included_scale) {
+  std::vector<double> normal1, normal2;  // u1.n1 and u2.n1 at the excluded pairs
+  double scale = std::max(included_scale, std::numeric_limits<double>::min());
+  for (const ContactPair& pair : pairing.excluded_pairs) {
+    normal1.push_back(displacement_of(0, pair).dot(pair.normal));
+    normal2.push_back(displacement_of(1, pair).dot(pair.normal));
+    scale =
+        std::max({scale, std::abs(pair.gap), std::abs(normal1.back()), std::abs(normal2.back())});
+  }
+  ExcludedPairClearance clearance;
+  for (std::size_t k = 0; k < pairing.excluded_pairs.size(); ++k) {
+    const double penetration = normal1[k] - normal2[k] - pairing.excluded_pairs[k].gap;
+    if (penetration / scale <= clearance.relative_penetration) continue;
+    clearance.relative_penetration = penetration / scale;
+    clearance.description = pairing.excluded[k] +
+                            ": the prescribed displacements drive the bodies into each other by " +
+                            format_length(penetration) +
+                            " there (an excluded pair is not a contact constraint; do not "
+                            "prescribe the normal displacement of contact nodes)";
+  }
+  return clearance;
+}
+
 ContactAssignment ContactPairing::assignment(int body_index) const {
   ContactAssignment assignment;
   const double sign = body_index == 0 ? 1.0 : -1.0;
@@ -121,7 +171,7 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
     if (j < 0 || partner_of_second[j] >= 0) {
       throw InputError(
           "contact pairing: " + describe_node(name1, body1.node_tags[i], point) +
-          " has no matching node on body '" + name2 + "' within " + std::to_string(tolerance) +
+          " has no matching node on body '" + name2 + "' within " + format_length(tolerance) +
           " (non-matching contact meshes are not supported: mesh both contact boundaries with "
           "the same nodes)");
     }
@@ -130,6 +180,7 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
     pair.node1 = body1.node_ids[i];
     pair.node2 = body2.node_ids[j];
     pair.position = point;
+    pair.position2 = body2.coordinates[j];
     pair.normal = (body1.normals[i] - body2.normals[j]).normalized();
     pair.gap = (body2.coordinates[j] - point).dot(pair.normal);
     if (gap != nullptr) pair.gap += (*gap)(point.x(), point.y());
@@ -141,9 +192,19 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
           describe_node(fixed1 ? name1 : name2, fixed1 ? body1.node_tags[i] : body2.node_tags[j],
                         point) +
           ": normal displacement prescribed by a Dirichlet condition; pair excluded from contact");
+      pairing.excluded_pairs.push_back(pair);
       continue;
     }
     pairing.pairs.push_back(pair);
+  }
+  if (pairing.pairs.empty()) {
+    throw InputError("contact pairing of bodies '" + name1 + "' and '" + name2 + "': all " +
+                     std::to_string(pairing.excluded.size()) +
+                     " node pairs have their normal displacement prescribed by Dirichlet "
+                     "conditions (first: " +
+                     pairing.excluded.front() +
+                     "), so no contact is left to solve; the contact boundary must not be a "
+                     "Dirichlet boundary (check contact_boundary and dirichlet of both bodies)");
   }
   for (std::size_t j = 0; j < body2.node_ids.size(); ++j) {
     if (partner_of_second[j] < 0) {

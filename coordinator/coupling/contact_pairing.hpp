@@ -4,9 +4,15 @@
 // normalised average of body 1's outward normal and minus body 2's; the initial normal gap
 //   d_i = (x2_i - x1_i) . n1_i + g0(x1_i)
 // and the boundary weight m_i (average of both sides). A pair whose normal displacement is
-// prescribed on either side by Dirichlet conditions is excluded (reported in `excluded`).
+// prescribed on either side by Dirichlet conditions is excluded (reported in `excluded`): its
+// normal displacement is data, not an unknown of the contact problem (typically the corner
+// where a clamped side meets the contact boundary). Its clearance is checked on the solution
+// (excluded_pair_clearance): a prescribed displacement that drives one body into the other is
+// reported, never solved silently. A negative gap d_i < 0 is an initial overlap (an
+// interference fit): legal, solved by pushing the bodies apart, and reported (overlap_warning).
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -16,17 +22,19 @@
 namespace robin {
 
 struct ContactPair {
-  int node1 = -1;                                      // mesh node index in body 1
-  int node2 = -1;                                      // mesh node index in body 2
-  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // body-1 node
-  Eigen::Vector2d normal = Eigen::Vector2d::Zero();    // n1 (unit, outward from body 1)
-  double gap = 0.0;                                    // d_i (length)
-  double weight = 0.0;                                 // m_i (length)
+  int node1 = -1;                                       // mesh node index in body 1
+  int node2 = -1;                                       // mesh node index in body 2
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();   // body-1 node
+  Eigen::Vector2d position2 = Eigen::Vector2d::Zero();  // body-2 node
+  Eigen::Vector2d normal = Eigen::Vector2d::Zero();     // n1 (unit, outward from body 1)
+  double gap = 0.0;                                     // d_i (length)
+  double weight = 0.0;                                  // m_i (length)
 };
 
 struct ContactPairing {
   std::vector<ContactPair> pairs;
-  std::vector<std::string> excluded;  // one line per excluded pair, with the reason
+  std::vector<std::string> excluded;        // one line per excluded pair, with the reason
+  std::vector<ContactPair> excluded_pairs;  // the same pairs, in the same order
 
   std::size_t size() const { return pairs.size(); }
   /// The assignment for body 0 (normals n1) or body 1 (normals -n1).
@@ -38,9 +46,31 @@ struct ContactPairing {
 /// Pairs the two interfaces. `gap` may be null. A body-1 node matches the body-2 node whose
 /// offset from it is, up to the normal component, shorter than relative_tolerance times the
 /// shortest contact edge; every node of both sides must be matched. Throws InputError naming
-/// the first unmatched node (body, mesh node tag, coordinates).
+/// the first unmatched node (body, mesh node tag, coordinates), or when every pair is excluded
+/// (the contact boundary is a Dirichlet boundary: nothing is left for contact).
 ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::string& name1,
                                   const InterfaceDescription& body2, const std::string& name2,
                                   const GapFunction* gap, double relative_tolerance);
+
+/// "" when every gap d_i >= 0; otherwise one line for the log and summary.json: how many pairs
+/// overlap initially, the largest overlap and where.
+std::string overlap_warning(const ContactPairing& pairing);
+
+/// The clearance of the excluded pairs in a solution: the largest penetration
+/// u1.n1 + u2.n2 - d_i over them, relative to the displacement scale: the larger of
+/// `included_scale` (the caller's largest |d_i| and |u.n| over the included pairs) and the
+/// largest |d_i| and |u.n| at the excluded pairs. `displacement_of(body_index, pair)` is the
+/// displacement vector of body `body_index`'s (0 or 1) node of an excluded pair.
+struct ExcludedPairClearance {
+  double relative_penetration = 0.0;  // 0 when no excluded pair penetrates
+  std::string description;            // the worst pair, "" when none penetrates
+};
+using PairDisplacement = std::function<Eigen::Vector2d(int body_index, const ContactPair& pair)>;
+ExcludedPairClearance excluded_pair_clearance(const ContactPairing& pairing,
+                                              const PairDisplacement& displacement_of,
+                                              double included_scale);
+/// Largest relative penetration of an excluded pair that still counts as touching (round-off
+/// of the solution); above it the tools report an error.
+inline constexpr double excluded_pair_penetration_limit = 1e-6;
 
 }  // namespace robin

@@ -66,6 +66,38 @@ auto on_both_ports(const std::array<SubdomainPort*, 2>& ports, Request request) 
   return std::array<decltype(first), 2>{std::move(first), std::move(other)};
 }
 
+/// The displacement of the output node nearest to `point` (node ids are opaque to the
+/// coordinator, positions are not); zero when the fields carry no displacement.
+Eigen::Vector2d displacement_near(const BodyOutput& output, const Eigen::Vector2d& point) {
+  const OutputField* displacement = nullptr;
+  for (const OutputField& field : output.point_fields) {
+    if (field.name == "displacement" && field.components == 2) displacement = &field;
+  }
+  if (displacement == nullptr || output.mesh.nodes.empty()) return Eigen::Vector2d::Zero();
+  std::size_t nearest = 0;
+  for (std::size_t k = 1; k < output.mesh.nodes.size(); ++k) {
+    if ((output.mesh.nodes[k] - point).squaredNorm() <
+        (output.mesh.nodes[nearest] - point).squaredNorm())
+      nearest = k;
+  }
+  return {displacement->values[2 * nearest], displacement->values[2 * nearest + 1]};
+}
+
+/// The excluded pairs in the final state, scaled by the included pairs' gaps and traces.
+ExcludedPairClearance excluded_clearance(const CoupledRunResult& result) {
+  const RobinResult& iteration = result.iteration;
+  double scale = 0.0;
+  for (const Eigen::VectorXd* values : {&iteration.normal_trace1, &iteration.normal_trace2}) {
+    if (values->size() > 0) scale = std::max(scale, values->cwiseAbs().maxCoeff());
+  }
+  if (result.pairing.size() > 0)
+    scale = std::max(scale, result.pairing.gaps().cwiseAbs().maxCoeff());
+  const auto displacement_of = [&](int body, const ContactPair& pair) {
+    return displacement_near(result.outputs[body], body == 0 ? pair.position : pair.position2);
+  };
+  return excluded_pair_clearance(result.pairing, displacement_of, scale);
+}
+
 void write_history_csv(const std::filesystem::path& path,
                        const std::vector<IterationRecord>& history) {
   std::ofstream file(path);
@@ -135,6 +167,8 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   }
   summary["contact_pairs"] = result.pairing.size();
   summary["excluded_pairs"] = result.pairing.excluded;
+  summary["excluded_pair_penetration"] = result.excluded_clearance.relative_penetration;
+  summary["initial_overlap"] = overlap_warning(result.pairing);
   summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
   double server_compute = 0.0;
   long iteration_bytes = 0;
@@ -190,6 +224,8 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   report_stage(observer, std::to_string(result.pairing.size()) + " contact pairs (" +
                              std::to_string(result.pairing.excluded.size()) + " excluded)");
   for (const std::string& line : result.pairing.excluded) report_stage(observer, line);
+  if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
+    report_stage(observer, overlap);
   for (int alpha = 0; alpha < 2; ++alpha)
     ports[alpha]->assign_contact(result.pairing.assignment(alpha));
   result.setup_seconds = seconds_since(start);
@@ -206,6 +242,7 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
     return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
   });
   for (int alpha = 0; alpha < 2; ++alpha) result.port_timings[alpha] = ports[alpha]->timings();
+  result.excluded_clearance = excluded_clearance(result);
   result.total_seconds = seconds_since(start);
   return result;
 }

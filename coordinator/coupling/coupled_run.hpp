@@ -22,6 +22,10 @@ struct CoupledRunResult {
   std::array<InterfaceDescription, 2> interfaces;
   std::array<PortTimings, 2> port_timings;            // whole run
   std::array<PortTimings, 2> iteration_port_timings;  // the iteration alone (no setup, fields)
+  /// The excluded pairs in the final state (contact_pairing.hpp): a penetration beyond
+  /// excluded_pair_penetration_limit means a Dirichlet condition drives the bodies into each
+  /// other, which the tools report as an error.
+  ExcludedPairClearance excluded_clearance;
   double setup_seconds = 0.0;
   double total_seconds = 0.0;
 };

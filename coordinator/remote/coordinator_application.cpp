@@ -67,11 +67,15 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
                               std::to_string(iteration.history.size()) +
                               " iterations (largest residual " + fmt::format("{:.2e}", largest) +
                               ")" + (iteration.message.empty() ? "" : ": " + iteration.message);
-  const int code = exit_code(iteration.status);
+  int code = exit_code(iteration.status);
   if (code == 0) {
     log.info("{}", outcome);
   } else {
     log.warn("{}", outcome);
+  }
+  if (result.excluded_clearance.relative_penetration > excluded_pair_penetration_limit) {
+    log.error("{}", result.excluded_clearance.description);
+    code = 1;
   }
   double compute = 0.0, round_trip = 0.0;
   for (const PortTimings& timings : result.port_timings) {

@@ -1,6 +1,7 @@
 // robin-monolithic CASE --output DIR
 // The single-process reference solver of the whole two-body contact problem (paper (5)).
-// Exit codes: 0 converged, 1 bad input or failure, 2 the QP did not converge.
+// Exit codes: 0 converged, 1 bad input or failure (also: a Dirichlet condition drives an excluded
+// contact pair into penetration; the results are written), 2 the QP did not converge.
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -22,8 +23,7 @@ using robin::MonolithicResult;
 nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult& result,
                             double total_seconds) {
   nlohmann::json summary;
-  const Eigen::Vector2d resultant =
-      robin::contact_resultant(problem.pairing, result.contact_force);
+  const Eigen::Vector2d resultant = robin::contact_resultant(problem.pairing, result.contact_force);
   summary["method"] = "monolithic";
   summary["case"] = problem.definition.file.string();
   summary["converged"] = result.qp.status == robin::QpStatus::converged;
@@ -32,19 +32,20 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   summary["operator_applications"] = result.qp.operator_applications;
   summary["contact_pairs"] = problem.pairing.size();
   summary["excluded_pairs"] = problem.pairing.excluded;
+  summary["initial_overlap"] = robin::overlap_warning(problem.pairing);
   summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
   summary["residuals"] = {{"penetration", result.residuals.penetration},
                           {"force_balance", result.residuals.force_balance},
                           {"complementarity", result.residuals.complementarity}};
   double assembly = 0, factorization = 0;
   for (const auto& body : problem.bodies) {
-    summary["bodies"].push_back({{"name", body->name()},
-                                 {"dofs", body->free_dof_count()},
-                                 {"nodes", body->mesh().node_count()},
-                                 {"elements", body->mesh().element_count()},
-                                 {"factor_nonzeros", body->factor_nonzeros()},
-                                 {"applied_force", {body->applied_force().x(),
-                                                    body->applied_force().y()}}});
+    summary["bodies"].push_back(
+        {{"name", body->name()},
+         {"dofs", body->free_dof_count()},
+         {"nodes", body->mesh().node_count()},
+         {"elements", body->mesh().element_count()},
+         {"factor_nonzeros", body->factor_nonzeros()},
+         {"applied_force", {body->applied_force().x(), body->applied_force().y()}}});
     assembly += body->timings().assembly_seconds;
     factorization += body->timings().factorization_seconds + body->timings().interface_seconds;
   }
@@ -56,11 +57,29 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   return summary;
 }
 
+/// The excluded pairs in the solution (node ids are this process's mesh node indices).
+robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem,
+                                                     const MonolithicResult& result) {
+  const std::array<Eigen::VectorXd, 2> displacements{
+      problem.bodies[0]->displacement(result.contact_force),
+      problem.bodies[1]->displacement(result.contact_force)};
+  const auto displacement_of = [&](int body, const robin::ContactPair& pair) {
+    const Eigen::Index node = body == 0 ? pair.node1 : pair.node2;
+    return Eigen::Vector2d(displacements[body].segment<2>(2 * node));
+  };
+  const double scale = std::max({problem.pairing.gaps().cwiseAbs().maxCoeff(),
+                                 result.normal_trace1.cwiseAbs().maxCoeff(),
+                                 result.normal_trace2.cwiseAbs().maxCoeff()});
+  return robin::excluded_pair_clearance(problem.pairing, displacement_of, scale);
+}
+
 void write_outputs(const std::filesystem::path& directory, const LocalProblem& problem,
                    const MonolithicResult& result, const nlohmann::json& summary) {
   std::filesystem::create_directories(directory);
-  const std::string file1 = robin::write_body_vtu(directory, *problem.bodies[0], result.contact_force);
-  const std::string file2 = robin::write_body_vtu(directory, *problem.bodies[1], result.contact_force);
+  const std::string file1 =
+      robin::write_body_vtu(directory, *problem.bodies[0], result.contact_force);
+  const std::string file2 =
+      robin::write_body_vtu(directory, *problem.bodies[1], result.contact_force);
   robin::write_solution_pvd(directory, file1, file2);
   robin::InterfaceState state{result.normal_trace1, result.normal_trace2, result.contact_force,
                               result.contact_force};
@@ -72,31 +91,40 @@ int run(const std::filesystem::path& case_path, const std::filesystem::path& out
   auto log = spdlog::get("monolithic");
   const auto start = std::chrono::steady_clock::now();
   const robin::CaseDefinition definition = robin::read_case_file(case_path);
-  log->info("case {}: bodies '{}' and '{}'", case_path.string(), definition.bodies[0].definition.name,
-            definition.bodies[1].definition.name);
+  log->info("case {}: bodies '{}' and '{}'", case_path.string(),
+            definition.bodies[0].definition.name, definition.bodies[1].definition.name);
   const LocalProblem problem = robin::prepare_local_problem(definition);
   for (const auto& body : problem.bodies) {
     log->info("body '{}': {} dofs, assembly {:.3f} s, factorization {:.3f} s ({} nonzeros in L)",
               body->name(), body->free_dof_count(), body->timings().assembly_seconds,
               body->timings().factorization_seconds, body->factor_nonzeros());
   }
-  log->info("{} contact pairs ({} excluded)", problem.pairing.size(), problem.pairing.excluded.size());
+  log->info("{} contact pairs ({} excluded)", problem.pairing.size(),
+            problem.pairing.excluded.size());
   for (const std::string& line : problem.pairing.excluded) log->warn("{}", line);
-  const MonolithicResult result = robin::solve_monolithic(
-      *problem.bodies[0], *problem.bodies[1], problem.pairing, definition.solver.qp);
+  if (const std::string overlap = robin::overlap_warning(problem.pairing); !overlap.empty())
+    log->warn("{}", overlap);
+  const MonolithicResult result = robin::solve_monolithic(*problem.bodies[0], *problem.bodies[1],
+                                                          problem.pairing, definition.solver.qp);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  log->info("MPRGP {}: {} iterations, {} operator products, {:.3f} s; residuals penetration {:.2e}, "
-            "complementarity {:.2e}",
-            robin::to_string(result.qp.status), result.qp.iterations,
-            result.qp.operator_applications, result.solve_seconds, result.residuals.penetration,
-            result.residuals.complementarity);
-  const nlohmann::json summary = make_summary(problem, result, total);
+  log->info(
+      "MPRGP {}: {} iterations, {} operator products, {:.3f} s; residuals penetration {:.2e}, "
+      "complementarity {:.2e}",
+      robin::to_string(result.qp.status), result.qp.iterations, result.qp.operator_applications,
+      result.solve_seconds, result.residuals.penetration, result.residuals.complementarity);
+  nlohmann::json summary = make_summary(problem, result, total);
+  const robin::ExcludedPairClearance clearance = excluded_pair_clearance(problem, result);
+  summary["excluded_pair_penetration"] = clearance.relative_penetration;
   write_outputs(output, problem, result, summary);
   log->info("results in {} (open solution.pvd in ParaView)", output.string());
   if (result.qp.status != robin::QpStatus::converged) {
     log->error("the contact QP did not converge: {}", result.qp.message);
     return 2;
+  }
+  if (clearance.relative_penetration > robin::excluded_pair_penetration_limit) {
+    log->error("{}", clearance.description);
+    return 1;
   }
   return 0;
 }

@@ -71,10 +71,25 @@ class BadInput : public ::testing::Test {
     const CommandResult result = run_command(binary + " " + case_path.string() + " --output " +
                                              (directory_ / "out").string());
     EXPECT_EQ(result.exit_code, 1) << result.output;
+    expect_fragments(result.output, fragments);
+  }
+
+  /// Runs robin-run (two robin-subdomain servers and the coordinator) on the case and checks a
+  /// clean failure whose message contains every fragment.
+  void expect_coupled_failure(const fs::path& case_path,
+                              const std::vector<std::string>& fragments) {
+    const std::string binary = std::string(ROBIN_BINARY_DIR) + "/bin/robin-run";
+    const CommandResult result = run_command(binary + " " + case_path.string() + " --output " +
+                                             (directory_ / "coupled").string());
+    EXPECT_EQ(result.exit_code, 1) << result.output;
+    expect_fragments(result.output, fragments);
+  }
+
+  static void expect_fragments(const std::string& output,
+                               const std::vector<std::string>& fragments) {
     for (const std::string& fragment : fragments) {
-      EXPECT_NE(result.output.find(fragment), std::string::npos)
-          << "missing '" << fragment << "' in:\n"
-          << result.output;
+      EXPECT_NE(output.find(fragment), std::string::npos) << "missing '" << fragment << "' in:\n"
+                                                          << output;
     }
   }
 
@@ -129,6 +144,28 @@ TEST_F(BadInput, BodyWithoutEnoughDirichletConditions) {
 TEST_F(BadInput, GapExpressionThatDoesNotParse) {
   expect_failure(write_case("[coupling]", "[gap]\nexpression = \"sin(x\"\n\n[coupling]"),
                  {"case.toml", "gap.expression"});
+}
+
+// A Dirichlet condition on the upper block's left side moves its corner contact node down by
+// the whole platen displacement 0.01, while the contact compresses the blocks by about half of
+// it: the excluded corner pair (its normal displacement is prescribed) penetrates by about 0.005.
+// Both tools write their results and exit 1 naming the node.
+TEST_F(BadInput, PrescribedDisplacementThatPenetratesIsAnError) {
+  const fs::path case_path =
+      write_case("boundary = \"top\"\nx = 0.0\ny = -0.01",
+                 "boundary = \"top\"\nx = 0.0\ny = -0.01\n[[body.dirichlet]]\n"
+                 "boundary = \"left\"\ny = -0.01");
+  const std::vector<std::string> fragments = {"body 'upper' contact node", "(-1, 0)",
+                                              "into each other"};
+  expect_failure(case_path, fragments);
+  EXPECT_TRUE(fs::exists(directory_ / "out" / "summary.json"));
+  expect_coupled_failure(case_path, fragments);
+  EXPECT_TRUE(fs::exists(directory_ / "coupled" / "summary.json"));
+}
+
+TEST_F(BadInput, ContactBoundaryThatIsADirichletBoundary) {
+  expect_failure(write_case("contact_boundary = \"contact\"", "contact_boundary = \"bottom\""),
+                 {"lower", "upper", "Dirichlet", "contact_boundary"});
 }
 
 }  // namespace

@@ -92,5 +92,55 @@ TEST(ContactPairing, PairsWithAPrescribedNormalDisplacementAreExcluded) {
   EXPECT_NE(pairing.excluded[1].find("body 'upper'"), std::string::npos);
 }
 
+TEST(ContactPairing, ContactBoundaryThatIsAllDirichletIsAnError) {
+  InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  const InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
+  for (std::size_t i = 0; i < 3; ++i) lower.y_fixed[i] = true;
+  try {
+    pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("bodies 'lower' and 'upper'"), std::string::npos) << message;
+    EXPECT_NE(message.find("all 3 node pairs"), std::string::npos) << message;
+    EXPECT_NE(message.find("Dirichlet"), std::string::npos) << message;
+  }
+}
+
+TEST(ContactPairing, InitialOverlapIsReportedWithTheDeepestPair) {
+  const InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  const InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
+  const GapFunction dip("0.1 - x", {}, "test");  // d = 0.1, -0.4, -0.9
+  const ContactPairing overlapping = pair_contact_nodes(lower, "lower", upper, "upper", &dip, 1e-6);
+  const std::string warning = overlap_warning(overlapping);
+  EXPECT_NE(warning.find("2 of 3 contact pairs overlap"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("0.9 at (1, 0)"), std::string::npos) << warning;
+  const ContactPairing touching = pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
+  EXPECT_EQ(overlap_warning(touching), "");  // d = 0 exactly is contact, not overlap
+}
+
+TEST(ContactPairing, ExcludedPairClearanceMeasuresThePenetrationOfPrescribedNodes) {
+  // Pair at x = 0 excluded (lower node clamped). Lower normal n1 = (0, 1), upper above.
+  InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  const InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
+  lower.x_fixed[0] = lower.y_fixed[0] = true;
+  const ContactPairing pairing = pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
+  ASSERT_EQ(pairing.excluded_pairs.size(), 1u);
+  // Upper node moved down by 0.01 onto a fixed lower node with d = 0: penetration
+  // u1.n1 + u2.n2 - d = 0 + 0.01 - 0; scale: the included traces' 0.02.
+  const auto pressed = [](int body, const ContactPair&) {
+    return body == 0 ? Eigen::Vector2d(0.0, 0.0) : Eigen::Vector2d(0.3, -0.01);
+  };
+  const ExcludedPairClearance clearance = excluded_pair_clearance(pairing, pressed, 0.02);
+  EXPECT_NEAR(clearance.relative_penetration, 0.01 / 0.02, 1e-15);
+  EXPECT_NE(clearance.description.find("tag 100"), std::string::npos) << clearance.description;
+  EXPECT_NE(clearance.description.find("0.01"), std::string::npos) << clearance.description;
+  // Lifted off instead: no penetration.
+  const auto lifted = [](int body, const ContactPair&) {
+    return body == 0 ? Eigen::Vector2d(0.0, 0.0) : Eigen::Vector2d(0.0, 0.01);
+  };
+  EXPECT_EQ(excluded_pair_clearance(pairing, lifted, 0.02).relative_penetration, 0.0);
+}
+
 }  // namespace
 }  // namespace robin
