@@ -72,6 +72,9 @@ class ServerChecks {
   std::string refused(Envelope request, const std::string& what,
                       const std::vector<protocol::ErrorCode>& codes, const std::string& state,
                       bool stamp_version = true);
+  std::string non_finite_refused(
+      const std::function<Envelope(const Eigen::VectorXd&)>& make_request,
+      const std::string& request_name, const std::string& field);
   std::string setup_body();
   std::string assign_contact();
   std::string contact_solve_free();
@@ -258,6 +261,29 @@ std::string ServerChecks::refused(Envelope request, const std::string& what,
       what, expect_error(session_.request(std::move(request), what, stamp_version), codes, state));
 }
 
+/// `make_request` of an otherwise valid vector of n_c ones with a NaN, then with -inf, at the
+/// middle contact node: each must be refused as INVALID_ARGUMENT, the server staying ready.
+std::string ServerChecks::non_finite_refused(
+    const std::function<Envelope(const Eigen::VectorXd&)>& make_request,
+    const std::string& request_name, const std::string& field) {
+  require_assignment();
+  const long middle = contact_count() / 2;
+  const double quiet_nan = std::numeric_limits<double>::quiet_NaN();
+  const double infinity = std::numeric_limits<double>::infinity();
+  for (const auto& [value, name] : {std::pair{quiet_nan, "NaN"}, std::pair{-infinity, "-inf"}}) {
+    Eigen::VectorXd values = Eigen::VectorXd::Ones(contact_count());
+    values(middle) = value;
+    const std::string what =
+        request_name + " with " + name + " in " + field + "[" + std::to_string(middle) + "]";
+    if (const std::string problem =
+            refused(make_request(values), what, {protocol::INVALID_ARGUMENT}, "ready");
+        !problem.empty()) {
+      return problem;
+    }
+  }
+  return "";
+}
+
 // Requests out of order, and refused bodies.
 
 void ServerChecks::run_state_checks() {
@@ -415,6 +441,14 @@ void ServerChecks::run_solve_checks() {
     require_assignment();
     return wrong_length(fields_request(Eigen::VectorXd::Zero(contact_count() + 1)),
                         "FieldsRequest with n_c + 1 contact_force values");
+  });
+  session_.run("contact_solve_non_finite", [this] {
+    return non_finite_refused(
+        [](const Eigen::VectorXd& obstacle) { return contact_solve_request(obstacle); },
+        "ContactSolveRequest", "obstacle");
+  });
+  session_.run("correction_non_finite", [this] {
+    return non_finite_refused(correction_request, "CorrectionRequest", "interface_force");
   });
   session_.run("contact_solve_free", [this] { return contact_solve_free(); });
   session_.run("contact_solve_signorini", [this] { return contact_solve_signorini(); });
@@ -579,20 +613,8 @@ void ServerChecks::run_neumann_solve_checks() {
     require_assignment();
     return invalid(Eigen::VectorXd::Ones(contact_count() + 1), "n_c + 1 contact_force values");
   });
-  run_if_neumann("neumann_solve_non_finite", [this, invalid] {
-    require_assignment();
-    const double quiet_nan = std::numeric_limits<double>::quiet_NaN();
-    const double infinity = std::numeric_limits<double>::infinity();
-    for (const auto& [value, name] : {std::pair{quiet_nan, "NaN"}, std::pair{-infinity, "-inf"}}) {
-      Eigen::VectorXd force = Eigen::VectorXd::Ones(contact_count());
-      force(contact_count() / 2) = value;
-      if (const std::string problem = invalid(force, std::string(name) + " in contact_force[" +
-                                                         std::to_string(contact_count() / 2) + "]");
-          !problem.empty()) {
-        return problem;
-      }
-    }
-    return std::string();
+  run_if_neumann("neumann_solve_non_finite", [this] {
+    return non_finite_refused(neumann_solve_request, "NeumannSolveRequest", "contact_force");
   });
   run_if_neumann("neumann_solve_free", [this] { return neumann_solve_free(); });
   run_if_neumann("neumann_solve_equation", [this] { return neumann_solve_equation(); });

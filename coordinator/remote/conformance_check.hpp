@@ -3,9 +3,11 @@
 //
 // check_server() drives the server at an endpoint through every message of the protocol
 // (proto/robin.proto, docs/protocol.md), well-formed and not: malformed bytes, requests out of
-// order, refused bodies and assignments, wrong vector lengths, an oversized message. It judges
-// only what travels on the wire, so that any implementation can be checked, and reports every
-// deviation in plain words naming the message.
+// order, refused bodies and assignments, wrong vector lengths, a NaN and an infinity in the
+// ContactSolveRequest obstacle and the CorrectionRequest interface force (INVALID_ARGUMENT,
+// the server staying ready), an oversized message. It judges only what travels on the wire, so
+// that any implementation can be checked, and reports every deviation in plain words naming the
+// message.
 //
 // The body it sets up is built in: the unit square [0, 1]^2 (a .geo script sent as
 // mesh_content), isotropic plane strain, its bottom edge lifted by a prescribed displacement

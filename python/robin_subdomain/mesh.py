@@ -10,9 +10,12 @@ The mesh read is what the C++ reader (subdomain/numerics/gmsh_reader.hpp) reads:
   - nodes: those used by the elements and boundary edges, numbered 0.. in ascending Gmsh tag
     order (the node ids of the protocol);
   - clockwise elements are reordered counter-clockwise; coordinates must lie in z = 0.
-Every problem raises InputError naming the source.
+Every problem of the mesh raises InputError naming the source. A temporary directory (TMPDIR,
+else /tmp) that cannot hold the files given to gmsh raises RequestError INTERNAL naming the
+source and the directory: the server's environment is at fault, not the mesh.
 """
 
+import contextlib
 import os
 import pathlib
 import shutil
@@ -21,7 +24,7 @@ import tempfile
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, RequestError
 
 TRIANGLE3, TRIANGLE6, QUADRILATERAL4 = "triangle3", "triangle6", "quadrilateral4"
 LINE2, LINE3 = "line2", "line3"
@@ -413,6 +416,34 @@ def read_msh_text(text, source):
     return extract_mesh(parse_msh(text, source), source)
 
 
+def _unusable_temporary_directory(source, directory, problem):
+    return RequestError(
+        "INTERNAL", "%s: cannot write the mesh to a temporary file in '%s' (%s): the server's "
+        "temporary directory (TMPDIR, else /tmp) is not writable or is full; give the server "
+        "process a writable TMPDIR (in a container: a tmpfs or emptyDir volume at /tmp)" %
+        (source, directory, problem))
+
+
+@contextlib.contextmanager
+def _temporary_directory(prefix, source):
+    """A fresh directory under the temporary directory (TMPDIR, else /tmp), removed on exit.
+    An OSError creating it or raised inside the block (writing the files for gmsh, reading its
+    output) becomes the RequestError INTERNAL of _unusable_temporary_directory."""
+    try:
+        directory = tempfile.mkdtemp(prefix=prefix)
+    except OSError as error:  # FileNotFoundError when no candidate directory is usable
+        raise _unusable_temporary_directory(
+            source, os.environ.get("TMPDIR") or tempfile.tempdir or "/tmp",
+            error.strerror or error)
+    try:
+        yield directory
+    except OSError as error:
+        raise _unusable_temporary_directory(source, os.path.dirname(directory),
+                                            error.strerror or error)
+    finally:
+        shutil.rmtree(directory, ignore_errors=True)
+
+
 def _format_size(size):
     return repr(float(size))
 
@@ -437,8 +468,7 @@ def _run_gmsh(arguments, source, action, input_path):
 def mesh_geo_file(geo_path, source, size=0.0, element_order=1, recombine=False):
     """Meshes a .geo in 2D with the gmsh command-line tool (`-setnumber h SIZE` when size > 0,
     `-order N`, Mesh.RecombineAll = 1 when recombine) and returns the .msh text (format 4.1)."""
-    directory = tempfile.mkdtemp(prefix="robin-subdomain-py-mesh-")
-    try:
+    with _temporary_directory("robin-subdomain-py-mesh-", source) as directory:
         output = os.path.join(directory, "mesh.msh")
         arguments = [str(geo_path), "-2", "-order", str(element_order), "-format", "msh41",
                      "-o", output]
@@ -448,8 +478,6 @@ def mesh_geo_file(geo_path, source, size=0.0, element_order=1, recombine=False):
             arguments[1:1] = ["-string", "Mesh.RecombineAll = 1;"]
         _run_gmsh(arguments, source, "meshing", geo_path)
         return pathlib.Path(output).read_text()
-    finally:
-        shutil.rmtree(directory, ignore_errors=True)
 
 
 def _is_native_msh(content):
@@ -465,16 +493,13 @@ def _is_native_msh(content):
 def read_msh_bytes(content, source):
     """The mesh of the bytes of a .msh file of any version Gmsh reads, ASCII or binary."""
     if not _is_native_msh(content):
-        directory = tempfile.mkdtemp(prefix="robin-subdomain-py-msh-")
-        try:
+        with _temporary_directory("robin-subdomain-py-msh-", source) as directory:
             original = os.path.join(directory, "original.msh")
             converted = os.path.join(directory, "converted.msh")
             pathlib.Path(original).write_bytes(content)
             _run_gmsh([original, "-0", "-save_all", "-format", "msh41", "-o", converted], source,
                       "reading", original)
             content = pathlib.Path(converted).read_bytes()
-        finally:
-            shutil.rmtree(directory, ignore_errors=True)
     try:
         text = content.decode("utf-8")
     except UnicodeDecodeError:
@@ -504,11 +529,8 @@ def read_mesh_content(content, extension, source, size=0.0, element_order=1, rec
                          (source, extension))
     if lowered == ".msh":
         return read_msh_bytes(content, source)
-    directory = tempfile.mkdtemp(prefix="robin-subdomain-py-geo-")
-    try:
+    with _temporary_directory("robin-subdomain-py-geo-", source) as directory:
         path = pathlib.Path(directory) / "mesh.geo"
         path.write_bytes(content)
         return read_mesh(path, source, size, element_order, recombine)
-    finally:
-        shutil.rmtree(directory, ignore_errors=True)
 

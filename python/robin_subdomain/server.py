@@ -7,7 +7,8 @@ maxmsgsize (a larger message is dropped by libzmq and its sender disconnected) a
 timeout after which the socket is re-created on the same endpoint. A message of several frames
 gets a MALFORMED_MESSAGE reply.
 Exit codes: 0 after Shutdown, SIGINT or SIGTERM; 1 when the endpoint cannot be bound or the
-transport fails; 2 for a bad command line.
+transport fails; 2 for a bad command line, including robin-subdomain's CurveZMQ options
+(--curve-secret-key, --curve-allow): this server speaks plain ZeroMQ only and says so.
 """
 
 import argparse
@@ -30,7 +31,29 @@ class BindError(Exception):
     pass
 
 
+CURVE_REFUSAL = (
+    "%s is not supported: robin-subdomain-py, the Python reference server, speaks plain ZeroMQ "
+    "only (no CurveZMQ encryption or authentication). Bind it to loopback "
+    "(--listen tcp://127.0.0.1:PORT) and reach it through an SSH tunnel "
+    "(ssh -L PORT:127.0.0.1:PORT HOST), or run it only on a network you trust; see "
+    "docs/security.md, 'What is not protected'. For CurveZMQ, use robin-subdomain.")
+
+
+def curve_option(arguments):
+    """The first argument that is one of robin-subdomain's CurveZMQ options (--curve-secret-key,
+    --curve-allow, with "=VALUE" or abbreviated as argparse allows: any word starting with
+    "--curve"), or None."""
+    for word in arguments:
+        if word == "--":
+            break
+        if word.startswith("--curve"):
+            return word.split("=", 1)[0]
+    return None
+
+
 def parse_arguments(arguments):
+    """The options of `arguments`; exits with status 2 (argparse's message) for a bad command
+    line, and with status 2 and CURVE_REFUSAL for a CurveZMQ option."""
     parser = argparse.ArgumentParser(
         prog="robin-subdomain-py",
         description="robin-subdomain-py: serves one elastic body of a robin-contact run over "
@@ -48,6 +71,9 @@ def parse_arguments(arguments):
     # Testing only: announce and accept another protocol major version.
     parser.add_argument("--protocol-major", type=int, default=PROTOCOL_MAJOR,
                         help=argparse.SUPPRESS)
+    curve = curve_option(arguments)
+    if curve is not None:
+        parser.exit(2, "%s: error: %s\n" % (parser.prog, CURVE_REFUSAL % curve))
     options = parser.parse_args(arguments)
     if options.max_message_size <= 0:
         parser.error("--max-message-size must be a positive number")

@@ -1,9 +1,11 @@
 """The protocol state machine of the Python subdomain server, without a socket: states and their
 transitions, the error codes of refused requests, and replies that echo the request id and carry
 version 1.1. The Neumann solve of 1.1 through the protocol: its refusals, and its answer equal to
-e - F lambda assembled from the server's own contact-solve and correction replies.
+e - F lambda assembled from the server's own contact-solve and correction replies. A temporary
+directory that cannot hold the files for gmsh is the server's fault: INTERNAL, naming the body.
 """
 
+import tempfile
 import unittest
 
 import numpy as np
@@ -156,6 +158,22 @@ class StateMachine(unittest.TestCase):
         self.assertEqual(self.server.state, "awaiting_assignment")
         self.expect_error(request(setup_body=setup_body(young_modulus=-1.0)), "BAD_INPUT",
                           "awaiting_setup")
+
+    def test_unusable_temporary_directory_is_internal_and_names_the_body(self):
+        saved = tempfile.tempdir
+        tempfile.tempdir = "/nonexistent/robin-test-temporary-directory"
+        try:
+            message = self.expect_error(request(setup_body=setup_body()), "INTERNAL",
+                                        "awaiting_setup")
+        finally:
+            tempfile.tempdir = saved
+        self.assertTrue(message.startswith("body 'lower': SetupBody.mesh_content: "), message)
+        self.assertIn("'/nonexistent/robin-test-temporary-directory'", message)
+        self.assertIn("temporary directory (TMPDIR, else /tmp) is not writable or is full",
+                      message)
+        self.assertNotIn("internal error", message)
+        self.ask(request(setup_body=setup_body()))  # the server goes on
+        self.assertEqual(self.server.state, "awaiting_assignment")
 
 
 if __name__ == "__main__":

@@ -4,13 +4,16 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <random>
 #include <set>
 #include <sstream>
+#include <system_error>
 #include <unordered_map>
 
 #include "numerics/errors.hpp"
@@ -342,20 +345,63 @@ Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source
   return mesh;
 }
 
-/// A file in the temporary directory with a unique name, removed on destruction.
+/// The directory std::filesystem::temp_directory_path() consults (libstdc++): the first set of
+/// TMPDIR, TMP, TEMP, TEMPDIR, else /tmp. Names the directory when that call fails.
+std::filesystem::path configured_temporary_directory() {
+  for (const char* variable : {"TMPDIR", "TMP", "TEMP", "TEMPDIR"}) {
+    if (const char* value = std::getenv(variable); value != nullptr && *value != '\0') {
+      return value;
+    }
+  }
+  return "/tmp";
+}
+
+/// The TemporaryDirectoryError for `directory`, whose `problem` prevented writing the mesh
+/// file of `label`.
+TemporaryDirectoryError unusable_temporary_directory(const std::string& label,
+                                                     const std::filesystem::path& directory,
+                                                     const std::string& problem) {
+  return TemporaryDirectoryError(
+      label + ": cannot write the mesh to a temporary file in '" + directory.string() + "' (" +
+      problem +
+      "): the server's temporary directory (TMPDIR, else /tmp) is not writable or is full; "
+      "give the server process a writable TMPDIR (in a container: a tmpfs or emptyDir volume "
+      "at /tmp)");
+}
+
+/// A file in the temporary directory (TMPDIR, else /tmp) with a unique name holding
+/// `content`, removed on destruction. Throws TemporaryDirectoryError (leaving no file) when
+/// the directory is missing or the file cannot be written whole.
 class TemporaryFile {
  public:
-  TemporaryFile(const std::string& content, const std::string& extension) {
+  TemporaryFile(const std::string& content, const std::string& extension,
+                const std::string& label) {
     static std::atomic<unsigned long> counter{0};
+    std::filesystem::path directory;
+    try {
+      directory = std::filesystem::temp_directory_path();
+    } catch (const std::filesystem::filesystem_error& error) {
+      throw unusable_temporary_directory(
+          label, error.path1().empty() ? configured_temporary_directory() : error.path1(),
+          error.code().message());
+    }
     std::random_device random;
-    const std::filesystem::path directory = std::filesystem::temp_directory_path();
+    std::error_code exists_error;
     do {
       path_ = directory / ("robin-mesh-" + std::to_string(random()) + "-" +
                            std::to_string(counter++) + extension);
-    } while (std::filesystem::exists(path_));
+    } while (std::filesystem::exists(path_, exists_error));
+    errno = 0;
     std::ofstream stream(path_, std::ios::binary);
     stream << content;
-    if (!stream) throw InputError("cannot write the temporary mesh file " + path_.string());
+    stream.close();
+    if (!stream) {
+      const std::string problem =
+          errno != 0 ? std::generic_category().message(errno) : "the write failed";
+      std::error_code remove_error;
+      std::filesystem::remove(path_, remove_error);
+      throw unusable_temporary_directory(label, directory, problem);
+    }
   }
   ~TemporaryFile() {
     std::error_code error;
@@ -390,7 +436,7 @@ Mesh read_gmsh_mesh_from_text(const std::string& content, const std::string& ext
   if (lowered != ".msh" && lowered != ".geo") {
     throw InputError(label + ": unsupported mesh extension '" + extension + "': give .msh or .geo");
   }
-  const TemporaryFile file(content, lowered);
+  const TemporaryFile file(content, lowered, label);
   const ErrorSource source{file.path().string(), label};
   return read_mesh_file(file.path(), source, options);
 }

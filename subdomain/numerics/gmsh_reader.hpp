@@ -9,6 +9,7 @@
 // Node coordinates must lie in the z = 0 plane.
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include "numerics/mesh.hpp"
@@ -25,9 +26,20 @@ struct MeshReadOptions {
 /// parse error, no 2D elements, unsupported element type, no physical groups).
 Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
+/// The process's temporary directory cannot hold the mesh file of
+/// read_gmsh_mesh_from_text: a fault of the environment (TMPDIR, else /tmp, missing,
+/// not writable or full), not of the mesh. The message starts with the label and names
+/// the directory.
+class TemporaryDirectoryError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Reads a mesh given as the text of a file with extension `extension` (".msh" or
-/// ".geo"); used when a mesh travels inside a protocol message. `label` names the
-/// source in error messages.
+/// ".geo"); used when a mesh travels inside a protocol message. The text is written to
+/// a file of the temporary directory (TMPDIR, else /tmp) for Gmsh and removed after.
+/// `label` names the source in error messages. Throws InputError for a bad extension
+/// or mesh, TemporaryDirectoryError when the file cannot be written.
 Mesh read_gmsh_mesh_from_text(const std::string& content, const std::string& extension,
                               const std::string& label, const MeshReadOptions& options = {});
 

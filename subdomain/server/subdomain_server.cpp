@@ -9,6 +9,7 @@
 
 #include "numerics/body_output.hpp"
 #include "numerics/errors.hpp"
+#include "numerics/gmsh_reader.hpp"
 #include "robin.pb.h"
 #include "server/reply_encoding.hpp"
 #include "server/request_error.hpp"
@@ -199,6 +200,9 @@ std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
     set_error(reply, protocol::SINGULAR_BODY, error.what(), state_);
   } catch (const InputError& error) {
     set_error(reply, protocol::BAD_INPUT, error.what(), state_);
+  } catch (const TemporaryDirectoryError& error) {
+    // The server's environment, not the request, is at fault: INTERNAL (§7 of the protocol).
+    set_error(reply, protocol::INTERNAL, error.what(), state_);
   } catch (const std::exception& error) {
     set_error(reply, protocol::INTERNAL, std::string("internal error: ") + error.what(), state_);
   } catch (...) {

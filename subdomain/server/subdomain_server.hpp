@@ -24,7 +24,9 @@
 //   SINGULAR_BODY      the Dirichlet conditions leave a rigid motion free (SingularBodyError)
 //   UNSUPPORTED        a reply type sent as a request, a request unknown to this version, or
 //                      a NeumannSolveRequest when "neumann_solve" is withheld (testing only)
-//   INTERNAL           any other exception
+//   INTERNAL           the server's environment fails it (TemporaryDirectoryError: the
+//                      temporary directory cannot hold the received mesh), or any other
+//                      exception ("internal error: ...")
 // The state after the request is in Acknowledge.state, HelloReply.state and Error.state.
 //
 // Capabilities (HelloReply.capabilities): the core "contact_solve", "correction_solve",

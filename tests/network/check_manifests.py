@@ -3,7 +3,10 @@
 Parses deploy/compose.yaml and deploy/kubernetes/*.yaml (PyYAML) and checks what a cluster would
 only reveal at run time: the coordinator connects to the names and ports the servers listen on,
 the StatefulSet's pods get DNS names from a headless Service, the ConfigMap holds the shipped
-case verbatim and mounts its meshes where the case expects them, labels and selectors agree.
+case verbatim and mounts its meshes where the case expects them, labels and selectors agree,
+and every container with a read-only root file system that runs a program writing to the
+temporary directory (robin-subdomain writes each received mesh there; robin-run starts
+robin-subdomain) has a writable /tmp: a tmpfs in compose, an emptyDir in Kubernetes.
 Prints one line per file; exits 1 with the list of problems.
 """
 import pathlib
@@ -23,6 +26,16 @@ def check(condition, message):
 def load_documents(path):
     with open(path) as handle:
         return [document for document in yaml.safe_load_all(handle) if document]
+
+
+# Programs that write to the temporary directory (TMPDIR, else /tmp), and the image's default
+# command (deploy/Dockerfile's CMD), which a container without `command` runs.
+WRITES_TEMPORARY_FILES = {"robin-subdomain", "robin-run"}
+IMAGE_DEFAULT_PROGRAM = "robin-subdomain"
+
+
+def program(command):
+    return command[0] if command else IMAGE_DEFAULT_PROGRAM
 
 
 def option_values(arguments, option):
@@ -48,6 +61,13 @@ def check_compose(source):
               f"{path}: the health check of {name} does not probe port {port}")
         check(services["coordinator"]["depends_on"][name]["condition"] == "service_healthy",
               f"{path}: the coordinator does not wait for {name} to be healthy")
+    for name, service in services.items():
+        if service.get("read_only") and program(service.get("command")) in WRITES_TEMPORARY_FILES:
+            tmpfs = service.get("tmpfs", [])
+            tmpfs = [tmpfs] if isinstance(tmpfs, str) else tmpfs
+            check("/tmp" in [entry.split(":", 1)[0] for entry in tmpfs],
+                  f"{path}: service {name} runs {program(service.get('command'))} on a read-only "
+                  f"root file system without a tmpfs at /tmp")
     case = coordinator[1]
     check(case.startswith("/opt/robin-contact/examples/") and
           (source / "examples" / case.split("/examples/", 1)[1]).is_file(),
@@ -96,6 +116,28 @@ def check_configmap(configmap, volume, source, path):
     return {item["path"] for item in volume["configMap"]["items"]}
 
 
+def check_temporary_directories(objects, path):
+    """Every container (init containers too) with readOnlyRootFilesystem that runs a program
+    of WRITES_TEMPORARY_FILES mounts a writable emptyDir at /tmp; returns how many do."""
+    count = 0
+    for kind in ("StatefulSet", "Job", "Deployment", "DaemonSet"):
+        for workload in objects.get(kind, []):
+            pod = workload["spec"]["template"]["spec"]
+            volumes = {volume["name"]: volume for volume in pod.get("volumes", [])}
+            for container in pod.get("initContainers", []) + pod["containers"]:
+                read_only = container.get("securityContext", {}).get("readOnlyRootFilesystem")
+                if not read_only or program(container.get("command")) not in WRITES_TEMPORARY_FILES:
+                    continue
+                mounts = [mount for mount in container.get("volumeMounts", [])
+                          if mount["mountPath"] == "/tmp" and not mount.get("readOnly")]
+                writable = mounts and "emptyDir" in volumes.get(mounts[0]["name"], {})
+                count += bool(check(writable, f"{path}: container {container['name']} of {kind} "
+                                              f"{workload['metadata']['name']} runs "
+                                              f"{program(container.get('command'))} on a read-only "
+                                              f"root file system without a writable emptyDir at /tmp"))
+    return count
+
+
 def check_kubernetes(source):
     directory = source / "deploy/kubernetes"
     kustomization = load_documents(directory / "kustomization.yaml")[0]
@@ -105,6 +147,7 @@ def check_kubernetes(source):
     objects = by_kind(documents)
     path = directory
     endpoints, server_labels = check_servers(objects, path)
+    temporary_directories = check_temporary_directories(objects, path)
     job = objects["Job"][0]["spec"]["template"]
     container = job["spec"]["containers"][0]
     arguments = container["args"]
@@ -134,7 +177,8 @@ def check_kubernetes(source):
     allowed = policy["ingress"][0]["from"][0]["podSelector"]["matchLabels"]
     check(allowed.items() <= job["metadata"]["labels"].items(),
           f"{path}: the NetworkPolicy does not admit the coordinator's pods")
-    print(f"{path}: {len(documents)} objects; Job -> {', '.join(endpoints)}")
+    print(f"{path}: {len(documents)} objects; Job -> {', '.join(endpoints)}; "
+          f"{temporary_directories} read-only container(s) with an emptyDir at /tmp")
 
 
 def main(source):
