@@ -18,6 +18,7 @@ source and the directory: the server's environment is at fault, not the mesh.
 import contextlib
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import tempfile
@@ -521,14 +522,42 @@ def read_mesh(path, source, size=0.0, element_order=1, recombine=False):
     return read_msh_bytes(path.read_bytes(), source)
 
 
+# Gmsh script keywords that reach the host (shell commands, files, environment, the process):
+# a .geo from a client is meshed only without them (docs/security.md; the same list as
+# subdomain/numerics/gmsh_script_check.hpp).
+REFUSED_GMSH_COMMANDS = frozenset((
+    "SystemCall", "NonBlockingSystemCall", "System", "NonBlockingSystem", "OnelabRun",
+    "OnelabAction", "Include", "Merge", "MergeWithBoundingBox", "ShapeFromFile", "Printf",
+    "Print", "Save", "CreateDir", "Exit", "Abort", "Sleep", "SendToServer", "Plugin", "GetEnv",
+    "GetString", "GetValue", "GetNumber", "SetString", "AbsolutePath", "FileExists"))
+
+# Comments, string literals (skipped) and identifiers (checked), in the order they appear.
+_GMSH_TOKENS = re.compile(r'//[^\n]*|/\*.*?(?:\*/|\Z)|"(?:\\.|[^"\\])*"?|[A-Za-z_][A-Za-z0-9_]*',
+                          re.DOTALL)
+
+
+def check_gmsh_script_from_client(script, source):
+    """Raises InputError naming the line of the first refused command of a .geo script."""
+    for match in _GMSH_TOKENS.finditer(script):
+        if match.group(0) in REFUSED_GMSH_COMMANDS:
+            line = script.count("\n", 0, match.start()) + 1
+            raise InputError(
+                "%s line %d: the Gmsh command '%s' is refused in a script sent to a server (it "
+                "can run commands, read or write files on the server's host; docs/security.md): "
+                "mesh the body with gmsh and send the .msh, or remove the command" %
+                (source, line, match.group(0)))
+
+
 def read_mesh_content(content, extension, source, size=0.0, element_order=1, recombine=False):
-    """The mesh of the bytes of a .msh or .geo file (mesh_content of SetupBody)."""
+    """The mesh of the bytes of a .msh or .geo file (mesh_content of SetupBody). A .geo is
+    meshed only without host-touching commands (check_gmsh_script_from_client)."""
     lowered = extension.lower()
     if lowered not in (".msh", ".geo"):
         raise InputError("%s: unsupported mesh extension '%s': give .msh or .geo" %
                          (source, extension))
     if lowered == ".msh":
         return read_msh_bytes(content, source)
+    check_gmsh_script_from_client(content.decode("utf-8", errors="replace"), source)
     with _temporary_directory("robin-subdomain-py-geo-", source) as directory:
         path = pathlib.Path(directory) / "mesh.geo"
         path.write_bytes(content)

@@ -5,6 +5,8 @@ e - F lambda assembled from the server's own contact-solve and correction replie
 directory that cannot hold the files for gmsh is the server's fault: INTERNAL, naming the body.
 """
 
+import os
+import pathlib
 import tempfile
 import unittest
 
@@ -152,6 +154,19 @@ class StateMachine(unittest.TestCase):
         self.expect_error(request(setup_body=singular), "SINGULAR_BODY", "awaiting_setup")
         self.expect_error(request(setup_body=setup_body(mesh_content=b"Point(1) = {0, 0, 0;")),
                           "BAD_INPUT", "awaiting_setup")
+
+    def test_geo_script_that_runs_a_command_is_refused_unrun(self):
+        witness = pathlib.Path(tempfile.gettempdir()) / ("robin-py-geo-witness-%d" % os.getpid())
+        witness.unlink(missing_ok=True)
+        hostile = LOWER_GEO + b'\nSystemCall "touch %s";\n' % str(witness).encode()
+        message = self.expect_error(request(setup_body=setup_body(mesh_content=hostile)),
+                                    "BAD_INPUT", "awaiting_setup")
+        self.assertIn("body 'lower': SetupBody.mesh_content line", message)
+        self.assertIn("'SystemCall' is refused", message)
+        self.assertFalse(witness.exists())
+        harmless = LOWER_GEO + b'\n// SystemCall "touch x";\nDummy = StrCat("Include");\n'
+        self.ask(request(setup_body=setup_body(mesh_content=harmless)))
+        self.assertEqual(self.server.state, "awaiting_assignment")
 
     def test_failed_setup_discards_the_previous_body(self):
         self.ask(request(setup_body=setup_body()))

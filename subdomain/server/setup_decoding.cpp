@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "numerics/errors.hpp"
+#include "numerics/gmsh_script_check.hpp"
 
 namespace robin {
 namespace {
@@ -56,13 +57,23 @@ MeshReadOptions decode_mesh_options(const protocol::SetupBody& message,
   return options;
 }
 
+bool is_geo_extension(std::string extension) {
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".geo";
+}
+
 /// The mesh from mesh_content (+ mesh_extension) or, when the content is empty, mesh_path.
-/// A reader error is rethrown with the body and field prepended.
+/// A reader error is rethrown with the body and field prepended. A .geo script in
+/// mesh_content is meshed only without host-touching commands (gmsh_script_check.hpp); a
+/// mesh_path names a file already on the server, which the server's operator put there.
 Mesh decode_mesh(const protocol::SetupBody& message, const std::string& context) {
   const MeshReadOptions options = decode_mesh_options(message, context);
   if (!message.mesh_content().empty()) {
     if (message.mesh_extension().empty()) {
       fail(context, "mesh_extension", "is empty: give \".msh\" or \".geo\" with mesh_content");
+    }
+    if (is_geo_extension(message.mesh_extension())) {
+      check_gmsh_script_from_client(message.mesh_content(), context + ": SetupBody.mesh_content");
     }
     return read_gmsh_mesh_from_text(message.mesh_content(), message.mesh_extension(),
                                     context + ": SetupBody.mesh_content", options);

@@ -580,6 +580,31 @@ TEST(SubdomainServer, BadBodyDefinitionsAreBadInputNamingTheBodyAndField) {
   }
 }
 
+// A .geo sent over the protocol is a Gmsh script: one that would run a shell command on the
+// server is refused before Gmsh sees it, and the command does not run (the file it would create
+// does not appear). The same script with the command only in a comment and a string meshes.
+TEST(SubdomainServer, GeoScriptThatRunsACommandIsRefusedUnrun) {
+  SubdomainServer server(quiet_settings());
+  const std::filesystem::path witness =
+      std::filesystem::temp_directory_path() / ("robin-geo-witness-" + std::to_string(::getpid()));
+  std::filesystem::remove(witness);
+  protocol::SetupBody hostile = lower_block_setup();
+  hostile.set_mesh_content(hostile.mesh_content() + "\nSystemCall \"touch " + witness.string() +
+                           "\";\n");
+  const protocol::Envelope reply = exchange(server, setup_request(1, hostile));
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  const std::string& message = reply.error().message();
+  EXPECT_NE(message.find("body 'lower': SetupBody.mesh_content line"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("'SystemCall' is refused"), std::string::npos) << message;
+  EXPECT_FALSE(std::filesystem::exists(witness));
+
+  protocol::SetupBody harmless = lower_block_setup();
+  harmless.set_mesh_content(harmless.mesh_content() +
+                            "\n// SystemCall \"touch x\";\nDummy = StrCat(\"Include\");\n");
+  EXPECT_TRUE(exchange(server, setup_request(2, harmless)).has_interface());
+}
+
 TEST(SubdomainServer, FailedSetupDiscardsThePreviousBody) {
   SubdomainServer server(quiet_settings());
   ASSERT_TRUE(exchange(server, setup_request(1, lower_block_setup())).has_interface());
