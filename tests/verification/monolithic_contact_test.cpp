@@ -1,7 +1,8 @@
 // Verification of the monolithic two-body reference against analytic results:
-//  - plane-strain Hertz (cylinder on a flat, gap x^2/2R): half-width and peak pressure within 5%
-//    of a = sqrt(4PR/(pi E*)), p0 = 2P/(pi a), and the contact resultant equal to the load taken
-//    by the Dirichlet boundary (reaction) to 1e-8;
+//  - plane-strain Hertz (cylinder on a flat, gap x^2/2R), force-driven: the load P is prescribed
+//    (the depth of the platen on the cylinder's top is found to carry it), the contact resultant
+//    equals P to 1e-8, and the half-width and peak pressure are within 5% of
+//    a = sqrt(4PR/(pi E*)), p0 = 2P/(pi a);
 //  - partial contact of two blocks: KKT residuals below 1e-10, each body's nodal equilibrium
 //    K u - f + B'lambda = 0 on its free dofs (K assembled here, u the returned displacement
 //    field) and its normal trace B u equal to the returned u_N, all below 1e-10 relative.
@@ -100,22 +101,72 @@ double free_dof_imbalance(const BodySolver& body, const ContactPairing& pairing,
   return worst / internal.cwiseAbs().maxCoeff();
 }
 
+/// The monolithic solve of examples/hertz.toml with the cylinder's top displaced by -depth (the
+/// rigid platen through which the load is applied) and its contact resultant P (vertical).
+struct HertzSolve {
+  LocalProblem problem;
+  MonolithicResult result;
+  double load = 0.0;
+};
+
+HertzSolve solve_hertz(double depth) {
+  CaseDefinition definition = read_case_file(example("hertz.toml"));
+  for (DirichletCondition& condition : definition.bodies[1].definition.dirichlet) {
+    if (condition.boundary == "top") condition.y = -depth;
+  }
+  HertzSolve solve{prepare_local_problem(definition), {}, 0.0};
+  solve.result = solve_monolithic(*solve.problem.bodies[0], *solve.problem.bodies[1],
+                                  solve.problem.pairing, solve.problem.definition.solver.qp);
+  EXPECT_EQ(solve.result.qp.status, QpStatus::converged) << solve.result.qp.message;
+  solve.load = contact_resultant(solve.problem.pairing, solve.result.contact_force).y();
+  return solve;
+}
+
+/// Force control: the platen depth whose contact resultant is `load`, to 1e-10 relative, by
+/// the Illinois variant of regula falsi on P(depth) - load (P is continuous and increasing in
+/// the depth, affine while the active set stays fixed, so the bracket closes in few solves).
+HertzSolve solve_hertz_under_load(double load) {
+  double low = 0.0, high = 0.002;
+  double residual_low = -load, residual_high = solve_hertz(high).load - load;
+  while (residual_high <= 0.0) residual_high = solve_hertz(high *= 2.0).load - load;
+  int last_side = 0;
+  for (int solves = 0; solves < 40; ++solves) {
+    const double depth =
+        (low * residual_high - high * residual_low) / (residual_high - residual_low);
+    HertzSolve solve = solve_hertz(depth);
+    const double residual = solve.load - load;
+    if (std::abs(residual) <= 1e-10 * load) return solve;
+    if (residual > 0.0) {
+      high = depth, residual_high = residual;
+      if (last_side > 0) residual_low /= 2.0;
+      last_side = 1;
+    } else {
+      low = depth, residual_low = residual;
+      if (last_side < 0) residual_high /= 2.0;
+      last_side = -1;
+    }
+  }
+  ADD_FAILURE() << "no platen depth gives the load " << load;
+  return solve_hertz(low);
+}
+
+// Force-driven: the load P is prescribed (P for the half-width a = 0.05 by Hertz's formula) and
+// the platen depth is found to carry exactly P; a and p0 are then the a-priori Hertz values.
 TEST(MonolithicContact, HertzHalfWidthAndPeakPressure) {
-  const LocalProblem problem = prepare_local_problem(read_case_file(example("hertz.toml")));
-  const MonolithicResult result = solve_monolithic(*problem.bodies[0], *problem.bodies[1],
-                                                   problem.pairing, problem.definition.solver.qp);
-  ASSERT_EQ(result.qp.status, QpStatus::converged) << result.qp.message;
-  expect_equilibrium(problem, result.contact_force, 1e-8);
-
-  // The load P is the force the upper body's top boundary pushes with (its reaction).
-  const double load = -total_reaction(*problem.bodies[1], result.contact_force).y();
-  const double resultant = contact_resultant(problem.pairing, result.contact_force).y();
-  EXPECT_NEAR(resultant, load, 1e-8 * load);
-
   const double young = 1000.0, poisson = 0.3, radius = 1.0;
   const double effective_modulus = 1.0 / (2.0 * (1.0 - poisson * poisson) / young);
-  const double half_width = std::sqrt(4.0 * load * radius / (std::numbers::pi * effective_modulus));
+  const double half_width = 0.05;
+  const double load = std::numbers::pi * effective_modulus * half_width * half_width / (4 * radius);
   const double peak_pressure = 2.0 * load / (std::numbers::pi * half_width);
+  const HertzSolve solve = solve_hertz_under_load(load);
+  const LocalProblem& problem = solve.problem;
+  const MonolithicResult& result = solve.result;
+
+  // The contact resultant is the prescribed load, and the platen (the top's reaction) and the
+  // flat's support carry it: each body is in equilibrium.
+  EXPECT_NEAR(solve.load, load, 1e-8 * load);
+  expect_equilibrium(problem, result.contact_force, 1e-8);
+  EXPECT_NEAR(-total_reaction(*problem.bodies[1], result.contact_force).y(), load, 1e-8 * load);
 
   // Measured half-width: midway between the outermost closed pair and its open neighbour on
   // each side; peak pressure: largest lambda_i / m_i.
@@ -137,8 +188,9 @@ TEST(MonolithicContact, HertzHalfWidthAndPeakPressure) {
   }
   const double measured_half_width = 0.5 * (outer_closed + inner_open);
   std::printf(
-      "Hertz: P = %.6g, a = %.6g (measured %.6g), p0 = %.6g (measured %.6g), %d closed pairs\n",
-      load, half_width, measured_half_width, peak_pressure, measured_peak, closed);
+      "Hertz under the load P = %.6g: a = %.6g (measured %.6g), p0 = %.6g (measured %.6g), %d "
+      "closed pairs, resultant %.12g\n",
+      load, half_width, measured_half_width, peak_pressure, measured_peak, closed, solve.load);
   EXPECT_GE(closed, 20);
   EXPECT_NEAR(measured_half_width, half_width, 0.05 * half_width);
   EXPECT_NEAR(measured_peak, peak_pressure, 0.05 * peak_pressure);
