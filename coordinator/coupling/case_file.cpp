@@ -282,4 +282,10 @@ BodyDefinition load_body(const BodyCase& body) {
   return definition;
 }
 
+std::string in_case_file(const std::filesystem::path& case_file, const std::string& message) {
+  const std::string path = case_file.string();
+  if (message.find(path) != std::string::npos) return message;
+  return path + ": " + message;
+}
+
 }  // namespace robin

@@ -86,6 +86,11 @@ struct CaseDefinition {
 /// relaxation).
 AccelerationOptions effective_acceleration(const CouplingOptions& options);
 
+/// `message` about the case in `case_file`, prefixed with the file's path unless it already
+/// names it (errors raised after reading: a body left with a rigid motion, unmatched contact
+/// nodes), so that every error names the file.
+std::string in_case_file(const std::filesystem::path& case_file, const std::string& message);
+
 /// Parses and validates a case file (without reading meshes): every key, type and range,
 /// the materials, the existence of the mesh files, and the gap expression (parsed and
 /// evaluated once). Throws InputError naming the file, line and field (and the body).

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "coupling/coupled_run.hpp"
+#include "numerics/errors.hpp"
 #include "remote/remote_port.hpp"
 #include "remote/run_interruption.hpp"
 
@@ -245,6 +246,8 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
         run_coupled_case(definition, {ports[0].get(), ports[1].get()}, options, make_observer(log));
     write_coupled_outputs(settings.output_directory, definition, result);
     code = report_outcome(result, settings, *log);
+  } catch (const InputError& error) {  // e.g. unmatched contact nodes: name the case file
+    code = failure_exit_code(InputError(in_case_file(definition.file, error.what())));
   } catch (const std::exception& error) {
     code = failure_exit_code(error);
   }

@@ -147,9 +147,9 @@ int main(int argc, char** argv) {
   try {
     return run(case_path, output);
   } catch (const robin::InputError& error) {
-    log->error("{}", error.what());
+    log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const robin::SingularBodyError& error) {
-    log->error("{}", error.what());
+    log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const std::exception& error) {
     log->error("failed: {}", error.what());
   }

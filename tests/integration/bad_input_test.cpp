@@ -138,7 +138,7 @@ TEST_F(BadInput, NonPositiveDefiniteVoigtMatrix) {
 }
 
 TEST_F(BadInput, BodyWithoutEnoughDirichletConditions) {
-  expect_failure(write_case("x = 0.0\ny = 0.0", "y = 0.0"), {"lower", "rigid motion"});
+  expect_failure(write_case("x = 0.0\ny = 0.0", "y = 0.0"), {"case.toml", "lower", "rigid motion"});
 }
 
 TEST_F(BadInput, GapExpressionThatDoesNotParse) {
