@@ -27,20 +27,28 @@ for size in "${sizes[@]}"; do
     printf '\n[solver]\ninterface_operator = "%s"\n' "$INTERFACE_OPERATOR" >> "$case_file"
   fi
   dd_start=$(date +%s.%N)
-  "$build/bin/robin-run" "$case_file" --output "$work/dd_$size" --log-level warn > /dev/null 2>&1 || true
+  dd_status=0
+  "$build/bin/robin-run" "$case_file" --output "$work/dd_$size" --log-level warn > "$work/dd_$size.log" 2>&1 || dd_status=$?
   dd_end=$(date +%s.%N)
+  if [ ! -f "$work/dd_$size/summary.json" ]; then
+    echo "| $size | robin-run failed with exit $dd_status and wrote no summary: $(tail -n 1 "$work/dd_$size.log") |"
+    continue
+  fi
   "$build/bin/robin-monolithic" "$case_file" --output "$work/mono_$size" --log-level warn > /dev/null 2>&1
   mono_end=$(date +%s.%N)
-  /usr/bin/python3 - "$work/dd_$size/summary.json" "$size" "$dd_start" "$dd_end" "$mono_end" <<'PY'
+  /usr/bin/python3 - "$work/dd_$size/summary.json" "$size" "$dd_start" "$dd_end" "$mono_end" "$dd_status" <<'PY'
 import json, sys
 summary = json.load(open(sys.argv[1]))
 size = sys.argv[2]
 dd_start, dd_end, mono_end = (float(value) for value in sys.argv[3:6])
+status = int(sys.argv[6])
 dd_wall, mono_wall = dd_end - dd_start, mono_end - dd_end
 timings = summary["timings"]
 dofs = sum(body["dofs"] for body in summary["bodies"])
 iterations = summary["iterations"]
-per_iteration = timings["iteration"] / max(1, iterations)
+if status != 0:  # not converged: the row says so instead of passing for a result
+    iterations = "%d (exit %d: %s)" % (iterations, status, summary["status"])
+per_iteration = timings["iteration"] / max(1, summary["iterations"])
 print(f"| {size:<7} | {dofs:<8} | {summary['contact_pairs']:<5} | {iterations:<5} | {dd_wall:8.2f} s | "
       f"{timings['setup']:8.2f} s | {timings['iteration']:8.3f} s | {mono_wall:6.2f} s | "
       f"{dd_wall / mono_wall:9.2f} | {summary['bytes_per_iteration']:11.0f} | "
