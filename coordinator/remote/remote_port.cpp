@@ -103,6 +103,11 @@ Envelope RemotePort::finish_request(int expected_content) {
     fail(pending.step, failure.what());
   }
   update_byte_counts();
+  if (!reply.has_version()) {
+    fail(pending.step,
+         "the reply carries no protocol version (Envelope.version is required in every "
+         "message; docs/protocol.md)");
+  }
   if (reply.version().major() != protocol::protocol_major) {
     fail(pending.step, "the server speaks protocol " +
                            version_text(reply.version().major(), reply.version().minor()) +

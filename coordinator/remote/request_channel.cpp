@@ -109,7 +109,9 @@ std::uint64_t RequestChannel::send(protocol::Envelope& envelope, const Deadline&
   const std::string payload = envelope.SerializeAsString();
   wait_for(ZMQ_POLLOUT, deadline,
            "could not send within " + format_seconds(deadline.seconds) +
-               " s: no connection to the server (is it running at that endpoint?)");
+               " s: no connection to the server (is it running at that endpoint? a peer that "
+               "accepts the TCP connection but never completes the ZeroMQ handshake looks the "
+               "same)");
   zmq::socket_t& dealer = sockets_->dealer;
   const bool sent = dealer.send(zmq::message_t(), zmq::send_flags::sndmore) &&
                     dealer.send(zmq::buffer(payload), zmq::send_flags::none);
@@ -119,8 +121,14 @@ std::uint64_t RequestChannel::send(protocol::Envelope& envelope, const Deadline&
 }
 
 protocol::Envelope RequestChannel::receive(std::uint64_t request_id, const Deadline& deadline) {
-  const std::string timeout_problem = "no reply within " + format_seconds(deadline.seconds) + " s";
-  for (;;) {
+  std::string timeout_problem = "no reply within " + format_seconds(deadline.seconds) + " s";
+  for (int discarded = 0;; ++discarded) {
+    if (discarded > 0) {  // a server that does not echo request_id looks silent otherwise
+      timeout_problem = "no reply within " + format_seconds(deadline.seconds) + " s (" +
+                        std::to_string(discarded) +
+                        " replies with another request_id were discarded: late replies to "
+                        "abandoned requests, or a server that does not echo request_id)";
+    }
     wait_for(ZMQ_POLLIN, deadline, timeout_problem);
     std::vector<zmq::message_t> frames;
     do {
@@ -138,7 +146,7 @@ protocol::Envelope RequestChannel::receive(std::uint64_t request_id, const Deadl
           "frame and one serialized Envelope); is this a robin-subdomain server?");
     }
     if (reply.request_id() == request_id) return reply;
-    // A late reply to an abandoned request: discard it and keep waiting.
+    // A late reply to an abandoned request: discard it (counted) and keep waiting.
   }
 }
 

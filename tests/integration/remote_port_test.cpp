@@ -224,11 +224,15 @@ TEST(RemotePort, FailureOfBothServersNamesBoth) {
 
 /// A REP server that answers the first request (a Hello) with a valid HelloReply and then
 /// receives the next request (SetupBody) without ever answering it.
+/// How the test server deviates in its HelloReply.
+enum class HelloDeviation { none, no_version, wrong_request_id };
+
 class HandshakeOnlyServer {
  public:
-  HandshakeOnlyServer() : socket_(context_, zmq::socket_type::rep) {
+  explicit HandshakeOnlyServer(HelloDeviation deviation = HelloDeviation::none)
+      : socket_(context_, zmq::socket_type::rep), deviation_(deviation) {
     socket_.set(zmq::sockopt::linger, 0);
-    socket_.set(zmq::sockopt::rcvtimeo, 10000);
+    socket_.set(zmq::sockopt::rcvtimeo, 3000);
     socket_.bind("tcp://127.0.0.1:*");
     endpoint_ = socket_.get(zmq::sockopt::last_endpoint);
     thread_ = std::thread([this] { serve(); });
@@ -237,7 +241,7 @@ class HandshakeOnlyServer {
     if (thread_.joinable()) thread_.join();
   }
   const std::string& endpoint() const { return endpoint_; }
-  /// Waits for the server thread (it ends once SetupBody arrived, or after 10 s without it);
+  /// Waits for the server thread (it ends once SetupBody arrived, or 3 s after the last message without it);
   /// true when a SetupBody request arrived.
   bool setup_arrived() {
     thread_.join();
@@ -251,9 +255,12 @@ class HandshakeOnlyServer {
     protocol::Envelope hello;
     hello.ParseFromArray(message.data(), static_cast<int>(message.size()));
     protocol::Envelope reply;
-    reply.mutable_version()->set_major(protocol::protocol_major);
-    reply.mutable_version()->set_minor(protocol::protocol_minor);
-    reply.set_request_id(hello.request_id());
+    if (deviation_ != HelloDeviation::no_version) {
+      reply.mutable_version()->set_major(protocol::protocol_major);
+      reply.mutable_version()->set_minor(protocol::protocol_minor);
+    }
+    reply.set_request_id(hello.request_id() +
+                         (deviation_ == HelloDeviation::wrong_request_id ? 1000 : 0));
     for (const char* capability : {"contact_solve", "correction_solve", "fields"})
       reply.mutable_hello_reply()->add_capabilities(capability);
     reply.mutable_hello_reply()->set_server_name("handshake only");
@@ -269,6 +276,7 @@ class HandshakeOnlyServer {
 
   zmq::context_t context_;
   zmq::socket_t socket_;
+  HelloDeviation deviation_;
   std::string endpoint_;
   std::thread thread_;
   bool setup_arrived_ = false;
@@ -296,6 +304,30 @@ TEST(RemotePort, SetupHasItsOwnDeadline) {
   EXPECT_GE(elapsed, 3.0 - 0.05);
   EXPECT_LT(elapsed, 3.0 + 1.0);
   EXPECT_TRUE(server.setup_arrived()) << "the handshake did not lead to a SetupBody request";
+}
+
+/// The PortError message of a setup against a server whose HelloReply deviates.
+std::string handshake_failure(HelloDeviation deviation) {
+  HandshakeOnlyServer server(deviation);
+  const CaseDefinition definition = two_blocks();
+  RemotePort port(server.endpoint(), "lower", port_options(1.0));
+  try {
+    port.setup(definition.bodies[0], definition.solver);
+  } catch (const PortError& error) {
+    std::cout << error.what() << "\n";
+    return error.what();
+  }
+  return "";
+}
+
+TEST(RemotePort, ReplyWithoutVersionOrWithAnotherRequestIdIsNamed) {
+  const std::string no_version = handshake_failure(HelloDeviation::no_version);
+  EXPECT_NE(no_version.find("step handshake"), std::string::npos) << no_version;
+  EXPECT_NE(no_version.find("carries no protocol version"), std::string::npos) << no_version;
+  const std::string wrong_id = handshake_failure(HelloDeviation::wrong_request_id);
+  EXPECT_NE(wrong_id.find("no reply within 1 s (1 replies with another request_id"),
+            std::string::npos)
+      << wrong_id;
 }
 
 TEST(RemotePort, ServerOfAnotherMajorVersionIsRefused) {
