@@ -3,7 +3,11 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "coupling/coupled_run.hpp"
 #include "numerics/errors.hpp"
@@ -30,6 +34,23 @@ CLI::Validator open_interval(double low, double high) {
                "), got " + text;
       },
       "in (" + fmt::format("{}", low) + ", " + fmt::format("{}", high) + ")");
+}
+
+/// Accepts a directory that exists or can be created, and in which a file can be written (the
+/// results are written at the end of a run: a typo must fail before the servers start).
+CLI::Validator writable_directory() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::error_code error;
+        std::filesystem::create_directories(text, error);
+        if (error) return "cannot create the directory '" + text + "': " + error.message();
+        const std::filesystem::path probe =
+            std::filesystem::path(text) / (".robin-write-test-" + std::to_string(::getpid()));
+        if (!std::ofstream(probe)) return "cannot write into the directory '" + text + "'";
+        std::filesystem::remove(probe, error);
+        return "";
+      },
+      "DIR");
 }
 
 /// Accepts finite numbers > 0 (CLI11's PositiveNumber prints its range as 300 digits).
@@ -98,7 +119,8 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--output,-o", settings.output_directory, "directory for the result files")
-      ->required();
+      ->required()
+      ->check(writable_directory());
   app.add_option("--relaxation", settings.relaxation,
                  "relaxation delta of the obstacle update, in (0, 2)")
       ->check(open_interval(0.0, 2.0));

@@ -168,4 +168,16 @@ TEST_F(BadInput, ContactBoundaryThatIsADirichletBoundary) {
                  {"lower", "upper", "Dirichlet", "contact_boundary"});
 }
 
+// An output directory that cannot be made is a command-line error before any server starts.
+TEST_F(BadInput, UnwritableOutputDirectoryIsACommandLineError) {
+  const fs::path blocker = directory_ / "a_file";
+  std::ofstream(blocker) << "not a directory";
+  const std::string binary = std::string(ROBIN_BINARY_DIR) + "/bin/robin-run";
+  const CommandResult result =
+      run_command(binary + " " + ROBIN_EXAMPLES + "/two_blocks.toml --output " +
+                  (blocker / "results").string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  expect_fragments(result.output, {"--output", "cannot create the directory", "a_file/results"});
+}
+
 }  // namespace
