@@ -20,6 +20,12 @@ double seconds_between(Clock::time_point start, Clock::time_point end) {
   return std::chrono::duration<double>(end - start).count();
 }
 
+std::string format_tolerance(double tolerance) {
+  std::ostringstream text;
+  text << tolerance;  // 1e-08, not std::to_string's 0.000000
+  return text.str();
+}
+
 double maximum_absolute(const Eigen::VectorXd& values) {
   return values.size() == 0 ? 0.0 : values.lpNorm<Eigen::Infinity>();
 }
@@ -339,7 +345,7 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   result.status = IterationStatus::max_iterations;
   result.message = "the iteration limit of " + std::to_string(options.max_iterations) +
                    " iterations was reached before the tolerance " +
-                   std::to_string(options.tolerance);
+                   format_tolerance(options.tolerance);
   for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
     const auto iteration_start = Clock::now();
     const CouplingEvaluation evaluation = scheme->evaluate(iterate, iteration);

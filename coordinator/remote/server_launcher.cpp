@@ -3,6 +3,9 @@
 #include <deque>
 #include <fstream>
 #include <sstream>
+#include <system_error>
+#include <thread>
+#include <vector>
 
 #include "remote/remote_port.hpp"
 
@@ -143,9 +146,18 @@ std::array<std::string, 2> LocalServers::endpoints() const {
 }
 
 void LocalServers::stop() noexcept {
+  // Both Shutdown requests at once: a server busy with a long setup answers neither, and its
+  // deadline should not be waited for twice.
+  std::vector<std::thread> requests;
   for (auto& server : servers_) {
-    if (server) server->request_shutdown();
+    if (!server) continue;
+    try {
+      requests.emplace_back([&server] { server->request_shutdown(); });
+    } catch (const std::system_error&) {  // no thread to spare: ask in this one
+      server->request_shutdown();
+    }
   }
+  for (std::thread& request : requests) request.join();
   for (auto& server : servers_) {
     if (server) server->finish_stop();
   }

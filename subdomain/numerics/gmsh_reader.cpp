@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <random>
@@ -319,8 +320,10 @@ std::string lower_extension(const std::filesystem::path& path) {
   return extension;
 }
 
+/// Reads (and, for a .geo, meshes) `path`; `after_open` runs once Gmsh has read the file, before
+/// the meshing, which no longer needs it.
 Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source,
-                    const MeshReadOptions& options) {
+                    const MeshReadOptions& options, const std::function<void()>& after_open = {}) {
   check_options(source, options);
   const std::string extension = lower_extension(path);
   if (extension != ".msh" && extension != ".geo") {
@@ -333,6 +336,7 @@ Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source
   const std::lock_guard<std::mutex> lock(gmsh_mutex());
   const GmshSession session(options.size);
   call_gmsh(source, "reading", [&] { gmsh::open(path.string()); });
+  if (after_open) after_open();
   if (extension == ".geo") {
     call_gmsh(source, "meshing", [&] {
       gmsh::option::setNumber("Mesh.ElementOrder", options.element_order);
@@ -403,7 +407,9 @@ class TemporaryFile {
       throw unusable_temporary_directory(label, directory, problem);
     }
   }
-  ~TemporaryFile() {
+  ~TemporaryFile() { remove(); }
+  /// Removes the file now (idempotent): a server stopped during a long meshing leaves nothing.
+  void remove() const noexcept {
     std::error_code error;
     std::filesystem::remove(path_, error);
   }
@@ -438,7 +444,7 @@ Mesh read_gmsh_mesh_from_text(const std::string& content, const std::string& ext
   }
   const TemporaryFile file(content, lowered, label);
   const ErrorSource source{file.path().string(), label};
-  return read_mesh_file(file.path(), source, options);
+  return read_mesh_file(file.path(), source, options, [&file] { file.remove(); });
 }
 
 }  // namespace robin

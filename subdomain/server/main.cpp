@@ -2,7 +2,9 @@
 // (proto/robin.proto). Prints exactly one line on stdout, "listening on ENDPOINT", once bound
 // (wildcards and ephemeral ports resolved); logs go to stderr.
 // With --curve-secret-key and --curve-allow the transport is CurveZMQ (docs/security.md).
-// Exit codes: 0 after Shutdown, SIGINT or SIGTERM; 1 when the endpoint cannot be bound, the
+// Exit codes: 0 after Shutdown, SIGINT or SIGTERM (between requests: after the loop's clean
+// shutdown; during a request, such as a long setup: at once, the request abandoned, since the
+// run it belongs to is being stopped); 1 when the endpoint cannot be bound, the
 // transport fails, or the CURVE options or key files are unusable; CLI11's codes for bad
 // command lines.
 
@@ -24,9 +26,14 @@
 namespace {
 
 std::atomic<bool> stop_requested{false};
+std::atomic<bool> handling_request{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
 
+/// Between requests: the loop notices the flag within its poll interval and shuts down
+/// cleanly. During a request (meshing and factorizing a large body can take minutes): _exit at
+/// once, which is async-signal-safe; the coordinator sees the lost connection.
 void request_stop(int) {
+  if (handling_request.load()) _exit(0);
   stop_requested.store(true);
 }
 
@@ -129,7 +136,8 @@ int main(int argc, char** argv) {
   robin::SubdomainServer server(command_line.server);
   try {
     const std::string reason = robin::run_server_loop(
-        server, command_line.loop, stop_requested, [](const std::string& endpoint) {
+        server, command_line.loop, stop_requested, handling_request,
+        [](const std::string& endpoint) {
           std::cout << "listening on " << endpoint << std::endl;  // the launcher reads this line
           // Nothing else goes to stdout: stray library output joins the logs on stderr, so a
           // launcher that stops reading the pipe can never block the server.

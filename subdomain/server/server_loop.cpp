@@ -114,7 +114,7 @@ std::string reply_to(SubdomainServer& server, const std::vector<zmq::message_t>&
 }  // namespace
 
 std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& options,
-                            const std::atomic<bool>& stop,
+                            const std::atomic<bool>& stop, std::atomic<bool>& busy,
                             const std::function<void(const std::string&)>& on_listening) {
   const auto logger = subdomain_logger();
   zmq::context_t context(1);
@@ -136,7 +136,10 @@ std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& op
     if (!wait_for_request(socket.socket(), options.poll_interval)) continue;
     const std::vector<zmq::message_t> frames = receive_frames(socket.socket());
     if (frames.empty()) continue;
-    if (!send_reply(socket.socket(), reply_to(server, frames))) {
+    busy.store(true);
+    const std::string reply = reply_to(server, frames);
+    busy.store(false);
+    if (!send_reply(socket.socket(), reply)) {
       logger->warn(
           "the reply could not be sent within {} ms (client gone?); re-creating the "
           "socket on {}",

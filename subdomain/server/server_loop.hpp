@@ -58,10 +58,12 @@ class BindError : public std::runtime_error {
 /// Binds the socket, calls `on_listening` once with the actual endpoint (ZMQ_LAST_ENDPOINT:
 /// wildcards and ephemeral ports resolved), then serves requests until `server` has answered a
 /// Shutdown or `stop` becomes true (checked every poll_interval; a signal handler may set it).
+/// `busy` is true while a request is being handled (a signal handler may then end the process
+/// at once instead of waiting for a long setup to finish).
 /// Returns "Shutdown request" or "stop requested", the reason it stopped.
 /// Throws BindError when binding fails, zmq::error_t on other transport failures.
 std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& options,
-                            const std::atomic<bool>& stop,
+                            const std::atomic<bool>& stop, std::atomic<bool>& busy,
                             const std::function<void(const std::string&)>& on_listening);
 
 }  // namespace robin

@@ -3,17 +3,37 @@
 //    with the contact resultant equal to the in-process run's, and leaves no robin-subdomain
 //    behind: this test makes itself a child subreaper, so a server the launcher failed to reap
 //    would become this process's child (found in /proc), and the servers' ports are closed;
-//  - robin-coordinator with one or three --subdomain options exits 2 with a clear message.
+//  - robin-coordinator with one or three --subdomain options exits 2 with a clear message;
+//  - robin-run stopped by SIGINT / SIGTERM during the body setup exits 130 / 143 within a
+//    deadline and its servers are gone (reaped by it, not orphaned);
+//  - robin-run whose second server exits before listening, or announces an endpoint and then
+//    exits, exits 1 naming that server, and stops the first one;
+//  - a contact QP tolerance far looser than the coupling tolerance makes robin-run stop with
+//    exit 5 and "stagnated", still writing its result files;
+//  - command-line options override the case file's [coupling] table (seen in summary.json),
+//    and --timeout 0 is rejected with exit 2.
+// The tests that must not hang run robin-run with a real deadline (run_robin_run).
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
+#include <sys/wait.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstdlib>
 #include <fstream>
+#include <functional>
+#include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <regex>
 #include <sstream>
+#include <thread>
 
 #include "coupling/coupled_run.hpp"
 #include "coupling/in_process_port.hpp"
@@ -29,8 +49,8 @@ using testing::ProcessOutcome;
 using testing::run_tool;
 using testing::TemporaryDirectory;
 
-/// The processes whose parent is this process and whose command name is `name`.
-std::vector<int> children_named(const std::string& name) {
+/// The processes whose parent is `parent` and whose command name is `name` (any name: empty).
+std::vector<int> child_processes(pid_t parent, const std::string& name = "") {
   std::vector<int> pids;
   for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
     const std::string pid = entry.path().filename().string();
@@ -43,9 +63,10 @@ std::vector<int> children_named(const std::string& name) {
     if (open == std::string::npos || close == std::string::npos) continue;
     std::istringstream rest(line.substr(close + 2));
     char state = 0;
-    int parent = 0;
-    rest >> state >> parent;
-    if (parent == getpid() && line.substr(open + 1, close - open - 1) == name.substr(0, 15)) {
+    int parent_pid = 0;
+    rest >> state >> parent_pid;
+    if (parent_pid == static_cast<int>(parent) &&
+        (name.empty() || line.substr(open + 1, close - open - 1) == name.substr(0, 15))) {
       pids.push_back(std::stoi(pid));
     }
   }
@@ -121,7 +142,8 @@ TEST(RobinRun, SolvesTwoBlocksAndLeavesNoServerBehind) {
     EXPECT_TRUE(tcp_port_closed(endpoint)) << endpoint << " still accepts connections";
   }
   EXPECT_EQ(servers.size(), 2u) << outcome.errors;
-  EXPECT_TRUE(children_named("robin-subdomain").empty()) << "orphaned servers were reparented here";
+  EXPECT_TRUE(child_processes(getpid(), "robin-subdomain").empty())
+      << "orphaned servers were reparented here";
   EXPECT_TRUE(std::filesystem::exists(output.path() / "logs" / "server-lower.log"));
   EXPECT_TRUE(std::filesystem::exists(output.path() / "logs" / "server-upper.log"));
 }
@@ -143,6 +165,289 @@ TEST(RobinCoordinator, RequiresExactlyTwoSubdomains) {
     EXPECT_NE(outcome.errors.find("got " + std::to_string(endpoints.size())), std::string::npos)
         << outcome.errors;
   }
+}
+
+// ---- Helpers of the tests below -----------------------------------------------------------
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+/// Polls `condition` every 20 ms until it holds (true) or `seconds` have passed (false).
+bool wait_until(const std::function<bool()>& condition, double seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  while (!condition()) {
+    if (testing::seconds_since(start) > seconds) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
+
+/// True when no process `pid` exists, not even as a zombie (kill fails with ESRCH).
+bool process_gone(int pid) {
+  return kill(pid, 0) == -1 && errno == ESRCH;
+}
+
+/// Makes this process the child subreaper of its descendants, so that a server that robin-run
+/// failed to reap is reparented here (orphans()) instead of to init, where it would vanish
+/// unseen. The destructor kills and reaps whatever is left, so a failing test leaves nothing
+/// running; declare it before the ChildProcess of robin-run (destroyed after it).
+class OrphanCatcher {
+ public:
+  OrphanCatcher() { EXPECT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0); }
+  ~OrphanCatcher() {
+    for (const int pid : orphans()) {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+    }
+  }
+  OrphanCatcher(const OrphanCatcher&) = delete;
+  OrphanCatcher& operator=(const OrphanCatcher&) = delete;
+  /// This process's children (robin-run itself must have been reaped).
+  std::vector<int> orphans() const { return child_processes(getpid()); }
+};
+
+/// Writes examples/`name` into `directory` with its mesh paths made absolute (they are
+/// relative to the case file), and every occurrence of each `from` replaced by its `to` (each
+/// must occur); returns the new file's path.
+std::filesystem::path write_case_variant(
+    const std::filesystem::path& directory, const std::string& name,
+    const std::vector<std::pair<std::string, std::string>>& replacements) {
+  const std::string meshes = example("meshes").string() + "/";
+  std::string text = std::regex_replace(read_text(example(name)), std::regex("meshes/"), meshes);
+  for (const auto& [from, to] : replacements) {
+    EXPECT_NE(text.find(from), std::string::npos) << "'" << from << "' is not in " << name;
+    for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+      text.replace(at, from.size(), to);
+    }
+  }
+  const std::filesystem::path path = directory / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+/// Writes an executable /bin/sh script `name` with body `text` into `directory`.
+std::filesystem::path write_script(const std::filesystem::path& directory, const std::string& name,
+                                   const std::string& text) {
+  const std::filesystem::path path = directory / name;
+  std::ofstream(path) << "#!/bin/sh\n" << text;
+  std::filesystem::permissions(path, std::filesystem::perms(0755));
+  return path;
+}
+
+nlohmann::json read_summary(const std::filesystem::path& directory) {
+  std::ifstream file(directory / "summary.json");
+  EXPECT_TRUE(file.good()) << "no summary.json in " << directory;
+  return file.good() ? nlohmann::json::parse(file) : nlohmann::json::object();
+}
+
+/// Runs build/bin/robin-run `arguments` and kills it unless it exits within `timeout_seconds`
+/// (run_tool's deadline only starts once the tool has closed its standard output), a failure.
+/// Prints the exit and the measured time.
+ProcessOutcome run_robin_run(const std::vector<std::string>& arguments,
+                             const std::filesystem::path& directory, double timeout_seconds) {
+  ChildProcessOptions options;
+  options.executable = testing::tool("robin-run");
+  options.arguments = arguments;
+  options.log_file = directory / "robin-run.stderr";
+  const auto start = std::chrono::steady_clock::now();
+  const auto deadline = start + std::chrono::duration_cast<ChildProcess::Clock::duration>(
+                                    std::chrono::duration<double>(timeout_seconds));
+  ChildProcess process(options);
+  ProcessOutcome outcome;
+  try {
+    while (const auto line = process.read_line(deadline)) outcome.output += *line + "\n";
+  } catch (const ChildTimeout&) {
+  }
+  EXPECT_TRUE(process.wait_for_exit(std::max(0.0, timeout_seconds - testing::seconds_since(start))))
+      << "robin-run did not exit within " << timeout_seconds << " s";
+  outcome.exit = process.exit_description();
+  outcome.errors = read_text(options.log_file);
+  std::cout << "robin-run " << outcome.exit << " after " << testing::seconds_since(start) << " s\n";
+  return outcome;
+}
+
+// ---- Stopping robin-run by a signal -------------------------------------------------------
+
+/// Starts `options` with TMPDIR set to `temporary` in its environment (restored here after the
+/// start): a server killed while meshing cannot remove its temporary mesh file, which then
+/// stays in the test's directory instead of /tmp.
+std::unique_ptr<ChildProcess> start_with_temporary_directory(
+    const ChildProcessOptions& options, const std::filesystem::path& temporary) {
+  const char* previous = std::getenv("TMPDIR");
+  const std::optional<std::string> saved =
+      previous ? std::optional<std::string>(previous) : std::nullopt;
+  setenv("TMPDIR", temporary.c_str(), 1);
+  auto process = std::make_unique<ChildProcess>(options);  // has executed: its copy is made
+  if (saved) {
+    setenv("TMPDIR", saved->c_str(), 1);
+  } else {
+    unsetenv("TMPDIR");
+  }
+  return process;
+}
+
+/// Waits (at most 120 s) until robin-run logged that the body setup began, then returns the
+/// pids of its robin-subdomain children; empty when it ended before.
+std::vector<int> servers_once_setting_up(ChildProcess& run, const std::filesystem::path& log) {
+  const bool setting_up = wait_until(
+      [&] {
+        return read_text(log).find("setting up both bodies") != std::string::npos || !run.running();
+      },
+      120.0);
+  if (!setting_up || !run.running()) return {};
+  return child_processes(run.pid(), "robin-subdomain");
+}
+
+/// Starts robin-run on Hertz with a mesh fine enough (h = 0.02 instead of 0.1) that the body
+/// setup lasts seconds, sends `signal_number` once the setup has begun, and checks the exit
+/// status 128 + signal within a "does not hang" deadline, and that the two servers it started
+/// are gone: reaped by robin-run (with this process the subreaper, an unreaped server would
+/// remain visible here as an orphan or zombie).
+void expect_signal_stops_run(int signal_number) {
+  OrphanCatcher catcher;
+  const TemporaryDirectory directory("robin-run-signal");
+  ChildProcessOptions options;
+  options.executable = testing::tool("robin-run");
+  options.arguments = {
+      write_case_variant(directory.path(), "hertz.toml", {{"mesh_size = 0.1", "mesh_size = 0.02"}})
+          .string(),
+      "--output", (directory.path() / "out").string()};
+  options.log_file = directory.path() / "robin-run.stderr";
+  const std::unique_ptr<ChildProcess> process =
+      start_with_temporary_directory(options, directory.path());
+  ChildProcess& run = *process;
+  const std::vector<int> servers = servers_once_setting_up(run, options.log_file);
+  ASSERT_EQ(servers.size(), 2u) << run.exit_description() << "\n" << read_text(options.log_file);
+  ASSERT_EQ(kill(run.pid(), signal_number), 0);
+  const auto signalled = std::chrono::steady_clock::now();
+  ASSERT_TRUE(run.wait_for_exit(30.0)) << "robin-run still runs 30 s after the signal";
+  std::cout << "robin-run " << run.exit_description() << " " << testing::seconds_since(signalled)
+            << " s after signal " << signal_number << "\n";
+  EXPECT_EQ(run.exit_description(), "exited with status " + std::to_string(128 + signal_number))
+      << read_text(options.log_file);
+  for (const int pid : servers) {
+    EXPECT_TRUE(wait_until([pid] { return process_gone(pid); }, 5.0)) << "server " << pid;
+  }
+  EXPECT_TRUE(catcher.orphans().empty()) << "robin-run left processes behind";
+}
+
+TEST(RobinRunSignals, SigintDuringSetupExits130AndStopsServers) {
+  expect_signal_stops_run(SIGINT);
+}
+
+TEST(RobinRunSignals, SigtermDuringSetupExits143AndStopsServers) {
+  expect_signal_stops_run(SIGTERM);
+}
+
+// ---- A failing server ---------------------------------------------------------------------
+
+/// robin-run on two_blocks with body 1 on the real robin-subdomain and body 2 ('upper') on a
+/// script `name` running `script`; checks exit 1 within 60 s, that the error names the script
+/// as body 'upper''s server and contains `reason`, that every server pid robin-run logged is
+/// gone and that nothing was orphaned. Returns robin-run's standard error.
+std::string expect_failing_upper_server(const std::string& name, const std::string& script,
+                                        const std::string& reason) {
+  OrphanCatcher catcher;
+  const TemporaryDirectory directory("robin-run-failing-server");
+  const std::filesystem::path failing = write_script(directory.path(), name, script);
+  const ProcessOutcome outcome = run_robin_run(
+      {example("two_blocks.toml").string(), "--output", (directory.path() / "out").string(),
+       "--server-executable", testing::tool("robin-subdomain").string(), "--server-executable",
+       failing.string()},
+      directory.path(), 60.0);
+  EXPECT_EQ(outcome.exit, "exited with status 1") << outcome.errors;
+  EXPECT_NE(outcome.errors.find(name + " for body 'upper' (pid "), std::string::npos)
+      << outcome.errors;
+  EXPECT_NE(outcome.errors.find(reason), std::string::npos) << outcome.errors;
+  for (const auto& [pid, endpoint] : listening_servers(outcome.errors)) {
+    EXPECT_TRUE(wait_until([&] { return process_gone(std::stoi(pid)); }, 5.0)) << "pid " << pid;
+  }
+  EXPECT_TRUE(catcher.orphans().empty()) << "robin-run left processes behind";
+  return outcome.errors;
+}
+
+TEST(RobinRunFailingServer, ServerExitingBeforeListeningIsNamed) {
+  expect_failing_upper_server("failing-server", "exit 3\n",
+                              "stopped before listening (it exited with status 3)");
+}
+
+TEST(RobinRunFailingServer, ServerExitingAfterListeningIsNamed) {
+  // It announces an ipc endpoint nobody binds, then exits: the coordinator's first request
+  // cannot be answered, and the launcher must report the exit instead of waiting.
+  const TemporaryDirectory unused("robin-run-no-endpoint");
+  const std::string errors = expect_failing_upper_server(
+      "lying-server", "echo 'listening on ipc://" + (unused.path() / "nobody").string() + "'\n",
+      "exited with status 0");
+  // Both servers were announced (the real one for 'lower' too), so both were checked gone.
+  EXPECT_EQ(listening_servers(errors).size(), 2u) << errors;
+}
+
+// ---- Exit codes of the iteration, and the command line ------------------------------------
+
+TEST(RobinRunExit, StagnationExits5AndWritesResults) {
+  // The contact QPs stop at relative accuracy 1e-6, so the residuals level off far above the
+  // tolerance 1e-15 (and far below the 0.1 that would mean divergence): within a window of 5
+  // iterations they stop decreasing by 1% -- measured: 16 iterations, largest residual 2.6e-6.
+  const TemporaryDirectory directory("robin-run-stagnation");
+  const std::filesystem::path output = directory.path() / "out";
+  const std::filesystem::path case_file = write_case_variant(
+      directory.path(), "two_blocks.toml",
+      {{"[coupling]", "[solver]\nqp_tolerance = 1e-6\n\n[coupling]\nstagnation_window = 5"}});
+  const ProcessOutcome outcome =
+      run_robin_run({case_file.string(), "--output", output.string(), "--tolerance", "1e-15"},
+                    directory.path(), 120.0);
+  EXPECT_EQ(outcome.exit, "exited with status 5") << outcome.errors;
+  const nlohmann::json summary = read_summary(output);
+  EXPECT_EQ(summary.value("status", ""), "stagnated");
+  EXPECT_EQ(summary.value("converged", true), false);
+  const int iterations = summary.value("iterations", 0);
+  EXPECT_GT(iterations, 5);    // a full window after the first iteration
+  EXPECT_LT(iterations, 100);  // the case's max_iterations was not what stopped it
+  EXPECT_NE(summary.value("message", "").find("stagnated"), std::string::npos);
+  for (const char* file :
+       {"history.csv", "contact.csv", "solution.pvd", "lower.vtu", "upper.vtu"}) {
+    EXPECT_TRUE(std::filesystem::exists(output / file)) << file;
+  }
+  // One history row per iteration below the header.
+  std::ifstream history(output / "history.csv");
+  EXPECT_EQ(std::count(std::istreambuf_iterator<char>(history), {}, '\n'), iterations + 1);
+}
+
+TEST(RobinRunCommandLine, OptionsOverrideTheCaseFile) {
+  // The case says relaxation 0.25, and by default IQN-ILS, either-sequence stopping and at
+  // most 100 iterations: every value in summary.json below comes from the command line.
+  const TemporaryDirectory directory("robin-run-overrides");
+  const std::filesystem::path output = directory.path() / "out";
+  const std::filesystem::path case_file = write_case_variant(
+      directory.path(), "two_blocks.toml", {{"relaxation = 0.5", "relaxation = 0.25"}});
+  const ProcessOutcome outcome =
+      run_robin_run({case_file.string(), "--output", output.string(), "--acceleration", "none",
+                     "--relaxation", "0.5", "--stopping", "joint", "--max-iterations", "2"},
+                    directory.path(), 120.0);
+  EXPECT_EQ(outcome.exit, "exited with status 3") << outcome.errors;
+  const nlohmann::json summary = read_summary(output);
+  EXPECT_EQ(summary.value("acceleration", ""), "none");
+  EXPECT_EQ(summary.value("stopping", ""), "joint");
+  EXPECT_EQ(summary.value("relaxation", 0.0), 0.5);
+  EXPECT_EQ(summary.value("status", ""), "iteration limit reached");
+  EXPECT_EQ(summary.value("converged", true), false);
+  EXPECT_EQ(summary.value("iterations", 0), 2);
+}
+
+TEST(RobinRunCommandLine, ZeroTimeoutIsRejected) {
+  // A bad option value is a command-line error (exit 2) found before anything is written.
+  const TemporaryDirectory directory("robin-run-timeout");
+  const std::filesystem::path output = directory.path() / "out";
+  const ProcessOutcome outcome = run_robin_run(
+      {example("two_blocks.toml").string(), "--output", output.string(), "--timeout", "0"},
+      directory.path(), 30.0);
+  EXPECT_EQ(outcome.exit, "exited with status 2") << outcome.errors;
+  EXPECT_NE(outcome.errors.find("--timeout"), std::string::npos) << outcome.errors;
+  EXPECT_NE(outcome.errors.find("must be a finite number > 0"), std::string::npos)
+      << outcome.errors;
+  EXPECT_FALSE(std::filesystem::exists(output));
 }
 
 }  // namespace
