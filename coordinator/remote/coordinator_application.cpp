@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "coupling/coupled_run.hpp"
 #include "numerics/errors.hpp"
@@ -37,18 +38,30 @@ CLI::Validator open_interval(double low, double high) {
 }
 
 /// Accepts a directory that exists or can be created, and in which a file can be written (the
-/// results are written at the end of a run: a typo must fail before the servers start).
+/// results are written at the end of a run: a typo must fail before the servers start). Leaves
+/// no trace: the directories it had to create for the test are removed again.
 CLI::Validator writable_directory() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
+        std::vector<std::filesystem::path> created;  // innermost first
         std::error_code error;
+        for (std::filesystem::path path = std::filesystem::absolute(text, error);
+             !path.empty() && !std::filesystem::exists(path, error); path = path.parent_path()) {
+          created.push_back(path);
+          if (path == path.parent_path()) break;
+        }
+        std::string problem;
         std::filesystem::create_directories(text, error);
-        if (error) return "cannot create the directory '" + text + "': " + error.message();
         const std::filesystem::path probe =
             std::filesystem::path(text) / (".robin-write-test-" + std::to_string(::getpid()));
-        if (!std::ofstream(probe)) return "cannot write into the directory '" + text + "'";
+        if (error) {
+          problem = "cannot create the directory '" + text + "': " + error.message();
+        } else if (!std::ofstream(probe)) {
+          problem = "cannot write into the directory '" + text + "'";
+        }
         std::filesystem::remove(probe, error);
-        return "";
+        for (const std::filesystem::path& path : created) std::filesystem::remove(path, error);
+        return problem;
       },
       "DIR");
 }
