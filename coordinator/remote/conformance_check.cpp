@@ -29,6 +29,7 @@ using protocol::Envelope;
 
 const std::vector<std::string> core_capabilities = {"contact_solve", "correction_solve", "fields"};
 constexpr const char* neumann_solve_capability = "neumann_solve";  // optional, protocol 1.1
+constexpr unsigned run_id_minor = 2;  // Envelope.run_id and its rule: since protocol 1.2
 const std::vector<std::string> state_names = {"awaiting_setup", "awaiting_assignment", "ready"};
 
 // --- The checks -------------------------------------------------------------------------------
@@ -93,6 +94,7 @@ class ServerChecks {
   std::string end_run();
   std::string second_run();
   std::string setup_body_in_ready_state();
+  std::string other_run_refused();
   std::string oversized_message();
   std::string shutdown();
   std::string still_answers(const std::string& after);
@@ -114,6 +116,7 @@ class ServerChecks {
   std::optional<Eigen::VectorXd> free_trace_;  // e: u_N of the far-obstacle contact solve
   bool capabilities_known_ = false;            // a HelloReply to 'hello' arrived
   bool neumann_offered_ = false;               // HelloReply.capabilities has "neumann_solve"
+  unsigned server_minor_ = 0;                  // the minor version of the HelloReply
   Eigen::VectorXd first_force_;                // r1 of 'correction_linearity'
   Eigen::VectorXd first_response_;             // its reply w(r1)
 };
@@ -214,6 +217,7 @@ std::string ServerChecks::hello() {
     }
   }
   capabilities_known_ = true;
+  server_minor_ = exchange.reply->version().minor();
   neumann_offered_ =
       std::find(offered.begin(), offered.end(), neumann_solve_capability) != offered.end();
   if (std::find(state_names.begin(), state_names.end(), reply.state()) == state_names.end()) {
@@ -769,6 +773,19 @@ void ServerChecks::run_run_control_checks() {
   session_.run("end_run", [this] { return end_run(); });
   session_.run("second_run", [this] { return second_run(); });
   session_.run("setup_body_in_ready_state", [this] { return setup_body_in_ready_state(); });
+  if (!capabilities_known_) {
+    session_.run("other_run_refused", []() -> std::string {
+      throw NotChecked("needs the server's protocol version from its HelloReply (see 'hello')");
+    });
+  } else if (server_minor_ < run_id_minor) {
+    session_.record_note("other_run_refused",
+                         "not applicable: the server speaks protocol " +
+                             std::to_string(protocol::protocol_major) + "." +
+                             std::to_string(server_minor_) +
+                             ", and Envelope.run_id is since 1.2; not checked");
+  } else {
+    session_.run("other_run_refused", [this] { return other_run_refused(); });
+  }
   session_.run("end_run_after_checks", [this] {
     return in_context("EndRun", expect_acknowledge(session_.request(end_run_request(), "EndRun"),
                                                    "awaiting_setup"));
@@ -831,6 +848,70 @@ std::string ServerChecks::setup_body_in_ready_state() {
   return refused(contact_solve_request(obstacle_of(nodes_, true)),
                  "ContactSolveRequest after a new SetupBody", {protocol::WRONG_STATE},
                  "awaiting_assignment");
+}
+
+/// Protocol 1.2: a body set up with run_id A refuses the requests of run B (WRONG_STATE, the
+/// state kept, and an EndRun of run B ends nothing), and serves run A's requests and those
+/// without run_id from the same body (the free solve: u_N = lift).
+std::string ServerChecks::other_run_refused() {
+  require_interface();
+  const std::string first_run = "conformance-check-run-a", other_run = "conformance-check-run-b";
+  const auto of_run = [](Envelope request, const std::string& run_id) {
+    request.set_run_id(run_id);
+    return request;
+  };
+  const std::string setup_what = "SetupBody with run_id '" + first_run + "'";
+  const Exchange setup =
+      session_.request(of_run(setup_request(square_body()), first_run), setup_what);
+  if (const std::string problem = expect_content(setup, Envelope::kInterface); !problem.empty()) {
+    return setup_what + ": " + problem;
+  }
+  if (const std::string problem = interface_size_problems(setup.reply->interface());
+      !problem.empty()) {
+    return setup_what + ": " + problem;
+  }
+  const std::vector<ContactNode> nodes = pair_order(setup.reply->interface());
+  const long count = static_cast<long>(nodes.size());
+  const std::string assign_what = "AssignContact with run_id '" + first_run + "'";
+  if (const std::string problem = expect_acknowledge(
+          session_.request(of_run(assign_request(nodes), first_run), assign_what), "ready");
+      !problem.empty()) {
+    return assign_what + ": " + problem;
+  }
+  const Envelope solve = contact_solve_request(obstacle_of(nodes, false));
+  const std::string after = " after a SetupBody with run_id '" + first_run + "'";
+  if (const std::string problem = refused(
+          of_run(solve, other_run), "ContactSolveRequest with run_id '" + other_run + "'" + after,
+          {protocol::WRONG_STATE}, "ready");
+      !problem.empty()) {
+    return problem;
+  }
+  if (const std::string problem =
+          refused(of_run(end_run_request(), other_run),
+                  "EndRun with run_id '" + other_run + "'" + after + " (it must end nothing)",
+                  {protocol::WRONG_STATE}, "ready");
+      !problem.empty()) {
+    return problem;
+  }
+  for (const std::string& run_id : {first_run, std::string()}) {
+    const std::string what =
+        run_id.empty() ? "ContactSolveRequest without run_id (as a 1.1 coordinator sends it)" +
+                             after + " and the refused requests of run '" + other_run + "'"
+                       : "ContactSolveRequest with run_id '" + run_id +
+                             "' after the refused requests of run '" + other_run + "'";
+    ContactSolution solution;
+    if (const std::string problem =
+            read_contact_solution(session_.request(of_run(solve, run_id), what), count, solution);
+        !problem.empty()) {
+      return what + ": " + problem;
+    }
+    const double difference = (solution.normal_trace.array() - lift).abs().maxCoeff();
+    if (difference > tolerance_ * lift) {
+      return what + ": normal_trace differs from the free trace " + number(lift) + " by up to " +
+             number(difference) + " (the body of the run was not kept)";
+    }
+  }
+  return "";
 }
 
 // The oversized message and Shutdown.

@@ -29,6 +29,12 @@
 // is no deviation (the check 'neumann_solve_capability' passes with a note); the request must
 // then be refused as UNSUPPORTED.
 //
+// Runs (protocol 1.2, Envelope.run_id): 'other_run_refused' sets the body up and assigns it with
+// run_id A, then a ContactSolveRequest and an EndRun with run_id B must each be refused as
+// WRONG_STATE with Error.state 'ready', after which a ContactSolveRequest with run_id A and one
+// without run_id must be served from the same body. A server whose HelloReply carries a minor
+// version below 2 is not judged on it: the check passes with the note "not applicable".
+//
 // Deadlines: every request has reply_timeout_seconds. A request that gets no reply fails its
 // check; the checker then opens a new connection and sends a Hello. When that is not answered
 // either, the server is considered unresponsive and every remaining check fails at once as

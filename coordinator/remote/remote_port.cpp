@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
+#include <random>
 #include <sstream>
 
 #include "protocol_version.hpp"
@@ -81,6 +83,7 @@ void RemotePort::send_request(Envelope& request, const std::string& step, double
   if (pending_) fail(step, "the previous request ('" + pending_->step + "') is still in flight");
   const Deadline deadline = Deadline::after(timeout_seconds);
   const auto sent = Clock::now();
+  request.set_run_id(run_id_);
   std::uint64_t request_id = 0;
   try {
     request_id = channel_->send(request, deadline);
@@ -160,6 +163,7 @@ void RemotePort::handshake() {
 
 InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions& solver) {
   body_label_ = body.definition.name;
+  run_id_ = new_run_id();  // a new run: this port's requests carry it from now on
   if (server_name_.empty()) handshake();
   Envelope request;
   *request.mutable_setup_body() = encode_setup_body(body, solver);
@@ -290,6 +294,18 @@ void RemotePort::end_run() noexcept {
 
 const PortTimings& RemotePort::timings() const {
   return timings_;
+}
+
+std::string new_run_id() {
+  std::random_device source;
+  std::string text;
+  constexpr std::array<char, 16> digits{'0', '1', '2', '3', '4', '5', '6', '7',
+                                        '8', '9', 'a', 'b', 'c', 'd', 'e', 'f'};
+  for (int word = 0; word < 4; ++word) {
+    std::uint32_t bits = source();  // random_device yields 32 bits per call
+    for (int digit = 0; digit < 8; ++digit, bits >>= 4) text += digits[bits & 0xfu];
+  }
+  return text;
 }
 
 bool request_server_shutdown(const std::string& endpoint, double timeout_seconds,

@@ -17,6 +17,15 @@
 // Robin iteration as before, and start_neumann_solve throws a PortError naming server, body and
 // step, sending nothing. A server of minor version 0 is compatible (same major).
 //
+// Runs (protocol 1.2): setup() draws a fresh run_id (new_run_id(): 128 random bits) for this
+// port, and every request of the port from then on carries it in Envelope.run_id, the
+// handshake's Hello and the final EndRun included, until the next setup() draws another. Each
+// port (each server) thus has its own run_id. A server that another coordinator set up since
+// (the body now belongs to another run) refuses the requests of this run with WRONG_STATE, and
+// the step fails with a PortError "... server error WRONG_STATE: ... now belongs to another
+// run ..." instead of being answered from the other run's body; a best-effort EndRun refused
+// that way ends nothing on the server. A server of protocol 1.0 or 1.1 ignores run_id.
+//
 // Timings: compute_seconds adds the server-reported times of setup (assembly and
 // factorization), contact solves, corrections and Neumann solves; round_trip_seconds adds, for
 // the same requests, the time from sending the request to the decoded reply; bytes count every
@@ -72,6 +81,8 @@ class RemotePort final : public SubdomainPort {
   const std::vector<std::string>& server_capabilities() const { return capabilities_; }
   /// Whether the handshake announced `capability`.
   bool offers(const std::string& capability) const;
+  /// The run_id this port's requests carry (empty before the first setup()).
+  const std::string& run_id() const { return run_id_; }
 
  private:
   struct Pending;
@@ -92,8 +103,14 @@ class RemotePort final : public SubdomainPort {
   std::vector<std::string> capabilities_;
   long contact_size_ = 0;
   bool set_up_ = false;
+  std::string run_id_;  // Envelope.run_id of every request, drawn by setup()
   PortTimings timings_;
 };
+
+/// A fresh run identifier for Envelope.run_id: 128 bits from std::random_device, as 32
+/// lowercase hexadecimal digits. Distinct runs get distinct identifiers with overwhelming
+/// probability.
+std::string new_run_id();
 
 /// Asks the server at `endpoint` to stop (Shutdown request) on a fresh connection (a CurveZMQ
 /// one with `curve`); true when it acknowledged within `timeout_seconds`. Never throws.

@@ -14,11 +14,20 @@ shutdown_requested.
 Protocol 1.1: besides the core capabilities the server announces the optional "neumann_solve"
 (NeumannSolveRequest: u_N = B K^-1 (f - B' lambda) for a given contact force lambda).
 
-Every reply echoes the request_id and carries version (protocol_major, 1). Failures are Error
+Protocol 1.2, runs (Envelope.run_id): a successful SetupBody records its request's run_id with the
+body (any previous body is discarded whichever run it belonged to). While the body is held,
+AssignContact, ContactSolveRequest, CorrectionRequest, NeumannSolveRequest, FieldsRequest and
+EndRun whose run_id is non-empty and differs from a non-empty recorded one are refused with
+WRONG_STATE ("... now belongs to another run ..."), the state unchanged: another coordinator set
+the body up. An empty run_id (a 1.0 or 1.1 coordinator) is served as before. Replies echo the
+request's run_id.
+
+Every reply echoes the request_id and carries version (protocol_major, 2). Failures are Error
 replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH,
-WRONG_STATE, INVALID_ARGUMENT (sizes, unknown/repeated node ids, non-unit normals, non-finite
-values, unusable write_directory), BAD_INPUT (the body definition), SINGULAR_BODY, UNSUPPORTED
-(a reply sent as a request, a request unknown to this version), INTERNAL (anything else).
+WRONG_STATE (also for another run's run_id), INVALID_ARGUMENT (sizes, unknown/repeated node ids,
+non-unit normals, non-finite values, unusable write_directory), BAD_INPUT (the body definition),
+SINGULAR_BODY, UNSUPPORTED (a reply sent as a request, a request unknown to this version),
+INTERNAL (anything else).
 """
 
 import logging
@@ -35,7 +44,7 @@ from .fields import body_fields, write_vtu
 from .mesh import VTK_CELL_TYPE
 from .setup_decoding import decode_setup_body
 
-PROTOCOL_MAJOR, PROTOCOL_MINOR = 1, 1
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 1, 2
 AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
 REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction",
             "neumann_solve", "fields", "end_run", "shutdown")
@@ -76,6 +85,7 @@ class SubdomainProtocol:
         self.state = AWAITING_SETUP
         self.shutdown_requested = False
         self.body = None
+        self.run_id = ""                  # run_id of the SetupBody of self.body; "" if none
         self.interface_positions = {}     # contact boundary node id -> position
         self.settings = None
 
@@ -95,6 +105,7 @@ class SubdomainProtocol:
                 raise RequestError("MALFORMED_MESSAGE", "the message (%d bytes) is not a "
                                    "serialized robin.protocol.Envelope" % len(request_bytes))
             reply.request_id = request.request_id
+            reply.run_id = request.run_id
             content = request.WhichOneof("content")
             record.type = self._type_name(request, content)
             if self.body is not None:
@@ -177,6 +188,16 @@ class SubdomainProtocol:
             raise RequestError("WRONG_STATE", "%s before AssignContact: send AssignContact for "
                                "body '%s' first" % (request_type, self.body.name))
 
+    def _require_same_run(self, request, request_type):
+        """WRONG_STATE when the request names another run than the body's (protocol 1.2)."""
+        if (self.body is None or not self.run_id or not request.run_id
+                or request.run_id == self.run_id):
+            return
+        raise RequestError("WRONG_STATE", "%s of run '%s': this server's body '%s' now belongs to "
+                           "another run (run_id '%s'): another coordinator set it up; this run's "
+                           "state is lost" % (request_type, request.run_id, self.body.name,
+                                              self.run_id))
+
     def _acknowledge(self, reply):
         reply.acknowledge.state = self.state
 
@@ -186,7 +207,9 @@ class SubdomainProtocol:
         reply.hello_reply.state = self.state
 
     def _on_end_run(self, request, reply, record):
+        self._require_same_run(request, "EndRun")
         self.body = None
+        self.run_id = ""
         self.interface_positions = {}
         self.state = AWAITING_SETUP
         self._acknowledge(reply)
@@ -197,6 +220,7 @@ class SubdomainProtocol:
 
     def _on_setup_body(self, request, reply, record):
         self.body = None                  # a SetupBody starts a new run, whatever its outcome
+        self.run_id = ""                  # (and whichever run the body belonged to)
         self.interface_positions = {}
         self.state = AWAITING_SETUP
         record.body = request.setup_body.body_name
@@ -217,9 +241,12 @@ class SubdomainProtocol:
         self.interface_positions = {int(node): k for k, node in enumerate(interface["node_ids"])}
         self.settings = settings
         self.body = body
+        self.run_id = request.run_id
         self.state = AWAITING_ASSIGNMENT
         record.outcome = "ok, %d nodes, %d free dofs, %d contact boundary nodes" % (
             body.mesh.node_count(), body.free_dof_count(), len(self.interface_positions))
+        if self.run_id:
+            record.outcome += ", run " + self.run_id
 
     def _checked_assignment(self, message):
         """Node ids and normals of an AssignContact: as many normals as nodes, known and
@@ -248,6 +275,7 @@ class SubdomainProtocol:
         return list(message.node_ids), list(message.normals)
 
     def _on_assign_contact(self, request, reply, record):
+        self._require_same_run(request, "AssignContact")
         self._require_state(AWAITING_ASSIGNMENT, "AssignContact")
         node_ids, normals = self._checked_assignment(request.assign_contact)
         self.state = AWAITING_ASSIGNMENT  # until the body accepted the assignment
@@ -258,6 +286,7 @@ class SubdomainProtocol:
     def _on_contact_solve(self, request, reply, record):
         message = request.contact_solve
         record.iteration = " iteration %d" % message.iteration
+        self._require_same_run(request, "ContactSolveRequest")
         self._require_state(READY, "ContactSolveRequest")
         interface = self.body.contact
         obstacle = _checked_vector(message.obstacle, interface.size(),
@@ -283,6 +312,7 @@ class SubdomainProtocol:
         start = time.perf_counter()
         message = request.correction
         record.iteration = " iteration %d" % message.iteration
+        self._require_same_run(request, "CorrectionRequest")
         self._require_state(READY, "CorrectionRequest")
         interface = self.body.contact
         force = _checked_vector(message.interface_force, interface.size(),
@@ -295,6 +325,7 @@ class SubdomainProtocol:
         start = time.perf_counter()
         message = request.neumann_solve
         record.iteration = " iteration %d" % message.iteration
+        self._require_same_run(request, "NeumannSolveRequest")
         self._require_state(READY, "NeumannSolveRequest")
         interface = self.body.contact
         force = _checked_vector(message.contact_force, interface.size(),
@@ -307,6 +338,7 @@ class SubdomainProtocol:
 
     def _on_fields(self, request, reply, record):
         message = request.fields
+        self._require_same_run(request, "FieldsRequest")
         self._require_state(READY, "FieldsRequest")
         force = _checked_vector(message.contact_force, self.body.contact.size(),
                                 "FieldsRequest.contact_force", self.body.name)

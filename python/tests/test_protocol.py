@@ -1,8 +1,10 @@
 """The protocol state machine of the Python subdomain server, without a socket: states and their
 transitions, the error codes of refused requests, and replies that echo the request id and carry
-version 1.1. The Neumann solve of 1.1 through the protocol: its refusals, and its answer equal to
-e - F lambda assembled from the server's own contact-solve and correction replies. A temporary
-directory that cannot hold the files for gmsh is the server's fault: INTERNAL, naming the body.
+version 1.2. The Neumann solve of 1.1 through the protocol: its refusals, and its answer equal to
+e - F lambda assembled from the server's own contact-solve and correction replies. The run rule of
+1.2 (Envelope.run_id): another run's requests are WRONG_STATE and change nothing, the body's run
+and requests without run_id are served. A temporary directory that cannot hold the files for gmsh
+is the server's fault: INTERNAL, naming the body.
 """
 
 import os
@@ -20,9 +22,10 @@ protocol = load_protocol()
 LOWER_GEO = (support.REPOSITORY / "examples" / "meshes" / "block_lower.geo").read_bytes()
 
 
-def request(request_id=7, major=1, **content):
+def request(request_id=7, major=1, run_id="", **content):
     envelope = protocol.Envelope()
     envelope.request_id = request_id
+    envelope.run_id = run_id
     if major is not None:
         envelope.version.major = major
     for name, message in content.items():
@@ -49,7 +52,7 @@ class StateMachine(unittest.TestCase):
     def ask(self, data):
         reply = protocol.Envelope()
         reply.ParseFromString(self.server.handle(data))
-        self.assertEqual((reply.version.major, reply.version.minor), (1, 1))
+        self.assertEqual((reply.version.major, reply.version.minor), (1, 2))
         return reply
 
     def expect_error(self, data, code, state):
@@ -74,7 +77,7 @@ class StateMachine(unittest.TestCase):
         message = self.expect_error(request(major=2, hello=protocol.Hello()), "VERSION_MISMATCH",
                                     "awaiting_setup")
         self.assertIn("2.0", message)
-        self.assertIn("1.1", message)
+        self.assertIn("this server 1.2", message)
         self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
                           "awaiting_setup")
         # field 31 of the Envelope: a request type this version does not know
@@ -142,6 +145,64 @@ class StateMachine(unittest.TestCase):
         scale = max(np.abs(free.normal_trace).max(), np.abs(response).max())
         np.testing.assert_allclose(trace, expected, rtol=0, atol=1e-10 * scale)
         self.assertEqual(self.server.state, "ready")
+
+    def test_requests_of_another_run_are_wrong_state_and_change_nothing(self):
+        run, other = "0123456789abcdef0123456789abcdef", "another-coordinator"
+        reply = self.ask(request(run_id=run, setup_body=setup_body()))
+        self.assertEqual(reply.run_id, run)                       # echoed
+        interface = reply.interface
+        count = len(interface.node_ids)
+        assign = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
+
+        def refused(state, **content):
+            message = self.expect_error(request(run_id=other, **content), "WRONG_STATE", state)
+            self.assertIn("this server's body 'lower' now belongs to another run (run_id '%s')" %
+                          run, message)
+            return message
+
+        refused("awaiting_assignment", assign_contact=assign)
+        refused("awaiting_assignment", end_run=protocol.EndRun())
+        self.assertEqual(self.ask(request(run_id=run, assign_contact=assign)).acknowledge.state,
+                         "ready")
+        solve = protocol.ContactSolveRequest(obstacle=[1.0] * count)
+        message = refused("ready", contact_solve=solve)
+        self.assertEqual(message, "ContactSolveRequest of run '%s': this server's body 'lower' "
+                         "now belongs to another run (run_id '%s'): another coordinator set it "
+                         "up; this run's state is lost" % (other, run))
+        refused("ready", correction=protocol.CorrectionRequest(interface_force=[1.0] * count))
+        refused("ready", neumann_solve=protocol.NeumannSolveRequest(contact_force=[1.0] * count))
+        refused("ready", fields=protocol.FieldsRequest(contact_force=[0.0] * count))
+        refused("ready", end_run=protocol.EndRun())
+        refused("ready", assign_contact=assign)
+        self.assertEqual(self.server.state, "ready")
+        # the run's own requests, and those without run_id (a 1.1 coordinator), are served
+        for run_id in (run, ""):
+            reply = self.ask(request(run_id=run_id, contact_solve=solve))
+            self.assertEqual(reply.run_id, run_id)
+            self.assertEqual(reply.contact_result.status, protocol.CONVERGED)
+            self.assertEqual(list(reply.contact_result.contact_force), [0.0] * count)
+        # another run may always take the server over; the first run is then refused
+        self.ask(request(run_id=other, setup_body=setup_body()))
+        message = self.expect_error(request(run_id=run, contact_solve=solve), "WRONG_STATE",
+                                    "awaiting_assignment")
+        self.assertIn("now belongs to another run (run_id '%s')" % other, message)
+        self.expect_error(request(run_id=run, end_run=protocol.EndRun()), "WRONG_STATE",
+                          "awaiting_assignment")
+        self.assertEqual(self.ask(request(run_id=other, end_run=protocol.EndRun()))
+                         .acknowledge.state, "awaiting_setup")
+        # without a body no run owns the server
+        message = self.expect_error(request(run_id=run, contact_solve=solve), "WRONG_STATE",
+                                    "awaiting_setup")
+        self.assertEqual(message, "ContactSolveRequest before SetupBody: send SetupBody first")
+
+    def test_body_set_up_without_run_id_serves_every_run(self):
+        interface = self.ask(request(setup_body=setup_body())).interface
+        assign = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
+        self.assertEqual(self.ask(request(run_id="b", assign_contact=assign)).acknowledge.state,
+                         "ready")
+        solve = protocol.ContactSolveRequest(obstacle=[1.0] * len(interface.node_ids))
+        self.assertEqual(self.ask(request(run_id="c", contact_solve=solve)).contact_result.status,
+                         protocol.CONVERGED)
 
     def test_bad_bodies(self):
         self.expect_error(request(setup_body=setup_body(poisson_ratio=0.5)), "BAD_INPUT",

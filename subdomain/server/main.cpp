@@ -75,7 +75,8 @@ void add_options(CLI::App& app, CommandLine& command_line) {
                  "allow-list of client public keys for CurveZMQ: one Z85 key per line (bare or "
                  "public-key = \"...\", i.e. concatenated .public files), '#' comments")
       ->type_name("FILE");
-  // Testing only: announce and accept another protocol major version, announce another minor.
+  // Testing only: announce and accept another protocol major version, announce another minor
+  // (below 2 the server also ignores Envelope.run_id, as a protocol 1.1 server would).
   app.add_option("--protocol-major", command_line.server.protocol_major)->group("");
   app.add_option("--protocol-minor", command_line.server.protocol_minor)->group("");
   app.add_option("--without-capability", command_line.server.withheld_capabilities,

@@ -190,6 +190,7 @@ std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
                              " bytes) is not a serialized robin.protocol.Envelope");
     }
     reply.set_request_id(request.request_id());
+    reply.set_run_id(request.run_id());
     record.type = content_type_name(request);
     if (body_) record.body = body_->name();
     check_version(request);
@@ -275,7 +276,9 @@ void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Enve
     case Envelope::kFields:
       return on_fields(request, reply);
     case Envelope::kEndRun:
+      require_same_run(request, "EndRun");
       body_.reset();
+      run_id_.clear();
       interface_nodes_.clear();
       state_ = ServerState::awaiting_setup;
       return acknowledge(reply);
@@ -312,6 +315,18 @@ void SubdomainServer::require_state(ServerState minimum, const std::string& requ
   }
 }
 
+void SubdomainServer::require_same_run(const protocol::Envelope& request,
+                                       const std::string& request_type) const {
+  if (settings_.protocol_minor < 2 || !body_ || run_id_.empty() || request.run_id().empty() ||
+      request.run_id() == run_id_) {
+    return;
+  }
+  throw RequestError(protocol::WRONG_STATE,
+                     request_type + " of run '" + request.run_id() + "': this server's body '" +
+                         body_->name() + "' now belongs to another run (run_id '" + run_id_ +
+                         "'): another coordinator set it up; this run's state is lost");
+}
+
 void SubdomainServer::on_hello(protocol::Envelope& reply) {
   protocol::HelloReply& hello = *reply.mutable_hello_reply();
   hello.set_server_name(server_name());
@@ -324,7 +339,8 @@ void SubdomainServer::on_hello(protocol::Envelope& reply) {
 
 void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol::Envelope& reply,
                                     RequestRecord& record) {
-  body_.reset();  // a SetupBody starts a new run, whatever its outcome
+  body_.reset();  // a SetupBody starts a new run, whatever its outcome (and whose the body was)
+  run_id_.clear();
   interface_nodes_.clear();
   state_ = ServerState::awaiting_setup;
   record.body = request.setup_body().body_name();
@@ -339,14 +355,17 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   interface_nodes_ = interface.node_ids;
   qp_parameters_ = setup.qp;
   body_ = std::move(body);
+  run_id_ = request.run_id();
   state_ = ServerState::awaiting_assignment;
   record.outcome = "ok, " + std::to_string(body_->mesh().node_count()) + " nodes, " +
                    std::to_string(body_->free_dof_count()) + " free dofs, " +
                    std::to_string(interface_nodes_.size()) + " contact boundary nodes";
+  if (!run_id_.empty()) record.outcome += ", run " + run_id_;
 }
 
 void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
                                         protocol::Envelope& reply) {
+  require_same_run(request, "AssignContact");
   require_state(ServerState::awaiting_assignment, "AssignContact");
   const ContactAssignment assignment =
       checked_assignment(request.assign_contact(), interface_nodes_, body_->mesh(), body_->name());
@@ -360,6 +379,7 @@ void SubdomainServer::on_contact_solve(const protocol::Envelope& request, protoc
                                        RequestRecord& record) {
   const protocol::ContactSolveRequest& message = request.contact_solve();
   record.iteration = " iteration " + std::to_string(message.iteration());
+  require_same_run(request, "ContactSolveRequest");
   require_state(ServerState::ready, "ContactSolveRequest");
   const Eigen::VectorXd obstacle = checked_vector(message.obstacle(), body_->contact_size(),
                                                   "ContactSolveRequest.obstacle", body_->name());
@@ -375,6 +395,7 @@ void SubdomainServer::on_correction(const protocol::Envelope& request, protocol:
   const auto start = Clock::now();
   const protocol::CorrectionRequest& message = request.correction();
   record.iteration = " iteration " + std::to_string(message.iteration());
+  require_same_run(request, "CorrectionRequest");
   require_state(ServerState::ready, "CorrectionRequest");
   const Eigen::VectorXd interface_force =
       checked_vector(message.interface_force(), body_->contact_size(),
@@ -396,6 +417,7 @@ void SubdomainServer::on_neumann_solve(const protocol::Envelope& request, protoc
                        "NeumannSolveRequest is not served: this server withholds the capability "
                        "'neumann_solve' (started with --without-capability neumann_solve)");
   }
+  require_same_run(request, "NeumannSolveRequest");
   require_state(ServerState::ready, "NeumannSolveRequest");
   const Eigen::VectorXd contact_force =
       checked_vector(message.contact_force(), body_->contact_size(),
@@ -410,6 +432,7 @@ void SubdomainServer::on_neumann_solve(const protocol::Envelope& request, protoc
 
 void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Envelope& reply) {
   const protocol::FieldsRequest& message = request.fields();
+  require_same_run(request, "FieldsRequest");
   require_state(ServerState::ready, "FieldsRequest");
   const Eigen::VectorXd contact_force = checked_vector(
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());

@@ -13,11 +13,22 @@
 // shutdown_requested() becomes true. The body is factorized once per SetupBody; contact solves
 // warm-start from the previous converged solution of the same assignment.
 //
+// Runs (protocol 1.2, Envelope.run_id): a successful SetupBody records its request's run_id
+// with the body (any previous body is discarded whichever run it belonged to: a new run may
+// always take over a server whose coordinator died). While the body is held, AssignContact,
+// ContactSolveRequest, CorrectionRequest, NeumannSolveRequest, FieldsRequest and EndRun whose
+// run_id is non-empty and differs from a non-empty recorded one are refused with WRONG_STATE
+// ("... now belongs to another run ..."), the state unchanged: another coordinator set the body
+// up, and this run must not be answered from it. An empty run_id (a 1.0 or 1.1 coordinator) is
+// served as before. A server announcing a minor version below 2 (ServerSettings, testing)
+// ignores run_id, as a 1.1 server would. Replies echo the request's run_id.
+//
 // Every reply echoes the request_id and carries this server's Version. Failures are Error
 // replies, never exceptions:
 //   MALFORMED_MESSAGE  not a parsable Envelope, no version, or no content
 //   VERSION_MISMATCH   the request's major version differs from ours (both are named)
-//   WRONG_STATE        the request is not accepted in the current state
+//   WRONG_STATE        the request is not accepted in the current state, or it names another
+//                      run than the body's (run_id, see above)
 //   INVALID_ARGUMENT   wrong sizes, unknown or repeated node ids, non-unit normals, non-finite
 //                      values, a write_directory where the fields cannot be written
 //   BAD_INPUT          the body definition is unusable (robin::InputError while setting up)
@@ -60,7 +71,8 @@ struct ServerSettings {
   std::string name;  // optional label, appended to HelloReply.server_name and the logs
   /// The major version announced and accepted (tests set another one to provoke a mismatch).
   unsigned protocol_major = protocol::protocol_major;
-  /// The minor version announced (tests set 0 to play a protocol 1.0 server).
+  /// The minor version announced (tests set 0 to play a protocol 1.0 server). Below 2 the
+  /// server also ignores Envelope.run_id, as a protocol 1.1 server would.
   unsigned protocol_minor = protocol::protocol_minor;
   /// Optional capabilities neither announced nor served (testing only: with "neumann_solve"
   /// the server answers NeumannSolveRequest with UNSUPPORTED, like a protocol 1.0 server).
@@ -96,6 +108,8 @@ class SubdomainServer {
                 RequestRecord& record);
   void check_version(const protocol::Envelope& request) const;
   void require_state(ServerState minimum, const std::string& request_type) const;
+  /// Throws WRONG_STATE when `request` names another run than the body's (see above).
+  void require_same_run(const protocol::Envelope& request, const std::string& request_type) const;
   void on_hello(protocol::Envelope& reply);
   void on_setup_body(const protocol::Envelope& request, protocol::Envelope& reply,
                      RequestRecord& record);
@@ -118,6 +132,7 @@ class SubdomainServer {
   ServerState state_ = ServerState::awaiting_setup;
   bool shutdown_requested_ = false;
   std::unique_ptr<BodySolver> body_;
+  std::string run_id_;  // run_id of the SetupBody that set up body_; "" without body or run_id
   std::vector<int> interface_nodes_;  // the contact boundary's node ids, ascending
   MprgpParameters qp_parameters_;
 };

@@ -5,7 +5,10 @@
 // line. Each deviation must fail the checks that judge it, with an explanation naming the
 // message, and the checker must keep to its deadlines. The optional Neumann solve (protocol
 // 1.1) is checked when announced; a server without it (robin-subdomain --protocol-minor 0
-// --without-capability neumann_solve, as a 1.0 server) conforms.
+// --without-capability neumann_solve, as a 1.0 server) conforms. The run rule of protocol 1.2
+// (Envelope.run_id: another run's requests are WRONG_STATE) is judged only for servers of minor
+// version 2 or later: a server playing 1.1 ignores run_id and still conforms, and a proxy that
+// strips run_id fails the check.
 
 #include "remote/conformance_check.hpp"
 
@@ -251,10 +254,12 @@ TEST_F(ConformanceTest, ReferenceServerPassesEveryCheck) {
                            "neumann_solve_non_finite",
                            "neumann_solve_free",
                            "neumann_solve_equation",
-                           "neumann_solve_contact_consistency"}) {
+                           "neumann_solve_contact_consistency",
+                           "other_run_refused"}) {
     EXPECT_TRUE(passes(report, name)) << name;
   }
   EXPECT_EQ(find_check(report, "neumann_solve_capability")->explanation, "announced: checked");
+  EXPECT_EQ(find_check(report, "other_run_refused")->explanation, "");  // judged, no note
   EXPECT_EQ(find_check(report, "neumann_solve_unsupported"), nullptr);
   EXPECT_EQ(find_check(report, "shutdown"), nullptr);  // only with include_shutdown
   EXPECT_LT(seconds, 20.0);
@@ -305,6 +310,29 @@ TEST_F(ConformanceTest, ServerWithoutTheOptionalNeumannSolveConforms) {
   }
   EXPECT_NE(format_report(report).find("PASS neumann_solve_capability (not announced"),
             std::string::npos);
+  EXPECT_NE(format_report(report).find("PASS other_run_refused (not applicable: the server "
+                                       "speaks protocol 1.0"),
+            std::string::npos)
+      << format_report(report);
+}
+
+TEST_F(ConformanceTest, ServerOfProtocol11IsNotJudgedOnRunIds) {
+  // robin-subdomain --protocol-minor 1 ignores Envelope.run_id, as a 1.1 server does: it would
+  // fail 'other_run_refused', which must therefore not judge it.
+  testing::TemporaryDirectory directory("conformance-1.1");
+  ServerLaunchOptions launch = testing::server_options(directory.path());
+  launch.extra_arguments = {"--protocol-minor", "1"};
+  SubdomainServer server("old", launch);
+  server.await_listening();
+  const ConformanceReport report = check_server(server.endpoint(), quick_options());
+  EXPECT_TRUE(report.conforms()) << failed_checks(report);
+  const ConformanceCheck* note = find_check(report, "other_run_refused");
+  ASSERT_NE(note, nullptr);
+  EXPECT_TRUE(note->passed);
+  EXPECT_NE(note->explanation.find("not applicable: the server speaks protocol 1.1"),
+            std::string::npos)
+      << note->explanation;
+  EXPECT_TRUE(passes(report, "neumann_solve_equation"));  // 1.1 has the Neumann solve
 }
 
 // --- Servers that do not conform ----------------------------------------------------------------
@@ -469,6 +497,16 @@ Deviation errors_without_version() {
             {"the Error{VERSION_MISMATCH} reply to Hello with version 2.0 carries no Version"}}}};
 }
 
+Deviation dropped_run_ids() {
+  // The server never sees run_id (as a 1.1 server ignores it) but announces 1.2.
+  return {"DroppedRunIds",
+          [](Envelope& request) { request.clear_run_id(); },
+          {},
+          {{"other_run_refused",
+            {"ContactSolveRequest with run_id 'conformance-check-run-b'",
+             "expected Error{WRONG_STATE}", "ContactSolveResult"}}}};
+}
+
 Deviation no_fields_reactions() {
   return {"NoReactionResultant",
           {},
@@ -482,7 +520,8 @@ INSTANTIATE_TEST_SUITE_P(Conformance, DeviationTest,
                          ::testing::Values(negated_contact_force(), ignored_pair_order(),
                                            shifted_correction(), negated_neumann_force(),
                                            neumann_without_loads(), wrong_request_ids(),
-                                           errors_without_version(), no_fields_reactions()),
+                                           errors_without_version(), no_fields_reactions(),
+                                           dropped_run_ids()),
                          [](const auto& info) { return info.param.name; });
 
 // --- Shutdown (only with include_shutdown) ------------------------------------------------------

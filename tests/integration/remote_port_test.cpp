@@ -10,7 +10,11 @@
 //  - when neither server answers, the error names both servers and bodies;
 //  - a server that answers the handshake but not SetupBody fails the setup at the setup
 //    timeout (3 s), not at the shorter request timeout (1 s);
-//  - a server speaking protocol 2.x is refused with both versions in the message.
+//  - a server speaking protocol 2.x is refused with both versions in the message;
+//  - protocol 1.2 runs: when a second coordinator (another RemotePort) sets up the server of a
+//    run in progress, the first run's next contact solve fails with a PortError saying that the
+//    body belongs to another run (before 1.2 it was answered from the other run's body), and
+//    the first run's EndRun does not end the second run.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -241,8 +245,8 @@ class HandshakeOnlyServer {
     if (thread_.joinable()) thread_.join();
   }
   const std::string& endpoint() const { return endpoint_; }
-  /// Waits for the server thread (it ends once SetupBody arrived, or 3 s after the last message without it);
-  /// true when a SetupBody request arrived.
+  /// Waits for the server thread (it ends once SetupBody arrived, or 3 s after the last message
+  /// without it); true when a SetupBody request arrived.
   bool setup_arrived() {
     thread_.join();
     return setup_arrived_;
@@ -346,8 +350,50 @@ TEST(RemotePort, ServerOfAnotherMajorVersionIsRefused) {
     std::cout << message << "\n";
     EXPECT_NE(message.find("server " + server.endpoint()), std::string::npos) << message;
     EXPECT_NE(message.find("speaks protocol 2."), std::string::npos) << message;
-    EXPECT_NE(message.find("this coordinator speaks 1.1"), std::string::npos) << message;
+    EXPECT_NE(message.find("this coordinator speaks 1.2"), std::string::npos) << message;
   }
+}
+
+TEST(RemotePort, SecondCoordinatorTakingTheServerOverFailsTheFirstRun) {
+  const TemporaryDirectory logs("remote-port-takeover");
+  const CaseDefinition definition = two_blocks();
+  SubdomainServer server("lower", server_options(logs.path()));
+  server.await_listening();
+  RemotePort first(server.endpoint(), "lower", port_options(10.0));
+  const InterfaceDescription interface = first.setup(definition.bodies[0], definition.solver);
+  ContactAssignment assignment;
+  assignment.node_ids = interface.node_ids;
+  assignment.normals = interface.normals;
+  first.assign_contact(assignment);
+  const Eigen::VectorXd obstacle =
+      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(interface.node_ids.size()), 1.0);
+  first.start_contact_solve(obstacle, 1);
+  EXPECT_EQ(first.finish_contact_solve().status, QpStatus::converged);
+
+  // Another coordinator sets the same body up on the same server: the contact sizes match, so
+  // before protocol 1.2 the first run went on, silently answered from the other run's body.
+  RemotePort second(server.endpoint(), "lower", port_options(10.0));
+  second.setup(definition.bodies[0], definition.solver);
+  second.assign_contact(assignment);
+  EXPECT_EQ(first.run_id().size(), 32u);
+  EXPECT_NE(first.run_id(), second.run_id());
+  try {
+    first.start_contact_solve(obstacle, 2);
+    first.finish_contact_solve();
+    ADD_FAILURE() << "the first run was answered from the second run's body";
+  } catch (const PortError& error) {
+    const std::string message = error.what();
+    std::cout << message << "\n";
+    EXPECT_NE(message.find("server " + server.endpoint() + " (body 'lower')"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("step contact solve (iteration 2)"), std::string::npos) << message;
+    EXPECT_NE(message.find("WRONG_STATE"), std::string::npos) << message;
+    EXPECT_NE(message.find("another run"), std::string::npos) << message;
+  }
+  first.end_run();  // refused by the server: it must not end the second run
+  second.start_contact_solve(obstacle, 1);
+  EXPECT_EQ(second.finish_contact_solve().status, QpStatus::converged);
+  second.end_run();
 }
 
 }  // namespace

@@ -346,7 +346,7 @@ TEST(SubdomainProcess, HiddenProtocolMajorFlagProvokesAVersionMismatch) {
   ASSERT_TRUE(reply.has_error());
   EXPECT_EQ(reply.error().code(), protocol::VERSION_MISMATCH);
   EXPECT_EQ(reply.version().major(), 2u);
-  // "the request speaks 1.1, this server 2.1": the flag changes the major version only.
+  // "the request speaks 1.2, this server 2.2": the flag changes the major version only.
   EXPECT_NE(
       reply.error().message().find("this server 2." + std::to_string(protocol::protocol_minor)),
       std::string::npos)

@@ -3,7 +3,9 @@
 // directly from the same body definition, the equilibrium of the returned fields, and every
 // error reply of the state machine. The Neumann solve of protocol 1.1 (NeumannSolveRequest)
 // against the normal trace of BodySolver::displacement, its refusals, and a server that
-// withholds it (as a protocol 1.0 server would not know it).
+// withholds it (as a protocol 1.0 server would not know it). The run rule of protocol 1.2
+// (Envelope.run_id): requests of another run than the body's are WRONG_STATE and change nothing,
+// the body's run and requests without run_id are served, and a server playing 1.1 ignores it.
 
 #include "server/subdomain_server.hpp"
 
@@ -403,7 +405,10 @@ TEST(SubdomainServer, OtherMajorVersionIsAMismatchNamingBothVersions) {
   const protocol::Envelope reply = exchange(server, hello_request(9, 2));
   expect_error(reply, protocol::VERSION_MISMATCH, "awaiting_setup");
   EXPECT_NE(reply.error().message().find("2.0"), std::string::npos) << reply.error().message();
-  EXPECT_NE(reply.error().message().find("1.1"), std::string::npos) << reply.error().message();
+  const std::string ours =
+      std::to_string(protocol::protocol_major) + "." + std::to_string(protocol::protocol_minor);
+  EXPECT_NE(reply.error().message().find("this server " + ours), std::string::npos)
+      << reply.error().message();
   EXPECT_TRUE(exchange(server, hello_request(10)).has_hello_reply());  // still serving
 }
 
@@ -533,6 +538,114 @@ TEST(SubdomainServer, WithheldNeumannCapabilityIsNeitherAnnouncedNorServed) {
   expect_error(reply, protocol::UNSUPPORTED, "ready");
   EXPECT_NE(reply.error().message().find("'neumann_solve'"), std::string::npos);
   EXPECT_TRUE(handle(contact_solve_request(5, Eigen::VectorXd::Ones(21))).has_contact_result());
+}
+
+/// `envelope` with Envelope.run_id `run_id` (protocol 1.2).
+protocol::Envelope of_run(protocol::Envelope envelope, const std::string& run_id) {
+  envelope.set_run_id(run_id);
+  return envelope;
+}
+
+/// A WRONG_STATE reply in `state` whose message says the body belongs to another run.
+void expect_other_run(const protocol::Envelope& reply, const std::string& state) {
+  expect_error(reply, protocol::WRONG_STATE, state);
+  EXPECT_NE(reply.error().message().find("body 'lower' now belongs to another run"),
+            std::string::npos)
+      << reply.error().message();
+}
+
+TEST(SubdomainServer, RequestsOfAnotherRunAreWrongStateAndChangeNothing) {
+  SubdomainServer server(quiet_settings());
+  BodySolver reference(lower_block_definition());
+  const InterfaceDescription interface = reference.contact_boundary();
+  const std::string run = "0123456789abcdef0123456789abcdef", other = "another-coordinator";
+  protocol::Envelope reply = exchange(server, of_run(setup_request(1, lower_block_setup()), run));
+  ASSERT_TRUE(reply.has_interface()) << reply.DebugString();
+  EXPECT_EQ(reply.run_id(), run);  // echoed
+
+  // Before the assignment: the other run's AssignContact and EndRun are refused.
+  expect_other_run(exchange(server, of_run(assign_all_request(2, interface), other)),
+                   "awaiting_assignment");
+  protocol::Envelope end_run = request(3);
+  end_run.mutable_end_run();
+  expect_other_run(exchange(server, of_run(end_run, other)), "awaiting_assignment");
+  ASSERT_TRUE(exchange(server, of_run(assign_all_request(4, interface), run)).has_acknowledge());
+  reference.assign_contact(assign_all(interface));
+
+  // In ready: every request of the other run is refused, the state and warm start kept.
+  const Eigen::VectorXd obstacle = sloped_obstacle(interface);
+  reply = exchange(server, of_run(contact_solve_request(5, obstacle), other));
+  expect_other_run(reply, "ready");
+  EXPECT_EQ(reply.error().message(),
+            "ContactSolveRequest of run '" + other +
+                "': this server's body 'lower' now belongs to another run (run_id '" + run +
+                "'): another coordinator set it up; this run's state is lost");
+  EXPECT_EQ(reply.run_id(), other);
+  protocol::Envelope correction = request(6);
+  correction.mutable_correction()->mutable_interface_force()->Resize(21, 1.0);
+  expect_other_run(exchange(server, of_run(correction, other)), "ready");
+  expect_other_run(
+      exchange(server, of_run(neumann_solve_request(7, Eigen::VectorXd::Ones(21)), other)),
+      "ready");
+  protocol::Envelope fields = request(8);
+  fields.mutable_fields()->mutable_contact_force()->Resize(21, 0.0);
+  expect_other_run(exchange(server, of_run(fields, other)), "ready");
+  expect_other_run(exchange(server, of_run(end_run, other)), "ready");
+  expect_other_run(exchange(server, of_run(assign_all_request(9, interface), other)), "ready");
+  EXPECT_EQ(server.state(), ServerState::ready);
+
+  // The run's own requests, and requests without run_id (a 1.1 coordinator), are served from
+  // its body as if nothing had happened.
+  reply = exchange(server, of_run(contact_solve_request(10, obstacle), run));
+  ASSERT_TRUE(reply.has_contact_result()) << reply.DebugString();
+  expect_contact_result(reply.contact_result(), reference.solve_contact(obstacle), obstacle);
+  const Eigen::VectorXd second_obstacle = 0.5 * obstacle.array() - 0.0002;
+  reply = exchange(server, contact_solve_request(11, second_obstacle));
+  ASSERT_TRUE(reply.has_contact_result()) << reply.DebugString();
+  EXPECT_EQ(reply.run_id(), "");
+  expect_contact_result(reply.contact_result(), reference.solve_contact(second_obstacle),
+                        second_obstacle);
+
+  // Another run may always take the server over with SetupBody; the first run is then refused.
+  ASSERT_TRUE(
+      exchange(server, of_run(setup_request(12, lower_block_setup()), other)).has_interface());
+  expect_other_run(exchange(server, of_run(contact_solve_request(13, obstacle), run)),
+                   "awaiting_assignment");
+  expect_other_run(exchange(server, of_run(end_run, run)), "awaiting_assignment");
+  reply = exchange(server, of_run(end_run, other));
+  ASSERT_TRUE(reply.has_acknowledge()) << reply.DebugString();
+  EXPECT_EQ(reply.acknowledge().state(), "awaiting_setup");
+
+  // Without a body no run owns the server: a request of any run gets the plain state refusal.
+  reply = exchange(server, of_run(contact_solve_request(14, obstacle), run));
+  expect_error(reply, protocol::WRONG_STATE, "awaiting_setup");
+  EXPECT_EQ(reply.error().message(), "ContactSolveRequest before SetupBody: send SetupBody first");
+}
+
+TEST(SubdomainServer, BodySetUpWithoutRunIdServesEveryRun) {
+  SubdomainServer server(quiet_settings());
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  ASSERT_TRUE(exchange(server, setup_request(1, lower_block_setup())).has_interface());
+  ASSERT_TRUE(exchange(server, of_run(assign_all_request(2, interface), "b")).has_acknowledge());
+  EXPECT_TRUE(exchange(server, of_run(contact_solve_request(3, Eigen::VectorXd::Ones(21)), "c"))
+                  .has_contact_result());
+}
+
+TEST(SubdomainServer, ServerPlayingProtocol11IgnoresRunId) {
+  ServerSettings settings = quiet_settings();
+  settings.protocol_minor = 1;
+  SubdomainServer server(settings);
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  const auto handle = [&server](const protocol::Envelope& envelope) {
+    protocol::Envelope reply;
+    EXPECT_TRUE(reply.ParseFromString(server.handle(envelope.SerializeAsString())));
+    EXPECT_EQ(reply.version().minor(), 1u);
+    return reply;
+  };
+  ASSERT_TRUE(handle(of_run(setup_request(1, lower_block_setup()), "a")).has_interface());
+  ASSERT_TRUE(handle(of_run(assign_all_request(2, interface), "b")).has_acknowledge());
+  EXPECT_TRUE(handle(of_run(contact_solve_request(3, Eigen::VectorXd::Ones(21)), "b"))
+                  .has_contact_result());
 }
 
 TEST_F(ReadyServer, BadAssignmentsAreInvalidAndKeepThePreviousAssignment) {
