@@ -1,7 +1,8 @@
 // robin-subdomain-py (python/robin-subdomain-py run by /usr/bin/python3), the independent Python
 // implementation of a subdomain server (its own Gmsh reader, elements, factorization and QP),
 // driven by the coordinator's RemotePort:
-//  - coupled runs of examples/two_blocks.toml, two_blocks_partial.toml and hertz.toml with body 1
+//  - coupled runs of examples/two_blocks.toml, two_blocks_partial.toml, hertz.toml and
+//    asymmetric.toml (two Python servers) with body 1
 //    on the C++ robin-subdomain and body 2 on the Python server, and with both bodies on Python
 //    servers, equal the all-C++ run (InProcessPort: the C++ numerics in this process, which
 //    remote_port_test shows equal to C++ servers to 1e-12) to 1e-6 relative in contact forces,
@@ -144,6 +145,12 @@ TEST(PythonServer, HertzTwoPythonServersEqualsAllCpp) {
 
 TEST(PythonServer, PartialContactTwoPythonServersEqualsAllCpp) {
   expect_equal_to_cpp("two_blocks_partial.toml", run_with_python("two_blocks_partial.toml", true));
+}
+
+// The asymmetric pair: a cantilever loaded by a pressure on a block, stiffness ratio 10 and
+// different boundary conditions (the case the default acceleration is for).
+TEST(PythonServer, AsymmetricPairTwoPythonServersEqualsAllCpp) {
+  expect_equal_to_cpp("asymmetric.toml", run_with_python("asymmetric.toml", true));
 }
 
 /// Every contact node of `boundary` by descending x, with `sign` times the normal that

@@ -142,5 +142,26 @@ TEST(ContactPairing, ExcludedPairClearanceMeasuresThePenetrationOfPrescribedNode
   EXPECT_EQ(excluded_pair_clearance(pairing, lifted, 0.02).relative_penetration, 0.0);
 }
 
+// The tolerance is relative to the shortest contact edge (0.5 here): a tangential offset of
+// 0.9 of the tolerance pairs, 1.1 of it does not; a normal offset of any size (an open gap)
+// pairs and enters the gap.
+TEST(ContactPairing, TangentialOffsetIsComparedWithTheRelativeTolerance) {
+  const double relative_tolerance = 1e-3, edge = 0.5;
+  const InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  for (const double fraction : {0.9, 1.1}) {
+    const double offset = fraction * relative_tolerance * edge;
+    const InterfaceDescription upper = flat_interface({0.0, 0.5 + offset, 1.0}, 0.25, -1.0);
+    if (fraction < 1.0) {
+      const ContactPairing pairing =
+          pair_contact_nodes(lower, "lower", upper, "upper", nullptr, relative_tolerance);
+      ASSERT_EQ(pairing.size(), 3u);
+      for (const ContactPair& pair : pairing.pairs) EXPECT_NEAR(pair.gap, 0.25, 1e-15);
+    } else {
+      EXPECT_THROW(pair_contact_nodes(lower, "lower", upper, "upper", nullptr, relative_tolerance),
+                   InputError);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace robin
