@@ -129,6 +129,28 @@ protocol::SetupBody square_body() {
   return body;
 }
 
+protocol::SetupBody with_voigt_material(protocol::SetupBody body) {
+  const double modulus = body.young_modulus(), nu = body.poisson_ratio();
+  double diagonal = 0.0, coupling = 0.0, shear = 0.0;
+  if (body.model() == protocol::PLANE_STRESS) {
+    const double factor = modulus / (1.0 - nu * nu);
+    diagonal = factor;
+    coupling = factor * nu;
+    shear = factor * (1.0 - nu) / 2.0;
+  } else {
+    const double factor = modulus / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    diagonal = factor * (1.0 - nu);
+    coupling = factor * nu;
+    shear = factor * (1.0 - 2.0 * nu) / 2.0;
+  }
+  body.clear_young_modulus();
+  body.clear_poisson_ratio();
+  for (const double value : {diagonal, coupling, 0.0, coupling, diagonal, 0.0, 0.0, 0.0, shear}) {
+    body.add_voigt(value);
+  }
+  return body;
+}
+
 Envelope setup_request(const protocol::SetupBody& body) {
   Envelope envelope;
   *envelope.mutable_setup_body() = body;

@@ -36,6 +36,14 @@ double partial_obstacle(double x);
 
 /// The valid SetupBody of the built-in body (tests derive the refused ones from it).
 protocol::SetupBody square_body();
+/// `body` with its isotropic young_modulus/poisson_ratio replaced by the equivalent row-major
+/// 3x3 `voigt` matrix of its model (Voigt order xx, yy, xy, engineering shear strain), as
+/// robin-coordinator sends every material that is not isotropic plane strain:
+///   plane strain: E / ((1 + nu)(1 - 2 nu)) [[1 - nu, nu, 0], [nu, 1 - nu, 0],
+///                                           [0, 0, (1 - 2 nu) / 2]],
+///   plane stress: E / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]].
+/// Both definitions describe the same material: a server must give the same answers.
+protocol::SetupBody with_voigt_material(protocol::SetupBody body);
 
 /// A contact node of the built-in body: its server-side id and abscissa.
 struct ContactNode {

@@ -93,6 +93,8 @@ class ServerChecks {
   std::string fields_pair_order();
   std::string end_run();
   std::string second_run();
+  std::string voigt_material();
+  std::string set_up_again(const protocol::SetupBody& body, const std::string& what);
   std::string setup_body_in_ready_state();
   std::string other_run_refused();
   std::string oversized_message();
@@ -772,6 +774,7 @@ std::string ServerChecks::fields_pair_order() {
 void ServerChecks::run_run_control_checks() {
   session_.run("end_run", [this] { return end_run(); });
   session_.run("second_run", [this] { return second_run(); });
+  session_.run("voigt_material", [this] { return voigt_material(); });
   session_.run("setup_body_in_ready_state", [this] { return setup_body_in_ready_state(); });
   if (!capabilities_known_) {
     session_.run("other_run_refused", []() -> std::string {
@@ -803,26 +806,36 @@ std::string ServerChecks::end_run() {
                  "ContactSolveRequest after EndRun", {protocol::WRONG_STATE}, "awaiting_setup");
 }
 
-/// SetupBody, AssignContact and the partial-contact solve again: the same answer.
-std::string ServerChecks::second_run() {
-  const ContactSolution& first = require_partial_solution();
-  const Exchange setup = session_.request(setup_request(square_body()), "SetupBody (second run)");
+/// Sets `body` up and assigns its contact nodes in the pair order of the first run (the same
+/// positions, maybe other ids, into nodes_): "" or the problem, naming the requests with
+/// `what` (e.g. "second run").
+std::string ServerChecks::set_up_again(const protocol::SetupBody& body, const std::string& what) {
+  const Exchange setup = session_.request(setup_request(body), "SetupBody (" + what + ")");
   if (const std::string problem = expect_content(setup, Envelope::kInterface); !problem.empty()) {
-    return "SetupBody (second run): " + problem;
+    return "SetupBody (" + what + "): " + problem;
   }
   const protocol::InterfaceDescription& description = setup.reply->interface();
   if (!interface_size_problems(description).empty() ||
       description.node_ids_size() != contact_count()) {
-    return "SetupBody (second run): the InterfaceDescription differs from the first run's";
+    return "SetupBody (" + what + "): the InterfaceDescription differs from the first run's";
   }
   std::vector<ContactNode> nodes = pair_order(description);
   std::stable_sort(nodes.begin(), nodes.end(), [this](const ContactNode& a, const ContactNode& b) {
     return (nodes_.front().x > nodes_.back().x) ? a.x > b.x : a.x < b.x;
   });
   nodes_ = nodes;  // same positions, maybe other ids
-  const Exchange assign = session_.request(assign_request(nodes_), "AssignContact (second run)");
+  const Exchange assign = session_.request(assign_request(nodes_), "AssignContact (" + what + ")");
   if (const std::string problem = expect_acknowledge(assign, "ready"); !problem.empty()) {
-    return "AssignContact (second run): " + problem;
+    return "AssignContact (" + what + "): " + problem;
+  }
+  return "";
+}
+
+/// SetupBody, AssignContact and the partial-contact solve again: the same answer.
+std::string ServerChecks::second_run() {
+  const ContactSolution& first = require_partial_solution();
+  if (const std::string problem = set_up_again(square_body(), "second run"); !problem.empty()) {
+    return problem;
   }
   ContactSolution again;
   if (const std::string problem = solve_partial("ContactSolveRequest (second run)", again);
@@ -834,6 +847,52 @@ std::string ServerChecks::second_run() {
   if (difference > tolerance_ * scale) {
     return "the second run's contact_force differs from the first run's by " + number(difference) +
            " (max lambda " + number(scale) + ")";
+  }
+  return "";
+}
+
+/// The material as robin-coordinator sends every material but isotropic plane strain: the
+/// body set up again with the equivalent `voigt` matrix of its isotropic material (see
+/// with_voigt_material) must give the isotropic definition's partial-contact solution (lambda
+/// relative to max |lambda|, u_N relative to lift) and, when 'correction_linearity' ran, its
+/// correction w(r1) (relative to max |w(r1)|), to the checker's tolerance.
+std::string ServerChecks::voigt_material() {
+  const ContactSolution& isotropic = require_partial_solution();
+  const std::string what = "the equivalent Voigt matrix instead of young_modulus/poisson_ratio";
+  if (const std::string problem = set_up_again(with_voigt_material(square_body()), what);
+      !problem.empty()) {
+    return problem;
+  }
+  const std::string convention =
+      ": the server does not read SetupBody.voigt as the same material (row-major 3x3, Voigt "
+      "order xx, yy, xy, engineering shear strain)";
+  ContactSolution solution;
+  const std::string solve_what = "ContactSolveRequest with g = lift (0.5 + x) (" + what + ")";
+  if (const std::string problem = solve_partial(solve_what, solution); !problem.empty()) {
+    return solve_what + ": " + problem;
+  }
+  const double force_scale = std::max(isotropic.contact_force.cwiseAbs().maxCoeff(), 1e-300);
+  const double force_difference =
+      (solution.contact_force - isotropic.contact_force).cwiseAbs().maxCoeff();
+  const double trace_difference =
+      (solution.normal_trace - isotropic.normal_trace).cwiseAbs().maxCoeff();
+  if (force_difference > tolerance_ * force_scale || trace_difference > tolerance_ * lift) {
+    return solve_what + ": contact_force differs from the isotropic definition's by up to " +
+           number(force_difference) + " (max lambda " + number(force_scale) +
+           ") and normal_trace by up to " + number(trace_difference) + convention;
+  }
+  if (first_force_.size() == 0) return "";  // 'correction_linearity' failed: nothing to compare
+  Eigen::VectorXd response;
+  const std::string correction_what = "CorrectionRequest with r (" + what + ")";
+  if (const std::string problem = correction(first_force_, correction_what, response);
+      !problem.empty()) {
+    return problem;
+  }
+  const double scale = std::max(first_response_.cwiseAbs().maxCoeff(), 1e-300);
+  const double difference = (response - first_response_).cwiseAbs().maxCoeff();
+  if (difference > tolerance_ * scale) {
+    return correction_what + ": normal_trace differs from the isotropic definition's w(r) by " +
+           "up to " + number(difference) + " (max |w(r)| " + number(scale) + ")" + convention;
   }
   return "";
 }

@@ -29,6 +29,11 @@
 // is no deviation (the check 'neumann_solve_capability' passes with a note); the request must
 // then be refused as UNSUPPORTED.
 //
+// Materials: robin-coordinator sends every material that is not isotropic plane strain as the
+// 3x3 SetupBody.voigt matrix. 'voigt_material' sets the body up again with the Voigt matrix
+// equivalent to its isotropic material; the partial-contact solve and the correction w(r1) must
+// equal those of the isotropic definition to the tolerance.
+//
 // Runs (protocol 1.2, Envelope.run_id): 'other_run_refused' sets the body up and assigns it with
 // run_id A, then a ContactSolveRequest and an EndRun with run_id B must each be refused as
 // WRONG_STATE with Error.state 'ready', after which a ContactSolveRequest with run_id A and one
@@ -38,7 +43,9 @@
 // Deadlines: every request has reply_timeout_seconds. A request that gets no reply fails its
 // check; the checker then opens a new connection and sends a Hello. When that is not answered
 // either, the server is considered unresponsive and every remaining check fails at once as
-// "not checked", so a silent server costs about two timeouts, never a hang.
+// "not checked", so a silent server costs about two timeouts, never a hang. A server that
+// refuses the connection (e.g. its CurveZMQ allow-list does not hold this client's key) fails
+// the first check at once with the reason, and every further check as "not checked".
 //
 // The oversized-message rule: a Hello of oversized_message_bytes bytes (its client_name padded)
 // must either be answered (its HelloReply or any Error carrying the request id) or be dropped

@@ -203,7 +203,8 @@ Exchange Session::send_raw(const std::vector<std::string>& frames, const std::st
                            std::optional<std::uint64_t> expected_id) {
   Exchange exchange;
   std::unique_ptr<ProbeConnection>& connection = transport_->connection;
-  if (!connection)
+  if (!connection && !admission_checked_) exchange.problem = admission_problem();
+  if (!connection && exchange.problem.empty())
     exchange.problem = transport_->connect(endpoint_, connection, transport_->immediate);
   const Deadline deadline = Deadline::after(options_.reply_timeout_seconds);
   if (exchange.problem.empty()) exchange.problem = connection->send(frames, deadline);
@@ -242,7 +243,28 @@ void Session::run(const std::string& name, const std::function<std::string()>& c
     spoiled_ = true;
   }
   record(name, problem);
+  if (refused_ && unresponsive_.empty()) {
+    unresponsive_ = "the connection was refused (see check '" + name + "')";
+    spoiled_ = false;
+    reconnect();
+  }
   if (spoiled_) recover(name);
+}
+
+std::string Session::admission_problem() {
+  admission_checked_ = true;
+  const Deadline deadline = Deadline::after(options_.reply_timeout_seconds);
+  try {
+    ChannelOptions channel_options;
+    channel_options.curve = options_.curve;
+    RequestChannel channel(endpoint_, channel_options);
+    Envelope hello = hello_request();
+    channel.send(hello, deadline);  // returns once the handshake succeeded and Hello is queued
+    return "";
+  } catch (const ChannelFailure& failure) {
+    refused_ = Clock::now() < deadline.at;  // not a timeout: a handshake failure or bad endpoint
+    return failure.what();
+  }
 }
 
 void Session::record(const std::string& name, const std::string& problem) {

@@ -8,6 +8,14 @@
 // stamps our version and a request id on every request and discards replies with another id:
 // the checker must send malformed requests and see every reply as it is.
 //
+// Admission: before its first connection, the session sends a Hello through a RequestChannel
+// (the reply is not awaited), whose socket monitor reports a refused security handshake at
+// once (the server's ZAP handler refusing this client's CURVE key, mismatched mechanisms, the
+// wrong server key; see request_channel.hpp). A failure before the deadline fails the first
+// check with RequestChannel's explanation and every further check at once as "not checked": the
+// server does not admit this client. A send that times out fails that check like any request
+// without a reply (the recovery Hello then decides whether the server is unresponsive).
+//
 // Deadlines: every request has ConformanceOptions::reply_timeout_seconds. After a request
 // without a reply (or one that could not be sent) the connection is replaced, so that a late
 // reply is never taken for the next request's, and a Hello must be answered on the new one;
@@ -108,6 +116,9 @@ class Session {
  private:
   struct Transport;
   void recover(const std::string& after_check);
+  /// The admission Hello described above: "" when it could be sent, otherwise why not
+  /// (setting refused_ when that was known before the deadline).
+  std::string admission_problem();
   std::string reply_rule_problems(const std::vector<std::string>& problems) const;
 
   std::string endpoint_;
@@ -116,6 +127,8 @@ class Session {
   std::unique_ptr<Transport> transport_;
   std::uint64_t next_id_ = 1;
   bool spoiled_ = false;
+  bool admission_checked_ = false;
+  bool refused_ = false;      // the server (or ZeroMQ) refused the connection: nothing can run
   std::string unresponsive_;  // why every further check is not run
   int reply_count_ = 0;
   std::vector<std::string> id_problems_;

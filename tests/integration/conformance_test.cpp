@@ -244,6 +244,7 @@ TEST_F(ConformanceTest, ReferenceServerPassesEveryCheck) {
                            "fields_structure",
                            "end_run",
                            "second_run",
+                           "voigt_material",
                            "oversized_message",
                            "request_id_echoed",
                            "version_on_every_reply",
@@ -507,6 +508,30 @@ Deviation dropped_run_ids() {
              "expected Error{WRONG_STATE}", "ContactSolveResult"}}}};
 }
 
+Deviation tensor_shear_voigt() {
+  // The server reads SetupBody.voigt with tensor shear strain (C_33 = 2 G): another material.
+  return {"TensorShearVoigt",
+          [](Envelope& request) {
+            if (!request.has_setup_body() || request.setup_body().voigt_size() != 9) return;
+            request.mutable_setup_body()->set_voigt(8, 2.0 * request.setup_body().voigt(8));
+          },
+          {},
+          {{"voigt_material",
+            {"equivalent Voigt matrix", "isotropic definition's",
+             "does not read SetupBody.voigt as the same material"}}}};
+}
+
+Deviation isotropic_only_material() {
+  // The server understands only young_modulus/poisson_ratio: a Voigt material is no material.
+  return {"IsotropicOnlyMaterial",
+          [](Envelope& request) {
+            if (request.has_setup_body()) request.mutable_setup_body()->clear_voigt();
+          },
+          {},
+          {{"voigt_material",
+            {"SetupBody (the equivalent Voigt matrix", "expected InterfaceDescription"}}}};
+}
+
 Deviation no_fields_reactions() {
   return {"NoReactionResultant",
           {},
@@ -521,7 +546,8 @@ INSTANTIATE_TEST_SUITE_P(Conformance, DeviationTest,
                                            shifted_correction(), negated_neumann_force(),
                                            neumann_without_loads(), wrong_request_ids(),
                                            errors_without_version(), no_fields_reactions(),
-                                           dropped_run_ids()),
+                                           dropped_run_ids(), tensor_shear_voigt(),
+                                           isotropic_only_material()),
                          [](const auto& info) { return info.param.name; });
 
 // --- Shutdown (only with include_shutdown) ------------------------------------------------------

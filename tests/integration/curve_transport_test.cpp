@@ -10,12 +10,15 @@
 //    CURVE against a server without it, fails the handshake with a message that says so;
 //  - robin-run --curve writes the in-process run's contact.csv (to 1e-12), its servers log
 //    CurveZMQ, and the keys it made for the run are removed;
-//  - the conformance checker (--check-server) with the client keys passes a CURVE server;
+//  - the conformance checker (--check-server) with the client keys passes a CURVE server; with
+//    a key that is not on the allow-list it says at once that authentication was refused and
+//    runs no further check (exit 1, no deadline);
 //  - deploy/remote-servers.sh passes --server-arguments to its servers and the coordinator's
 //    CURVE options through: the run is admitted and writes the in-process contact.csv.
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -351,6 +354,30 @@ TEST(CurveTransport, ConformanceCheckerSpeaksCurve) {
                work.path(), 120.0);
   EXPECT_EQ(outcome.exit, "exited with status 0") << outcome.output << outcome.errors;
   EXPECT_NE(outcome.output.find("the server conforms"), std::string::npos) << outcome.output;
+
+  const auto start = std::chrono::steady_clock::now();
+  const testing::ProcessOutcome refused =
+      run_tool("robin-coordinator",
+               {"--check-server", server.endpoint(), "--timeout", "30", "--curve-secret-key",
+                keys.file("stranger.secret").string(), "--curve-server-key",
+                keys.file("server1.public").string()},
+               work.path(), 60.0);
+  EXPECT_LT(testing::seconds_since(start), 10.0);  // not one 30 s deadline
+  EXPECT_EQ(refused.exit, "exited with status 1") << refused.output << refused.errors;
+  EXPECT_NE(refused.output.find("FAIL hello: Hello: authentication refused by the server"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_NE(
+      refused.output.find(keys.pair("stranger").public_key + " is not on the server's allow-list"),
+      std::string::npos)
+      << refused.output;
+  EXPECT_NE(refused.output.find("FAIL setup_body: not checked: the connection was refused (see "
+                                "check 'hello')"),
+            std::string::npos)
+      << refused.output;
+  expect_not_a_deadline(refused.output);
+  EXPECT_NE(refused.output.find("does not conform"), std::string::npos) << refused.output;
+  EXPECT_EQ(server.failure(), "");  // still running
 }
 
 TEST(CurveTransport, RemoteServersScriptPassesTheCurveOptions) {
