@@ -7,6 +7,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "coupling/case_file_body.hpp"
 #include "numerics/errors.hpp"
 
 namespace robin {
@@ -16,13 +17,6 @@ std::string format_point(const Eigen::Vector2d& point) {
   std::ostringstream stream;
   stream.precision(10);
   stream << "(" << point.x() << ", " << point.y() << ")";
-  return stream.str();
-}
-
-std::string format_length(double length) {
-  std::ostringstream stream;
-  stream.precision(6);
-  stream << length;
   return stream.str();
 }
 
@@ -125,7 +119,7 @@ ExcludedPairClearance excluded_pair_clearance(const ContactPairing& pairing,
     clearance.relative_penetration = penetration / scale;
     clearance.description = pairing.excluded[k] +
                             ": the prescribed displacements drive the bodies into each other by " +
-                            format_length(penetration) +
+                            format_number(penetration) +
                             " there (an excluded pair is not a contact constraint; do not "
                             "prescribe the normal displacement of contact nodes)";
   }
@@ -171,7 +165,7 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
     if (j < 0 || partner_of_second[j] >= 0) {
       throw InputError(
           "contact pairing: " + describe_node(name1, body1.node_tags[i], point) +
-          " has no matching node on body '" + name2 + "' within " + format_length(tolerance) +
+          " has no matching node on body '" + name2 + "' within " + format_number(tolerance) +
           " (non-matching contact meshes are not supported: mesh both contact boundaries with "
           "the same nodes)");
     }

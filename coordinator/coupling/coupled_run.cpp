@@ -132,15 +132,14 @@ nlohmann::json residuals_json(const IterationRecord& record) {
 /// complete state has no force imbalance and no correction by construction, and carries the
 /// estimated error of its contact force instead.
 nlohmann::json final_residuals_json(const RobinResult& iteration) {
-  const IterationRecord& last = iteration.history.back();
-  if (iteration.completed_by_sequence == 0) return residuals_json(last);
-  const SequenceResiduals& accepted = last.sequences[iteration.completed_by_sequence - 1];
-  return {{"obstacle_change", accepted.obstacle_change},
-          {"penetration", accepted.penetration},
+  const SequenceResiduals* accepted = iteration.accepted_sequence();
+  if (accepted == nullptr) return residuals_json(iteration.history.back());
+  return {{"obstacle_change", accepted->obstacle_change},
+          {"penetration", accepted->penetration},
           {"force_balance", 0.0},
-          {"complementarity", accepted.complementarity},
+          {"complementarity", accepted->complementarity},
           {"correction", 0.0},
-          {"force_error_estimate", accepted.force_error}};
+          {"force_error_estimate", accepted->force_error}};
 }
 
 nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunResult& result) {

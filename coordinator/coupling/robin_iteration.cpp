@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "coupling/case_file_body.hpp"
 #include "coupling/coupling_scheme.hpp"
 #include "coupling/monolithic_solver.hpp"
 
@@ -18,12 +19,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_between(Clock::time_point start, Clock::time_point end) {
   return std::chrono::duration<double>(end - start).count();
-}
-
-std::string format_tolerance(double tolerance) {
-  std::ostringstream text;
-  text << tolerance;  // 1e-08, not std::to_string's 0.000000
-  return text.str();
 }
 
 double maximum_absolute(const Eigen::VectorXd& values) {
@@ -274,11 +269,15 @@ double IterationRecord::progress(bool either_sequence) const {
   return value;
 }
 
+const SequenceResiduals* RobinResult::accepted_sequence() const {
+  if (history.empty() || completed_by_sequence == 0) return nullptr;
+  return &history.back().sequences[completed_by_sequence - 1];
+}
+
 double RobinResult::final_largest_residual() const {
   if (history.empty()) return 0.0;
-  if (completed_by_sequence > 0)
-    return history.back().sequences[completed_by_sequence - 1].largest();
-  return history.back().largest();
+  const SequenceResiduals* accepted = accepted_sequence();
+  return accepted != nullptr ? accepted->largest() : history.back().largest();
 }
 
 std::string to_string(IterationStatus status) {
@@ -345,7 +344,7 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   result.status = IterationStatus::max_iterations;
   result.message = "the iteration limit of " + std::to_string(options.max_iterations) +
                    " iterations was reached before the tolerance " +
-                   format_tolerance(options.tolerance);
+                   format_number(options.tolerance);
   for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
     const auto iteration_start = Clock::now();
     const CouplingEvaluation evaluation = scheme->evaluate(iterate, iteration);

@@ -85,6 +85,9 @@ struct RobinResult {
   /// above hold that state (both contact forces equal, corrections zero) and its residuals are
   /// history.back().sequences[completed_by_sequence - 1], not those of the joint state.
   int completed_by_sequence = 0;
+  /// The residuals of the accepted complete state, or null when the joint state was accepted
+  /// (or the run stopped otherwise).
+  const SequenceResiduals* accepted_sequence() const;
   /// The largest scaled residual of the state in the fields above: that of the accepted
   /// complete state, or of the last joint state.
   double final_largest_residual() const;
