@@ -4,9 +4,10 @@
 
 namespace robin::protocol {
 
-inline constexpr unsigned protocol_major = 1;
-/// 1.1 adds NeumannSolveRequest (optional, capability "neumann_solve"); 1.2 adds
-/// Envelope.run_id (a server refuses the requests of another run than its body's).
-inline constexpr unsigned protocol_minor = 2;
+inline constexpr unsigned protocol_major = 2;
+/// 2.0: meshes as data (no scripts from the wire), the general constraint operator B in
+/// AssignContact, contact surfaces in InterfaceDescription. Within 1.x, 1.1 added
+/// NeumannSolveRequest and 1.2 Envelope.run_id.
+inline constexpr unsigned protocol_minor = 0;
 
 }  // namespace robin::protocol

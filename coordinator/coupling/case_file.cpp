@@ -261,13 +261,10 @@ CaseDefinition read_case_file(const std::filesystem::path& path) {
   return definition;
 }
 
-BodyDefinition load_body(const BodyCase& body) {
-  BodyDefinition definition = body.definition;
-  try {
-    definition.mesh = read_gmsh_mesh(body.mesh_path, body.mesh_options);
-  } catch (const InputError& error) {
-    throw InputError(body.context + ": mesh: " + error.what());
-  }
+namespace {
+
+/// Checks every boundary name of `body` against its loaded mesh.
+void check_boundary_names(const BodyCase& body, const BodyDefinition& definition) {
   const std::vector<BoundaryReference> references =
       body.boundary_references.empty() ? references_of(definition) : body.boundary_references;
   for (const BoundaryReference& reference : references) {
@@ -279,7 +276,49 @@ BodyDefinition load_body(const BodyCase& body) {
                      "' is not a physical curve of mesh '" + body.mesh_path.string() +
                      "' (available: " + join_boundary_names(definition.mesh) + ")");
   }
+}
+
+/// The InputError of a mesh reader, with the context of the body whose file it names.
+InputError mesh_error(const std::vector<BodyCase*>& bodies, const InputError& error) {
+  const std::string message = error.what();
+  for (const BodyCase* body : bodies) {
+    if (message.find(body->mesh_path.string()) != std::string::npos) {
+      return InputError(body->context + ": mesh: " + message);
+    }
+  }
+  return error;
+}
+
+}  // namespace
+
+BodyDefinition load_body(const BodyCase& body) {
+  BodyDefinition definition = body.definition;
+  try {
+    definition.mesh = read_gmsh_mesh(body.mesh_path, body.mesh_options);
+  } catch (const InputError& error) {
+    throw InputError(body.context + ": mesh: " + error.what());
+  }
+  check_boundary_names(body, definition);
   return definition;
+}
+
+void load_meshes(CaseDefinition& definition) {
+  std::vector<BodyCase*> bodies;
+  std::vector<MeshFileRequest> requests;
+  for (BodyCase& body : definition.bodies) {
+    bodies.push_back(&body);
+    requests.push_back({body.mesh_path, body.mesh_options});
+  }
+  std::vector<Mesh> meshes;
+  try {
+    meshes = read_gmsh_meshes(requests);
+  } catch (const InputError& error) {
+    throw mesh_error(bodies, error);
+  }
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    bodies[k]->definition.mesh = std::move(meshes[k]);
+    check_boundary_names(*bodies[k], bodies[k]->definition);
+  }
 }
 
 std::string in_case_file(const std::filesystem::path& case_file, const std::string& message) {

@@ -24,7 +24,7 @@ struct BoundaryReference {
   std::string location;  // "case.toml:31" (file:line of the value)
 };
 
-/// One body as written in the case file. `definition.mesh` is empty until load_body.
+/// One body as written in the case file. `definition.mesh` is empty until load_meshes.
 struct BodyCase {
   BodyDefinition definition;
   std::filesystem::path mesh_path;  // absolute (resolved against the case file's directory)
@@ -101,5 +101,9 @@ CaseDefinition read_case_file(const std::filesystem::path& path);
 /// definition. Throws InputError naming the case file, body, field and mesh file and listing
 /// the mesh's boundary names; a mesh reader error is rethrown with `context` prepended.
 BodyDefinition load_body(const BodyCase& body);
+
+/// Reads every body's mesh into its definition at once (read_gmsh_meshes: each .geo meshed in a
+/// process of its own, concurrently) and checks every boundary name, as load_body does.
+void load_meshes(CaseDefinition& definition);
 
 }  // namespace robin

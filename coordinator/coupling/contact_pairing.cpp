@@ -126,14 +126,17 @@ ExcludedPairClearance excluded_pair_clearance(const ContactPairing& pairing,
   return clearance;
 }
 
-ContactAssignment ContactPairing::assignment(int body_index) const {
-  ContactAssignment assignment;
+ContactOperator ContactPairing::assignment(int body_index) const {
   const double sign = body_index == 0 ? 1.0 : -1.0;
+  std::vector<int> nodes;
+  std::vector<Eigen::Vector2d> normals;
+  std::vector<double> weights;
   for (const ContactPair& pair : pairs) {
-    assignment.node_ids.push_back(body_index == 0 ? pair.node1 : pair.node2);
-    assignment.normals.push_back(sign * pair.normal);
+    nodes.push_back(body_index == 0 ? pair.node1 : pair.node2);
+    normals.push_back(sign * pair.normal);
+    weights.push_back(pair.weight);
   }
-  return assignment;
+  return node_to_node_operator(nodes, normals, weights);
 }
 
 Eigen::VectorXd ContactPairing::gaps() const {

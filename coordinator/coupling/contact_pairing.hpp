@@ -37,8 +37,9 @@ struct ContactPairing {
   std::vector<ContactPair> excluded_pairs;  // the same pairs, in the same order
 
   std::size_t size() const { return pairs.size(); }
-  /// The assignment for body 0 (normals n1) or body 1 (normals -n1).
-  ContactAssignment assignment(int body_index) const;
+  /// The node-to-node constraint operator of body 0 (rows n1 at node1) or body 1 (rows -n1 at
+  /// node2), weights m_i.
+  ContactOperator assignment(int body_index) const;
   Eigen::VectorXd gaps() const;
   Eigen::VectorXd weights() const;
 };

@@ -212,9 +212,12 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   const auto start = Clock::now();
   CoupledRunResult result;
   result.options = options;
-  report_stage(observer, "setting up both bodies (mesh, assembly, factorization)");
+  report_stage(observer, "reading and meshing both bodies");
+  CaseDefinition loaded = definition;
+  load_meshes(loaded);
+  report_stage(observer, "setting up both bodies (assembly, factorization)");
   result.interfaces = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
-    return port.setup(definition.bodies[alpha], definition.solver);
+    return port.setup(loaded.bodies[alpha], definition.solver);
   });
   const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
   result.pairing = pair_contact_nodes(result.interfaces[0], definition.bodies[0].definition.name,

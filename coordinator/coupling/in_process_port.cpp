@@ -12,14 +12,17 @@ BodySolver& InProcessPort::body() {
 InterfaceDescription InProcessPort::setup(const BodyCase& body_case, const SolverOptions& solver) {
   name_ = body_case.definition.name;
   qp_ = solver.qp;
-  body_ = std::make_unique<BodySolver>(load_body(body_case), solver.body);
+  if (body_case.definition.mesh.node_count() == 0) {
+    throw PortError(describe() + ": body '" + name_ + "' has no mesh (load_meshes first)");
+  }
+  body_ = std::make_unique<BodySolver>(body_case.definition, solver.body);
   timings_.compute_seconds +=
       body_->timings().assembly_seconds + body_->timings().factorization_seconds;
   return body_->contact_boundary();
 }
 
-void InProcessPort::assign_contact(const ContactAssignment& assignment) {
-  body().assign_contact(assignment);
+void InProcessPort::assign_contact(const ContactOperator& contact) {
+  body().assign_contact(contact);
 }
 
 void InProcessPort::start_contact_solve(const Eigen::VectorXd& obstacle, int /*iteration*/) {

@@ -13,7 +13,7 @@ class InProcessPort final : public SubdomainPort {
   InProcessPort() = default;
   std::string describe() const override { return "in-process body '" + name_ + "'"; }
   InterfaceDescription setup(const BodyCase& body, const SolverOptions& solver) override;
-  void assign_contact(const ContactAssignment& assignment) override;
+  void assign_contact(const ContactOperator& contact) override;
   void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) override;
   ContactSolveResult finish_contact_solve() override;
   void start_correction(const Eigen::VectorXd& interface_force, int iteration) override;

@@ -14,12 +14,13 @@ LocalProblem prepare_local_problem(const CaseDefinition& definition) {
   LocalProblem problem;
   problem.definition = definition;
   problem.gap = make_gap_function(definition);
+  const auto start = std::chrono::steady_clock::now();
+  CaseDefinition loaded = definition;
+  load_meshes(loaded);
+  problem.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (int alpha = 0; alpha < 2; ++alpha) {
-    const auto start = std::chrono::steady_clock::now();
-    BodyDefinition body = load_body(definition.bodies[alpha]);
-    problem.mesh_seconds +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    problem.bodies[alpha] = std::make_unique<BodySolver>(std::move(body), definition.solver.body);
+    problem.bodies[alpha] = std::make_unique<BodySolver>(std::move(loaded.bodies[alpha].definition),
+                                                         definition.solver.body);
   }
   const BodySolver& body1 = *problem.bodies[0];
   const BodySolver& body2 = *problem.bodies[1];

@@ -42,9 +42,11 @@ class SubdomainPort {
   virtual ~SubdomainPort() = default;
   /// "server tcp://host:port" or "in-process", for messages.
   virtual std::string describe() const = 0;
-  /// Sends the body; returns its contact boundary. Throws PortError.
+  /// Sends the body, whose mesh is loaded (load_meshes); returns its contact boundary. Throws
+  /// PortError.
   virtual InterfaceDescription setup(const BodyCase& body, const SolverOptions& solver) = 0;
-  virtual void assign_contact(const ContactAssignment& assignment) = 0;
+  /// Sends the body's contact constraint operator B. Throws PortError.
+  virtual void assign_contact(const ContactOperator& contact) = 0;
   virtual void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) = 0;
   virtual ContactSolveResult finish_contact_solve() = 0;
   virtual void start_correction(const Eigen::VectorXd& interface_force, int iteration) = 0;

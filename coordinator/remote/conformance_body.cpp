@@ -1,5 +1,8 @@
 #include "remote/conformance_body.hpp"
 
+#include "mesh_codec.hpp"
+#include "numerics/rectangle_mesher.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -13,25 +16,7 @@ using protocol::Envelope;
 
 namespace {
 
-constexpr const char* square_geo = R"(// robin-coordinator --check-server: the unit square [0, 1]^2.
-DefineConstant[ h = 0.25 ];
-Point(1) = {0, 0, 0, h};
-Point(2) = {1, 0, 0, h};
-Point(3) = {1, 1, 0, h};
-Point(4) = {0, 1, 0, h};
-Line(1) = {1, 2};
-Line(2) = {2, 3};
-Line(3) = {3, 4};
-Line(4) = {4, 1};
-Curve Loop(1) = {1, 2, 3, 4};
-Plane Surface(1) = {1};
-Physical Curve("bottom") = {1};
-Physical Curve("right") = {2};
-Physical Curve("top") = {3};
-Physical Curve("left") = {4};
-Physical Surface("square") = {1};
-)";
-constexpr double mesh_size = 0.25;
+constexpr int cells_per_side = 4;  // h = 0.25
 constexpr double poisson_ratio = 0.3;
 
 Eigen::VectorXd to_vector(const google::protobuf::RepeatedField<double>& values) {
@@ -113,10 +98,10 @@ double partial_obstacle(double x) {
 protocol::SetupBody square_body() {
   protocol::SetupBody body;
   body.set_body_name(body_name);
-  body.set_mesh_content(square_geo);
-  body.set_mesh_extension(".geo");
-  body.set_mesh_size(mesh_size);
-  body.set_element_order(1);
+  Mesh square = make_rectangle_mesh(0.0, 0.0, 1.0, 1.0, cells_per_side, cells_per_side,
+                                    ElementType::triangle3);
+  square.source = "robin-coordinator --check-server: the unit square";
+  *body.mutable_mesh() = encode_mesh(square);
   body.set_model(protocol::PLANE_STRAIN);
   body.set_young_modulus(young_modulus);
   body.set_poisson_ratio(poisson_ratio);
@@ -124,7 +109,7 @@ protocol::SetupBody square_body() {
   support.set_boundary("bottom");
   support.set_x(0.0);
   support.set_y(lift);
-  body.set_contact_boundary("top");
+  body.add_contact_boundaries("top");
   body.mutable_solver()->set_qp_tolerance(1e-12);
   return body;
 }
@@ -160,10 +145,17 @@ Envelope setup_request(const protocol::SetupBody& body) {
 Envelope assign_request(const std::vector<ContactNode>& nodes, double normal_length) {
   Envelope envelope;
   protocol::AssignContact& assign = *envelope.mutable_assign_contact();
+  assign.add_row_offsets(0);
   for (const ContactNode& node : nodes) {
+    // One row per node: (B u)_i = u(node) . (0, normal_length), the top edge's outward normal.
     assign.add_node_ids(node.id);
-    assign.add_normals(0.0);  // the outward normal of the top edge, (0, 1)
-    assign.add_normals(normal_length);
+    assign.add_components(0);
+    assign.add_values(0.0);
+    assign.add_node_ids(node.id);
+    assign.add_components(1);
+    assign.add_values(normal_length);
+    assign.add_row_offsets(static_cast<std::uint64_t>(assign.values_size()));
+    assign.add_weights(1.0);
   }
   return envelope;
 }
@@ -229,8 +221,7 @@ std::string interface_size_problems(const protocol::InterfaceDescription& descri
   expect_size("coordinates", description.coordinates_size(), 2 * count);
   expect_size("normals", description.normals_size(), 2 * count);
   expect_size("weights", description.weights_size(), count);
-  expect_size("x_fixed", description.x_fixed_size(), count);
-  expect_size("y_fixed", description.y_fixed_size(), count);
+  expect_size("fixed", description.fixed_size(), 2 * count);
   if (count < 2) {
     problems.push_back(std::to_string(count) +
                        " node_ids for the contact boundary 'top', expected at least its two "
@@ -267,7 +258,7 @@ std::vector<std::string> interface_node_problems(const protocol::InterfaceDescri
     if (!(description.weights(i) > 0.0)) {
       problems.push_back(node + " has weight " + number(description.weights(i)) + ", expected > 0");
     }
-    if (description.x_fixed(i) || description.y_fixed(i)) {
+    if (description.fixed(2 * i) || description.fixed(2 * i + 1)) {
       problems.push_back(node + " is flagged fixed, but no Dirichlet condition reaches the top");
     }
   }

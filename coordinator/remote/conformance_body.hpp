@@ -2,8 +2,8 @@
 // The conformance checker's built-in body, the requests about it and the judgement of the
 // replies (internal to robin_remote; see conformance_check.hpp).
 //
-// The body: the unit square [0, 1]^2 (a .geo script sent as mesh_content, h = 0.25, linear
-// triangles), isotropic plane strain (E = 1000, nu = 0.3), its bottom edge prescribed to
+// The body: the unit square [0, 1]^2 (sent as MeshData: a structured mesh of 4 x 4 squares,
+// each split into two linear triangles), isotropic plane strain (E = 1000, nu = 0.3), its bottom edge prescribed to
 // u = (0, lift), no load, its top edge y = 1 the contact boundary with outward normal (0, 1).
 // Without contact it translates rigidly: u = (0, lift) everywhere, no stress, so the free
 // normal trace is e_i = lift at every contact node. On this mesh F = B K^-1 B' is
@@ -52,7 +52,8 @@ struct ContactNode {
 };
 
 protocol::Envelope setup_request(const protocol::SetupBody& body);
-/// AssignContact of `nodes` in that (pair) order, each with the normal (0, normal_length).
+/// AssignContact of one node-to-node row per node of `nodes`, in that (constraint) order, each
+/// with the normal (0, normal_length) and weight 1.
 protocol::Envelope assign_request(const std::vector<ContactNode>& nodes,
                                   double normal_length = 1.0);
 protocol::Envelope contact_solve_request(const Eigen::VectorXd& obstacle, unsigned iteration = 1);

@@ -323,7 +323,8 @@ void ServerChecks::run_setup_checks() {
   };
   session_.run("setup_unknown_boundary", [bad_setup, bad_input] {
     protocol::SetupBody body = square_body();
-    body.set_contact_boundary("no_such_curve");
+    body.clear_contact_boundaries();
+    body.add_contact_boundaries("no_such_curve");
     return bad_setup(body, "the unknown contact boundary 'no_such_curve'", bad_input);
   });
   session_.run("setup_poisson_ratio_half", [bad_setup, bad_input] {
@@ -394,18 +395,30 @@ void ServerChecks::run_assignment_checks() {
     nodes.front().id = unknown;
     return invalid(assign_request(nodes), "the unknown node id " + std::to_string(unknown));
   });
-  session_.run("assign_wrong_normal_count", [this, invalid] {
+  session_.run("assign_wrong_entry_count", [this, invalid] {
     Envelope request = assign_request(require_interface());
-    request.mutable_assign_contact()->mutable_normals()->RemoveLast();
-    return invalid(request, "2n - 1 normal values for n nodes");
+    request.mutable_assign_contact()->mutable_values()->RemoveLast();
+    return invalid(request, "one value fewer than node_ids and components");
   });
-  session_.run("assign_non_unit_normals", [this, invalid] {
-    return invalid(assign_request(require_interface(), 1.5), "normals of length 1.5");
+  session_.run("assign_bad_row_offsets", [this, invalid] {
+    Envelope request = assign_request(require_interface());
+    request.mutable_assign_contact()->set_row_offsets(1, 0);
+    return invalid(request, "an empty first row (row_offsets 0, 0, ...)");
   });
-  session_.run("assign_repeated_node", [this, invalid] {
-    std::vector<ContactNode> nodes = require_interface();
-    nodes[1].id = nodes[0].id;
-    return invalid(assign_request(nodes), "a node id given twice");
+  session_.run("assign_non_positive_weight", [this, invalid] {
+    Envelope request = assign_request(require_interface());
+    request.mutable_assign_contact()->set_weights(0, 0.0);
+    return invalid(request, "the weight 0 for the first constraint");
+  });
+  session_.run("assign_non_finite_value", [this, invalid] {
+    Envelope request = assign_request(require_interface());
+    request.mutable_assign_contact()->set_values(1, std::numeric_limits<double>::quiet_NaN());
+    return invalid(request, "a NaN coefficient");
+  });
+  session_.run("assign_repeated_entry", [this, invalid] {
+    Envelope request = assign_request(require_interface());
+    request.mutable_assign_contact()->set_components(0, 1);  // row 0 names (node, y) twice
+    return invalid(request, "a row that names the same node and component twice");
   });
   session_.run("assign_contact", [this] { return assign_contact(); });
   session_.run("hello_reports_state", [this] {

@@ -166,7 +166,7 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   run_id_ = new_run_id();  // a new run: this port's requests carry it from now on
   if (server_name_.empty()) handshake();
   Envelope request;
-  *request.mutable_setup_body() = encode_setup_body(body, solver);
+  *request.mutable_setup_body() = encode_setup_body(body.definition, body.context, solver);
   const Envelope reply =
       exchange(request, "setup", options_.setup_timeout_seconds, Envelope::kInterface);
   timings_.compute_seconds += reply.interface().setup_seconds();
@@ -180,11 +180,11 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   }
 }
 
-void RemotePort::assign_contact(const ContactAssignment& assignment) {
+void RemotePort::assign_contact(const ContactOperator& contact) {
   Envelope request;
-  *request.mutable_assign_contact() = encode_contact_assignment(assignment);
+  *request.mutable_assign_contact() = encode_contact_operator(contact);
   exchange(request, "contact assignment", options_.request_timeout_seconds, Envelope::kAcknowledge);
-  contact_size_ = static_cast<long>(assignment.node_ids.size());
+  contact_size_ = contact.row_count();
 }
 
 void RemotePort::start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) {

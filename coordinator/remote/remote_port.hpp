@@ -62,7 +62,7 @@ class RemotePort final : public SubdomainPort {
 
   std::string describe() const override;
   InterfaceDescription setup(const BodyCase& body, const SolverOptions& solver) override;
-  void assign_contact(const ContactAssignment& assignment) override;
+  void assign_contact(const ContactOperator& contact) override;
   void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) override;
   ContactSolveResult finish_contact_solve() override;
   void start_correction(const Eigen::VectorXd& interface_force, int iteration) override;

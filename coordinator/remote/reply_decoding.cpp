@@ -125,14 +125,41 @@ ElementType element_type_of_vtk_cell(unsigned cell_type) {
   }
 }
 
+/// The segments of the one contact surface (positions into node_ids, checked in range).
+void decode_surface(const protocol::InterfaceDescription& message, InterfaceDescription& interface) {
+  if (message.surfaces_size() != 1) {
+    throw MalformedReply("surfaces has " + std::to_string(message.surfaces_size()) +
+                         " entries, expected one (the body's contact boundary)");
+  }
+  const protocol::ContactSurface& surface = message.surfaces(0);
+  const int nodes_per_segment = surface.segment_type() == protocol::LINE3 ? 3 : 2;
+  if (surface.segment_type() != protocol::LINE2 && surface.segment_type() != protocol::LINE3) {
+    throw MalformedReply("surfaces[0].segment_type is not LINE2 or LINE3");
+  }
+  if (surface.segments_size() % nodes_per_segment != 0) {
+    throw MalformedReply("surfaces[0].segments has " + std::to_string(surface.segments_size()) +
+                         " entries, not a multiple of " + std::to_string(nodes_per_segment));
+  }
+  for (const std::uint32_t position : surface.segments()) {
+    if (position >= static_cast<std::uint32_t>(message.node_ids_size())) {
+      throw MalformedReply("surfaces[0].segments names position " + std::to_string(position) +
+                           ", beyond the " + std::to_string(message.node_ids_size()) + " nodes");
+    }
+  }
+  interface.segment_type = nodes_per_segment == 3 ? EdgeType::line3 : EdgeType::line2;
+  interface.segments.assign(surface.segments().begin(), surface.segments().end());
+}
+
 InterfaceDescription decode_interface(const protocol::InterfaceDescription& message) {
   const long count = message.node_ids_size();
+  if (message.dimension() != 2) {
+    throw MalformedReply("dimension is " + std::to_string(message.dimension()) + ", expected 2");
+  }
   expect_size(message.node_tags(), count, "node_tags");
   expect_size(message.coordinates(), 2 * count, "coordinates");
   expect_size(message.normals(), 2 * count, "normals");
   expect_size(message.weights(), count, "weights");
-  expect_size(message.x_fixed(), count, "x_fixed");
-  expect_size(message.y_fixed(), count, "y_fixed");
+  expect_size(message.fixed(), 2 * count, "fixed");
   expect_finite(message.coordinates(), "coordinates");
   expect_finite(message.normals(), "normals");
   expect_finite(message.weights(), "weights");
@@ -142,8 +169,11 @@ InterfaceDescription decode_interface(const protocol::InterfaceDescription& mess
   interface.coordinates = to_points(message.coordinates());
   interface.normals = to_points(message.normals());
   interface.weights.assign(message.weights().begin(), message.weights().end());
-  interface.x_fixed.assign(message.x_fixed().begin(), message.x_fixed().end());
-  interface.y_fixed.assign(message.y_fixed().begin(), message.y_fixed().end());
+  for (long i = 0; i < count; ++i) {
+    interface.x_fixed.push_back(message.fixed(static_cast<int>(2 * i)));
+    interface.y_fixed.push_back(message.fixed(static_cast<int>(2 * i + 1)));
+  }
+  decode_surface(message, interface);
   interface.dof_count = static_cast<int>(message.dof_count());
   return interface;
 }

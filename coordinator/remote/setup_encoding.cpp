@@ -3,34 +3,14 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <optional>
 
+#include "mesh_codec.hpp"
 #include "numerics/errors.hpp"
 
 namespace robin {
 
 namespace {
-
-std::string lowercase(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
-}
-
-std::string read_file_bytes(const BodyCase& body) {
-  std::ifstream stream(body.mesh_path, std::ios::binary);
-  if (!stream.is_open()) {
-    throw InputError(body.context + ": cannot open mesh file '" + body.mesh_path.string() +
-                     "' to send it to the server");
-  }
-  std::string content((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
-  if (stream.bad()) {
-    throw InputError(body.context + ": cannot read mesh file '" + body.mesh_path.string() + "'");
-  }
-  return content;
-}
 
 /// Young's modulus E for which make_isotropic_material(E, nu, plane strain) yields `stiffness`
 /// exactly, searched a few ulps around the closed form E = C_00 (1 + nu)(1 - 2 nu) / (1 - nu);
@@ -101,7 +81,7 @@ void encode_material(const Material& material, const std::string& context,
     if (!young) {
       throw InputError(context +
                        ": material: an out-of-plane stress factor with a non-isotropic "
-                       "stiffness cannot be sent in protocol 1 (give young and poisson)");
+                       "stiffness cannot be sent in the protocol (give young and poisson)");
     }
     message.set_young_modulus(*young);
     message.set_poisson_ratio(nu);
@@ -112,18 +92,14 @@ void encode_material(const Material& material, const std::string& context,
   }
 }
 
-protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions& solver) {
-  const BodyDefinition& definition = body.definition;
+protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
+                                      const SolverOptions& solver) {
   protocol::SetupBody message;
   message.set_body_name(definition.name);
-  message.set_mesh_content(read_file_bytes(body));
-  message.set_mesh_extension(lowercase(body.mesh_path.extension().string()));
-  message.set_mesh_size(body.mesh_options.size);
-  message.set_element_order(static_cast<std::uint32_t>(body.mesh_options.element_order));
-  message.set_recombine(body.mesh_options.recombine);
+  *message.mutable_mesh() = encode_mesh(definition.mesh);
   message.set_model(definition.material.model == PlaneModel::plane_strain ? protocol::PLANE_STRAIN
                                                                           : protocol::PLANE_STRESS);
-  encode_material(definition.material, body.context, message);
+  encode_material(definition.material, context, message);
   message.add_body_force(definition.body_force.x());
   message.add_body_force(definition.body_force.y());
   for (const DirichletCondition& condition : definition.dirichlet) {
@@ -132,18 +108,18 @@ protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions&
   for (const TractionCondition& condition : definition.tractions) {
     encode_traction(condition, *message.add_traction());
   }
-  message.set_contact_boundary(definition.contact_boundary);
+  message.add_contact_boundaries(definition.contact_boundary);
   encode_solver(solver, *message.mutable_solver());
   return message;
 }
 
-protocol::AssignContact encode_contact_assignment(const ContactAssignment& assignment) {
+protocol::AssignContact encode_contact_operator(const ContactOperator& contact) {
   protocol::AssignContact message;
-  for (int node : assignment.node_ids) message.add_node_ids(node);
-  for (const Eigen::Vector2d& normal : assignment.normals) {
-    message.add_normals(normal.x());
-    message.add_normals(normal.y());
-  }
+  message.mutable_row_offsets()->Assign(contact.row_offsets.begin(), contact.row_offsets.end());
+  message.mutable_node_ids()->Assign(contact.nodes.begin(), contact.nodes.end());
+  message.mutable_components()->Assign(contact.components.begin(), contact.components.end());
+  message.mutable_values()->Assign(contact.values.begin(), contact.values.end());
+  message.mutable_weights()->Assign(contact.weights.begin(), contact.weights.end());
   return message;
 }
 

@@ -10,12 +10,12 @@
 
 namespace robin {
 
-/// The SetupBody request for `body`: the mesh file's bytes (mesh_content, with its extension,
-/// so that the server needs no access to the coordinator's files) and .geo options, the plane
-/// model, the material (see encode_material), body force, Dirichlet conditions, tractions,
-/// contact boundary and the body solver settings of `solver`.
-/// Throws InputError naming the body and the mesh file when the file cannot be read.
-protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions& solver);
+/// The SetupBody request for `definition` (its mesh loaded): the mesh as MeshData (the server
+/// needs no access to the coordinator's files and runs no script), the plane model, the
+/// material (see encode_material), body force, Dirichlet conditions, tractions, the contact
+/// boundary and the body solver settings of `solver`. `context` names the body for errors.
+protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
+                                      const SolverOptions& solver);
 
 /// Writes `material` into `message` exactly (the server rebuilds the same Material bit for bit):
 ///  - an isotropic plane-strain material (the only kind with out_of_plane_poisson != 0) is sent
@@ -29,7 +29,7 @@ protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions&
 void encode_material(const Material& material, const std::string& context,
                      protocol::SetupBody& message);
 
-/// The AssignContact request: node ids and unit normals in pair order.
-protocol::AssignContact encode_contact_assignment(const ContactAssignment& assignment);
+/// The AssignContact request: the constraint operator B in compressed rows.
+protocol::AssignContact encode_contact_operator(const ContactOperator& contact);
 
 }  // namespace robin

@@ -2,6 +2,9 @@
 
 #include <stdexcept>
 
+#include <unistd.h>
+#include <cstdlib>
+
 #include "numerics/elasticity.hpp"
 
 namespace robin {
@@ -11,13 +14,14 @@ std::vector<double> to_values(const double* data, Eigen::Index size) {
   return std::vector<double>(data, data + size);
 }
 
-/// lambda_i / m_i at the contact nodes (force per unit length), zero elsewhere.
+/// |(B' lambda) at node k| / m_k at the nodes of the contact boundary (force per unit length),
+/// zero elsewhere; m_k is the node's boundary weight. For node-to-node rows this is lambda_i / m_i.
 std::vector<double> nodal_contact_pressure(const BodySolver& body,
-                                           const Eigen::VectorXd& contact_force) {
+                                           const Eigen::VectorXd& contact_force_field) {
   std::vector<double> pressure(body.mesh().node_count(), 0.0);
-  for (int i = 0; i < body.contact_size(); ++i) {
-    const double weight = body.contact_weights()[i];
-    if (weight > 0) pressure[body.contact_nodes()[i]] = contact_force[i] / weight;
+  for (std::size_t node = 0; node < pressure.size(); ++node) {
+    const double weight = body.boundary_weights()[static_cast<Eigen::Index>(node)];
+    if (weight > 0) pressure[node] = contact_force_field.segment<2>(2 * node).norm() / weight;
   }
   return pressure;
 }
@@ -36,7 +40,7 @@ BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& conta
   if (contact_force.size() != body.contact_size()) {
     throw std::invalid_argument("body '" + body.name() + "': " +
                                 std::to_string(contact_force.size()) + " contact forces for " +
-                                std::to_string(body.contact_size()) + " contact nodes");
+                                std::to_string(body.contact_size()) + " contact constraints");
   }
   const Eigen::VectorXd displacement = body.displacement(contact_force);
   const StressField stress = recover_stress(body.mesh(), body.definition().material, displacement);
@@ -52,7 +56,7 @@ BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& conta
       {"stress", 3, to_values(stress.nodal_stress.data(), stress.nodal_stress.size()),
        stress_components},
       {"von_mises", 1, to_values(stress.nodal_von_mises.data(), stress.nodal_von_mises.size())},
-      {"contact_pressure", 1, nodal_contact_pressure(body, contact_force)},
+      {"contact_pressure", 1, nodal_contact_pressure(body, force_field)},
       {"contact_force", 2, to_values(force_field.data(), force_field.size())},
       {"reaction", 2, to_values(reaction.data(), reaction.size())}};
   output.cell_fields = {
@@ -72,7 +76,23 @@ std::string write_body_output(const std::filesystem::path& directory, const Body
                              "': body name '" + output.body_name + "' is not usable as a file name");
   }
   std::filesystem::create_directories(directory);
-  write_vtu(directory / file_name, output.mesh, output.point_fields, output.cell_fields);
+  // A fresh temporary file (mkstemp: O_EXCL, so never through an existing link), renamed into
+  // place: a symbolic link at the target is replaced, not followed, and a reader never sees a
+  // half-written file.
+  std::string temporary = (directory / ("." + file_name + ".XXXXXX")).string();
+  const int descriptor = mkstemp(temporary.data());
+  if (descriptor < 0) {
+    throw std::runtime_error("cannot create a temporary file in '" + directory.string() + "'");
+  }
+  close(descriptor);
+  try {
+    write_vtu(temporary, output.mesh, output.point_fields, output.cell_fields);
+    std::filesystem::rename(temporary, directory / file_name);
+  } catch (...) {
+    std::error_code error;
+    std::filesystem::remove(temporary, error);
+    throw;
+  }
   return file_name;
 }
 

@@ -14,7 +14,8 @@ struct BodyOutput {
   std::string body_name;
   Mesh mesh;
   /// displacement (2), stress (3: xx, yy, xy; nodal average), von_mises, contact_pressure
-  /// (lambda_i / m_i at contact nodes, 0 elsewhere), contact_force (2: -lambda_i n_i), reaction (2)
+  /// (|B' lambda| / m_k at contact boundary nodes, 0 elsewhere), contact_force (2: -B' lambda),
+  /// reaction (2)
   std::vector<OutputField> point_fields;
   /// stress (3, at element centroids), von_mises
   std::vector<OutputField> cell_fields;
@@ -22,7 +23,7 @@ struct BodyOutput {
   Eigen::Vector2d applied_force = Eigen::Vector2d::Zero();       // body forces + tractions
 };
 
-/// Fields of `body` under contact forces lambda (pair order of its assignment).
+/// Fields of `body` under contact forces lambda (constraint order of its assignment).
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force);
 
 /// Writes <directory>/<body_name>.vtu; returns the file name.

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "numerics/errors.hpp"
+#include "numerics/finite_element.hpp"
 
 namespace robin {
 namespace {
@@ -95,6 +96,28 @@ Eigen::VectorXd assemble_external_load(const BodyDefinition& body) {
   return load;
 }
 
+/// The edges of `group` as positions into `nodes` (sorted), each with the body on its left.
+std::vector<int> oriented_segments(const Mesh& mesh, const BoundaryGroup& group,
+                                   const std::vector<int>& nodes) {
+  const NodeElementMap adjacency(mesh);
+  const int count = nodes_per_edge(group.type);
+  std::vector<int> segments;
+  for (std::size_t e = 0; e < group.edge_count(); ++e) {
+    // Without adjacency the normal is the tangent turned clockwise (body on the left).
+    const Eigen::Vector2d left = EdgeGeometry(mesh, group, e).evaluate(0.0).outward_normal;
+    const Eigen::Vector2d outward =
+        EdgeGeometry(mesh, group, e, adjacency).evaluate(0.0).outward_normal;
+    const std::size_t first = segments.size();
+    for (int i = 0; i < count; ++i) {
+      const int node = group.connectivity[e * count + i];
+      segments.push_back(static_cast<int>(
+          std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
+    }
+    if (left.dot(outward) < 0.0) std::swap(segments[first], segments[first + 1]);
+  }
+  return segments;
+}
+
 }  // namespace
 
 BodySolver::BodySolver(BodyDefinition definition, BodySolverOptions options)
@@ -125,6 +148,7 @@ void BodySolver::assemble() {
   timings_.assembly_seconds = seconds_since(start);
 
   start = std::chrono::steady_clock::now();
+  boundary_weights_ = robin::boundary_weights(mesh, mesh.boundary(definition_.contact_boundary));
   factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name(), trailing_unknowns());
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
   timings_.factorization_seconds = seconds_since(start);
@@ -149,7 +173,7 @@ InterfaceDescription BodySolver::contact_boundary() const {
   interface.dof_count = dofs_->free_count();
   interface.node_ids = group.nodes();
   interface.normals = boundary_node_normals(mesh, group);
-  const Eigen::VectorXd weights = boundary_weights(mesh, group);
+  const Eigen::VectorXd& weights = boundary_weights_;
   for (int node : interface.node_ids) {
     interface.node_tags.push_back(mesh.node_tags[node]);
     interface.coordinates.push_back(mesh.nodes[node]);
@@ -157,48 +181,31 @@ InterfaceDescription BodySolver::contact_boundary() const {
     interface.x_fixed.push_back(dofs_->is_prescribed(2 * node));
     interface.y_fixed.push_back(dofs_->is_prescribed(2 * node + 1));
   }
+  interface.segment_type = group.type;
+  interface.segments = oriented_segments(mesh, group, interface.node_ids);
   return interface;
 }
 
-void BodySolver::assign_contact(const ContactAssignment& assignment) {
+void BodySolver::assign_contact(const ContactOperator& contact) {
   const auto start = std::chrono::steady_clock::now();
-  const Mesh& mesh = definition_.mesh;
-  const BoundaryGroup& group = mesh.boundary(definition_.contact_boundary);
-  const std::vector<int> boundary_nodes = group.nodes();
-  const Eigen::VectorXd weights = boundary_weights(mesh, group);
-  if (assignment.node_ids.size() != assignment.normals.size()) {
-    throw InputError("body '" + name() + "': contact assignment has " +
-                     std::to_string(assignment.node_ids.size()) + " nodes but " +
-                     std::to_string(assignment.normals.size()) + " normals");
-  }
-  const int contact_count = static_cast<int>(assignment.node_ids.size());
+  const std::vector<int> boundary_nodes =
+      definition_.mesh.boundary(definition_.contact_boundary).nodes();
+  check_contact_operator(contact, boundary_nodes, "body '" + name() + "'");
+  const int row_count = contact.row_count();
   std::vector<Eigen::Triplet<double>> triplets;
-  prescribed_trace_ = Eigen::VectorXd::Zero(contact_count);
-  contact_weights_ = Eigen::VectorXd::Zero(contact_count);
-  for (int i = 0; i < contact_count; ++i) {
-    const int node = assignment.node_ids[i];
-    const Eigen::Vector2d& normal = assignment.normals[i];
-    if (!std::binary_search(boundary_nodes.begin(), boundary_nodes.end(), node)) {
-      throw InputError("body '" + name() + "': contact node " + std::to_string(node) +
-                       " is not on the contact boundary '" + definition_.contact_boundary + "'");
-    }
-    if (!std::isfinite(normal.norm()) || std::abs(normal.norm() - 1.0) > 1e-8) {
-      throw InputError("body '" + name() + "': the normal of contact node " +
-                       std::to_string(node) + " is not a unit vector");
-    }
-    contact_weights_[i] = weights[node];
-    for (int component = 0; component < 2; ++component) {
-      const int dof = 2 * node + component;
+  prescribed_trace_ = Eigen::VectorXd::Zero(row_count);
+  for (int row = 0; row < row_count; ++row) {
+    for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
+      const int dof = 2 * contact.nodes[k] + contact.components[k];
       if (dofs_->is_prescribed(dof)) {
-        prescribed_trace_[i] += normal[component] * dofs_->prescribed_values()[dof];
+        prescribed_trace_[row] += contact.values[k] * dofs_->prescribed_values()[dof];
       } else {
-        triplets.emplace_back(i, dofs_->free_index(dof), normal[component]);
+        triplets.emplace_back(row, dofs_->free_index(dof), contact.values[k]);
       }
     }
   }
-  contact_nodes_ = assignment.node_ids;
-  contact_normals_ = assignment.normals;
-  trace_.resize(contact_count, dofs_->free_count());
+  contact_ = contact;
+  trace_.resize(row_count, dofs_->free_count());
   trace_.setFromTriplets(triplets.begin(), triplets.end());
   free_trace_ = trace_ * free_solution_ + prescribed_trace_;  // e = B K^{-1} f + B u_p
   build_interface_operator();
@@ -304,8 +311,11 @@ Eigen::Vector2d BodySolver::applied_force() const {
 
 Eigen::VectorXd BodySolver::contact_force_field(const Eigen::VectorXd& contact_force) const {
   Eigen::VectorXd field = Eigen::VectorXd::Zero(dofs_->total_count());
-  for (int i = 0; i < contact_size(); ++i) {
-    field.segment<2>(2 * contact_nodes_[i]) -= contact_force[i] * contact_normals_[i];
+  for (int row = 0; row < contact_size(); ++row) {
+    for (std::size_t k = contact_.row_offsets[row]; k < contact_.row_offsets[row + 1]; ++k) {
+      field[2 * contact_.nodes[k] + contact_.components[k]] -=
+          contact_.values[k] * contact_force[row];
+    }
   }
   return field;
 }

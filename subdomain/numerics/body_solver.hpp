@@ -3,12 +3,12 @@
 // factor computed once, and the operators of the dual (contact-force) formulation on the
 // contact nodes assigned to it.
 //
-// With B the normal-trace operator on the assigned contact nodes ((B u)_i = u(node_i).n_i,
-// n_i the normal assigned to node i), K the stiffness on free dofs and f the reduced load:
+// With B the contact constraint operator assigned to the body (numerics/contact_operator.hpp;
+// node-to-node: (B u)_i = u(node_i).n_i), K the stiffness on free dofs and f the reduced load:
 //   e = B K^{-1} f + B u_p          free normal trace (no contact force)
 //   F = B K^{-1} B'                 interface compliance (Neumann-to-Dirichlet map)
 //   u_N = e - F lambda              normal trace under nodal contact forces lambda
-// where lambda_i >= 0 is the compressive nodal normal force, K u = f - B' lambda.
+// where lambda_j >= 0 is the compressive contact force of constraint j, K u = f - B' lambda.
 //
 // Local contact problem (paper (10)): minimise 1/2 u'Ku - f'u subject to B u <= g, solved
 // in its dual form  minimise 1/2 lambda'F lambda - lambda'(e - g), lambda >= 0, by MPRGP.
@@ -21,6 +21,7 @@
 
 #include "numerics/body_definition.hpp"
 #include "numerics/cholesky.hpp"
+#include "numerics/contact_operator.hpp"
 #include "numerics/dof_map.hpp"
 #include "numerics/elasticity.hpp"
 #include "numerics/linear_operator.hpp"
@@ -37,13 +38,12 @@ struct InterfaceDescription {
   std::vector<double> weights;               // m_i = int_{contact boundary} phi_i ds (length)
   std::vector<bool> x_fixed;                 // u_x prescribed by a Dirichlet condition
   std::vector<bool> y_fixed;                 // u_y prescribed by a Dirichlet condition
+  /// The contact boundary's segments as positions into node_ids, nodes_per_edge(segment_type)
+  /// per segment (endpoints, then the midpoint), each oriented with the body on its left: the
+  /// outward normal is the direction from the first to the second endpoint turned clockwise.
+  EdgeType segment_type = EdgeType::line2;
+  std::vector<int> segments;
   int dof_count = 0;                         // free degrees of freedom of the body
-};
-
-/// The contact nodes the body must use, in pair order, with the normal to use for each.
-struct ContactAssignment {
-  std::vector<int> node_ids;
-  std::vector<Eigen::Vector2d> normals;  // unit; body 2 gets n2 = -n1
 };
 
 enum class InterfaceOperatorKind {
@@ -102,12 +102,13 @@ class BodySolver {
   /// The nodes of the contact boundary with geometric normals and weights.
   InterfaceDescription contact_boundary() const;
 
-  /// Sets the contact nodes and normals (pair order) and builds e and F. Resets the warm start.
-  /// Throws InputError if a node id is not on the contact boundary or a normal is not unit.
-  void assign_contact(const ContactAssignment& assignment);
-  int contact_size() const { return static_cast<int>(contact_nodes_.size()); }
-  const std::vector<int>& contact_nodes() const { return contact_nodes_; }
-  const std::vector<Eigen::Vector2d>& contact_normals() const { return contact_normals_; }
+  /// Sets the contact constraint operator B and builds e and F. Resets the warm start.
+  /// Throws InputError (check_contact_operator) when B is malformed or uses a node that is not
+  /// on the contact boundary.
+  void assign_contact(const ContactOperator& contact);
+  /// The number of constraints (rows of B).
+  int contact_size() const { return contact_.row_count(); }
+  const ContactOperator& contact_operator() const { return contact_; }
 
   /// e = B K^{-1} f + B u_p.
   const Eigen::VectorXd& free_trace() const { return free_trace_; }
@@ -133,10 +134,11 @@ class BodySolver {
   Eigen::VectorXd reactions(const Eigen::VectorXd& displacement) const;
   /// Total applied external force (body force + tractions), (F_x, F_y).
   Eigen::Vector2d applied_force() const;
-  /// Contact force field as nodal vectors: -lambda_i n_i at node i (force acting on this body).
+  /// Contact force field as nodal vectors, full size: -B' lambda (force acting on this body).
   Eigen::VectorXd contact_force_field(const Eigen::VectorXd& contact_force) const;
-  /// Boundary weight m_i of each assigned contact node.
-  const Eigen::VectorXd& contact_weights() const { return contact_weights_; }
+  /// Boundary weight of every mesh node on the contact boundary (zero elsewhere): the integral
+  /// of its shape function over the contact boundary (length).
+  const Eigen::VectorXd& boundary_weights() const { return boundary_weights_; }
 
  private:
   void assemble();
@@ -155,9 +157,8 @@ class BodySolver {
   std::unique_ptr<CholeskyFactor> factor_;
   Eigen::VectorXd free_solution_;  // K^{-1} f (free dofs)
 
-  std::vector<int> contact_nodes_;
-  std::vector<Eigen::Vector2d> contact_normals_;
-  Eigen::VectorXd contact_weights_;
+  ContactOperator contact_;
+  Eigen::VectorXd boundary_weights_;
   SparseMatrix trace_;  // B on free dofs (n_c x free)
   Eigen::VectorXd prescribed_trace_;  // B u_p
   Eigen::VectorXd free_trace_;

@@ -17,6 +17,10 @@
 #include <system_error>
 #include <unordered_map>
 
+#include <sys/wait.h>
+#include <unistd.h>
+#include <optional>
+
 #include "numerics/errors.hpp"
 
 namespace robin {
@@ -118,9 +122,16 @@ std::string gmsh_element_name(int gmsh_type) {
   return name + " (Gmsh type " + std::to_string(gmsh_type) + ")";
 }
 
+/// Area elements of one type: Gmsh node tags, and each element's tag and surface entity.
+struct GmshAreaBlock {
+  std::vector<std::size_t> node_tags;
+  std::vector<std::size_t> element_tags;
+  std::vector<int> surfaces;
+};
+
 /// Area elements and boundary edges with Gmsh node tags, before compaction.
 struct GmshElements {
-  std::map<ElementType, std::vector<std::size_t>> areas;
+  std::map<ElementType, GmshAreaBlock> areas;
   std::map<std::string, std::pair<EdgeType, std::vector<std::size_t>>> edges;
 };
 
@@ -159,8 +170,11 @@ void read_area_elements(const ErrorSource& source, GmshElements& elements) {
         throw source.error("unsupported 2D element " + gmsh_element_name(types[k]) +
                            "; use 3-node or 6-node triangles or 4-node quadrilaterals");
       }
-      std::vector<std::size_t>& block = elements.areas[type];
-      block.insert(block.end(), node_tags[k].begin(), node_tags[k].end());
+      GmshAreaBlock& block = elements.areas[type];
+      block.node_tags.insert(block.node_tags.end(), node_tags[k].begin(), node_tags[k].end());
+      block.element_tags.insert(block.element_tags.end(), element_tags[k].begin(),
+                                element_tags[k].end());
+      block.surfaces.insert(block.surfaces.end(), element_tags[k].size(), surface);
     }
   }
   if (elements.areas.empty()) {
@@ -201,7 +215,9 @@ void read_boundary_edges(const ErrorSource& source, GmshElements& elements) {
 /// Node tag -> compact index, for the nodes used by elements or edges, in ascending tag order.
 std::unordered_map<std::size_t, int> compact_nodes(const GmshElements& elements) {
   std::vector<std::size_t> used;
-  for (const auto& [type, tags] : elements.areas) used.insert(used.end(), tags.begin(), tags.end());
+  for (const auto& [type, area] : elements.areas) {
+    used.insert(used.end(), area.node_tags.begin(), area.node_tags.end());
+  }
   for (const auto& [name, edges] : elements.edges) {
     used.insert(used.end(), edges.second.begin(), edges.second.end());
   }
@@ -257,23 +273,36 @@ double twice_signed_area(const Mesh& mesh, ElementType type, const int* nodes) {
   return sum;
 }
 
-/// Reorders the nodes of clockwise elements so that every element is counter-clockwise.
-void orient_counter_clockwise(const ErrorSource& source, Mesh& mesh, ElementBlock& block) {
+/// Orients every element counter-clockwise, surface by surface: Gmsh meshes each surface
+/// consistently, so the sign of the surface's total signed area gives its orientation, and a
+/// clockwise surface has every element reversed. An element whose sign differs from its
+/// surface's is inverted (a folded or tangled mesh) and refused, naming its tag.
+void orient_counter_clockwise(const ErrorSource& source, Mesh& mesh, ElementBlock& block,
+                              const std::vector<int>& surfaces) {
   // Clockwise -> counter-clockwise: reverse the corner order (triangle6 midpoints follow).
   static const std::map<ElementType, std::vector<int>> reversed = {
       {ElementType::triangle3, {0, 2, 1}},
       {ElementType::triangle6, {0, 2, 1, 5, 4, 3}},
       {ElementType::quadrilateral4, {0, 3, 2, 1}}};
   const int count = nodes_per_element(block.type);
+  std::map<int, double> surface_area;
+  for (std::size_t e = 0; e < block.element_count(); ++e) {
+    surface_area[surfaces[e]] += twice_signed_area(mesh, block.type, &block.connectivity[e * count]);
+  }
   const std::vector<int>& order = reversed.at(block.type);
   for (std::size_t e = 0; e < block.element_count(); ++e) {
     int* nodes = &block.connectivity[e * count];
     const double area = twice_signed_area(mesh, block.type, nodes);
-    if (area == 0.0) {
-      throw source.error("a " + to_string(block.type) + " element at node " +
-                         std::to_string(mesh.node_tags[nodes[0]]) + " has zero area");
+    const double orientation = surface_area[surfaces[e]] < 0.0 ? -1.0 : 1.0;
+    if (area * orientation <= 0.0) {
+      throw source.error(block.element_label(e) + " (" + to_string(block.type) + " at node tag " +
+                         std::to_string(mesh.node_tags[nodes[0]]) + ") " +
+                         (area == 0.0 ? "has zero area"
+                                      : "is inverted against the other elements of surface " +
+                                            std::to_string(surfaces[e]) +
+                                            " (a folded or tangled mesh)"));
     }
-    if (area > 0.0) continue;
+    if (orientation > 0.0) continue;
     const std::vector<int> original(nodes, nodes + count);
     for (int i = 0; i < count; ++i) nodes[i] = original[order[i]];
   }
@@ -293,9 +322,9 @@ Mesh extract_mesh(const ErrorSource& source) {
   const std::unordered_map<std::size_t, int> index = compact_nodes(elements);
   Mesh mesh;
   fill_nodes(source, index, mesh);
-  for (const auto& [type, tags] : elements.areas) {
-    ElementBlock block{type, to_indices(tags, index)};
-    orient_counter_clockwise(source, mesh, block);
+  for (const auto& [type, area] : elements.areas) {
+    ElementBlock block{type, to_indices(area.node_tags, index), area.element_tags};
+    orient_counter_clockwise(source, mesh, block, area.surfaces);
     mesh.blocks.push_back(std::move(block));
   }
   for (const auto& [name, edges] : elements.edges) {
@@ -320,10 +349,9 @@ std::string lower_extension(const std::filesystem::path& path) {
   return extension;
 }
 
-/// Reads (and, for a .geo, meshes) `path`; `after_open` runs once Gmsh has read the file, before
-/// the meshing, which no longer needs it.
+/// Reads (and, for a .geo, meshes) `path`.
 Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source,
-                    const MeshReadOptions& options, const std::function<void()>& after_open = {}) {
+                    const MeshReadOptions& options) {
   check_options(source, options);
   const std::string extension = lower_extension(path);
   if (extension != ".msh" && extension != ".geo") {
@@ -336,7 +364,6 @@ Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source
   const std::lock_guard<std::mutex> lock(gmsh_mutex());
   const GmshSession session(options.size);
   call_gmsh(source, "reading", [&] { gmsh::open(path.string()); });
-  if (after_open) after_open();
   if (extension == ".geo") {
     call_gmsh(source, "meshing", [&] {
       gmsh::option::setNumber("Mesh.ElementOrder", options.element_order);
@@ -349,72 +376,103 @@ Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source
   return mesh;
 }
 
-/// The directory std::filesystem::temp_directory_path() consults (libstdc++): the first set of
-/// TMPDIR, TMP, TEMP, TEMPDIR, else /tmp. Names the directory when that call fails.
-std::filesystem::path configured_temporary_directory() {
-  for (const char* variable : {"TMPDIR", "TMP", "TEMP", "TEMPDIR"}) {
-    if (const char* value = std::getenv(variable); value != nullptr && *value != '\0') {
-      return value;
-    }
+/// Meshes the .geo `geo` in this (child) process and writes the mesh to `output` as binary
+/// MSH 4.1 with every element, so that reading `output` gives the mesh that reading `geo`
+/// gives. Throws InputError like read_mesh_file.
+void mesh_to_file(const std::filesystem::path& geo, const MeshReadOptions& options,
+                  const std::filesystem::path& output) {
+  const ErrorSource source{"", "mesh file '" + geo.string() + "'"};
+  check_options(source, options);
+  const GmshSession session(options.size);
+  call_gmsh(source, "reading", [&] { gmsh::open(geo.string()); });
+  call_gmsh(source, "meshing", [&] {
+    gmsh::option::setNumber("Mesh.ElementOrder", options.element_order);
+    if (options.recombine) gmsh::option::setNumber("Mesh.RecombineAll", 1);
+    gmsh::model::mesh::generate(2);
+  });
+  call_gmsh(source, "writing the mesh", [&] {
+    gmsh::option::setNumber("Mesh.Binary", 1);
+    gmsh::option::setNumber("Mesh.SaveAll", 1);
+    gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+    gmsh::write(output.string());
+  });
+}
+
+/// A .geo being meshed by a child process: its pid, the pipe that carries its error message
+/// and the file it writes.
+struct MeshingChild {
+  pid_t pid = -1;
+  int error_pipe = -1;
+  std::filesystem::path output;
+};
+
+MeshingChild start_meshing_child(const MeshFileRequest& request,
+                                 const std::filesystem::path& output) {
+  int pipe_ends[2];
+  if (pipe(pipe_ends) != 0) throw std::runtime_error("cannot create a pipe for meshing");
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(pipe_ends[0]);
+    close(pipe_ends[1]);
+    throw std::runtime_error("cannot start a meshing process (fork failed)");
   }
-  return "/tmp";
-}
-
-/// The TemporaryDirectoryError for `directory`, whose `problem` prevented writing the mesh
-/// file of `label`.
-TemporaryDirectoryError unusable_temporary_directory(const std::string& label,
-                                                     const std::filesystem::path& directory,
-                                                     const std::string& problem) {
-  return TemporaryDirectoryError(
-      label + ": cannot write the mesh to a temporary file in '" + directory.string() + "' (" +
-      problem +
-      "): the server's temporary directory (TMPDIR, else /tmp) is not writable or is full; "
-      "give the server process a writable TMPDIR (in a container: a tmpfs or emptyDir volume "
-      "at /tmp)");
-}
-
-/// A file in the temporary directory (TMPDIR, else /tmp) with a unique name holding
-/// `content`, removed on destruction. Throws TemporaryDirectoryError (leaving no file) when
-/// the directory is missing or the file cannot be written whole.
-class TemporaryFile {
- public:
-  TemporaryFile(const std::string& content, const std::string& extension,
-                const std::string& label) {
-    static std::atomic<unsigned long> counter{0};
-    std::filesystem::path directory;
+  if (pid == 0) {
+    close(pipe_ends[0]);
+    std::string message;
     try {
-      directory = std::filesystem::temp_directory_path();
-    } catch (const std::filesystem::filesystem_error& error) {
-      throw unusable_temporary_directory(
-          label, error.path1().empty() ? configured_temporary_directory() : error.path1(),
-          error.code().message());
+      mesh_to_file(request.path, request.options, output);
+      _exit(0);
+    } catch (const std::exception& error) {
+      message = error.what();
+    } catch (...) {
+      message = "mesh file '" + request.path.string() + "': meshing failed";
     }
-    std::random_device random;
-    std::error_code exists_error;
-    do {
-      path_ = directory / ("robin-mesh-" + std::to_string(random()) + "-" +
-                           std::to_string(counter++) + extension);
-    } while (std::filesystem::exists(path_, exists_error));
-    errno = 0;
-    std::ofstream stream(path_, std::ios::binary);
-    stream << content;
-    stream.close();
-    if (!stream) {
-      const std::string problem =
-          errno != 0 ? std::generic_category().message(errno) : "the write failed";
-      std::error_code remove_error;
-      std::filesystem::remove(path_, remove_error);
-      throw unusable_temporary_directory(label, directory, problem);
-    }
+    const ssize_t written = write(pipe_ends[1], message.data(), message.size());
+    _exit(written >= 0 ? 1 : 2);
   }
-  ~TemporaryFile() { remove(); }
-  /// Removes the file now (idempotent): a server stopped during a long meshing leaves nothing.
-  void remove() const noexcept {
+  close(pipe_ends[1]);
+  return {pid, pipe_ends[0], output};
+}
+
+/// Waits for `child`; returns its error message ("" when it succeeded).
+std::string finish_meshing_child(const MeshingChild& child, const MeshFileRequest& request) {
+  std::string message;
+  char buffer[4096];
+  for (ssize_t count; (count = read(child.error_pipe, buffer, sizeof buffer)) != 0;) {
+    if (count < 0 && errno == EINTR) continue;
+    if (count < 0) break;
+    message.append(buffer, static_cast<std::size_t>(count));
+  }
+  close(child.error_pipe);
+  int status = 0;
+  while (waitpid(child.pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
+  if (message.empty()) {
+    message = "mesh file '" + request.path.string() + "': the meshing process " +
+              (WIFSIGNALED(status) ? "was killed by signal " + std::to_string(WTERMSIG(status))
+                                   : "failed");
+  }
+  return message;
+}
+
+/// A private directory for the meshes of the children, removed on destruction.
+class PrivateDirectory {
+ public:
+  PrivateDirectory() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "robin-mesh-XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr) {
+      throw std::runtime_error("cannot create a temporary directory for meshing in '" +
+                               std::filesystem::temp_directory_path().string() + "'");
+    }
+    path_ = pattern;
+  }
+  ~PrivateDirectory() {
     std::error_code error;
-    std::filesystem::remove(path_, error);
+    std::filesystem::remove_all(path_, error);
   }
-  TemporaryFile(const TemporaryFile&) = delete;
-  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  PrivateDirectory(const PrivateDirectory&) = delete;
+  PrivateDirectory& operator=(const PrivateDirectory&) = delete;
   const std::filesystem::path& path() const { return path_; }
 
  private:
@@ -433,18 +491,40 @@ extern "C" const char* __lsan_default_suppressions() {
 
 Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& options) {
   const ErrorSource source{"", "mesh file '" + path.string() + "'"};
-  return read_mesh_file(path, source, options);
+  Mesh mesh = read_mesh_file(path, source, options);
+  mesh.source = path.string();
+  return mesh;
 }
 
-Mesh read_gmsh_mesh_from_text(const std::string& content, const std::string& extension,
-                              const std::string& label, const MeshReadOptions& options) {
-  const std::string lowered = lower_extension("mesh" + extension);
-  if (lowered != ".msh" && lowered != ".geo") {
-    throw InputError(label + ": unsupported mesh extension '" + extension + "': give .msh or .geo");
+std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests) {
+  std::vector<Mesh> meshes(requests.size());
+  std::vector<std::optional<MeshingChild>> children(requests.size());
+  const PrivateDirectory directory;
+  std::string first_error;
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    if (lower_extension(requests[k].path) != ".geo") continue;
+    const ErrorSource source{"", "mesh file '" + requests[k].path.string() + "'"};
+    check_options(source, requests[k].options);
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(requests[k].path, error)) {
+      throw source.error("the file does not exist or is not a regular file");
+    }
+    children[k] =
+        start_meshing_child(requests[k], directory.path() / ("body" + std::to_string(k) + ".msh"));
   }
-  const TemporaryFile file(content, lowered, label);
-  const ErrorSource source{file.path().string(), label};
-  return read_mesh_file(file.path(), source, options, [&file] { file.remove(); });
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    if (!children[k]) continue;
+    const std::string error = finish_meshing_child(*children[k], requests[k]);
+    if (!error.empty() && first_error.empty()) first_error = error;
+  }
+  if (!first_error.empty()) throw InputError(first_error);
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    const std::filesystem::path& path = children[k] ? children[k]->output : requests[k].path;
+    const ErrorSource source{path.string(), "mesh file '" + requests[k].path.string() + "'"};
+    meshes[k] = read_mesh_file(path, source, children[k] ? MeshReadOptions{} : requests[k].options);
+    meshes[k].source = requests[k].path.string();
+  }
+  return meshes;
 }
 
 }  // namespace robin

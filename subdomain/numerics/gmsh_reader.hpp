@@ -9,8 +9,8 @@
 // Node coordinates must lie in the z = 0 plane.
 
 #include <filesystem>
-#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "numerics/mesh.hpp"
 
@@ -26,21 +26,17 @@ struct MeshReadOptions {
 /// parse error, no 2D elements, unsupported element type, no physical groups).
 Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
-/// The process's temporary directory cannot hold the mesh file of
-/// read_gmsh_mesh_from_text: a fault of the environment (TMPDIR, else /tmp, missing,
-/// not writable or full), not of the mesh. The message starts with the label and names
-/// the directory.
-class TemporaryDirectoryError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
+/// One mesh file to read, with its .geo options.
+struct MeshFileRequest {
+  std::filesystem::path path;
+  MeshReadOptions options;
 };
 
-/// Reads a mesh given as the text of a file with extension `extension` (".msh" or
-/// ".geo"); used when a mesh travels inside a protocol message. The text is written to
-/// a file of the temporary directory (TMPDIR, else /tmp) for Gmsh and removed after.
-/// `label` names the source in error messages. Throws InputError for a bad extension
-/// or mesh, TemporaryDirectoryError when the file cannot be written.
-Mesh read_gmsh_mesh_from_text(const std::string& content, const std::string& extension,
-                              const std::string& label, const MeshReadOptions& options = {});
+/// Reads several mesh files at once, each as read_gmsh_mesh reads it. Gmsh holds one model per
+/// process, so each .geo is meshed in a child process of its own, all concurrently; a child
+/// writes its mesh as binary MSH 4.1 into a private temporary directory, which this process
+/// reads (a .msh is read directly). Only the user's own files belong here: a .geo is a program.
+/// Throws InputError naming the file for the first request that fails.
+std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests);
 
 }  // namespace robin

@@ -41,6 +41,11 @@ std::string to_string(ElementType type) {
   throw std::invalid_argument("to_string: unknown element type");
 }
 
+std::string ElementBlock::element_label(std::size_t element) const {
+  if (element < tags.size()) return "element tag " + std::to_string(tags[element]);
+  return "element " + std::to_string(element + 1) + " of the " + to_string(type) + " block";
+}
+
 std::vector<int> BoundaryGroup::nodes() const {
   std::vector<int> distinct = connectivity;
   std::sort(distinct.begin(), distinct.end());

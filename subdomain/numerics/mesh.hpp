@@ -30,6 +30,10 @@ std::string to_string(ElementType type);
 struct ElementBlock {
   ElementType type = ElementType::triangle3;
   std::vector<int> connectivity;
+  /// Each element's tag in the mesh file (for messages); empty when unknown.
+  std::vector<std::size_t> tags;
+  /// "element tag T" (or "element N of the TYPE block", 1-based, when the tags are unknown).
+  std::string element_label(std::size_t element) const;
   std::size_t element_count() const { return connectivity.size() / nodes_per_element(type); }
 };
 
@@ -43,6 +47,7 @@ struct BoundaryGroup {
 };
 
 struct Mesh {
+  std::string source;  // the file the mesh came from, for messages ("" when unknown)
   std::vector<Eigen::Vector2d> nodes;
   std::vector<std::size_t> node_tags;  // original (Gmsh) tag of each node, for output
   std::vector<ElementBlock> blocks;
@@ -56,5 +61,6 @@ struct Mesh {
   /// for messages.
   std::string boundary_label(const BoundaryGroup& group) const;
 };
+
 
 }  // namespace robin

@@ -67,6 +67,18 @@ void add_options(CLI::App& app, CommandLine& command_line) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--name", command_line.server.name, "label for the logs and HelloReply");
+  app.add_option("--data-directory", command_line.server.data_directory,
+                 "the directory under which SetupBody.mesh_path may name mesh files (relative "
+                 "paths; nothing outside it, also through symbolic links); without it every "
+                 "mesh_path is refused and meshes come only as data")
+      ->type_name("DIR")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--output-root", command_line.server.output_root,
+                 "the directory under which FieldsRequest.write_directory may write <body>.vtu "
+                 "(relative paths, no symbolic links followed); without it every "
+                 "write_directory is refused")
+      ->type_name("DIR")
+      ->check(CLI::ExistingDirectory);
   app.add_option("--curve-secret-key", command_line.curve_secret_key,
                  "the server's key pair (a robin-keygen .secret file): encrypts the transport "
                  "with CurveZMQ and admits only the clients of --curve-allow")

@@ -34,18 +34,25 @@ void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
 
 }  // namespace
 
-void encode_interface(const std::string& body_name, const InterfaceDescription& interface,
+void encode_interface(const std::string& body_name, const std::string& contact_boundary,
+                      const InterfaceDescription& interface,
                       protocol::InterfaceDescription& message) {
   message.set_body_name(body_name);
+  message.set_dimension(2);
   for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
     message.add_node_ids(interface.node_ids[i]);
     message.add_node_tags(static_cast<std::int64_t>(interface.node_tags[i]));
     add_vector(interface.coordinates[i], *message.mutable_coordinates());
     add_vector(interface.normals[i], *message.mutable_normals());
     message.add_weights(interface.weights[i]);
-    message.add_x_fixed(interface.x_fixed[i]);
-    message.add_y_fixed(interface.y_fixed[i]);
+    message.add_fixed(interface.x_fixed[i]);
+    message.add_fixed(interface.y_fixed[i]);
   }
+  protocol::ContactSurface& surface = *message.add_surfaces();
+  surface.set_boundary(contact_boundary);
+  surface.set_segment_type(interface.segment_type == EdgeType::line3 ? protocol::LINE3
+                                                                     : protocol::LINE2);
+  surface.mutable_segments()->Assign(interface.segments.begin(), interface.segments.end());
 }
 
 protocol::SolveStatus to_protocol(QpStatus status) {

@@ -13,7 +13,8 @@ namespace robin {
 
 /// The contact boundary as InterfaceDescription: per-node values in the order of
 /// interface.node_ids, interleaved (x, y) vectors.
-void encode_interface(const std::string& body_name, const InterfaceDescription& interface,
+void encode_interface(const std::string& body_name, const std::string& contact_boundary,
+                      const InterfaceDescription& interface,
                       protocol::InterfaceDescription& message);
 
 /// A contact solve result; compute_seconds = result.seconds.

@@ -6,8 +6,11 @@
 #include <limits>
 #include <sstream>
 
+#include "mesh_codec.hpp"
 #include "numerics/errors.hpp"
-#include "numerics/gmsh_script_check.hpp"
+#include "numerics/gmsh_reader.hpp"
+#include "numerics/mesh_validity.hpp"
+#include "server/file_access.hpp"
 
 namespace robin {
 namespace {
@@ -30,6 +33,11 @@ std::string format_value(double value) {
 }
 
 std::string decode_body_name(const std::string& name) {
+  constexpr std::size_t maximum_length = 64;
+  if (name.size() > maximum_length) {
+    throw InputError("SetupBody.body_name has " + std::to_string(name.size()) +
+                     " characters: at most 64 (letters, digits, '_' and '-')");
+  }
   const bool valid = !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
     return std::isalnum(c) != 0 || c == '_' || c == '-';
   });
@@ -40,49 +48,22 @@ std::string decode_body_name(const std::string& name) {
   return name;
 }
 
-MeshReadOptions decode_mesh_options(const protocol::SetupBody& message,
-                                    const std::string& context) {
-  MeshReadOptions options;
-  if (!std::isfinite(message.mesh_size()) || message.mesh_size() < 0.0) {
-    fail(context, "mesh_size", "is " + format_value(message.mesh_size()) + ", expected >= 0");
-  }
-  options.size = message.mesh_size();
-  if (message.element_order() > 2) {
-    fail(context, "element_order",
-         "is " + std::to_string(message.element_order()) + ", expected 1 or 2 (0 means 1)");
-  }
-  options.element_order =
-      message.element_order() == 0 ? 1 : static_cast<int>(message.element_order());
-  options.recombine = message.recombine();
-  return options;
-}
-
-bool is_geo_extension(std::string extension) {
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return extension == ".geo";
-}
-
-/// The mesh from mesh_content (+ mesh_extension) or, when the content is empty, mesh_path.
-/// A reader error is rethrown with the body and field prepended. A .geo script in
-/// mesh_content is meshed only without host-touching commands (gmsh_script_check.hpp); a
-/// mesh_path names a file already on the server, which the server's operator put there.
-Mesh decode_mesh(const protocol::SetupBody& message, const std::string& context) {
-  const MeshReadOptions options = decode_mesh_options(message, context);
-  if (!message.mesh_content().empty()) {
-    if (message.mesh_extension().empty()) {
-      fail(context, "mesh_extension", "is empty: give \".msh\" or \".geo\" with mesh_content");
-    }
-    if (is_geo_extension(message.mesh_extension())) {
-      check_gmsh_script_from_client(message.mesh_content(), context + ": SetupBody.mesh_content");
-    }
-    return read_gmsh_mesh_from_text(message.mesh_content(), message.mesh_extension(),
-                                    context + ": SetupBody.mesh_content", options);
-  }
+/// The mesh from `mesh` (MeshData) or, when absent, `mesh_path` under the data directory. A
+/// reader error is rethrown with the body and field prepended. Nothing received is run: a
+/// MeshData is data, and a mesh_path names a file the server's operator put in the data
+/// directory.
+Mesh decode_body_mesh(const protocol::SetupBody& message, const std::string& context,
+                      const std::filesystem::path& data_directory) {
+  if (message.has_mesh()) return decode_mesh(message.mesh(), context);
   if (message.mesh_path().empty()) {
-    fail(context, "mesh_content", "and SetupBody.mesh_path are both empty: send the mesh");
+    fail(context, "mesh", "and SetupBody.mesh_path are both absent: send the mesh as MeshData");
   }
+  const std::filesystem::path path =
+      resolve_data_file(data_directory, message.mesh_path(), context + ": SetupBody.mesh_path");
   try {
-    return read_gmsh_mesh(message.mesh_path(), options);
+    Mesh mesh = read_gmsh_mesh(path);
+    check_element_validity(mesh, context + ": SetupBody.mesh_path");
+    return mesh;
   } catch (const InputError& error) {
     throw InputError(context + ": SetupBody.mesh_path: " + error.what());
   }
@@ -150,6 +131,7 @@ void check_boundary(const Mesh& mesh, const std::string& name, const std::string
 DirichletCondition decode_dirichlet(const protocol::Dirichlet& message, const Mesh& mesh,
                                     const std::string& context, const std::string& field) {
   check_boundary(mesh, message.boundary(), context, field + ".boundary");
+  if (message.has_z()) fail(context, field + ".z", "is given: a plane problem has no u_z");
   if (!message.has_x() && !message.has_y()) {
     fail(context, field, "prescribes neither x nor y: give at least one");
   }
@@ -217,7 +199,21 @@ void decode_solver(const protocol::SolverSettings& message, const std::string& c
 
 }  // namespace
 
-DecodedSetup decode_setup_body(const protocol::SetupBody& message) {
+/// The one contact boundary robin-subdomain serves (several per body come with many-body
+/// contact; the protocol carries them already).
+std::string decode_contact_boundary(const protocol::SetupBody& message, const Mesh& mesh,
+                                    const std::string& context) {
+  if (message.contact_boundaries_size() != 1) {
+    fail(context, "contact_boundaries",
+         "has " + std::to_string(message.contact_boundaries_size()) +
+             " names: robin-subdomain serves exactly one contact boundary per body");
+  }
+  check_boundary(mesh, message.contact_boundaries(0), context, "contact_boundaries[0]");
+  return message.contact_boundaries(0);
+}
+
+DecodedSetup decode_setup_body(const protocol::SetupBody& message,
+                               const std::filesystem::path& data_directory) {
   DecodedSetup setup;
   BodyDefinition& definition = setup.definition;
   definition.name = decode_body_name(message.body_name());
@@ -227,9 +223,8 @@ DecodedSetup decode_setup_body(const protocol::SetupBody& message) {
     definition.body_force = decode_vector(message.body_force(), context, "body_force");
   }
   decode_solver(message.solver(), context, setup);
-  definition.mesh = decode_mesh(message, context);
-  check_boundary(definition.mesh, message.contact_boundary(), context, "contact_boundary");
-  definition.contact_boundary = message.contact_boundary();
+  definition.mesh = decode_body_mesh(message, context, data_directory);
+  definition.contact_boundary = decode_contact_boundary(message, definition.mesh, context);
   for (int k = 0; k < message.dirichlet_size(); ++k) {
     definition.dirichlet.push_back(decode_dirichlet(message.dirichlet(k), definition.mesh, context,
                                                     "dirichlet[" + std::to_string(k) + "]"));

@@ -2,9 +2,10 @@
 // Decoding of a SetupBody request (proto/robin.proto) into the numerics' body definition and
 // solver settings. Part of the server's protocol module: the generated types stop here.
 
+#include <filesystem>
+
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
-#include "numerics/gmsh_reader.hpp"
 #include "numerics/mprgp.hpp"
 #include "robin.pb.h"
 
@@ -17,13 +18,14 @@ struct DecodedSetup {
   BodySolverOptions body;
 };
 
-/// Decodes and checks `message`: body name ([A-Za-z0-9_-]+), mesh (mesh_content with
-/// mesh_extension ".msh"/".geo", or mesh_path; .geo options), plane model (must be given),
-/// material (young_modulus/poisson_ratio, or 9 `voigt` values, not both), body force (0 or 2
-/// values), Dirichlet (at least one of x/y) and traction conditions, the contact boundary, and
-/// the solver settings (0 or empty = server default). Every boundary name is checked against
-/// the mesh. Throws InputError naming the body and the field, e.g.
-///   "body 'upper': SetupBody.voigt has 4 values, expected 9".
-DecodedSetup decode_setup_body(const protocol::SetupBody& message);
+/// Decodes and checks `message`: body name ([A-Za-z0-9_-]+, at most 64), mesh (MeshData,
+/// checked by decode_mesh; or mesh_path, a file under `data_directory`, refused when that is
+/// empty), plane model (must be given), material (young_modulus/poisson_ratio, or 9 `voigt`
+/// values, not both), body force (0 or 2 values), Dirichlet (at least one of x/y) and traction
+/// conditions, exactly one contact boundary, and the solver settings (0 or empty = server
+/// default). Every boundary name is checked against the mesh. Throws InputError naming the body
+/// and the field, e.g. "body 'upper': SetupBody.voigt has 4 values, expected 9".
+DecodedSetup decode_setup_body(const protocol::SetupBody& message,
+                               const std::filesystem::path& data_directory);
 
 }  // namespace robin

@@ -9,9 +9,9 @@
 
 #include "numerics/body_output.hpp"
 #include "numerics/errors.hpp"
-#include "numerics/gmsh_reader.hpp"
 #include "robin.pb.h"
 #include "server/reply_encoding.hpp"
+#include "server/file_access.hpp"
 #include "server/request_error.hpp"
 #include "server/server_logging.hpp"
 #include "server/setup_decoding.hpp"
@@ -95,40 +95,50 @@ Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& va
   return to_vector(values);
 }
 
-/// The assignment of an AssignContact request, checked against the body's contact boundary:
-/// as many normals as nodes, known and distinct node ids, unit normals (to 1e-8).
-ContactAssignment checked_assignment(const protocol::AssignContact& message,
-                                     const std::vector<int>& interface_nodes, const Mesh& mesh,
-                                     const std::string& body_name) {
+/// The constraint operator B of an AssignContact request, its sizes checked against the message
+/// before anything is allocated; its entries are checked by BodySolver::assign_contact.
+ContactOperator decoded_operator(const protocol::AssignContact& message,
+                                 const std::string& body_name) {
   const auto invalid = [&](const std::string& problem) {
     return RequestError(protocol::INVALID_ARGUMENT,
                         "AssignContact for body '" + body_name + "': " + problem);
   };
-  if (message.normals_size() != 2 * message.node_ids_size()) {
-    throw invalid(std::to_string(message.normals_size()) + " normal values for " +
-                  std::to_string(message.node_ids_size()) + " nodes, expected 2 per node");
+  const int entries = message.values_size();
+  if (message.node_ids_size() != entries || message.components_size() != entries) {
+    throw invalid(std::to_string(message.node_ids_size()) + " node_ids, " +
+                  std::to_string(message.components_size()) + " components and " +
+                  std::to_string(entries) + " values: expected one of each per entry");
   }
-  ContactAssignment assignment;
-  std::vector<bool> used(interface_nodes.size(), false);
-  for (int i = 0; i < message.node_ids_size(); ++i) {
-    const std::int64_t id = message.node_ids(i);
-    const auto found = std::lower_bound(interface_nodes.begin(), interface_nodes.end(), id);
-    if (found == interface_nodes.end() || *found != id) {
-      throw invalid("node id " + std::to_string(id) +
-                    " is not a node of the contact boundary (see InterfaceDescription.node_ids)");
-    }
-    const std::string node =
-        "node id " + std::to_string(id) + " (tag " + std::to_string(mesh.node_tags[*found]) + ")";
-    if (used[found - interface_nodes.begin()]) throw invalid(node + " is assigned twice");
-    used[found - interface_nodes.begin()] = true;
-    const Eigen::Vector2d normal(message.normals(2 * i), message.normals(2 * i + 1));
-    if (!std::isfinite(normal.norm()) || std::abs(normal.norm() - 1.0) > 1e-8) {
-      throw invalid("the normal of " + node + " is not a unit vector");
-    }
-    assignment.node_ids.push_back(*found);
-    assignment.normals.push_back(normal);
+  if (message.row_offsets_size() < 2 || message.weights_size() != message.row_offsets_size() - 1) {
+    throw invalid(std::to_string(message.row_offsets_size()) + " row_offsets and " +
+                  std::to_string(message.weights_size()) +
+                  " weights: expected constraints + 1 offsets and one weight per constraint");
   }
-  return assignment;
+  ContactOperator contact;
+  contact.row_offsets.assign(message.row_offsets().begin(), message.row_offsets().end());
+  contact.weights.assign(message.weights().begin(), message.weights().end());
+  contact.values.assign(message.values().begin(), message.values().end());
+  contact.components.reserve(static_cast<std::size_t>(entries));
+  contact.nodes.reserve(static_cast<std::size_t>(entries));
+  for (int k = 0; k < entries; ++k) {
+    const std::int64_t node = message.node_ids(k);
+    // Out-of-range ids become -1, which check_contact_operator refuses as unknown nodes.
+    contact.nodes.push_back(node >= 0 && node <= std::numeric_limits<int>::max()
+                                ? static_cast<int>(node)
+                                : -1);
+    contact.components.push_back(static_cast<int>(std::min<std::uint32_t>(message.components(k), 1000)));
+  }
+  return contact;
+}
+
+/// Refuses a result with a NaN or an infinity: SOLVER_FAILURE naming the body and the request.
+void require_finite(const Eigen::Ref<const Eigen::VectorXd>& values, const std::string& what,
+                    const std::string& body_name) {
+  if (values.allFinite()) return;
+  throw RequestError(protocol::SOLVER_FAILURE,
+                     what + " of body '" + body_name +
+                         "' has a value that is not a finite number (the data overflow the "
+                         "solver: check the magnitudes of loads, obstacles and forces)");
 }
 
 /// Writes <directory>/<body>.vtu (creating the directory); returns the path written. An
@@ -201,9 +211,6 @@ std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
     set_error(reply, protocol::SINGULAR_BODY, error.what(), state_);
   } catch (const InputError& error) {
     set_error(reply, protocol::BAD_INPUT, error.what(), state_);
-  } catch (const TemporaryDirectoryError& error) {
-    // The server's environment, not the request, is at fault: INTERNAL (§7 of the protocol).
-    set_error(reply, protocol::INTERNAL, error.what(), state_);
   } catch (const std::exception& error) {
     set_error(reply, protocol::INTERNAL, std::string("internal error: ") + error.what(), state_);
   } catch (...) {
@@ -317,7 +324,8 @@ void SubdomainServer::require_state(ServerState minimum, const std::string& requ
 
 void SubdomainServer::require_same_run(const protocol::Envelope& request,
                                        const std::string& request_type) const {
-  if (settings_.protocol_minor < 2 || !body_ || run_id_.empty() || request.run_id().empty() ||
+  const bool before_run_ids = settings_.protocol_major < 2 && settings_.protocol_minor < 2;
+  if (before_run_ids || !body_ || run_id_.empty() || request.run_id().empty() ||
       request.run_id() == run_id_) {
     return;
   }
@@ -344,11 +352,11 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   interface_nodes_.clear();
   state_ = ServerState::awaiting_setup;
   record.body = request.setup_body().body_name();
-  DecodedSetup setup = decode_setup_body(request.setup_body());
+  DecodedSetup setup = decode_setup_body(request.setup_body(), settings_.data_directory);
   auto body = std::make_unique<BodySolver>(std::move(setup.definition), setup.body);
   const InterfaceDescription interface = body->contact_boundary();
   protocol::InterfaceDescription& description = *reply.mutable_interface();
-  encode_interface(body->name(), interface, description);
+  encode_interface(body->name(), body->definition().contact_boundary, interface, description);
   description.set_dof_count(static_cast<std::uint64_t>(body->free_dof_count()));
   description.set_setup_seconds(body->timings().assembly_seconds +
                                 body->timings().factorization_seconds);
@@ -367,10 +375,13 @@ void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
                                         protocol::Envelope& reply) {
   require_same_run(request, "AssignContact");
   require_state(ServerState::awaiting_assignment, "AssignContact");
-  const ContactAssignment assignment =
-      checked_assignment(request.assign_contact(), interface_nodes_, body_->mesh(), body_->name());
+  const ContactOperator contact = decoded_operator(request.assign_contact(), body_->name());
   state_ = ServerState::awaiting_assignment;  // until the body accepted the assignment
-  body_->assign_contact(assignment);
+  try {
+    body_->assign_contact(contact);
+  } catch (const InputError& error) {
+    throw RequestError(protocol::INVALID_ARGUMENT, error.what());
+  }
   state_ = ServerState::ready;
   acknowledge(reply);
 }
@@ -384,6 +395,8 @@ void SubdomainServer::on_contact_solve(const protocol::Envelope& request, protoc
   const Eigen::VectorXd obstacle = checked_vector(message.obstacle(), body_->contact_size(),
                                                   "ContactSolveRequest.obstacle", body_->name());
   const ContactSolveResult result = body_->solve_contact(obstacle, qp_parameters_);
+  require_finite(result.normal_trace, "ContactSolveResult.normal_trace", body_->name());
+  require_finite(result.contact_force, "ContactSolveResult.contact_force", body_->name());
   encode_contact_result(result, *reply.mutable_contact_result());
   record.outcome = protocol::SolveStatus_Name(to_protocol(result.status)) + ", " +
                    std::to_string(result.iterations) + " QP iterations";
@@ -401,6 +414,7 @@ void SubdomainServer::on_correction(const protocol::Envelope& request, protocol:
       checked_vector(message.interface_force(), body_->contact_size(),
                      "CorrectionRequest.interface_force", body_->name());
   const Eigen::VectorXd trace = body_->solve_correction(interface_force);  // w_N = B K^-1 B' r
+  require_finite(trace, "CorrectionResult.normal_trace", body_->name());
   protocol::CorrectionResult& result = *reply.mutable_correction_result();
   result.mutable_normal_trace()->Assign(trace.begin(), trace.end());
   result.set_compute_seconds(seconds_since(start));
@@ -423,6 +437,7 @@ void SubdomainServer::on_neumann_solve(const protocol::Envelope& request, protoc
       checked_vector(message.contact_force(), body_->contact_size(),
                      "NeumannSolveRequest.contact_force", body_->name());
   const Eigen::VectorXd trace = body_->solve_neumann(contact_force);  // u_N = e - F lambda
+  require_finite(trace, "NeumannSolveResult.normal_trace", body_->name());
   protocol::NeumannSolveResult& result = *reply.mutable_neumann_result();
   result.mutable_normal_trace()->Assign(trace.begin(), trace.end());
   result.set_compute_seconds(seconds_since(start));
@@ -437,11 +452,29 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   const Eigen::VectorXd contact_force = checked_vector(
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
   const BodyOutput output = make_body_output(*body_, contact_force);
+  for (const OutputField& field : output.point_fields) {
+    require_finite(Eigen::Map<const Eigen::VectorXd>(field.values.data(),
+                                                     static_cast<Eigen::Index>(field.values.size())),
+                   "FieldsReply point field '" + field.name + "'", body_->name());
+  }
+  for (const OutputField& field : output.cell_fields) {
+    require_finite(Eigen::Map<const Eigen::VectorXd>(field.values.data(),
+                                                     static_cast<Eigen::Index>(field.values.size())),
+                   "FieldsReply cell field '" + field.name + "'", body_->name());
+  }
+  std::filesystem::path directory;
+  if (!message.write_directory().empty()) {
+    try {
+      directory = resolve_output_directory(settings_.output_root, message.write_directory(),
+                                           "FieldsRequest.write_directory");
+    } catch (const InputError& error) {
+      throw RequestError(protocol::INVALID_ARGUMENT,
+                         "body '" + body_->name() + "': " + error.what());
+    }
+  }
   protocol::FieldsReply& fields = *reply.mutable_fields_reply();
   encode_fields(output, fields);
-  if (!message.write_directory().empty()) {
-    fields.set_written_file(write_fields_file(message.write_directory(), output));
-  }
+  if (!directory.empty()) fields.set_written_file(write_fields_file(directory, output));
 }
 
 bool SubdomainServer::offers(const std::string& name) const {

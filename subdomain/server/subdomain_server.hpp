@@ -13,15 +13,15 @@
 // shutdown_requested() becomes true. The body is factorized once per SetupBody; contact solves
 // warm-start from the previous converged solution of the same assignment.
 //
-// Runs (protocol 1.2, Envelope.run_id): a successful SetupBody records its request's run_id
+// Runs (protocol 1.2 and later, Envelope.run_id): a successful SetupBody records its request's run_id
 // with the body (any previous body is discarded whichever run it belonged to: a new run may
 // always take over a server whose coordinator died). While the body is held, AssignContact,
 // ContactSolveRequest, CorrectionRequest, NeumannSolveRequest, FieldsRequest and EndRun whose
 // run_id is non-empty and differs from a non-empty recorded one are refused with WRONG_STATE
 // ("... now belongs to another run ..."), the state unchanged: another coordinator set the body
 // up, and this run must not be answered from it. An empty run_id (a 1.0 or 1.1 coordinator) is
-// served as before. A server announcing a minor version below 2 (ServerSettings, testing)
-// ignores run_id, as a 1.1 server would. Replies echo the request's run_id.
+// served as before. A server announcing a version below 1.2 (ServerSettings, testing) ignores
+// run_id, as a 1.1 server would. Replies echo the request's run_id.
 //
 // Every reply echoes the request_id and carries this server's Version. Failures are Error
 // replies, never exceptions:
@@ -29,21 +29,22 @@
 //   VERSION_MISMATCH   the request's major version differs from ours (both are named)
 //   WRONG_STATE        the request is not accepted in the current state, or it names another
 //                      run than the body's (run_id, see above)
-//   INVALID_ARGUMENT   wrong sizes, unknown or repeated node ids, non-unit normals, non-finite
-//                      values, a write_directory where the fields cannot be written
+//   INVALID_ARGUMENT   wrong sizes, a malformed constraint operator B (AssignContact),
+//                      non-finite values, a write_directory outside the output root or where
+//                      the fields cannot be written
 //   BAD_INPUT          the body definition is unusable (robin::InputError while setting up)
 //   SINGULAR_BODY      the Dirichlet conditions leave a rigid motion free (SingularBodyError)
 //   UNSUPPORTED        a reply type sent as a request, a request unknown to this version, or
 //                      a NeumannSolveRequest when "neumann_solve" is withheld (testing only)
-//   INTERNAL           the server's environment fails it (TemporaryDirectoryError: the
-//                      temporary directory cannot hold the received mesh), or any other
-//                      exception ("internal error: ...")
+//   SOLVER_FAILURE     a result with a non-finite value (never sent)
+//   INTERNAL           any other exception ("internal error: ...")
 // The state after the request is in Acknowledge.state, HelloReply.state and Error.state.
 //
 // Capabilities (HelloReply.capabilities): the core "contact_solve", "correction_solve",
 // "fields", and since protocol 1.1 the optional "neumann_solve" (NeumannSolveRequest:
 // u_N = B K^{-1} (f - B' lambda) = e - F lambda for a given contact force lambda).
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -77,6 +78,12 @@ struct ServerSettings {
   /// Optional capabilities neither announced nor served (testing only: with "neumann_solve"
   /// the server answers NeumannSolveRequest with UNSUPPORTED, like a protocol 1.0 server).
   std::vector<std::string> withheld_capabilities;
+  /// The directory under which SetupBody.mesh_path may name files (--data-directory); empty:
+  /// every mesh_path is refused.
+  std::filesystem::path data_directory;
+  /// The directory under which FieldsRequest.write_directory may write (--output-root); empty:
+  /// every write_directory is refused.
+  std::filesystem::path output_root;
   /// Where requests are logged; null means subdomain_logger().
   std::shared_ptr<spdlog::logger> logger;
 };

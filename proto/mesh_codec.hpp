@@ -1,0 +1,26 @@
+#pragma once
+// MeshData (proto/robin.proto) to and from the numerics' Mesh: how a mesh travels as data.
+// The decoder is the server's gate for meshes from the wire: it checks every size against the
+// message before it allocates, every index and value, and every element's validity.
+
+#include <string>
+
+#include "numerics/mesh.hpp"
+#include "robin.pb.h"
+
+namespace robin {
+
+/// The mesh as MeshData: dimension 2, coordinates, node and element tags, element blocks and
+/// named boundaries, `mesh.source` as the source.
+protocol::MeshData encode_mesh(const Mesh& mesh);
+
+/// The Mesh of `data`. Throws InputError "<context>: SetupBody.mesh.<field> ..." naming the
+/// field, the block or boundary and the mesh's source for: a dimension other than 2; a
+/// coordinate count that is not a multiple of 2, no node, or a non-finite coordinate; tags of
+/// the wrong count; an unknown or misplaced cell type; a connectivity length that is not a
+/// multiple of the nodes per cell; a node index out of range; a node that no cell uses; a
+/// boundary name that is empty, longer than 64 characters, not [A-Za-z0-9_.-]+ or repeated;
+/// and (check_element_validity) an inverted, folded or degenerate element, named by its tag.
+Mesh decode_mesh(const protocol::MeshData& data, const std::string& context);
+
+}  // namespace robin
