@@ -1,11 +1,12 @@
 """One elastic body: assembled stiffness, Dirichlet reduction, a sparse LU factor computed once,
-and the operators of the dual (contact-force) formulation on its assigned contact nodes.
+its contact boundaries (ContactBoundaries) and the operators of the dual (contact-force)
+formulation for its assigned constraint operator B (AssignContact, assignment.ContactOperator).
 
-With B the normal trace on the assigned nodes ((B u)_i = u(node_i) . n_i), K the stiffness on
-the free dofs and f the reduced load (f_f - K_fp u_p):
+With B the constraint operator (one row per constraint; node-to-node: (B u)_i = u(node_i) . n_i),
+K the stiffness on the free dofs and f the reduced load (f_f - K_fp u_p):
   e = B K^-1 f + B u_p       free normal trace
   F = B K^-1 B'              interface compliance, assembled densely
-  u_N = e - F lambda         normal trace under nodal contact forces lambda (K u = f - B' lambda)
+  u_N = e - F lambda         normal trace under contact forces lambda (K u = f - B' lambda)
 """
 
 import time
@@ -15,22 +16,24 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from . import contact, fem
+from .contact_boundaries import ContactBoundaries
 from .errors import InputError, SingularBodyError
 
 
 class BodyDefinition:
     """Plain data: name, mesh, material, body_force (2), dirichlet [(boundary, x or None,
-    y or None)], tractions [(boundary, vector (2) or None, pressure or None)], contact_boundary."""
+    y or None)], tractions [(boundary, vector (2) or None, pressure or None)],
+    contact_boundaries (names of mesh boundaries, at least one)."""
 
     def __init__(self, name, mesh, material, body_force=(0.0, 0.0), dirichlet=(), tractions=(),
-                 contact_boundary=""):
+                 contact_boundaries=()):
         self.name = name
         self.mesh = mesh
         self.material = material
         self.body_force = np.asarray(body_force, dtype=float)
         self.dirichlet = list(dirichlet)
         self.tractions = list(tractions)
-        self.contact_boundary = contact_boundary
+        self.contact_boundaries = list(contact_boundaries)
 
 
 def prescribed_values(definition):
@@ -106,6 +109,8 @@ class Body:
                 "body '%s': the Dirichlet conditions leave a rigid motion free (translation or "
                 "rotation); fix u_x and u_y on a boundary segment, or enough components on "
                 "several boundaries" % self.name)
+        self.interface = ContactBoundaries(self.mesh, definition.contact_boundaries,
+                                           self.is_prescribed)
         self.free_dofs = np.flatnonzero(~self.is_prescribed)
         self.free_index = np.full(len(self.prescribed), -1, dtype=np.int64)
         self.free_index[self.free_dofs] = np.arange(len(self.free_dofs))
@@ -136,26 +141,10 @@ class Body:
     def free_dof_count(self):
         return len(self.free_dofs)
 
-    def contact_edges(self):
-        boundary = self.definition.contact_boundary
-        return fem.EdgeSet(self.mesh, boundary, self.mesh.boundaries[boundary])
-
-    def contact_boundary(self):
-        """The contact boundary as the body sees it: dict of node_ids (ascending), node_tags,
-        coordinates (n x 2), normals (n x 2), weights (n), x_fixed, y_fixed."""
-        edges = self.contact_edges()
-        nodes = edges.group.nodes()
-        return {"node_ids": nodes, "node_tags": self.mesh.node_tags[nodes],
-                "coordinates": self.mesh.nodes[nodes],
-                "normals": fem.boundary_node_normals(self.mesh, edges),
-                "weights": fem.boundary_weights(self.mesh, edges)[nodes],
-                "x_fixed": self.is_prescribed[2 * nodes],
-                "y_fixed": self.is_prescribed[2 * nodes + 1]}
-
-    def assign_contact(self, node_ids, normals):
-        """Sets the contact nodes (pair order) and their unit normals; builds e and F."""
-        self.contact = contact.ContactInterface(self, np.asarray(node_ids, dtype=np.int64),
-                                                np.asarray(normals, dtype=float).reshape(-1, 2))
+    def assign_contact(self, operator):
+        """Sets the constraint operator B (an assignment.ContactOperator whose nodes are contact
+        nodes); builds e and F."""
+        self.contact = contact.ContactInterface(self, operator)
 
     def displacement(self, contact_force):
         """Full displacement (2 per node): u_f = K^-1 (f - B' lambda), prescribed values kept."""

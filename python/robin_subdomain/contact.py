@@ -25,7 +25,6 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 
-from .errors import InputError
 
 CONVERGED, NOT_CONVERGED, BREAKDOWN = "CONVERGED", "NOT_CONVERGED", "BREAKDOWN"
 COLUMN_BLOCK = 16  # SuperLU solves are fastest per column with about 16 right-hand sides
@@ -174,7 +173,8 @@ def solve_bound_qp(matrix, right_hand_side, start, tolerance, max_iterations, no
             steps += more
     except (np.linalg.LinAlgError, ValueError) as error:
         gradient = problem.gradient(x)
-        return QpResult(x, gradient, BREAKDOWN, 0, float("nan"),
+        return QpResult(x, gradient, BREAKDOWN, 0,
+                        float(np.linalg.norm(projected_gradient(x, gradient))),
                         "the compliance is not positive definite on the free set: %s" % error)
     gradient = problem.gradient(x)
     norm_projected = float(np.linalg.norm(projected_gradient(x, gradient)))
@@ -191,32 +191,36 @@ def solve_bound_qp(matrix, right_hand_side, start, tolerance, max_iterations, no
 
 
 class ContactInterface:
-    """B, e, F and the warm start of one contact assignment of `body`."""
+    """B, e, F and the warm start of one contact assignment (a ContactOperator) of `body`:
+    trace = B on the free dofs (rows x free), prescribed_trace = B u_p (rows),
+    full_operator = B on all dofs (rows x 2n), free_trace e, compliance F."""
 
-    def __init__(self, body, node_ids, normals):
+    def __init__(self, body, operator):
         start = time.perf_counter()
         self.body = body
-        self.node_ids = node_ids
-        self.normals = normals
-        count = len(node_ids)
-        if len(normals) != count:
-            raise InputError("body '%s': contact assignment has %d nodes but %d normals" %
-                             (body.name, count, len(normals)))
-        dofs = np.column_stack([2 * node_ids, 2 * node_ids + 1])          # n_c x 2
+        self.operator = operator
+        count = operator.row_count
+        dofs = operator.dofs()
         prescribed = body.is_prescribed[dofs]
-        # B u_p, and B on the free dofs (n_c x free)
-        self.prescribed_trace = np.where(
-            prescribed, normals * np.nan_to_num(body.prescribed[dofs]), 0.0).sum(axis=1)
-        rows = np.repeat(np.arange(count), 2)[~prescribed.ravel()]
-        columns = body.free_index[dofs.ravel()[~prescribed.ravel()]]
+        # B u_p, and B on the free dofs (rows x free)
+        self.prescribed_trace = np.zeros(count)
+        np.add.at(self.prescribed_trace, operator.entry_rows[prescribed],
+                  operator.values[prescribed] * body.prescribed[dofs[prescribed]])
+        free = ~prescribed
         self.trace = scipy.sparse.csr_matrix(
-            (normals.ravel()[~prescribed.ravel()], (rows, columns)),
+            (operator.values[free], (operator.entry_rows[free], body.free_index[dofs[free]])),
             shape=(count, body.free_dof_count()))
+        self.full_operator = scipy.sparse.csr_matrix(
+            (operator.values, (operator.entry_rows, dofs)), shape=(count, len(body.prescribed)))
         self.free_trace = self.trace @ body.free_solution + self.prescribed_trace  # e
         self.compliance = self._dense_compliance()
         self.norm = estimate_norm(self.compliance)
         self.warm_start = np.zeros(count)
         self.seconds = time.perf_counter() - start
+
+    def nodal_forces(self, contact_force):
+        """B' lambda on every dof (2n): minus the contact forces acting on the body."""
+        return self.full_operator.T @ contact_force
 
     def _dense_compliance(self):
         """F = B K^-1 B', COLUMN_BLOCK columns per block of solves, symmetrised."""
@@ -229,7 +233,8 @@ class ContactInterface:
         return 0.5 * (compliance + compliance.T)
 
     def size(self):
-        return len(self.node_ids)
+        """The number of constraints (rows of B)."""
+        return self.operator.row_count
 
     def solve_contact(self, obstacle, tolerance, max_iterations):
         """Step 1 with obstacle g, warm-started. Returns a dict of the ContactSolveResult values."""
@@ -248,12 +253,12 @@ class ContactInterface:
                 "seconds": time.perf_counter() - start, "message": qp.message}
 
     def solve_correction(self, interface_force):
-        """Step 2: w_N = B K^-1 B' r = F r."""
+        """Step 2: w_N = B w with K w = B' r (homogeneous Dirichlet conditions), = F r."""
         return self.compliance @ interface_force
 
     def solve_neumann(self, contact_force):
-        """The Neumann solve (protocol 1.1): u_N = B u with K u = f - B' lambda, u = u_p on the
-        prescribed dofs. One solve with the body's factor, not e - F lambda (so that it is an
-        independent check of F and e)."""
+        """The Neumann solve (since protocol 1.1): u_N = B u with K u = f - B' lambda, u = u_p
+        on the prescribed dofs. One solve with the body's factor, not e - F lambda (so that it
+        is an independent check of F and e)."""
         load = self.body.reduced_load - self.trace.T @ contact_force
         return self.trace @ self.body.factor.solve(load) + self.prescribed_trace

@@ -27,14 +27,31 @@ def _describe_element(mesh, element_type, nodes):
     return "mesh element %s with node tags (%s)" % (element_type, tags)
 
 
+def jacobians(coordinates, element_type, reference):
+    """Jacobian matrices (elements x 2 x 2) and their determinants (elements) at one reference
+    point, for element node coordinates (elements x k x 2): J_ij = sum_k x_k,i dN_k/dxi_j."""
+    _, reference_gradients = element.shape_functions(element_type, reference)
+    jacobian = np.einsum("eki,kj->eij", coordinates, reference_gradients)
+    determinant = jacobian[:, 0, 0] * jacobian[:, 1, 1] - jacobian[:, 0, 1] * jacobian[:, 1, 0]
+    return jacobian, determinant
+
+
+def jacobian_check_points(element_type):
+    """The reference points where an element's Jacobian must be positive: its nodes (corners
+    and midpoints), its centroid and the points of every quadrature rule used on it."""
+    points = [element.reference_nodes(element_type), [element.reference_centroid(element_type)]]
+    for degree in (STIFFNESS_DEGREE[element_type], LOAD_DEGREE[element_type]):
+        points.append(element.element_quadrature(element_type, degree)[0])
+    return np.vstack(points)
+
+
 def element_points(mesh, block, reference):
     """Shape values N (k), physical gradients (elements x k x 2), Jacobian determinants and
     positions (elements x 2) of every element of `block` at one reference point.
     J_ij = dx_i/dxi_j = sum_k x_k,i dN_k/dxi_j; dN/dx = dN/dxi J^-1."""
     values, reference_gradients = element.shape_functions(block.type, reference)
     coordinates = mesh.nodes[block.connectivity]                      # e x k x 2
-    jacobian = np.einsum("eki,kj->eij", coordinates, reference_gradients)
-    determinant = jacobian[:, 0, 0] * jacobian[:, 1, 1] - jacobian[:, 0, 1] * jacobian[:, 1, 0]
+    jacobian, determinant = jacobians(coordinates, block.type, reference)
     bad = np.flatnonzero(~(determinant > 0.0))
     if len(bad):
         raise InputError("%s has a non-positive Jacobian %g at reference point (%g, %g): the "
@@ -141,6 +158,16 @@ class EdgeSet:
             orientation[edge] = 1.0 if turned.dot(middle - centroid) >= 0.0 else -1.0
         return orientation
 
+    def segments_with_body_on_the_left(self):
+        """The group's connectivity (edges x m) with each edge's endpoints in the order that has
+        the body on its left (outward normal = the direction turned clockwise); midpoints stay
+        last."""
+        connectivity = self.group.connectivity.copy()
+        reversed_edges = self.orientation < 0.0
+        connectivity[reversed_edges, 0] = self.group.connectivity[reversed_edges, 1]
+        connectivity[reversed_edges, 1] = self.group.connectivity[reversed_edges, 0]
+        return connectivity
+
     def evaluate(self, t):
         """Shape values (m), positions (edges x 2), length elements |dx/dt| (edges) and unit
         outward normals orientation (t_y, -t_x) / |t| (edges x 2) at reference t."""
@@ -196,21 +223,33 @@ def boundary_weights(mesh, edges):
     return weights_out
 
 
-def boundary_node_normals(mesh, edges):
-    """Unit outward normal at each node of the group (ascending node order): the normalised sum
-    of its edges' outward normals at the node times the edges' lengths."""
+def boundary_normal_sums(mesh, edges):
+    """Per mesh node (n x 2): the sum over the edges of `edges` touching the node of the edge's
+    outward normal at the node times the edge's length (zero off the group)."""
     sums = np.zeros((mesh.node_count(), 2))
     lengths = edges.lengths()
     for k, t in enumerate(element.edge_reference_nodes(edges.group.type)):
         _, _, _, normals = edges.evaluate(t)
         np.add.at(sums, edges.group.connectivity[:, k], lengths[:, None] * normals)
-    nodes = edges.group.nodes()
+    return sums
+
+
+def unit_normals(mesh, sums, nodes, boundary_names):
+    """The normalised rows `nodes` of normal sums (n x 2); a zero sum (the normals of the
+    edges at a node cancel out) is an InputError naming the boundaries and the node tag."""
     norms = np.hypot(sums[nodes, 0], sums[nodes, 1])
     zero = np.flatnonzero(norms == 0.0)
     if len(zero):
         raise InputError("boundary '%s': the normals at node %d cancel out (a cusp or a fold)" %
-                         (edges.name, mesh.node_tags[nodes[zero[0]]]))
+                         ("', '".join(boundary_names), mesh.node_tags[nodes[zero[0]]]))
     return sums[nodes] / norms[:, None]
+
+
+def boundary_node_normals(mesh, edges):
+    """Unit outward normal at each node of the group (ascending node order): the normalised sum
+    of its edges' outward normals at the node times the edges' lengths."""
+    return unit_normals(mesh, boundary_normal_sums(mesh, edges), edges.group.nodes(),
+                        [edges.name])
 
 
 def recover_stress(mesh, material, displacement):

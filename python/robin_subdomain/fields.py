@@ -1,14 +1,12 @@
 """A body's result fields under contact forces lambda (FieldsReply of proto/robin.proto), and
-their VTK XML unstructured-grid file (ASCII .vtu).
+the text of their VTK XML unstructured-grid file (ASCII .vtu; paths.write_under_root writes it).
 
 Point fields: displacement (2), stress (3: xx, yy, xy; nodal average), von_mises,
-contact_pressure (lambda_i / m_i at contact nodes, 0 elsewhere), contact_force (2: -lambda_i n_i),
-reaction (2: K u - f at prescribed dofs). Cell fields: stress (3, element centroids), von_mises.
+contact_pressure (|(B' lambda) at the node| / m_i, m_i the node's weight on the contact
+boundaries; 0 off them), contact_force (2: -B' lambda at each node), reaction (2: K u - f at
+prescribed dofs). Cell fields: stress (3, element centroids), von_mises.
 reaction_resultant: sum of the reactions; applied_force: sum of body forces and tractions.
 """
-
-import os
-import pathlib
 
 import numpy as np
 
@@ -25,19 +23,19 @@ class BodyFields:
 
 
 def body_fields(body, contact_force):
-    """The fields of `body` (with an assigned contact) under nodal contact forces lambda."""
+    """The fields of `body` (with an assigned contact) under contact forces lambda (one per
+    constraint)."""
     mesh = body.mesh
-    interface = body.contact
     displacement = body.displacement(contact_force)
     element_stress, nodal_stress, element_von_mises, nodal_von_mises = fem.recover_stress(
         mesh, body.definition.material, displacement)
     reaction = body.reactions(displacement)
-    weights = fem.boundary_weights(mesh, body.contact_edges())[interface.node_ids]
+    force_field = -body.contact.nodal_forces(contact_force).reshape(-1, 2)
+    weights = body.interface.node_weights
     pressure = np.zeros(mesh.node_count())
     positive = weights > 0.0
-    pressure[interface.node_ids[positive]] = contact_force[positive] / weights[positive]
-    force_field = np.zeros((mesh.node_count(), 2))
-    np.add.at(force_field, interface.node_ids, -contact_force[:, None] * interface.normals)
+    pressure[positive] = np.hypot(force_field[positive, 0],
+                                  force_field[positive, 1]) / weights[positive]
     point_fields = [("displacement", 2, displacement.reshape(-1, 2)),
                     ("stress", 3, nodal_stress), ("von_mises", 1, nodal_von_mises[:, None]),
                     ("contact_pressure", 1, pressure[:, None]),
@@ -53,12 +51,8 @@ def _data_array(name, components, values, indent):
             '</DataArray>\n' % (indent, name, components, text))
 
 
-def write_vtu(directory, name, mesh, fields):
-    """Writes <directory>/<name>.vtu (creating the directory); returns its path."""
-    if not name or os.sep in name:
-        raise OSError("body name '%s' is not usable as a file name" % name)
-    directory = pathlib.Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
+def vtu_text(mesh, fields):
+    """The .vtu file (VTK XML unstructured grid, ASCII) of `mesh` and its BodyFields."""
     connectivity = np.concatenate([block.connectivity.ravel() for block in mesh.blocks])
     sizes = np.concatenate([np.full(len(block.connectivity), NODES_PER_ELEMENT[block.type])
                             for block in mesh.blocks])
@@ -82,6 +76,4 @@ def write_vtu(directory, name, mesh, fields):
     parts += [_data_array(field, components, values, "  ")
               for field, components, values in fields.cell_fields]
     parts += ['</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n']
-    path = directory / (name + ".vtu")
-    path.write_text("".join(parts))
-    return path
+    return "".join(parts)

@@ -1,5 +1,8 @@
 """2D meshes from Gmsh files: .msh (ASCII formats 4.1 and 2.2) read here, other .msh versions
 and binary files converted to ASCII 4.1 by the `gmsh` command-line tool, .geo meshed by it.
+Only files of the server's operator are read this way (SetupBody.mesh_path under the data
+directory, see paths.py); a mesh received on the wire is MeshData (mesh_data.py), which never
+reaches gmsh.
 
 The mesh read is what the C++ reader (subdomain/numerics/gmsh_reader.hpp) reads:
   - area elements of every entity in a 2D physical group (of every 2D entity when the file has
@@ -18,7 +21,6 @@ source and the directory: the server's environment is at fault, not the mesh.
 import contextlib
 import os
 import pathlib
-import re
 import shutil
 import subprocess
 import tempfile
@@ -48,12 +50,21 @@ REVERSED = {TRIANGLE3: [0, 2, 1], TRIANGLE6: [0, 2, 1, 5, 4, 3], QUADRILATERAL4:
 
 
 class ElementBlock:
-    """Elements of one type: connectivity (element_count x nodes per element), node indices."""
+    """Elements of one type: connectivity (element_count x nodes per element), node indices;
+    tags (element_count) the elements' tags in the user's mesh, or None (then the elements are
+    named by their 1-based position in the block)."""
 
-    def __init__(self, element_type, connectivity):
+    def __init__(self, element_type, connectivity, tags=None):
         self.type = element_type
         self.connectivity = np.asarray(connectivity, dtype=np.int64).reshape(
             -1, NODES_PER_ELEMENT[element_type])
+        self.tags = tags
+
+    def element_label(self, index):
+        """How messages name element `index` of the block: its tag, or its 1-based position."""
+        if self.tags is None:
+            return "at position %d" % (index + 1)
+        return "tag %d" % self.tags[index]
 
 
 class BoundaryGroup:
@@ -520,46 +531,3 @@ def read_mesh(path, source, size=0.0, element_order=1, recombine=False):
     if extension == ".geo":
         return read_msh_text(mesh_geo_file(path, source, size, element_order, recombine), source)
     return read_msh_bytes(path.read_bytes(), source)
-
-
-# Gmsh script keywords that reach the host (shell commands, files, environment, the process):
-# a .geo from a client is meshed only without them (docs/security.md; the same list as
-# subdomain/numerics/gmsh_script_check.hpp).
-REFUSED_GMSH_COMMANDS = frozenset((
-    "SystemCall", "NonBlockingSystemCall", "System", "NonBlockingSystem", "OnelabRun",
-    "OnelabAction", "Include", "Merge", "MergeWithBoundingBox", "ShapeFromFile", "Printf",
-    "Print", "Save", "CreateDir", "Exit", "Abort", "Sleep", "SendToServer", "Plugin", "GetEnv",
-    "GetString", "GetValue", "GetNumber", "SetString", "AbsolutePath", "FileExists"))
-
-# Comments, string literals (skipped) and identifiers (checked), in the order they appear.
-_GMSH_TOKENS = re.compile(r'//[^\n]*|/\*.*?(?:\*/|\Z)|"(?:\\.|[^"\\])*"?|[A-Za-z_][A-Za-z0-9_]*',
-                          re.DOTALL)
-
-
-def check_gmsh_script_from_client(script, source):
-    """Raises InputError naming the line of the first refused command of a .geo script."""
-    for match in _GMSH_TOKENS.finditer(script):
-        if match.group(0) in REFUSED_GMSH_COMMANDS:
-            line = script.count("\n", 0, match.start()) + 1
-            raise InputError(
-                "%s line %d: the Gmsh command '%s' is refused in a script sent to a server (it "
-                "can run commands, read or write files on the server's host; docs/security.md): "
-                "mesh the body with gmsh and send the .msh, or remove the command" %
-                (source, line, match.group(0)))
-
-
-def read_mesh_content(content, extension, source, size=0.0, element_order=1, recombine=False):
-    """The mesh of the bytes of a .msh or .geo file (mesh_content of SetupBody). A .geo is
-    meshed only without host-touching commands (check_gmsh_script_from_client)."""
-    lowered = extension.lower()
-    if lowered not in (".msh", ".geo"):
-        raise InputError("%s: unsupported mesh extension '%s': give .msh or .geo" %
-                         (source, extension))
-    if lowered == ".msh":
-        return read_msh_bytes(content, source)
-    check_gmsh_script_from_client(content.decode("utf-8", errors="replace"), source)
-    with _temporary_directory("robin-subdomain-py-geo-", source) as directory:
-        path = pathlib.Path(directory) / "mesh.geo"
-        path.write_bytes(content)
-        return read_mesh(path, source, size, element_order, recombine)
-

@@ -11,10 +11,19 @@ previous body first (a failed SetupBody leaves awaiting_setup); a refused Assign
 state and the previous assignment; EndRun -> awaiting_setup; Shutdown keeps the state and sets
 shutdown_requested.
 
-Protocol 1.1: besides the core capabilities the server announces the optional "neumann_solve"
+Protocol 2.0: the mesh arrives as data (SetupBody.mesh, mesh_data.py) or names a file under the
+data directory the operator gave at start (mesh_path, --data-directory); InterfaceDescription
+describes every contact boundary (dimension, fixed components, surfaces of segments);
+AssignContact carries a general sparse constraint operator B in compressed rows
+(assignment.py); FieldsRequest.write_directory is a relative directory under the output root
+given at start (--output-root), refused without one. No reply carries a non-finite number: a
+contact solve, correction, Neumann solve or fields reply that would is replaced by
+Error(SOLVER_FAILURE) naming the body and the request (the state is unchanged).
+
+Since 1.1: besides the core capabilities the server announces the optional "neumann_solve"
 (NeumannSolveRequest: u_N = B K^-1 (f - B' lambda) for a given contact force lambda).
 
-Protocol 1.2, runs (Envelope.run_id): a successful SetupBody records its request's run_id with the
+Since 1.2, runs (Envelope.run_id): a successful SetupBody records its request's run_id with the
 body (any previous body is discarded whichever run it belonged to). While the body is held,
 AssignContact, ContactSolveRequest, CorrectionRequest, NeumannSolveRequest, FieldsRequest and
 EndRun whose run_id is non-empty and differs from a non-empty recorded one are refused with
@@ -22,29 +31,32 @@ WRONG_STATE ("... now belongs to another run ..."), the state unchanged: another
 the body up. An empty run_id (a 1.0 or 1.1 coordinator) is served as before. Replies echo the
 request's run_id.
 
-Every reply echoes the request_id and carries version (protocol_major, 2). Failures are Error
-replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH,
-WRONG_STATE (also for another run's run_id), INVALID_ARGUMENT (sizes, unknown/repeated node ids,
-non-unit normals, non-finite values, unusable write_directory), BAD_INPUT (the body definition),
-SINGULAR_BODY, UNSUPPORTED (a reply sent as a request, a request unknown to this version),
-INTERNAL (anything else).
+Every reply echoes the request_id and carries version (protocol_major, 0). Failures are Error
+replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH (another
+major version, e.g. a 1.x request), WRONG_STATE (also for another run's run_id),
+INVALID_ARGUMENT (sizes, the constraint operator, non-finite values, a refused write_directory),
+BAD_INPUT (the body definition, its mesh, a refused mesh_path), SINGULAR_BODY, SOLVER_FAILURE
+(a reply would carry a non-finite number), UNSUPPORTED (a reply sent as a request, a request
+unknown to this version), INTERNAL (anything else).
 """
 
 import logging
-import math
 import time
 
 import numpy as np
 from google.protobuf.message import DecodeError
 
 from . import SERVER_NAME
+from .assignment import decode_assign_contact
 from .body import Body
 from .errors import InputError, RequestError, SingularBodyError
-from .fields import body_fields, write_vtu
-from .mesh import VTK_CELL_TYPE
+from .fields import body_fields, vtu_text
+from .mesh import LINE2, VTK_CELL_TYPE
+from .mesh_data import quoted
+from .paths import PathRefused, check_output_directory, write_under_root
 from .setup_decoding import decode_setup_body
 
-PROTOCOL_MAJOR, PROTOCOL_MINOR = 1, 2
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 0
 AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
 REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction",
             "neumann_solve", "fields", "end_run", "shutdown")
@@ -63,10 +75,10 @@ class _Record:
 
 
 def _checked_vector(values, size, field, body_name):
-    """A per-contact-node vector of a request: its length and finiteness."""
+    """A per-constraint vector of a request: its length and finiteness."""
     if len(values) != size:
         raise RequestError("INVALID_ARGUMENT",
-                           "%s has %d values for the %d contact nodes of body '%s' (pair order of "
+                           "%s has %d values for the %d constraints of body '%s' (the rows of "
                            "AssignContact)" % (field, len(values), size, body_name))
     vector = np.array(values, dtype=float)
     bad = np.flatnonzero(~np.isfinite(vector))
@@ -76,17 +88,41 @@ def _checked_vector(values, size, field, body_name):
     return vector
 
 
+def first_non_finite(message, prefix):
+    """(field, value) of the first NaN or infinite number in `message` and the messages it
+    holds, the field named from `prefix` (e.g. "ContactSolveResult.normal_trace[3]"); None when
+    every number is finite."""
+    for descriptor, value in message.ListFields():
+        name = "%s.%s" % (prefix, descriptor.name)
+        repeated = descriptor.label == descriptor.LABEL_REPEATED
+        if descriptor.type == descriptor.TYPE_MESSAGE:
+            for index, item in enumerate(value if repeated else [value]):
+                found = first_non_finite(item, name + ("[%d]" % index if repeated else ""))
+                if found:
+                    return found
+        elif descriptor.cpp_type in (descriptor.CPPTYPE_DOUBLE, descriptor.CPPTYPE_FLOAT):
+            numbers = np.array(value if repeated else [value], dtype=float)
+            bad = np.flatnonzero(~np.isfinite(numbers))
+            if len(bad):
+                return (name + ("[%d]" % bad[0] if repeated else ""), numbers[bad[0]])
+    return None
+
+
 class SubdomainProtocol:
-    def __init__(self, protocol, name="", protocol_major=PROTOCOL_MAJOR, logger=None):
+    def __init__(self, protocol, name="", protocol_major=PROTOCOL_MAJOR, logger=None,
+                 data_directory=None, output_root=None):
+        """`data_directory`: where SetupBody.mesh_path is resolved (None: refused);
+        `output_root`: where FieldsRequest.write_directory is created (None: refused)."""
         self.protocol = protocol          # the robin_pb2 module
         self.name = name
         self.protocol_major = protocol_major
+        self.data_directory = data_directory
+        self.output_root = output_root
         self.logger = logger or logging.getLogger("robin-subdomain-py")
         self.state = AWAITING_SETUP
         self.shutdown_requested = False
         self.body = None
         self.run_id = ""                  # run_id of the SetupBody of self.body; "" if none
-        self.interface_positions = {}     # contact boundary node id -> position
         self.settings = None
 
     def server_name(self):
@@ -210,7 +246,6 @@ class SubdomainProtocol:
         self._require_same_run(request, "EndRun")
         self.body = None
         self.run_id = ""
-        self.interface_positions = {}
         self.state = AWAITING_SETUP
         self._acknowledge(reply)
 
@@ -221,67 +256,62 @@ class SubdomainProtocol:
     def _on_setup_body(self, request, reply, record):
         self.body = None                  # a SetupBody starts a new run, whatever its outcome
         self.run_id = ""                  # (and whichever run the body belonged to)
-        self.interface_positions = {}
         self.state = AWAITING_SETUP
-        record.body = request.setup_body.body_name
-        definition, settings = decode_setup_body(request.setup_body, self.protocol)
+        record.body = quoted(request.setup_body.body_name, 64)[1:-1]
+        definition, settings = decode_setup_body(request.setup_body, self.protocol,
+                                                 self.data_directory)
         body = Body(definition)
-        interface = body.contact_boundary()
-        description = reply.interface
-        description.body_name = body.name
-        description.node_ids.extend(int(node) for node in interface["node_ids"])
-        description.node_tags.extend(int(tag) for tag in interface["node_tags"])
-        description.coordinates.extend(interface["coordinates"].ravel().tolist())
-        description.normals.extend(interface["normals"].ravel().tolist())
-        description.weights.extend(interface["weights"].tolist())
-        description.x_fixed.extend(bool(flag) for flag in interface["x_fixed"])
-        description.y_fixed.extend(bool(flag) for flag in interface["y_fixed"])
-        description.dof_count = body.free_dof_count()
-        description.setup_seconds = body.assembly_seconds + body.factorization_seconds
-        self.interface_positions = {int(node): k for k, node in enumerate(interface["node_ids"])}
+        self._describe_interface(body, reply.interface)
         self.settings = settings
         self.body = body
         self.run_id = request.run_id
         self.state = AWAITING_ASSIGNMENT
         record.outcome = "ok, %d nodes, %d free dofs, %d contact boundary nodes" % (
-            body.mesh.node_count(), body.free_dof_count(), len(self.interface_positions))
+            body.mesh.node_count(), body.free_dof_count(), body.interface.size())
         if self.run_id:
             record.outcome += ", run " + self.run_id
 
-    def _checked_assignment(self, message):
-        """Node ids and normals of an AssignContact: as many normals as nodes, known and
-        distinct ids, unit normals (to 1e-8)."""
-        name = self.body.name
-
-        def invalid(problem):
-            return RequestError("INVALID_ARGUMENT", "AssignContact for body '%s': %s" %
-                                (name, problem))
-
-        if len(message.normals) != 2 * len(message.node_ids):
-            raise invalid("%d normal values for %d nodes, expected 2 per node" %
-                          (len(message.normals), len(message.node_ids)))
-        used = set()
-        for i, node in enumerate(message.node_ids):
-            if node not in self.interface_positions:
-                raise invalid("node id %d is not a node of the contact boundary (see "
-                              "InterfaceDescription.node_ids)" % node)
-            label = "node id %d (tag %d)" % (node, self.body.mesh.node_tags[node])
-            if node in used:
-                raise invalid(label + " is assigned twice")
-            used.add(node)
-            length = math.hypot(message.normals[2 * i], message.normals[2 * i + 1])
-            if not math.isfinite(length) or abs(length - 1.0) > 1e-8:
-                raise invalid("the normal of %s is not a unit vector" % label)
-        return list(message.node_ids), list(message.normals)
+    def _describe_interface(self, body, description):
+        """Fills the InterfaceDescription of `body` (contact_boundaries.ContactBoundaries)."""
+        interface = body.interface
+        description.body_name = body.name
+        description.dimension = 2
+        description.node_ids.extend(int(node) for node in interface.node_ids)
+        description.node_tags.extend(int(tag) for tag in interface.node_tags)
+        description.coordinates.extend(interface.coordinates.ravel().tolist())
+        description.normals.extend(interface.normals.ravel().tolist())
+        description.weights.extend(interface.weights.tolist())
+        description.fixed.extend(bool(flag) for flag in interface.fixed.ravel())
+        for surface in interface.surfaces:
+            message = description.surfaces.add()
+            message.boundary = surface.name
+            message.segment_type = (self.protocol.LINE2 if surface.segment_type == LINE2
+                                    else self.protocol.LINE3)
+            message.segments.extend(int(position) for position in surface.segments.ravel())
+        description.dof_count = body.free_dof_count()
+        description.setup_seconds = body.assembly_seconds + body.factorization_seconds
 
     def _on_assign_contact(self, request, reply, record):
         self._require_same_run(request, "AssignContact")
         self._require_state(AWAITING_ASSIGNMENT, "AssignContact")
-        node_ids, normals = self._checked_assignment(request.assign_contact)
+        operator = decode_assign_contact(request.assign_contact, self.body.interface.node_ids,
+                                         self.body.mesh.node_tags, self.body.name)
         self.state = AWAITING_ASSIGNMENT  # until the body accepted the assignment
-        self.body.assign_contact(node_ids, normals)
+        self.body.assign_contact(operator)
         self.state = READY
         self._acknowledge(reply)
+        record.outcome = "ok, %d constraints, %d entries" % (operator.row_count,
+                                                             len(operator.values))
+
+    def _require_finite(self, result, request_type, record):
+        """SOLVER_FAILURE instead of a reply `result` that holds a NaN or infinite number."""
+        found = first_non_finite(result, result.DESCRIPTOR.name)
+        if found is None:
+            return
+        raise RequestError("SOLVER_FAILURE", "body '%s': %s%s: the reply would carry the "
+                           "non-finite number %s = %r, which is never sent: the solver failed "
+                           "(check the body's material, loads and the request's values)" %
+                           (self.body.name, request_type, record.iteration, found[0], found[1]))
 
     def _on_contact_solve(self, request, reply, record):
         message = request.contact_solve
@@ -304,6 +334,7 @@ class SubdomainProtocol:
         out.complementarity = result["complementarity"]
         out.compute_seconds = result["seconds"]
         out.message = result["message"]
+        self._require_finite(out, "ContactSolveRequest", record)
         record.outcome = "%s, %d QP iterations" % (result["status"], result["iterations"])
         if result["message"]:
             record.outcome += " (%s)" % result["message"]
@@ -319,9 +350,10 @@ class SubdomainProtocol:
                                 "CorrectionRequest.interface_force", self.body.name)
         reply.correction_result.normal_trace.extend(interface.solve_correction(force).tolist())
         reply.correction_result.compute_seconds = time.perf_counter() - start
+        self._require_finite(reply.correction_result, "CorrectionRequest", record)
 
     def _on_neumann_solve(self, request, reply, record):
-        """Protocol 1.1: K u = f - B' lambda for the given lambda; replies u_N = B u."""
+        """Since protocol 1.1: K u = f - B' lambda for the given lambda; replies u_N = B u."""
         start = time.perf_counter()
         message = request.neumann_solve
         record.iteration = " iteration %d" % message.iteration
@@ -333,6 +365,7 @@ class SubdomainProtocol:
         trace = interface.solve_neumann(force)
         reply.neumann_result.normal_trace.extend(trace.tolist())
         reply.neumann_result.compute_seconds = time.perf_counter() - start
+        self._require_finite(reply.neumann_result, "NeumannSolveRequest", record)
         record.outcome = "ok, max |lambda| %.3e, max |u_N| %.3e" % (
             np.max(np.abs(force), initial=0.0), np.max(np.abs(trace), initial=0.0))
 
@@ -342,8 +375,35 @@ class SubdomainProtocol:
         self._require_state(READY, "FieldsRequest")
         force = _checked_vector(message.contact_force, self.body.contact.size(),
                                 "FieldsRequest.contact_force", self.body.name)
+        if message.write_directory:
+            self._output_refusal(lambda: check_output_directory(self.output_root,
+                                                                message.write_directory),
+                                 message.write_directory)
         fields = body_fields(self.body, force)
-        out = reply.fields_reply
+        self._fill_fields_reply(fields, reply.fields_reply)
+        self._require_finite(reply.fields_reply, "FieldsRequest", record)
+        if message.write_directory:
+            text = vtu_text(self.body.mesh, fields)
+            path = self._output_refusal(
+                lambda: write_under_root(self.output_root, message.write_directory,
+                                         self.body.name + ".vtu", text),
+                message.write_directory)
+            reply.fields_reply.written_file = path
+
+    def _output_refusal(self, action, write_directory):
+        """action(), its PathRefused or OSError an INVALID_ARGUMENT naming the body and the
+        field."""
+        try:
+            return action()
+        except PathRefused as refusal:
+            problem = str(refusal)
+        except OSError as error:
+            problem = "cannot be written: %s" % (error.strerror or error)
+        raise RequestError("INVALID_ARGUMENT", "FieldsRequest.write_directory %s of body '%s' %s"
+                           % (quoted(write_directory), self.body.name, problem))
+
+    def _fill_fields_reply(self, fields, out):
+        """The mesh and the BodyFields of the body in a FieldsReply."""
         mesh = self.body.mesh
         out.node_coordinates.extend(mesh.nodes.ravel().tolist())
         out.node_tags.extend(int(tag) for tag in mesh.node_tags)
@@ -361,12 +421,3 @@ class SubdomainProtocol:
                 field.values.extend(np.ravel(values).tolist())
         out.reaction_resultant.extend(fields.reaction_resultant.tolist())
         out.applied_force.extend(fields.applied_force.tolist())
-        if message.write_directory:
-            try:
-                path = write_vtu(message.write_directory, self.body.name, mesh, fields)
-            except OSError as error:
-                raise RequestError("INVALID_ARGUMENT",
-                                   "FieldsRequest.write_directory: cannot write the fields of "
-                                   "body '%s' to '%s': %s" % (self.body.name,
-                                                              message.write_directory, error))
-            out.written_file = str(path)

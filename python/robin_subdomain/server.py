@@ -1,5 +1,10 @@
 """robin-subdomain-py: serves one elastic body of a robin-contact run over ZeroMQ
-(proto/robin.proto), with the command line of the C++ robin-subdomain.
+(proto/robin.proto, protocol 2.0), with the command line of the C++ robin-subdomain.
+
+Files: the server reads a mesh file only for SetupBody.mesh_path, and only under the directory
+given by --data-directory DIR (without it every mesh_path is refused); it writes result files
+only for FieldsRequest.write_directory, and only under --output-root DIR (without it every
+write_directory is refused). Both must be existing directories (else exit status 2).
 
 Prints exactly one line on stdout, "listening on ENDPOINT", once bound (wildcards and ephemeral
 ports resolved through ZMQ_LAST_ENDPOINT); logs go to stderr. The REP socket has linger 0,
@@ -67,6 +72,14 @@ def parse_arguments(arguments):
                         help="largest accepted request in bytes; libzmq drops a larger message "
                              "and disconnects its sender, who gets no reply")
     parser.add_argument("--name", default="", help="label for the logs and HelloReply")
+    parser.add_argument("--data-directory", metavar="DIR",
+                        help="directory of the mesh files SetupBody.mesh_path may name "
+                             "(relative paths that stay inside it); without it every mesh_path "
+                             "is refused")
+    parser.add_argument("--output-root", metavar="DIR",
+                        help="directory under which FieldsRequest.write_directory is created "
+                             "(relative paths, no symbolic links); without it every "
+                             "write_directory is refused")
     parser.add_argument("--send-timeout-ms", type=int, default=10000, help=argparse.SUPPRESS)
     # Testing only: announce and accept another protocol major version.
     parser.add_argument("--protocol-major", type=int, default=PROTOCOL_MAJOR,
@@ -77,6 +90,10 @@ def parse_arguments(arguments):
     options = parser.parse_args(arguments)
     if options.max_message_size <= 0:
         parser.error("--max-message-size must be a positive number")
+    for option, value in (("--data-directory", options.data_directory),
+                          ("--output-root", options.output_root)):
+        if value is not None and not os.path.isdir(value):
+            parser.error("%s '%s' is not an existing directory" % (option, value))
     return options
 
 
@@ -191,7 +208,9 @@ def main(arguments=None):
     signal.signal(signal.SIGTERM, request_stop)
     try:
         protocol_module = load_protocol()
-        handler = SubdomainProtocol(protocol_module, options.name, options.protocol_major, logger)
+        handler = SubdomainProtocol(protocol_module, options.name, options.protocol_major, logger,
+                                    data_directory=options.data_directory,
+                                    output_root=options.output_root)
         reason = serve(handler, options, lambda: bool(stop_requested), logger)
         logger.info("stopped: %s", reason)
         return 0

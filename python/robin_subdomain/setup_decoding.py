@@ -1,19 +1,27 @@
-"""SetupBody (proto/robin.proto) to a BodyDefinition and the solver settings, with the checks
-and messages of the C++ server (subdomain/server/setup_decoding.cpp). Every problem is an
-InputError naming the body and the SetupBody field.
+"""SetupBody (proto/robin.proto, protocol 2.0) to a BodyDefinition and the solver settings, with
+the checks and messages of the C++ server (subdomain/server/setup_decoding.cpp). Every problem is
+an InputError (BAD_INPUT) naming the body and the SetupBody field.
+
+The mesh is SetupBody.mesh (MeshData, decoded by mesh_data.py: data only, never given to gmsh),
+or else SetupBody.mesh_path: a .msh or .geo file of the server's operator under the data
+directory given at start (--data-directory; paths.resolve_data_file), read by mesh.read_mesh.
+Without a data directory every mesh_path is refused.
 """
 
 import math
-import pathlib
 import re
 
 from . import mesh as mesh_reader
 from .body import BodyDefinition
 from .errors import InputError
+from .mesh_data import decode_mesh_data, quoted
+from .paths import PathRefused, resolve_data_file
 from .material import PLANE_STRAIN, PLANE_STRESS, isotropic_material, voigt_material
 
 DEFAULT_QP_TOLERANCE = 1e-12
 DEFAULT_QP_MAX_ITERATIONS = 20000
+MAXIMUM_BODY_NAME_LENGTH = 64
+LISTED_BOUNDARY_NAMES = 20
 
 
 class SolverSettings:
@@ -31,9 +39,10 @@ def _number(value):
 
 
 def _body_name(name):
-    if not re.fullmatch(r"[A-Za-z0-9_-]+", name):
-        raise InputError("SetupBody.body_name '%s' is not a valid body name (letters, digits, '_' "
-                         "and '-', not empty)" % name)
+    if len(name) > MAXIMUM_BODY_NAME_LENGTH or not re.fullmatch(r"[A-Za-z0-9_-]+", name):
+        raise InputError("SetupBody.body_name %s is not a valid body name (letters, digits, '_' "
+                         "and '-', 1 to %d characters)" % (quoted(name),
+                                                           MAXIMUM_BODY_NAME_LENGTH))
     return name
 
 
@@ -88,43 +97,56 @@ def _solver(message, context):
     return settings
 
 
-def _mesh_options(message, context):
-    if not math.isfinite(message.mesh_size) or message.mesh_size < 0.0:
-        _fail(context, "mesh_size", "is %s, expected >= 0" % _number(message.mesh_size))
-    if message.element_order > 2:
-        _fail(context, "element_order",
-              "is %d, expected 1 or 2 (0 means 1)" % message.element_order)
-    return {"size": message.mesh_size, "element_order": message.element_order or 1,
-            "recombine": message.recombine}
+def _mesh_file(message, data_directory, context):
+    """The mesh of SetupBody.mesh_path, a file under the data directory (or None)."""
+    try:
+        path = resolve_data_file(data_directory, message.mesh_path)
+    except PathRefused as refusal:
+        _fail(context, "mesh_path", "%s %s" % (quoted(message.mesh_path), refusal))
+    return mesh_reader.read_mesh(path, "%s: SetupBody.mesh_path: mesh file %s" %
+                                 (context, quoted(message.mesh_path)))
 
 
-def _mesh(message, context):
-    options = _mesh_options(message, context)
-    if message.mesh_content:
-        if not message.mesh_extension:
-            _fail(context, "mesh_extension", "is empty: give \".msh\" or \".geo\" with "
-                  "mesh_content")
-        return mesh_reader.read_mesh_content(message.mesh_content, message.mesh_extension,
-                                             context + ": SetupBody.mesh_content", **options)
+def _mesh(message, protocol, data_directory, context):
+    """The body's mesh: SetupBody.mesh when given, else the file SetupBody.mesh_path."""
+    if message.HasField("mesh"):
+        return decode_mesh_data(message.mesh, protocol, context)
     if not message.mesh_path:
-        _fail(context, "mesh_content", "and SetupBody.mesh_path are both empty: send the mesh")
-    path = pathlib.Path(message.mesh_path)
-    return mesh_reader.read_mesh(path, "%s: SetupBody.mesh_path: mesh file '%s'" % (context, path),
-                                 **options)
+        _fail(context, "mesh", "and SetupBody.mesh_path are both empty: send the mesh")
+    return _mesh_file(message, data_directory, context)
 
 
 def _check_boundary(mesh, name, context, field):
     if not name:
-        _fail(context, field, "is empty: give the name of a physical curve")
+        _fail(context, field, "is empty: give the name of a boundary of the mesh")
     if name not in mesh.boundaries:
-        known = ", ".join(sorted(mesh.boundaries)) or "none"
-        _fail(context, field, "'%s' is not a boundary of the mesh (its boundaries: %s)" %
-              (name, known))
+        names = sorted(mesh.boundaries)
+        known = ", ".join(names[:LISTED_BOUNDARY_NAMES]) or "none"
+        if len(names) > LISTED_BOUNDARY_NAMES:
+            known += ", ... (%d in all)" % len(names)
+        _fail(context, field, "%s is not a boundary of the mesh (its boundaries: %s)" %
+              (quoted(name), known))
+
+
+def _contact_boundaries(message, mesh, context):
+    """SetupBody.contact_boundaries: at least one, each a distinct named boundary."""
+    names = list(message.contact_boundaries)
+    if not names:
+        _fail(context, "contact_boundaries", "is empty: name at least one boundary that may "
+              "touch another body")
+    for index, name in enumerate(names):
+        _check_boundary(mesh, name, context, "contact_boundaries[%d]" % index)
+        if name in names[:index]:
+            _fail(context, "contact_boundaries[%d]" % index, "repeats '%s'" % name)
+    return names
 
 
 def _dirichlet(message, mesh, context, field):
     _check_boundary(mesh, message.boundary, context, field + ".boundary")
     has_x, has_y = message.HasField("x"), message.HasField("y")
+    if message.HasField("z"):
+        _fail(context, field + ".z", "is given, but the body is two-dimensional: give x and y "
+              "only")
     if not has_x and not has_y:
         _fail(context, field, "prescribes neither x nor y: give at least one")
     x = message.x if has_x else None
@@ -145,8 +167,9 @@ def _traction(message, mesh, context, field):
     return (message.boundary, None, message.pressure)
 
 
-def decode_setup_body(message, protocol):
-    """(BodyDefinition, SolverSettings) of a SetupBody; `protocol` is the robin_pb2 module."""
+def decode_setup_body(message, protocol, data_directory=None):
+    """(BodyDefinition, SolverSettings) of a SetupBody; `protocol` is the robin_pb2 module,
+    `data_directory` the directory mesh_path is resolved in (None: mesh_path refused)."""
     name = _body_name(message.body_name)
     context = "body '%s'" % name
     material = _material(message, protocol, context)
@@ -154,12 +177,12 @@ def decode_setup_body(message, protocol):
     if len(message.body_force):
         body_force = _vector(message.body_force, context, "body_force")
     settings = _solver(message.solver, context)
-    mesh = _mesh(message, context)
-    _check_boundary(mesh, message.contact_boundary, context, "contact_boundary")
+    mesh = _mesh(message, protocol, data_directory, context)
+    contact_boundaries = _contact_boundaries(message, mesh, context)
     dirichlet = [_dirichlet(condition, mesh, context, "dirichlet[%d]" % k)
                  for k, condition in enumerate(message.dirichlet)]
     tractions = [_traction(condition, mesh, context, "traction[%d]" % k)
                  for k, condition in enumerate(message.traction)]
     definition = BodyDefinition(name, mesh, material, body_force, dirichlet, tractions,
-                                message.contact_boundary)
+                                contact_boundaries)
     return definition, settings

@@ -1,9 +1,13 @@
-"""Helpers of the Python server's unit tests: the package on sys.path and meshes from .geo text."""
+"""Helpers of the Python server's unit tests: the package on sys.path, meshes from .geo text and
+from the repository's .msh files, MeshData and AssignContact messages (protocol 2.0), and an
+independent P1 stiffness for checks that must not reuse the code under test."""
 
 import os
 import pathlib
 import sys
 import tempfile
+
+import numpy as np
 
 PYTHON_DIRECTORY = pathlib.Path(__file__).resolve().parent.parent
 REPOSITORY = PYTHON_DIRECTORY.parent
@@ -34,6 +38,10 @@ Physical Curve("left") = {4};
 Physical Surface("body") = {1};
 """
 
+CELL_TYPE_NAMES = {mesh_reader.TRIANGLE3: "TRIANGLE3", mesh_reader.TRIANGLE6: "TRIANGLE6",
+                   mesh_reader.QUADRILATERAL4: "QUADRILATERAL4", mesh_reader.LINE2: "LINE2",
+                   mesh_reader.LINE3: "LINE3"}
+
 
 def mesh_from_geo(text, size=0.0, element_order=1, recombine=False):
     """The mesh of .geo `text`, meshed by the gmsh command-line tool."""
@@ -42,3 +50,87 @@ def mesh_from_geo(text, size=0.0, element_order=1, recombine=False):
         with open(path, "w") as stream:
             stream.write(text)
         return mesh_reader.read_mesh(path, "test.geo", size, element_order, recombine)
+
+
+def _cell_block(protocol, target, cell_type, connectivity):
+    target.type = protocol.CellType.Value(CELL_TYPE_NAMES[cell_type])
+    target.connectivity.extend(int(node) for node in np.ravel(connectivity))
+
+
+def mesh_data(protocol, mesh, source):
+    """The MeshData message of a Mesh (node tags, cells as they are, named boundaries); cell
+    tags 1, 2, ... per block (so that messages name them)."""
+    message = protocol.MeshData(dimension=2, source=source)
+    message.coordinates.extend(mesh.nodes.ravel().tolist())
+    message.node_tags.extend(int(tag) for tag in mesh.node_tags)
+    for block in mesh.blocks:
+        cells = message.cells.add()
+        _cell_block(protocol, cells, block.type, block.connectivity)
+        cells.tags.extend(range(1, len(block.connectivity) + 1))
+    for name, group in sorted(mesh.boundaries.items()):
+        boundary = message.boundaries.add(name=name)
+        _cell_block(protocol, boundary.segments, group.type, group.connectivity)
+    return message
+
+
+def mesh_data_from_msh(protocol, file_name):
+    """The MeshData of tests/data/<file_name>, read with the package's .msh reader."""
+    mesh = mesh_reader.read_mesh(TEST_DATA / file_name, file_name)
+    return mesh_data(protocol, mesh, file_name)
+
+
+def node_to_node_assignment(protocol, interface):
+    """The AssignContact of node-to-node contact on every node of an InterfaceDescription: one
+    row per node with the components of its normal, weighted by the node's boundary weight."""
+    count = len(interface.node_ids)
+    return protocol.AssignContact(
+        row_offsets=range(0, 2 * count + 1, 2), node_ids=np.repeat(interface.node_ids, 2),
+        components=[0, 1] * count, values=interface.normals, weights=interface.weights)
+
+
+def sparse_rows(protocol, rows):
+    """AssignContact of rows [(weight, [(node id, component, value), ...]), ...]."""
+    message = protocol.AssignContact(row_offsets=[0])
+    for weight, entries in rows:
+        for node, component, value in entries:
+            message.node_ids.append(node)
+            message.components.append(component)
+            message.values.append(value)
+        message.row_offsets.append(len(message.values))
+        message.weights.append(weight)
+    return message
+
+
+def p1_stiffness(nodes, triangles, elasticity):
+    """K (2n x 2n, dense) of linear triangles, assembled here independently of the package:
+    K_e = area B' C B with the constant strain-displacement matrix of each triangle."""
+    stiffness = np.zeros((2 * len(nodes), 2 * len(nodes)))
+    for triangle in triangles:
+        (x1, y1), (x2, y2), (x3, y3) = nodes[triangle]
+        twice_area = (x2 - x1) * (y3 - y1) - (x3 - x1) * (y2 - y1)
+        b = np.array([y2 - y3, y3 - y1, y1 - y2]) / twice_area    # dN/dx
+        c = np.array([x3 - x2, x1 - x3, x2 - x1]) / twice_area    # dN/dy
+        strain = np.zeros((3, 6))
+        strain[0, 0::2], strain[1, 1::2] = b, c
+        strain[2, 0::2], strain[2, 1::2] = c, b
+        dofs = np.ravel([[2 * node, 2 * node + 1] for node in triangle])
+        stiffness[np.ix_(dofs, dofs)] += 0.5 * twice_area * strain.T @ elasticity @ strain
+    return stiffness
+
+
+def p1_body_force(nodes, triangles, force):
+    """Consistent nodal load of a constant body force on linear triangles: a third of each
+    triangle's area times the force at each of its corners."""
+    load = np.zeros((len(nodes), 2))
+    for triangle in triangles:
+        (x1, y1), (x2, y2), (x3, y3) = nodes[triangle]
+        area = 0.5 * abs((x2 - x1) * (y3 - y1) - (x3 - x1) * (y2 - y1))
+        load[triangle] += area / 3.0 * np.asarray(force)
+    return load.ravel()
+
+
+def plane_strain_elasticity(young, poisson):
+    """The plane-strain Voigt stiffness, written out here (not the package's)."""
+    factor = young / ((1.0 + poisson) * (1.0 - 2.0 * poisson))
+    return factor * np.array([[1.0 - poisson, poisson, 0.0], [poisson, 1.0 - poisson, 0.0],
+                              [0.0, 0.0, 0.5 - poisson]])

@@ -1,24 +1,36 @@
 """The command line of robin-subdomain-py (python/robin-subdomain-py), run as a process: the
 CurveZMQ options of robin-subdomain are refused with exit status 2 and a message that says the
-server speaks plain ZeroMQ only and points to docs/security.md, before anything is bound.
+server speaks plain ZeroMQ only and points to docs/security.md, before anything is bound;
+--data-directory and --output-root must name existing directories (else exit status 2); a server
+started with them reads SetupBody.mesh_path only under the data directory and writes
+FieldsRequest.write_directory only under the output root, answers after refusals and exits 0
+after Shutdown.
 """
 
 import os
+import pathlib
+import shutil
 import subprocess
 import sys
+import tempfile
 import unittest
 
 import support
+from robin_subdomain.proto_module import load_protocol
 
 SERVER = support.PYTHON_DIRECTORY / "robin-subdomain-py"
+protocol = load_protocol()
+
+
+def server_environment():
+    return dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
 
 
 def run_server(*arguments):
     """Runs the server with `arguments`; returns (exit status, stdout, stderr)."""
-    environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
     completed = subprocess.run([sys.executable, str(SERVER)] + list(arguments),
                                capture_output=True, text=True, timeout=60, check=False,
-                               stdin=subprocess.DEVNULL, env=environment)
+                               stdin=subprocess.DEVNULL, env=server_environment())
     return completed.returncode, completed.stdout, completed.stderr
 
 
@@ -50,6 +62,95 @@ class CurveOptions(unittest.TestCase):
         status, _, stderr = run_server("--listen", "tcp://127.0.0.1:*", "--no-such-option")
         self.assertEqual(status, 2)
         self.assertIn("unrecognized arguments: --no-such-option", stderr)
+
+
+class Directories(unittest.TestCase):
+    def setUp(self):
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-py-command-line-"))
+        self.data = self.scratch / "data"
+        self.output = self.scratch / "output"
+        self.data.mkdir()
+        self.output.mkdir()
+        shutil.copy(support.TEST_DATA / "case_lower.msh", self.data / "lower.msh")
+        shutil.copy(support.TEST_DATA / "case_lower.msh", self.scratch / "outside.msh")
+
+    def tearDown(self):
+        shutil.rmtree(self.scratch)
+
+    def test_missing_directories_are_refused(self):
+        missing = str(self.scratch / "missing")
+        for option in ("--data-directory", "--output-root"):
+            status, stdout, stderr = run_server("--listen", "tcp://127.0.0.1:*", option, missing)
+            self.assertEqual(status, 2, stderr)
+            self.assertEqual(stdout, "")
+            self.assertIn("%s '%s' is not an existing directory" % (option, missing), stderr)
+
+    def start_server(self):
+        """Starts the server with both directories; returns (process, ask) where ask(**content)
+        sends one request Envelope (version 2.0) and returns the reply Envelope."""
+        import zmq
+        process = subprocess.Popen(
+            [sys.executable, str(SERVER), "--listen", "tcp://127.0.0.1:*", "--log-level", "warn",
+             "--data-directory", str(self.data), "--output-root", str(self.output)],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
+            text=True, env=server_environment())
+        self.addCleanup(self.stop, process)
+        line = process.stdout.readline()
+        self.assertTrue(line.startswith("listening on "), line)
+        context = zmq.Context()
+        self.addCleanup(context.term)
+        socket = context.socket(zmq.REQ)
+        self.addCleanup(socket.close, 0)
+        socket.setsockopt(zmq.RCVTIMEO, 30000)
+        socket.connect(line.split()[-1])
+
+        def ask(**content):
+            envelope = protocol.Envelope(request_id=3)
+            envelope.version.major = 2
+            for name, message in content.items():
+                getattr(envelope, name).CopyFrom(message)
+            socket.send(envelope.SerializeToString())
+            reply = protocol.Envelope()
+            reply.ParseFromString(socket.recv())
+            return reply
+
+        return process, ask
+
+    @staticmethod
+    def setup_body(path):
+        body = protocol.SetupBody(body_name="lower", mesh_path=path, model=protocol.PLANE_STRAIN,
+                                  young_modulus=1000.0, poisson_ratio=0.3,
+                                  contact_boundaries=["contact"])
+        body.dirichlet.add(boundary="bottom", x=0.0, y=0.0)
+        return body
+
+    def test_served_files_stay_under_the_directories(self):
+        process, ask = self.start_server()
+        refused = ask(setup_body=self.setup_body("../outside.msh"))
+        self.assertEqual(refused.error.code, protocol.BAD_INPUT)
+        self.assertIn("leaves the server's data directory", refused.error.message)
+        self.assertEqual(ask(hello=protocol.Hello()).hello_reply.state, "awaiting_setup")
+        interface = ask(setup_body=self.setup_body("lower.msh")).interface
+        self.assertEqual(len(interface.node_ids), 3)     # y = 0 of [0, 1] x [-1, 0], h = 0.5
+        assign = support.node_to_node_assignment(protocol, interface)
+        self.assertEqual(ask(assign_contact=assign).acknowledge.state, "ready")
+        fields = protocol.FieldsRequest(contact_force=[0.0] * 3, write_directory="../escape")
+        self.assertEqual(ask(fields=fields).error.code, protocol.INVALID_ARGUMENT)
+        fields.write_directory = "run"
+        written = ask(fields=fields).fields_reply.written_file
+        self.assertEqual(written, str(self.output.resolve() / "run" / "lower.vtu"))
+        self.assertTrue(os.path.isfile(written))
+        self.assertEqual(sorted(os.listdir(self.scratch)), ["data", "output", "outside.msh"])
+        self.assertEqual(ask(shutdown=protocol.Shutdown()).acknowledge.state, "ready")
+        self.assertEqual(process.wait(timeout=30), 0)
+
+    @staticmethod
+    def stop(process):
+        """Ends the server this test started (if still running) and closes its pipe."""
+        if process.poll() is None:
+            process.kill()
+            process.wait(timeout=30)
+        process.stdout.close()
 
 
 if __name__ == "__main__":

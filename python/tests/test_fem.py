@@ -8,6 +8,8 @@
 - Body force, boundary weights and outward normals of a rectangle: totals and directions.
 - The .msh 2.2 and 4.1 files of the same mesh read alike (binary and 4.0 files through gmsh);
   rigid motions left free and conflicting Dirichlet values are refused.
+- MeshData (protocol 2.0): a mesh sent as data decodes to the mesh it was made from, the patch
+  tests pass through it, and a crossed ("bow-tie") quadrilateral is refused by its tag.
 """
 
 import os
@@ -20,12 +22,15 @@ import scipy.sparse.linalg
 
 import support
 from robin_subdomain import fem
+from robin_subdomain.mesh_data import decode_mesh_data
+from robin_subdomain.proto_module import load_protocol
 from robin_subdomain.body import Body, BodyDefinition
 from robin_subdomain.errors import InputError, SingularBodyError
 from robin_subdomain.material import (PLANE_STRAIN, PLANE_STRESS, isotropic_material,
                                       voigt_material)
 from robin_subdomain.mesh import QUADRILATERAL4, TRIANGLE3, TRIANGLE6, read_mesh
 
+protocol = load_protocol()
 YOUNG, POISSON = 210.0, 0.3
 # u(x) = a + G x with a general (non-symmetric) gradient G
 OFFSET = np.array([0.01, -0.02])
@@ -37,8 +42,17 @@ def hexagon(element_order=1, recombine=False):
                      element_order, recombine)
 
 
+def through_mesh_data(mesh, source="test"):
+    """The mesh sent as MeshData and decoded by the server."""
+    return decode_mesh_data(support.mesh_data(protocol, mesh, source), protocol, "body 'test'")
+
+
 class PatchTest(unittest.TestCase):
+    THROUGH_MESH_DATA = False
+
     def check_patch(self, mesh, expected_type):
+        if self.THROUGH_MESH_DATA:
+            mesh = through_mesh_data(mesh)
         self.assertIn(expected_type, [block.type for block in mesh.blocks])
         material = isotropic_material(YOUNG, POISSON, PLANE_STRAIN, "patch")
         stiffness = fem.assemble_stiffness(mesh, material)
@@ -69,6 +83,10 @@ class PatchTest(unittest.TestCase):
         self.check_patch(hexagon(recombine=True), QUADRILATERAL4)
 
 
+class PatchTestThroughMeshData(PatchTest):
+    THROUGH_MESH_DATA = True
+
+
 def rectangle(element_order=1, recombine=False):
     return support.mesh_from_geo(support.RECTANGLE_GEO, 0.0, element_order, recombine)
 
@@ -77,7 +95,7 @@ def uniaxial_body(mesh, material, traction):
     """Rollers on the left (u_x = 0) and bottom (u_y = 0); `traction` on the right."""
     return Body(BodyDefinition("block", mesh, material, (0.0, 0.0),
                                [("left", 0.0, None), ("bottom", None, 0.0)], [traction],
-                               "top"))
+                               ["top"]))
 
 
 class UniaxialTension(unittest.TestCase):
@@ -194,16 +212,47 @@ class MeshesAndConditions(unittest.TestCase):
     def test_free_rotation_is_a_singular_body(self):
         material = isotropic_material(YOUNG, POISSON, PLANE_STRAIN, "test")
         definition = BodyDefinition("loose", rectangle(), material, (0.0, 0.0),
-                                    [("left", 0.0, None)], [], "top")
+                                    [("left", 0.0, None)], [], ["top"])
         with self.assertRaises(SingularBodyError):
             Body(definition)
 
     def test_conflicting_dirichlet_values_are_refused(self):
         material = isotropic_material(YOUNG, POISSON, PLANE_STRAIN, "test")
         definition = BodyDefinition("clash", rectangle(), material, (0.0, 0.0),
-                                    [("left", 0.0, 0.0), ("bottom", 0.1, 0.0)], [], "top")
+                                    [("left", 0.0, 0.0), ("bottom", 0.1, 0.0)], [], ["top"])
         with self.assertRaisesRegex(InputError, "prescribe different values"):
             Body(definition)
+
+
+
+class MeshDataDecoding(unittest.TestCase):
+    def test_decodes_to_the_mesh_it_was_made_from(self):
+        mesh = read_mesh(support.TEST_DATA / "mesh_square_v41.msh", "v41")
+        decoded = through_mesh_data(mesh)
+        np.testing.assert_array_equal(decoded.nodes, mesh.nodes)
+        np.testing.assert_array_equal(decoded.node_tags, mesh.node_tags)
+        self.assertEqual([block.type for block in decoded.blocks], [TRIANGLE3])
+        np.testing.assert_array_equal(decoded.blocks[0].connectivity, mesh.blocks[0].connectivity)
+        np.testing.assert_array_equal(decoded.blocks[0].tags, np.arange(1, 15))
+        self.assertEqual(sorted(decoded.boundaries), sorted(mesh.boundaries))
+        for name, group in mesh.boundaries.items():
+            np.testing.assert_array_equal(decoded.boundaries[name].connectivity,
+                                          group.connectivity)
+
+    def quadrilateral(self, corners):
+        message = protocol.MeshData(dimension=2, source="quadrilateral.msh")
+        message.coordinates.extend(np.ravel(corners).tolist())
+        message.cells.add(type=protocol.QUADRILATERAL4, connectivity=[0, 1, 2, 3], tags=[5])
+        return decode_mesh_data(message, protocol, "body 'test'")
+
+    def test_crossed_quadrilateral_is_refused(self):
+        self.assertEqual(self.quadrilateral([[0, 0], [1, 0], [1.2, 1], [0, 0.8]])
+                         .element_count(), 1)
+        # corners 0, 1, 2 turn left, the last edge crosses the first: a bow tie
+        with self.assertRaisesRegex(InputError, r"^body 'test': SetupBody.mesh.cells\[0\]: cell "
+                                    r"tag 5 \(quadrilateral4\) is inverted, folded or "
+                                    r"degenerate.*\(mesh 'quadrilateral.msh'\)$"):
+            self.quadrilateral([[0, 0], [1, 0], [0, 1], [1, 1]])
 
 
 if __name__ == "__main__":

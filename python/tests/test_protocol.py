@@ -1,67 +1,106 @@
-"""The protocol state machine of the Python subdomain server, without a socket: states and their
-transitions, the error codes of refused requests, and replies that echo the request id and carry
-version 1.2. The Neumann solve of 1.1 through the protocol: its refusals, and its answer equal to
-e - F lambda assembled from the server's own contact-solve and correction replies. The run rule of
-1.2 (Envelope.run_id): another run's requests are WRONG_STATE and change nothing, the body's run
-and requests without run_id are served. A temporary directory that cannot hold the files for gmsh
-is the server's fault: INTERNAL, naming the body.
+"""The protocol state machine of the Python subdomain server (protocol 2.0), without a socket:
+states and their transitions, the error codes of refused requests, and replies that echo the
+request id and carry version 2.0 (a 1.x request is VERSION_MISMATCH naming both versions).
+SetupBody: MeshData checked (sizes, indices, names, inverted or folded cells named by tag and
+source), mesh_path confined to the data directory, InterfaceDescription with its fixed components
+and its segments oriented with the body on their left. AssignContact: every inconsistency of the
+compressed-row operator is INVALID_ARGUMENT naming the field. The Neumann solve (since 1.1), the
+run rule of 1.2, FieldsRequest.write_directory confined to the output root, SOLVER_FAILURE instead
+of a non-finite reply. After every error the server answers a following Hello.
 """
 
 import os
 import pathlib
+import shutil
 import tempfile
 import unittest
+from unittest import mock
 
 import numpy as np
 
 import support
+from robin_subdomain import setup_decoding
 from robin_subdomain.proto_module import load_protocol
 from robin_subdomain.protocol import SubdomainProtocol
 
 protocol = load_protocol()
-LOWER_GEO = (support.REPOSITORY / "examples" / "meshes" / "block_lower.geo").read_bytes()
+LOWER_GEO_PATH = support.REPOSITORY / "examples" / "meshes" / "block_lower.geo"
+# block_lower.geo with h = 0.5: [-1, 1] x [-1, 0], contact edge y = 0 meshed from x = -1 to 1.
+LOWER_MESH = support.mesh_data(protocol, support.mesh_from_geo(LOWER_GEO_PATH.read_text(), 0.5),
+                               "block_lower.geo")
 
 
-def request(request_id=7, major=1, run_id="", **content):
+def request(request_id=7, major=2, minor=0, run_id="", **content):
     envelope = protocol.Envelope()
     envelope.request_id = request_id
     envelope.run_id = run_id
     if major is not None:
         envelope.version.major = major
+        envelope.version.minor = minor
     for name, message in content.items():
         getattr(envelope, name).CopyFrom(message)
     return envelope.SerializeToString()
 
 
-def setup_body(**changes):
-    message = protocol.SetupBody(body_name="lower", mesh_content=LOWER_GEO, mesh_extension=".geo",
-                                 mesh_size=0.5, model=protocol.PLANE_STRAIN, young_modulus=1000.0,
-                                 poisson_ratio=0.3, contact_boundary="contact")
+def setup_body(mesh=LOWER_MESH, **changes):
+    """The lower block: bottom clamped, contact boundary 'contact'."""
+    message = protocol.SetupBody(body_name="lower", model=protocol.PLANE_STRAIN,
+                                 young_modulus=1000.0, poisson_ratio=0.3,
+                                 contact_boundaries=["contact"])
+    if mesh is not None:
+        message.mesh.CopyFrom(mesh)
     condition = message.dirichlet.add()
     condition.boundary, condition.x, condition.y = "bottom", 0.0, 0.0
     for name, value in changes.items():
-        setattr(message, name, value)
+        if isinstance(value, list):
+            message.ClearField(name)
+            getattr(message, name).extend(value)
+        else:
+            setattr(message, name, value)
     return message
 
 
-class StateMachine(unittest.TestCase):
+def changed_mesh(change):
+    """A copy of LOWER_MESH after change(copy)."""
+    mesh = protocol.MeshData()
+    mesh.CopyFrom(LOWER_MESH)
+    change(mesh)
+    return mesh
+
+
+class ServerTestCase(unittest.TestCase):
+    def make_server(self, **options):
+        server = SubdomainProtocol(protocol, **options)
+        server.logger.disabled = True
+        return server
+
     def setUp(self):
-        self.server = SubdomainProtocol(protocol)
-        self.server.logger.disabled = True
+        self.server = self.make_server()
 
     def ask(self, data):
         reply = protocol.Envelope()
         reply.ParseFromString(self.server.handle(data))
-        self.assertEqual((reply.version.major, reply.version.minor), (1, 2))
+        self.assertEqual((reply.version.major, reply.version.minor), (2, 0))
         return reply
 
     def expect_error(self, data, code, state):
+        """The message of the expected Error; the server then answers a Hello."""
         reply = self.ask(data)
         self.assertEqual(reply.WhichOneof("content"), "error", reply)
         self.assertEqual(protocol.ErrorCode.Name(reply.error.code), code, reply.error.message)
         self.assertEqual(reply.error.state, state)
+        hello = self.ask(request(request_id=1000, hello=protocol.Hello()))
+        self.assertEqual(hello.hello_reply.state, state)
         return reply.error.message
 
+    def set_up_and_assign(self, body=None):
+        interface = self.ask(request(setup_body=body or setup_body())).interface
+        assign = support.node_to_node_assignment(protocol, interface)
+        self.assertEqual(self.ask(request(assign_contact=assign)).acknowledge.state, "ready")
+        return interface
+
+
+class StateMachine(ServerTestCase):
     def test_garbage_is_malformed_and_the_server_goes_on(self):
         self.expect_error(b"\xff\xfe not protobuf", "MALFORMED_MESSAGE", "awaiting_setup")
         reply = self.ask(request(request_id=11, hello=protocol.Hello()))
@@ -74,10 +113,12 @@ class StateMachine(unittest.TestCase):
         self.expect_error(request(), "MALFORMED_MESSAGE", "awaiting_setup")
         self.expect_error(request(major=None, hello=protocol.Hello()), "MALFORMED_MESSAGE",
                           "awaiting_setup")
-        message = self.expect_error(request(major=2, hello=protocol.Hello()), "VERSION_MISMATCH",
-                                    "awaiting_setup")
-        self.assertIn("2.0", message)
-        self.assertIn("this server 1.2", message)
+        for major, minor in ((1, 2), (1, 0), (3, 1)):
+            message = self.expect_error(request(major=major, minor=minor, hello=protocol.Hello()),
+                                        "VERSION_MISMATCH", "awaiting_setup")
+            self.assertIn("the request speaks %d.%d, this server 2.0" % (major, minor), message)
+        self.expect_error(request(major=1, minor=2, setup_body=setup_body()), "VERSION_MISMATCH",
+                          "awaiting_setup")
         self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
                           "awaiting_setup")
         # field 31 of the Envelope: a request type this version does not know
@@ -86,18 +127,26 @@ class StateMachine(unittest.TestCase):
     def test_states_and_transitions(self):
         solve = protocol.ContactSolveRequest(obstacle=[0.0])
         self.expect_error(request(contact_solve=solve), "WRONG_STATE", "awaiting_setup")
-        reply = self.ask(request(setup_body=setup_body()))
-        interface = reply.interface
+        body = setup_body()
+        body.dirichlet.add(boundary="left", x=0.0)
+        interface = self.ask(request(setup_body=body)).interface
         self.assertEqual(interface.body_name, "lower")
+        self.assertEqual(interface.dimension, 2)
         count = len(interface.node_ids)
         self.assertEqual(count, 5)  # the transfinite contact edge, h = 0.5
+        self.assertEqual(list(interface.node_ids), sorted(interface.node_ids))
+        coordinates = np.array(interface.coordinates).reshape(-1, 2)
+        np.testing.assert_allclose(np.sort(coordinates[:, 0]), [-1, -0.5, 0, 0.5, 1], atol=1e-11)
+        np.testing.assert_array_equal(coordinates[:, 1], 0.0)
         np.testing.assert_allclose(np.array(interface.normals).reshape(-1, 2),
                                    np.tile([0.0, 1.0], (count, 1)), atol=1e-15)
         self.assertAlmostEqual(sum(interface.weights), 2.0, delta=1e-14)
+        # only the corner (-1, 0) lies on 'left', whose u_x is prescribed
+        fixed = np.array(interface.fixed).reshape(-1, 2)
+        np.testing.assert_array_equal(fixed[:, 0], coordinates[:, 0] == -1.0)
+        np.testing.assert_array_equal(fixed[:, 1], False)
         self.expect_error(request(contact_solve=solve), "WRONG_STATE", "awaiting_assignment")
-        bad = protocol.AssignContact(node_ids=[interface.node_ids[0]], normals=[0.0, 2.0])
-        self.expect_error(request(assign_contact=bad), "INVALID_ARGUMENT", "awaiting_assignment")
-        good = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
+        good = support.node_to_node_assignment(protocol, interface)
         self.assertEqual(self.ask(request(assign_contact=good)).acknowledge.state, "ready")
         self.expect_error(request(contact_solve=solve), "INVALID_ARGUMENT", "ready")
         solve = protocol.ContactSolveRequest(obstacle=[1.0] * count)
@@ -110,6 +159,39 @@ class StateMachine(unittest.TestCase):
                          "awaiting_setup")
         self.assertTrue(self.server.shutdown_requested)
 
+    def test_surface_segments_have_the_body_on_their_left(self):
+        interface = self.ask(request(setup_body=setup_body())).interface
+        self.assertEqual(len(interface.surfaces), 1)
+        surface = interface.surfaces[0]
+        self.assertEqual(surface.boundary, "contact")
+        self.assertEqual(surface.segment_type, protocol.LINE2)
+        coordinates = np.array(interface.coordinates).reshape(-1, 2)
+        segments = np.array(surface.segments).reshape(-1, 2)
+        self.assertEqual(len(segments), 4)
+        # the body lies below y = 0: with it on the left, every segment runs towards -x (the mesh
+        # has them towards +x), and the clockwise-turned direction (t_y, -t_x) is +y
+        directions = coordinates[segments[:, 1]] - coordinates[segments[:, 0]]
+        np.testing.assert_allclose(directions, np.tile([-0.5, 0.0], (4, 1)), atol=1e-11)
+        self.assertEqual(sorted(set(segments.ravel())), list(range(5)))
+
+    def test_two_contact_boundaries(self):
+        reply = self.ask(request(setup_body=setup_body(contact_boundaries=["contact", "right"])))
+        interface = reply.interface
+        coordinates = np.array(interface.coordinates).reshape(-1, 2)
+        on_contact = coordinates[:, 1] == 0.0
+        on_right = coordinates[:, 0] == 1.0
+        self.assertTrue(np.all(on_contact | on_right))
+        self.assertEqual((on_contact.sum(), on_right.sum(), len(coordinates)), (5, 3, 7))
+        self.assertEqual([surface.boundary for surface in interface.surfaces],
+                         ["contact", "right"])
+        self.assertAlmostEqual(sum(interface.weights), 3.0, delta=1e-14)  # lengths 2 + 1
+        normals = np.array(interface.normals).reshape(-1, 2)
+        corner = np.flatnonzero(on_contact & on_right)[0]
+        np.testing.assert_allclose(normals[corner], [np.sqrt(0.5), np.sqrt(0.5)], atol=1e-12)
+        right = np.array(interface.surfaces[1].segments).reshape(-1, 2)
+        directions = coordinates[right[:, 1]] - coordinates[right[:, 0]]
+        np.testing.assert_allclose(directions, np.tile([0.0, 0.5], (2, 1)), atol=1e-11)
+
     def test_neumann_solve(self):
         neumann = protocol.NeumannSolveRequest(iteration=3, contact_force=[0.0])
         self.expect_error(request(neumann_solve=neumann), "WRONG_STATE", "awaiting_setup")
@@ -118,11 +200,10 @@ class StateMachine(unittest.TestCase):
         interface = self.ask(request(setup_body=loaded)).interface
         count = len(interface.node_ids)
         self.expect_error(request(neumann_solve=neumann), "WRONG_STATE", "awaiting_assignment")
-        assign = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
-        self.ask(request(assign_contact=assign))
+        self.ask(request(assign_contact=support.node_to_node_assignment(protocol, interface)))
         message = self.expect_error(request(neumann_solve=neumann), "INVALID_ARGUMENT", "ready")
-        self.assertIn("NeumannSolveRequest.contact_force has 1 values for the %d" % count,
-                      message)
+        self.assertIn("NeumannSolveRequest.contact_force has 1 values for the %d constraints" %
+                      count, message)
         for bad in (float("nan"), float("inf")):
             neumann = protocol.NeumannSolveRequest(contact_force=[1.0] * (count - 1) + [bad])
             message = self.expect_error(request(neumann_solve=neumann), "INVALID_ARGUMENT",
@@ -152,7 +233,7 @@ class StateMachine(unittest.TestCase):
         self.assertEqual(reply.run_id, run)                       # echoed
         interface = reply.interface
         count = len(interface.node_ids)
-        assign = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
+        assign = support.node_to_node_assignment(protocol, interface)
 
         def refused(state, **content):
             message = self.expect_error(request(run_id=other, **content), "WRONG_STATE", state)
@@ -175,7 +256,7 @@ class StateMachine(unittest.TestCase):
         refused("ready", end_run=protocol.EndRun())
         refused("ready", assign_contact=assign)
         self.assertEqual(self.server.state, "ready")
-        # the run's own requests, and those without run_id (a 1.1 coordinator), are served
+        # the run's own requests, and those without run_id, are served
         for run_id in (run, ""):
             reply = self.ask(request(run_id=run_id, contact_solve=solve))
             self.assertEqual(reply.run_id, run_id)
@@ -197,37 +278,12 @@ class StateMachine(unittest.TestCase):
 
     def test_body_set_up_without_run_id_serves_every_run(self):
         interface = self.ask(request(setup_body=setup_body())).interface
-        assign = protocol.AssignContact(node_ids=interface.node_ids, normals=interface.normals)
+        assign = support.node_to_node_assignment(protocol, interface)
         self.assertEqual(self.ask(request(run_id="b", assign_contact=assign)).acknowledge.state,
                          "ready")
         solve = protocol.ContactSolveRequest(obstacle=[1.0] * len(interface.node_ids))
         self.assertEqual(self.ask(request(run_id="c", contact_solve=solve)).contact_result.status,
                          protocol.CONVERGED)
-
-    def test_bad_bodies(self):
-        self.expect_error(request(setup_body=setup_body(poisson_ratio=0.5)), "BAD_INPUT",
-                          "awaiting_setup")
-        message = self.expect_error(request(setup_body=setup_body(contact_boundary="lid")),
-                                    "BAD_INPUT", "awaiting_setup")
-        self.assertIn("bottom, contact, left, right", message)
-        singular = setup_body()
-        singular.ClearField("dirichlet")
-        self.expect_error(request(setup_body=singular), "SINGULAR_BODY", "awaiting_setup")
-        self.expect_error(request(setup_body=setup_body(mesh_content=b"Point(1) = {0, 0, 0;")),
-                          "BAD_INPUT", "awaiting_setup")
-
-    def test_geo_script_that_runs_a_command_is_refused_unrun(self):
-        witness = pathlib.Path(tempfile.gettempdir()) / ("robin-py-geo-witness-%d" % os.getpid())
-        witness.unlink(missing_ok=True)
-        hostile = LOWER_GEO + b'\nSystemCall "touch %s";\n' % str(witness).encode()
-        message = self.expect_error(request(setup_body=setup_body(mesh_content=hostile)),
-                                    "BAD_INPUT", "awaiting_setup")
-        self.assertIn("body 'lower': SetupBody.mesh_content line", message)
-        self.assertIn("'SystemCall' is refused", message)
-        self.assertFalse(witness.exists())
-        harmless = LOWER_GEO + b'\n// SystemCall "touch x";\nDummy = StrCat("Include");\n'
-        self.ask(request(setup_body=setup_body(mesh_content=harmless)))
-        self.assertEqual(self.server.state, "awaiting_assignment")
 
     def test_failed_setup_discards_the_previous_body(self):
         self.ask(request(setup_body=setup_body()))
@@ -235,21 +291,356 @@ class StateMachine(unittest.TestCase):
         self.expect_error(request(setup_body=setup_body(young_modulus=-1.0)), "BAD_INPUT",
                           "awaiting_setup")
 
+
+class BadBodies(ServerTestCase):
+    def refused(self, body, *fragments, code="BAD_INPUT"):
+        message = self.expect_error(request(setup_body=body), code, "awaiting_setup")
+        for fragment in fragments:
+            self.assertIn(fragment, message)
+        return message
+
+    def test_definition(self):
+        self.refused(setup_body(poisson_ratio=0.5), "Poisson ratio")
+        self.refused(setup_body(contact_boundaries=["lid"]), "SetupBody.contact_boundaries[0]",
+                     "'lid' is not a boundary of the mesh (its boundaries: bottom, contact, "
+                     "left, right)")
+        self.refused(setup_body(contact_boundaries=[]), "SetupBody.contact_boundaries is empty")
+        self.refused(setup_body(contact_boundaries=["contact", "contact"]),
+                     "contact_boundaries[1] repeats 'contact'")
+        self.refused(setup_body(body_name="b" * 65), "SetupBody.body_name", "1 to 64 characters")
+        self.refused(setup_body(body_name="../lower"), "SetupBody.body_name")
+        singular = setup_body()
+        singular.ClearField("dirichlet")
+        self.refused(singular, code="SINGULAR_BODY")
+        self.refused(setup_body(mesh=None), "SetupBody.mesh and SetupBody.mesh_path are both "
+                     "empty")
+        three = setup_body()
+        three.dirichlet.add(boundary="left", z=0.0)
+        self.refused(three, "dirichlet[1].z")
+
+    def test_mesh_data_sizes_and_indices(self):
+        node_count = len(LOWER_MESH.coordinates) // 2
+
+        def refused(change, *fragments):
+            message = self.refused(setup_body(mesh=changed_mesh(change)), *fragments)
+            self.assertTrue(message.startswith("body 'lower': SetupBody.mesh."), message)
+            self.assertIn("(mesh 'block_lower.geo')", message)
+
+        refused(lambda mesh: setattr(mesh, "dimension", 3), "mesh.dimension is 3, expected 2")
+        refused(lambda mesh: mesh.coordinates.append(0.5),
+                "mesh.coordinates has %d values, expected 2 per node" % (2 * node_count + 1))
+        refused(lambda mesh: mesh.coordinates.__setitem__(5, float("inf")),
+                "coordinates of node 3 (1-based position) are not finite")
+        refused(lambda mesh: mesh.node_tags.append(99),
+                "node_tags has %d values for %d nodes" % (node_count + 1, node_count))
+        refused(lambda mesh: mesh.cells[0].connectivity.__setitem__(4, node_count),
+                "mesh.cells[0].connectivity[4] is %d, not an index of the %d nodes" %
+                (node_count, node_count))
+        refused(lambda mesh: mesh.cells[0].connectivity.__setitem__(4, 2 ** 32 - 1),
+                "mesh.cells[0].connectivity[4] is 4294967295")
+        refused(lambda mesh: mesh.cells[0].connectivity.append(0),
+                "mesh.cells[0].connectivity has 67 entries, not a multiple of the 3 nodes")
+        refused(lambda mesh: mesh.cells[0].tags.append(1), "cells[0].tags has 23 values for 22")
+        refused(lambda mesh: setattr(mesh.cells[0], "type", protocol.LINE2),
+                "mesh.cells[0].type is LINE2, expected TRIANGLE3 or TRIANGLE6 or QUADRILATERAL4")
+        refused(lambda mesh: mesh.boundaries[1].segments.connectivity.__setitem__(0, 10 ** 6),
+                "mesh.boundaries[1].segments.connectivity[0] is 1000000")
+        refused(lambda mesh: setattr(mesh.boundaries[0].segments, "type", protocol.TRIANGLE3),
+                "boundaries[0].segments.type is TRIANGLE3, expected LINE2 or LINE3")
+        refused(lambda mesh: setattr(mesh.boundaries[2], "name", "le ft"),
+                "boundaries[2].name 'le ft' is not a boundary name")
+        refused(lambda mesh: setattr(mesh.boundaries[2], "name", "x" * 65),
+                "is not a boundary name ([A-Za-z0-9_.-], 1 to 64 characters)")
+        refused(lambda mesh: setattr(mesh.boundaries[2], "name", "contact"),
+                "boundaries[2].name 'contact' names two boundaries")
+        refused(lambda mesh: mesh.ClearField("cells"), "mesh.cells holds no domain cell")
+        # a node no cell uses (the last triangle dropped leaves its nodes... add a stray node)
+        refused(lambda mesh: mesh.coordinates.extend([5.0, 5.0]) or mesh.node_tags.append(999),
+                "define node %d (1-based position), which is not a node of any domain cell" %
+                (node_count + 1))
+
+    def inverted(self, change, *fragments):
+        message = self.refused(setup_body(mesh=changed_mesh(change)), *fragments)
+        self.assertIn("is inverted, folded or degenerate", message)
+        self.assertIn("(mesh 'block_lower.geo')", message)
+        return message
+
+    def test_inverted_triangle_is_refused_naming_its_tag(self):
+        def invert_cell_eight(mesh):
+            mesh.cells[0].tags[:] = range(101, 123)
+            first, second = mesh.cells[0].connectivity[22:24]
+            mesh.cells[0].connectivity[22:24] = [second, first]
+
+        self.inverted(invert_cell_eight, "body 'lower': SetupBody.mesh.cells[0]: cell tag 108 ")
+
+        def invert_without_tags(mesh):
+            mesh.cells[0].ClearField("tags")
+            first, second = mesh.cells[0].connectivity[0:2]
+            mesh.cells[0].connectivity[0:2] = [second, first]
+
+        self.inverted(invert_without_tags, "cell at position 1 (triangle3)")
+
+        def collapse(mesh):
+            """Cell k gets two equal corners; its replaced node is kept by another cell."""
+            cells = np.array(mesh.cells[0].connectivity).reshape(-1, 3)
+            uses = np.bincount(cells.ravel())
+            self.collapsed = next(k for k in range(len(cells)) if uses[cells[k, 1]] > 1)
+            mesh.cells[0].connectivity[3 * self.collapsed + 1] = int(cells[self.collapsed, 0])
+
+        self.inverted(collapse, "Jacobian is 0 ")
+        self.inverted(collapse, "cell tag %d (triangle3)" % (self.collapsed + 1))
+
+    def test_folded_quadratic_triangle_is_refused(self):
+        # one 6-node triangle, corners counter-clockwise, the midpoint of edge 0-1 pulled across
+        # the opposite corner: the corners alone look fine, the element is folded
+        mesh = protocol.MeshData(dimension=2, source="folded.msh")
+        mesh.coordinates.extend([0, 0, 1, 0, 0, 1, 0.5, 1.2, 0.5, 0.5, 0, 0.5])
+        mesh.cells.add(type=protocol.TRIANGLE6, connectivity=range(6), tags=[41])
+        mesh.boundaries.add(name="edge").segments.CopyFrom(
+            protocol.CellBlock(type=protocol.LINE3, connectivity=[0, 1, 3]))
+        corners = np.array(mesh.coordinates).reshape(-1, 2)[:3]
+        twice_area = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+        self.assertGreater(twice_area, 0.0)                       # counter-clockwise corners
+        body = setup_body(mesh=mesh, contact_boundaries=["edge"])
+        body.dirichlet[0].boundary = "edge"
+        self.refused(body, "SetupBody.mesh.cells[0]: cell tag 41 (triangle6) is inverted, "
+                     "folded or degenerate", "(mesh 'folded.msh')")
+
+    def test_mesh_data_is_not_reordered(self):
+        """A clockwise mesh is refused as sent, not turned around."""
+        def clockwise(mesh):
+            cells = np.array(mesh.cells[0].connectivity).reshape(-1, 3)
+            mesh.cells[0].connectivity[:] = cells[:, [0, 2, 1]].ravel().tolist()
+
+        self.inverted(clockwise, "cell tag 1 (triangle3)")
+
+
+class MeshPath(ServerTestCase):
+    """SetupBody.mesh_path: only files under the data directory, and nothing else is read."""
+
+    def setUp(self):
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-py-data-"))
+        self.data = self.scratch / "data"
+        (self.data / "sub").mkdir(parents=True)
+        shutil.copy(support.TEST_DATA / "case_lower.msh", self.data / "sub" / "lower.msh")
+        shutil.copy(LOWER_GEO_PATH, self.data / "block_lower.geo")
+        shutil.copy(support.TEST_DATA / "case_lower.msh", self.scratch / "outside.msh")
+        (self.data / "passwd.msh").symlink_to("/etc/passwd")
+        (self.data / "outside-link.msh").symlink_to(self.scratch / "outside.msh")
+        (self.data / "etc").symlink_to("/etc")
+        (self.data / "inside-link.msh").symlink_to("sub/lower.msh")
+        self.server = self.make_server(data_directory=str(self.data))
+
+    def tearDown(self):
+        shutil.rmtree(self.scratch)
+
+    def body(self, path):
+        return setup_body(mesh=None, mesh_path=path)
+
+    def test_paths_under_the_data_directory_are_read(self):
+        for path in ("sub/lower.msh", "./sub/../sub/lower.msh", "inside-link.msh"):
+            interface = self.ask(request(setup_body=self.body(path))).interface
+            coordinates = np.array(interface.coordinates).reshape(-1, 2)
+            # case_lower.msh: [0, 1] x [-1, 0], its contact edge y = 0 in two segments
+            np.testing.assert_allclose(coordinates[:, 0], [1.0, 0.0, 0.5], atol=1e-11)
+            np.testing.assert_allclose(interface.weights, [0.25, 0.25, 0.5], rtol=1e-11)
+
+    def test_geo_file_of_the_data_directory_is_meshed(self):
+        interface = self.ask(request(setup_body=self.body("block_lower.geo"))).interface
+        self.assertAlmostEqual(sum(interface.weights), 2.0, delta=1e-13)  # the edge y = 0
+
+    def test_paths_that_leave_the_data_directory_are_refused_unread(self):
+        outside = str(self.scratch / "outside.msh")
+        inside_absolute = str(self.data / "sub" / "lower.msh")
+        with mock.patch.object(setup_decoding.mesh_reader, "read_mesh",
+                               wraps=setup_decoding.mesh_reader.read_mesh) as reader:
+            for path, reason in (("../outside.msh", "leaves the server's data directory"),
+                                 ("sub/../../outside.msh", "leaves the server's data directory"),
+                                 (outside, "is an absolute path"),
+                                 (inside_absolute, "is an absolute path"),
+                                 ("passwd.msh", "leaves the server's data directory"),
+                                 ("outside-link.msh", "leaves the server's data directory"),
+                                 ("etc/passwd", "leaves the server's data directory")):
+                message = self.expect_error(request(setup_body=self.body(path)), "BAD_INPUT",
+                                            "awaiting_setup")
+                self.assertIn("body 'lower': SetupBody.mesh_path %r %s" % (path, reason),
+                              message)
+            reader.assert_not_called()
+            self.ask(request(setup_body=self.body("sub/lower.msh")))
+            reader.assert_called_once()
+
+    def test_without_data_directory_every_mesh_path_is_refused(self):
+        self.server = self.make_server()
+        with mock.patch.object(setup_decoding.mesh_reader, "read_mesh") as reader:
+            for path in ("sub/lower.msh", str(self.data / "sub" / "lower.msh")):
+                message = self.expect_error(request(setup_body=self.body(path)), "BAD_INPUT",
+                                            "awaiting_setup")
+                self.assertIn("SetupBody.mesh_path %r is refused: the server was started "
+                              "without --data-directory" % path, message)
+            reader.assert_not_called()
+
     def test_unusable_temporary_directory_is_internal_and_names_the_body(self):
         saved = tempfile.tempdir
         tempfile.tempdir = "/nonexistent/robin-test-temporary-directory"
         try:
-            message = self.expect_error(request(setup_body=setup_body()), "INTERNAL",
-                                        "awaiting_setup")
+            message = self.expect_error(request(setup_body=self.body("block_lower.geo")),
+                                        "INTERNAL", "awaiting_setup")
         finally:
             tempfile.tempdir = saved
-        self.assertTrue(message.startswith("body 'lower': SetupBody.mesh_content: "), message)
+        self.assertTrue(message.startswith("body 'lower': SetupBody.mesh_path: "), message)
         self.assertIn("'/nonexistent/robin-test-temporary-directory'", message)
         self.assertIn("temporary directory (TMPDIR, else /tmp) is not writable or is full",
                       message)
         self.assertNotIn("internal error", message)
-        self.ask(request(setup_body=setup_body()))  # the server goes on
+        self.ask(request(setup_body=self.body("block_lower.geo")))  # the server goes on
         self.assertEqual(self.server.state, "awaiting_assignment")
+
+
+class AssignContactChecks(ServerTestCase):
+    def setUp(self):
+        super().setUp()
+        self.interface = self.ask(request(setup_body=setup_body())).interface
+        self.nodes = list(self.interface.node_ids)
+
+    def refused(self, message, field, fragment, state="awaiting_assignment"):
+        text = self.expect_error(request(assign_contact=message), "INVALID_ARGUMENT", state)
+        self.assertIn("AssignContact for body 'lower': AssignContact." + field, text)
+        self.assertIn(fragment, text)
+
+    def test_every_inconsistency_is_invalid_argument_naming_the_field(self):
+        a, b = self.nodes[:2]
+        not_contact = min(set(range(100)) - set(self.nodes))
+
+        def rows(*entries, offsets=None, weights=None):
+            message = support.sparse_rows(protocol, [(1.0, list(row)) for row in entries])
+            if offsets is not None:
+                message.row_offsets[:] = offsets
+            if weights is not None:
+                message.weights[:] = weights
+            return message
+
+        one = [(a, 1, 1.0)]
+        self.refused(rows(one, offsets=[]), "row_offsets", "must start with 0")
+        self.refused(rows(one, offsets=[1, 1]), "row_offsets", "must start with 0")
+        self.refused(rows(one, offsets=[0, 2]), "row_offsets", "ends with 2, expected the "
+                     "number of entries (1 values)")
+        message = rows(one)
+        message.node_ids.append(b)
+        self.refused(message, "node_ids", "has 2 values for 1 entries")
+        message = rows(one)
+        message.components.append(0)
+        self.refused(message, "components", "has 2 values for 1 entries")
+        self.refused(rows(one, weights=[1.0, 1.0]), "weights", "has 2 values for 1 constraints")
+        self.refused(rows(one, [(b, 1, 1.0)], offsets=[0, 0, 2], weights=[1.0, 1.0]),
+                     "row_offsets", "row 0 is empty")
+        self.refused(rows(one, [(b, 1, 1.0)], [(a, 0, 1.0)], offsets=[0, 2, 1, 3],
+                          weights=[1.0] * 3), "row_offsets", "row 1 ends before it starts")
+        self.refused(rows(one, [(not_contact, 1, 1.0)]), "node_ids[1]",
+                     "is %d, not a node of the contact boundaries" % not_contact)
+        self.refused(rows([(-1, 1, 1.0)]), "node_ids[0]", "is -1, not a node")
+        self.refused(rows([(a, 2, 1.0)]), "components[0]", "is 2, expected 0 (x) or 1 (y)")
+        self.refused(rows([(a, 1, float("nan"))]), "values[0]", "is not a finite number")
+        self.refused(rows([(a, 1, 1.0)], weights=[0.0]), "weights[0]", "is 0, expected > 0")
+        self.refused(rows([(a, 1, 1.0)], weights=[-2.0]), "weights[0]", "expected > 0")
+        self.refused(rows([(a, 1, 1.0)], weights=[float("inf")]), "weights[0]", "not a finite")
+        self.refused(rows([(a, 1, 1.0), (b, 1, 1.0), (a, 1, 0.5)]), "node_ids[2]",
+                     "repeats node id %d" % a)
+        # the same pair in two rows, and both components of a node in one row, are fine
+        good = rows([(a, 0, 0.6), (a, 1, 0.8)], [(a, 1, 1.0)])
+        self.assertEqual(self.ask(request(assign_contact=good)).acknowledge.state, "ready")
+        # a refused assignment keeps the previous one
+        self.refused(rows([(a, 2, 1.0)]), "components[0]", "expected 0 (x) or 1 (y)", "ready")
+        solve = protocol.ContactSolveRequest(obstacle=[1.0, 1.0])
+        self.assertEqual(self.ask(request(contact_solve=solve)).contact_result.status,
+                         protocol.CONVERGED)
+
+
+class FieldsOutput(ServerTestCase):
+    """FieldsRequest.write_directory: only under the output root, no symbolic link followed."""
+
+    def setUp(self):
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-py-output-"))
+        self.root = self.scratch / "root"
+        self.elsewhere = self.scratch / "elsewhere"
+        self.root.mkdir()
+        self.elsewhere.mkdir()
+        (self.root / "link").symlink_to(self.elsewhere)
+        self.server = self.make_server(output_root=str(self.root))
+        self.count = len(self.set_up_and_assign().node_ids)
+
+    def tearDown(self):
+        shutil.rmtree(self.scratch)
+
+    def fields(self, directory):
+        return request(fields=protocol.FieldsRequest(contact_force=[0.0] * self.count,
+                                                     write_directory=directory))
+
+    def test_written_under_the_output_root(self):
+        reply = self.ask(self.fields("results/run-1")).fields_reply
+        expected = self.root / "results" / "run-1" / "lower.vtu"
+        self.assertEqual(reply.written_file, str(expected))
+        self.assertTrue(expected.read_text().startswith('<?xml version="1.0"?>'))
+
+    def test_a_symbolic_link_at_the_target_is_replaced_not_followed(self):
+        victim = self.elsewhere / "victim.txt"
+        victim.write_text("untouched")
+        (self.root / "out").mkdir()
+        (self.root / "out" / "lower.vtu").symlink_to(victim)
+        self.ask(self.fields("out"))
+        self.assertEqual(victim.read_text(), "untouched")
+        target = self.root / "out" / "lower.vtu"
+        self.assertFalse(target.is_symlink())
+        self.assertIn("<VTKFile", target.read_text())
+
+    def test_directories_outside_the_root_are_refused(self):
+        for directory, reason in (("../escape", "contains '..'"),
+                                  ("results/../../escape", "contains '..'"),
+                                  (str(self.elsewhere), "is an absolute path"),
+                                  ("link", "goes through the symbolic link 'link'"),
+                                  ("link/sub", "goes through the symbolic link 'link'")):
+            message = self.expect_error(self.fields(directory), "INVALID_ARGUMENT", "ready")
+            self.assertIn("FieldsRequest.write_directory %r of body 'lower' %s" %
+                          (directory, reason), message)
+        self.assertEqual(list(self.elsewhere.iterdir()), [])
+        self.assertFalse((self.scratch / "escape").exists())
+        self.assertEqual([path.name for path in self.root.iterdir()], ["link"])
+
+    def test_without_output_root_write_directory_is_refused(self):
+        self.server = self.make_server()
+        self.set_up_and_assign()
+        message = self.expect_error(self.fields("results"), "INVALID_ARGUMENT", "ready")
+        self.assertIn("FieldsRequest.write_directory 'results' of body 'lower' is refused: the "
+                      "server was started without --output-root", message)
+        self.assertFalse(os.path.exists("results"))
+        self.assertEqual(len(self.ask(self.fields("")).fields_reply.point_fields), 6)
+
+
+class NonFiniteReplies(ServerTestCase):
+    """A reply that would carry a NaN or an infinity is Error(SOLVER_FAILURE) instead."""
+
+    def test_overflowing_forces_are_solver_failure(self):
+        scratch = tempfile.mkdtemp(prefix="robin-py-output-")
+        self.addCleanup(shutil.rmtree, scratch)
+        self.server = self.make_server(output_root=scratch)
+        interface = self.ask(request(setup_body=setup_body())).interface
+        node = interface.node_ids[2]
+        # two constraints on the same u_y: B' lambda = 1.5e308 + 1.5e308 overflows
+        assign = support.sparse_rows(protocol, [(1.0, [(node, 1, 1.0)]), (1.0, [(node, 1, 1.0)])])
+        self.ask(request(assign_contact=assign))
+        huge = [1.5e308, 1.5e308]
+        message = self.expect_error(
+            request(neumann_solve=protocol.NeumannSolveRequest(iteration=5, contact_force=huge)),
+            "SOLVER_FAILURE", "ready")
+        self.assertIn("body 'lower': NeumannSolveRequest iteration 5: the reply would carry the "
+                      "non-finite number NeumannSolveResult.normal_trace[0]", message)
+        fields = protocol.FieldsRequest(contact_force=huge, write_directory="out")
+        message = self.expect_error(request(fields=fields), "SOLVER_FAILURE", "ready")
+        self.assertIn("body 'lower': FieldsRequest: the reply would carry the non-finite number "
+                      "FieldsReply.point_fields[0].values", message)
+        self.assertEqual(os.listdir(scratch), [])          # nothing written
+        finite = protocol.NeumannSolveRequest(contact_force=[1.0, 1.0])
+        self.assertEqual(len(self.ask(request(neumann_solve=finite)).neumann_result.normal_trace),
+                         2)
 
 
 if __name__ == "__main__":
