@@ -134,6 +134,13 @@ void BodySolver::assemble() {
     throw InputError("body '" + name() + "': the mesh has no elements");
   }
   mesh.boundary(definition_.contact_boundary);  // throws InputError for an unknown name
+  const long dof_count = 2L * static_cast<long>(mesh.node_count());
+  if (options_.maximum_dofs > 0 && dof_count > options_.maximum_dofs) {
+    throw ResourceLimitError("body '" + name() + "': " + std::to_string(dof_count) +
+                             " degrees of freedom, above this server's limit of " +
+                             std::to_string(options_.maximum_dofs) +
+                             " (robin-subdomain --max-dofs raises it)");
+  }
   dofs_ = std::make_unique<DofMap>(prescribed_dofs(definition_));
   if (!removes_rigid_motions(mesh, *dofs_)) {
     throw SingularBodyError(
@@ -149,7 +156,8 @@ void BodySolver::assemble() {
 
   start = std::chrono::steady_clock::now();
   boundary_weights_ = robin::boundary_weights(mesh, mesh.boundary(definition_.contact_boundary));
-  factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name(), trailing_unknowns());
+  factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name(), trailing_unknowns(),
+                                             options_.maximum_factor_bytes);
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
   timings_.factorization_seconds = seconds_since(start);
 }
@@ -214,10 +222,14 @@ void BodySolver::assign_contact(const ContactOperator& contact) {
 }
 
 void BodySolver::build_interface_operator() {
-  const bool dense =
-      options_.interface_operator == InterfaceOperatorKind::dense ||
-      (options_.interface_operator == InterfaceOperatorKind::automatic &&
-       contact_size() <= options_.dense_limit);
+  // A dense F takes 8 n_c^2 bytes: within the factor's memory limit, or F is applied through
+  // the factor instead (same answers, more work per product).
+  const double dense_bytes = 8.0 * contact_size() * static_cast<double>(contact_size());
+  const bool dense_fits =
+      options_.maximum_factor_bytes <= 0.0 || dense_bytes <= options_.maximum_factor_bytes;
+  const bool dense = dense_fits && (options_.interface_operator == InterfaceOperatorKind::dense ||
+                                    (options_.interface_operator == InterfaceOperatorKind::automatic &&
+                                     contact_size() <= options_.dense_limit));
   if (dense && factor_->has_trailing_block()) {
     compliance_ = std::make_unique<DenseOperator>(factor_->trailing_congruence(trace_));
   } else if (dense) {

@@ -59,6 +59,11 @@ struct BodySolverOptions {
   /// are at most 2 dense_limit of them), so a dense F comes from the factor's trailing block in
   /// O(m^2 n_c) instead of n_c solves with the whole factor (see numerics/cholesky.hpp).
   bool contact_unknowns_last = true;
+  /// Limits checked before the work starts (0 = none): the body's degrees of freedom (2 per
+  /// node, before assembly) and the memory of its Cholesky factor (from the symbolic
+  /// analysis, before the numerical factorization). ResourceLimitError otherwise.
+  long maximum_dofs = 0;
+  double maximum_factor_bytes = 0.0;
 };
 
 struct ContactSolveResult {

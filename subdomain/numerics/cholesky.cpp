@@ -178,7 +178,10 @@ struct CholeskyFactor::Implementation {
   bool has_trailing_block = false;
   std::vector<int> position;  // position[j] = step at which unknown j is eliminated
 
+  double memory_limit_bytes = 0.0;
+
   void factorize(const SparseMatrix& matrix, const std::vector<int>& trailing);
+  void check_memory_estimate();
   void check_pivots() const;
   void locate_trailing(const std::vector<int>& trailing);
 };
@@ -200,6 +203,7 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
     throw std::runtime_error("body '" + body_name + "': CHOLMOD analysis failed (status " +
                              std::to_string(common.status) + ", e.g. out of memory)");
   }
+  check_memory_estimate();
   cholesky.factorize(matrix);
   const cholmod_factor& factor = *cholesky.factor();
   if (common.status < CHOLMOD_OK) {
@@ -217,6 +221,24 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
   }
   check_pivots();
   locate_trailing(trailing);
+}
+
+/// The symbolic factor knows how many entries L will store (supernodal: xsize; simplicial:
+/// CHOLMOD's lnz estimate): refuse before the numerical factorization allocates them.
+void CholeskyFactor::Implementation::check_memory_estimate() {
+  if (memory_limit_bytes <= 0.0) return;
+  const cholmod_factor& symbolic = *cholesky.factor();
+  const double entries = symbolic.is_super ? static_cast<double>(symbolic.xsize)
+                                           : cholesky.cholmod().lnz;
+  const double bytes = 8.0 * entries;
+  if (bytes <= memory_limit_bytes) return;
+  const auto gibibytes = [](double value) { return format_number(value / 1073741824.0) + " GiB"; };
+  throw ResourceLimitError("body '" + body_name + "': its Cholesky factor would need " +
+                           gibibytes(bytes) + " (symbolic analysis: " + format_number(entries) +
+                           " entries for " + std::to_string(size) +
+                           " unknowns), above this server's limit of " +
+                           gibibytes(memory_limit_bytes) +
+                           " (robin-subdomain --max-factor-memory MIB raises it)");
 }
 
 void CholeskyFactor::Implementation::locate_trailing(const std::vector<int>& trailing) {
@@ -249,9 +271,11 @@ void CholeskyFactor::Implementation::check_pivots() const {
 }
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
-                               const std::vector<int>& trailing_unknowns)
+                               const std::vector<int>& trailing_unknowns,
+                               double memory_limit_bytes)
     : implementation_(std::make_unique<Implementation>()) {
   implementation_->body_name = body_name;
+  implementation_->memory_limit_bytes = memory_limit_bytes;
   if (matrix.rows() != matrix.cols()) {
     throw InputError("body '" + body_name + "': the stiffness matrix is " +
                      std::to_string(matrix.rows()) + " x " + std::to_string(matrix.cols()) +

@@ -27,8 +27,11 @@ class CholeskyFactor {
   /// `trailing_unknowns` (indices into the matrix, distinct) are eliminated last: the rest
   /// in CHOLMOD's fill-reducing order of the matrix without them (AMD or METIS), then these
   /// in the given order. Empty: CHOLMOD's order of the whole matrix.
+  /// `memory_limit_bytes` > 0 bounds the factor: when the symbolic analysis finds that L needs
+  /// more (8 bytes per stored entry), ResourceLimitError is thrown before the numerical
+  /// factorization allocates it.
   CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
-                 const std::vector<int>& trailing_unknowns = {});
+                 const std::vector<int>& trailing_unknowns = {}, double memory_limit_bytes = 0.0);
   ~CholeskyFactor();
   CholeskyFactor(const CholeskyFactor&) = delete;
   CholeskyFactor& operator=(const CholeskyFactor&) = delete;

@@ -22,4 +22,12 @@ class SingularBodyError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A body larger than the limits its solver was given (degrees of freedom, factor memory):
+/// refused before the work that would exceed them starts. Names the body, the limit and the
+/// option that raises it. An InputError: the request, not the server, is at fault.
+class ResourceLimitError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 }  // namespace robin

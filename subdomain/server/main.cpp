@@ -45,8 +45,18 @@ void install_signal_handlers() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
+/// Three quarters of the machine's physical memory in MiB (the default factor memory limit).
+double default_factor_memory_mebibytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long page_size = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page_size <= 0) return 0.0;
+  return 0.75 * static_cast<double>(pages) * static_cast<double>(page_size) / 1048576.0;
+}
+
 struct CommandLine {
   robin::ServerLoopOptions loop;
+  long maximum_dofs = 20'000'000;
+  double maximum_factor_mebibytes = default_factor_memory_mebibytes();
   robin::ServerSettings server;
   std::string log_level = "info";
   std::filesystem::path curve_secret_key;  // empty: no CURVE
@@ -67,6 +77,18 @@ void add_options(CLI::App& app, CommandLine& command_line) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--name", command_line.server.name, "label for the logs and HelloReply");
+  app.add_option("--max-dofs", command_line.maximum_dofs,
+                 "largest body served, in degrees of freedom (2 per node), checked before "
+                 "assembly")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--max-factor-memory", command_line.maximum_factor_mebibytes,
+                 "largest Cholesky factor (and dense interface operator) of a body in MiB, "
+                 "estimated by the symbolic analysis before the factorization; default: 3/4 of "
+                 "the physical memory")
+      ->type_name("MIB")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--data-directory", command_line.server.data_directory,
                  "the directory under which SetupBody.mesh_path may name mesh files (relative "
                  "paths; nothing outside it, also through symbolic links); without it every "
@@ -146,6 +168,8 @@ int main(int argc, char** argv) {
     logger->error("{}", error.what());
     return 1;
   }
+  command_line.server.maximum_dofs = command_line.maximum_dofs;
+  command_line.server.maximum_factor_bytes = command_line.maximum_factor_mebibytes * 1048576.0;
   robin::SubdomainServer server(command_line.server);
   try {
     const std::string reason = robin::run_server_loop(

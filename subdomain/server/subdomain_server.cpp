@@ -353,6 +353,8 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   state_ = ServerState::awaiting_setup;
   record.body = request.setup_body().body_name();
   DecodedSetup setup = decode_setup_body(request.setup_body(), settings_.data_directory);
+  setup.body.maximum_dofs = settings_.maximum_dofs;
+  setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;
   auto body = std::make_unique<BodySolver>(std::move(setup.definition), setup.body);
   const InterfaceDescription interface = body->contact_boundary();
   protocol::InterfaceDescription& description = *reply.mutable_interface();

@@ -84,6 +84,11 @@ struct ServerSettings {
   /// The directory under which FieldsRequest.write_directory may write (--output-root); empty:
   /// every write_directory is refused.
   std::filesystem::path output_root;
+  /// Resource limits of a body, checked before the work starts (0 = none): degrees of freedom
+  /// (--max-dofs) and the memory of its Cholesky factor and dense interface operator
+  /// (--max-factor-memory).
+  long maximum_dofs = 0;
+  double maximum_factor_bytes = 0.0;
   /// Where requests are logged; null means subdomain_logger().
   std::shared_ptr<spdlog::logger> logger;
 };
