@@ -12,7 +12,8 @@ namespace robin {
 
 namespace {
 
-const std::vector<std::string> root_keys{"title", "gap", "solver", "coupling", "body"};
+const std::vector<std::string> root_keys{"title", "gap", "solver", "coupling", "contact", "body"};
+const std::vector<std::string> contact_keys{"method", "non_mortar"};
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
     "qp_tolerance", "qp_max_iterations", "interface_operator", "dense_limit", "pairing_tolerance"};
@@ -117,6 +118,20 @@ void read_solver(const CheckedTable& root, SolverOptions& solver) {
   solver.body.dense_limit = integer_at_least(*table, "dense_limit", 1, solver.body.dense_limit);
   solver.pairing_tolerance =
       number_above(*table, "pairing_tolerance", 0.0, solver.pairing_tolerance);
+}
+
+void read_contact(const CheckedTable& root, ContactOptions& contact) {
+  const auto table = root.optional_table("contact", contact_keys);
+  if (!table) return;
+  if (const auto method =
+          table->optional_choice("method", {"auto", "node-to-node", "mortar", "node-to-segment"})) {
+    contact.method = *method == "node-to-node"      ? ContactMethod::node_to_node
+                     : *method == "mortar"          ? ContactMethod::mortar
+                     : *method == "node-to-segment" ? ContactMethod::node_to_segment
+                                                    : ContactMethod::automatic;
+  }
+  contact.non_mortar = table->optional_string("non_mortar").value_or("");
+  if (contact.non_mortar == "auto") contact.non_mortar.clear();
 }
 
 /// A relaxation factor delta in (0, 2), or nothing when the key is absent.
@@ -257,7 +272,15 @@ CaseDefinition read_case_file(const std::filesystem::path& path) {
   read_gap(root, definition);
   read_solver(root, definition.solver);
   read_coupling(root, definition.coupling);
+  read_contact(root, definition.contact);
   read_bodies(root, path.parent_path(), definition);
+  if (!definition.contact.non_mortar.empty() &&
+      definition.contact.non_mortar != definition.bodies[0].definition.name &&
+      definition.contact.non_mortar != definition.bodies[1].definition.name) {
+    const auto table = root.optional_table("contact", contact_keys);
+    table->fail("non_mortar", "'" + definition.contact.non_mortar +
+                                  "' is not the name of a body (nor \"auto\")");
+  }
   return definition;
 }
 

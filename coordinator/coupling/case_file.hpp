@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "coupling/acceleration.hpp"
+#include "coupling/contact_discretization.hpp"
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/gmsh_reader.hpp"
@@ -80,6 +81,7 @@ struct CaseDefinition {
   std::string gap_context;  // "case.toml:12: gap.expression", the GapFunction context
   SolverOptions solver;
   CouplingOptions coupling;
+  ContactOptions contact;  // [contact]: node-to-node or mortar
 };
 
 /// The acceleration options with the per-body relaxations resolved (relaxation1/2, else

@@ -57,23 +57,13 @@ int find_partner(const Eigen::Vector2d& point, const Eigen::Vector2d& normal,
   return best;
 }
 
-/// Orders pairs along the principal direction of the contact zone (a curve parameter for
-/// flat and gently curved zones), so that contact.csv reads as a profile.
-void order_along_zone(std::vector<ContactPair>& pairs) {
-  if (pairs.size() < 2) return;
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const ContactPair& pair : pairs) mean += pair.position;
-  mean /= static_cast<double>(pairs.size());
-  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-  for (const ContactPair& pair : pairs) {
-    scatter += (pair.position - mean) * (pair.position - mean).transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
-  Eigen::Vector2d direction = eigen.eigenvectors().col(1);
-  if (direction.x() < 0 || (direction.x() == 0 && direction.y() < 0)) direction = -direction;
-  std::stable_sort(pairs.begin(), pairs.end(), [&](const ContactPair& a, const ContactPair& b) {
-    return (a.position - mean).dot(direction) < (b.position - mean).dot(direction);
-  });
+/// Orders pairs along the principal direction of the contact zone.
+void order_pairs_along_zone(std::vector<ContactPair>& pairs) {
+  std::vector<Eigen::Vector2d> points;
+  for (const ContactPair& pair : pairs) points.push_back(pair.position);
+  std::vector<ContactPair> ordered;
+  for (const std::size_t k : order_along_zone(points)) ordered.push_back(pairs[k]);
+  pairs = std::move(ordered);
 }
 
 std::string describe_node(const std::string& body, std::size_t tag, const Eigen::Vector2d& point) {
@@ -126,7 +116,30 @@ ExcludedPairClearance excluded_pair_clearance(const ContactPairing& pairing,
   return clearance;
 }
 
+std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points) {
+  std::vector<std::size_t> order(points.size());
+  std::iota(order.begin(), order.end(), 0);
+  if (points.size() < 2) return order;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& point : points) mean += point;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector2d& point : points) {
+    scatter += (point - mean) * (point - mean).transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+  Eigen::Vector2d direction = eigen.eigenvectors().col(1);
+  if (direction.x() < 0 || (direction.x() == 0 && direction.y() < 0)) direction = -direction;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return (points[a] - mean).dot(direction) < (points[b] - mean).dot(direction);
+  });
+  return order;
+}
+
 ContactOperator ContactPairing::assignment(int body_index) const {
+  if (operators[static_cast<std::size_t>(body_index)].row_count() > 0) {
+    return operators[static_cast<std::size_t>(body_index)];
+  }
   const double sign = body_index == 0 ? 1.0 : -1.0;
   std::vector<int> nodes;
   std::vector<Eigen::Vector2d> normals;
@@ -166,11 +179,11 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
     const Eigen::Vector2d& point = body1.coordinates[i];
     const int j = find_partner(point, body1.normals[i], body2, tolerance);
     if (j < 0 || partner_of_second[j] >= 0) {
-      throw InputError(
+      throw UnmatchedContactNodes(
           "contact pairing: " + describe_node(name1, body1.node_tags[i], point) +
           " has no matching node on body '" + name2 + "' within " + format_number(tolerance) +
-          " (non-matching contact meshes are not supported: mesh both contact boundaries with "
-          "the same nodes)");
+          " (node-to-node pairing needs matching meshes: use [contact] method = \"mortar\" or "
+          "\"auto\" for non-matching ones)");
     }
     partner_of_second[j] = static_cast<int>(i);
     ContactPair pair;
@@ -205,12 +218,12 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
   }
   for (std::size_t j = 0; j < body2.node_ids.size(); ++j) {
     if (partner_of_second[j] < 0) {
-      throw InputError(
+      throw UnmatchedContactNodes(
           "contact pairing: " + describe_node(name2, body2.node_tags[j], body2.coordinates[j]) +
           " has no matching node on body '" + name1 + "'");
     }
   }
-  order_along_zone(pairing.pairs);
+  order_pairs_along_zone(pairing.pairs);
   return pairing;
 }
 

@@ -12,18 +12,22 @@
 // interference fit): legal, solved by pushing the bodies apart, and reported (overlap_warning).
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "coupling/gap_function.hpp"
+#include "numerics/errors.hpp"
 #include "numerics/body_solver.hpp"
 
 namespace robin {
 
+/// One contact constraint (a row of B1 u1 + B2 u2 <= d): a node pair for node-to-node
+/// pairing, a non-mortar node's weighted constraint for mortar coupling.
 struct ContactPair {
-  int node1 = -1;                                       // mesh node index in body 1
-  int node2 = -1;                                       // mesh node index in body 2
+  int node1 = -1;  // mesh node index in body 1 (node-to-node; mortar: the non-mortar node or -1)
+  int node2 = -1;  // mesh node index in body 2 (node-to-node; mortar: the non-mortar node or -1)
   Eigen::Vector2d position = Eigen::Vector2d::Zero();   // body-1 node
   Eigen::Vector2d position2 = Eigen::Vector2d::Zero();  // body-2 node
   Eigen::Vector2d normal = Eigen::Vector2d::Zero();     // n1 (unit, outward from body 1)
@@ -35,23 +39,40 @@ struct ContactPairing {
   std::vector<ContactPair> pairs;
   std::vector<std::string> excluded;        // one line per excluded pair, with the reason
   std::vector<ContactPair> excluded_pairs;  // the same pairs, in the same order
+  /// The constraint operators B1, B2 (one row per pair, in pair order) when they are not the
+  /// node-to-node rows of `pairs` (mortar coupling); empty for node-to-node pairing.
+  std::array<ContactOperator, 2> operators;
+  /// Mortar coupling: the body (0 or 1) carrying the multipliers, and how many of its contact
+  /// nodes face no part of the other body (no constraint). -1 and 0 for node-to-node pairing.
+  int non_mortar_body = -1;
+  int uncovered = 0;
 
   std::size_t size() const { return pairs.size(); }
-  /// The node-to-node constraint operator of body 0 (rows n1 at node1) or body 1 (rows -n1 at
-  /// node2), weights m_i.
+  /// The constraint operator of body 0 or 1: `operators` when set, otherwise the node-to-node
+  /// rows (n1 at node1 for body 0, -n1 at node2 for body 1), weights m_i.
   ContactOperator assignment(int body_index) const;
   Eigen::VectorXd gaps() const;
   Eigen::VectorXd weights() const;
 };
 
+/// Some contact node has no partner on the other side (the meshes do not match there).
+class UnmatchedContactNodes : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// Pairs the two interfaces. `gap` may be null. A body-1 node matches the body-2 node whose
 /// offset from it is, up to the normal component, shorter than relative_tolerance times the
-/// shortest contact edge; every node of both sides must be matched. Throws InputError naming
-/// the first unmatched node (body, mesh node tag, coordinates), or when every pair is excluded
+/// shortest contact edge; every node of both sides must be matched. Throws
+/// UnmatchedContactNodes naming the first unmatched node (body, mesh node tag, coordinates), or when every pair is excluded
 /// (the contact boundary is a Dirichlet boundary: nothing is left for contact).
 ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::string& name1,
                                   const InterfaceDescription& body2, const std::string& name2,
                                   const GapFunction* gap, double relative_tolerance);
+
+/// The order of `points` along the principal direction of their spread (a curve parameter for
+/// flat and gently curved zones, so that contact.csv reads as a profile): indices into points.
+std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points);
 
 /// "" when every gap d_i >= 0; otherwise one line for the log and summary.json: how many pairs
 /// overlap initially, the largest overlap and where.

@@ -165,6 +165,9 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
     summary["joint_state_residuals"] = residuals_json(iteration.history.back());
   }
   summary["contact_pairs"] = result.pairing.size();
+  summary["contact_discretization"] =
+      describe_contact(result.pairing, definition.bodies[0].definition.name,
+                       definition.bodies[1].definition.name);
   summary["excluded_pairs"] = result.pairing.excluded;
   summary["excluded_pair_penetration"] = result.excluded_clearance.relative_penetration;
   summary["initial_overlap"] = overlap_warning(result.pairing);
@@ -193,6 +196,8 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   summary["bytes_per_iteration"] = static_cast<double>(iteration_bytes) / iterations;
   const double messaging = iteration.messaging_seconds();
   summary["timings"] = {{"setup", result.setup_seconds},
+                        {"meshing", result.meshing_seconds},
+                        {"contact_coupling", result.coupling_seconds},
                         {"iteration", iteration.wall_seconds},
                         {"server_compute", server_compute},
                         {"server_compute_critical_path", iteration.critical_compute_seconds},
@@ -215,16 +220,20 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   report_stage(observer, "reading and meshing both bodies");
   CaseDefinition loaded = definition;
   load_meshes(loaded);
+  result.meshing_seconds = seconds_since(start);
   report_stage(observer, "setting up both bodies (assembly, factorization)");
   result.interfaces = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
     return port.setup(loaded.bodies[alpha], definition.solver);
   });
   const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
-  result.pairing = pair_contact_nodes(result.interfaces[0], definition.bodies[0].definition.name,
-                                      result.interfaces[1], definition.bodies[1].definition.name,
-                                      gap.get(), definition.solver.pairing_tolerance);
-  report_stage(observer, std::to_string(result.pairing.size()) + " contact pairs (" +
-                             std::to_string(result.pairing.excluded.size()) + " excluded)");
+  const std::string& name1 = definition.bodies[0].definition.name;
+  const std::string& name2 = definition.bodies[1].definition.name;
+  const auto coupling_start = Clock::now();
+  result.pairing = discretize_contact(result.interfaces[0], name1, result.interfaces[1], name2,
+                                      gap.get(), definition.contact,
+                                      definition.solver.pairing_tolerance);
+  result.coupling_seconds = seconds_since(coupling_start);
+  report_stage(observer, describe_contact(result.pairing, name1, name2));
   for (const std::string& line : result.pairing.excluded) report_stage(observer, line);
   if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
     report_stage(observer, overlap);

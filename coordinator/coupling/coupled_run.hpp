@@ -26,7 +26,9 @@ struct CoupledRunResult {
   /// excluded_pair_penetration_limit means a Dirichlet condition drives the bodies into each
   /// other, which the tools report as an error.
   ExcludedPairClearance excluded_clearance;
-  double setup_seconds = 0.0;
+  double setup_seconds = 0.0;     // meshing, server setups, contact coupling, assignment
+  double meshing_seconds = 0.0;   // reading and meshing both bodies (coordinator side)
+  double coupling_seconds = 0.0;  // building the contact rows (pairing or mortar)
   double total_seconds = 0.0;
 };
 

@@ -24,9 +24,9 @@ LocalProblem prepare_local_problem(const CaseDefinition& definition) {
   }
   const BodySolver& body1 = *problem.bodies[0];
   const BodySolver& body2 = *problem.bodies[1];
-  problem.pairing =
-      pair_contact_nodes(body1.contact_boundary(), body1.name(), body2.contact_boundary(),
-                         body2.name(), problem.gap.get(), definition.solver.pairing_tolerance);
+  problem.pairing = discretize_contact(body1.contact_boundary(), body1.name(),
+                                       body2.contact_boundary(), body2.name(), problem.gap.get(),
+                                       definition.contact, definition.solver.pairing_tolerance);
   for (int alpha = 0; alpha < 2; ++alpha) {
     problem.bodies[alpha]->assign_contact(problem.pairing.assignment(alpha));
   }

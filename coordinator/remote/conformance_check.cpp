@@ -118,7 +118,8 @@ class ServerChecks {
   std::optional<Eigen::VectorXd> free_trace_;  // e: u_N of the far-obstacle contact solve
   bool capabilities_known_ = false;            // a HelloReply to 'hello' arrived
   bool neumann_offered_ = false;               // HelloReply.capabilities has "neumann_solve"
-  unsigned server_minor_ = 0;                  // the minor version of the HelloReply
+  unsigned server_major_ = 0;                  // the version of the HelloReply
+  unsigned server_minor_ = 0;
   Eigen::VectorXd first_force_;                // r1 of 'correction_linearity'
   Eigen::VectorXd first_response_;             // its reply w(r1)
 };
@@ -219,6 +220,7 @@ std::string ServerChecks::hello() {
     }
   }
   capabilities_known_ = true;
+  server_major_ = exchange.reply->version().major();
   server_minor_ = exchange.reply->version().minor();
   neumann_offered_ =
       std::find(offered.begin(), offered.end(), neumann_solve_capability) != offered.end();
@@ -793,11 +795,10 @@ void ServerChecks::run_run_control_checks() {
     session_.run("other_run_refused", []() -> std::string {
       throw NotChecked("needs the server's protocol version from its HelloReply (see 'hello')");
     });
-  } else if (server_minor_ < run_id_minor) {
+  } else if (server_major_ < 2 && server_minor_ < run_id_minor) {
     session_.record_note("other_run_refused",
                          "not applicable: the server speaks protocol " +
-                             std::to_string(protocol::protocol_major) + "." +
-                             std::to_string(server_minor_) +
+                             std::to_string(server_major_) + "." + std::to_string(server_minor_) +
                              ", and Envelope.run_id is since 1.2; not checked");
   } else {
     session_.run("other_run_refused", [this] { return other_run_refused(); });

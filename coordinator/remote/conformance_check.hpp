@@ -9,8 +9,8 @@
 // that any implementation can be checked, and reports every deviation in plain words naming the
 // message.
 //
-// The body it sets up is built in: the unit square [0, 1]^2 (a .geo script sent as
-// mesh_content), isotropic plane strain, its bottom edge lifted by a prescribed displacement
+// The body it sets up is built in: the unit square [0, 1]^2 (a structured mesh of 4 x 4 squares
+// split into triangles, sent as MeshData), isotropic plane strain, its bottom edge lifted by a prescribed displacement
 // u = (0, lift) and no load, its top edge the contact boundary. Its solution without contact is
 // the rigid translation u = (0, lift), so e_i = lift at every contact node and the expected
 // answers of the free solve and of the fields are known exactly. The numerical checks use only
@@ -37,8 +37,8 @@
 // Runs (protocol 1.2, Envelope.run_id): 'other_run_refused' sets the body up and assigns it with
 // run_id A, then a ContactSolveRequest and an EndRun with run_id B must each be refused as
 // WRONG_STATE with Error.state 'ready', after which a ContactSolveRequest with run_id A and one
-// without run_id must be served from the same body. A server whose HelloReply carries a minor
-// version below 2 is not judged on it: the check passes with the note "not applicable".
+// without run_id must be served from the same body. A server whose HelloReply carries a version
+// below 1.2 is not judged on it: the check passes with the note "not applicable".
 //
 // Deadlines: every request has reply_timeout_seconds. A request that gets no reply fails its
 // check; the checker then opens a new connection and sends a Hello. When that is not answered

@@ -31,6 +31,8 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   summary["iterations"] = result.qp.iterations;
   summary["operator_applications"] = result.qp.operator_applications;
   summary["contact_pairs"] = problem.pairing.size();
+  summary["contact_discretization"] =
+      robin::describe_contact(problem.pairing, problem.bodies[0]->name(), problem.bodies[1]->name());
   summary["excluded_pairs"] = problem.pairing.excluded;
   summary["initial_overlap"] = robin::overlap_warning(problem.pairing);
   summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
@@ -99,8 +101,8 @@ int run(const std::filesystem::path& case_path, const std::filesystem::path& out
               body->name(), body->free_dof_count(), body->timings().assembly_seconds,
               body->timings().factorization_seconds, body->factor_nonzeros());
   }
-  log->info("{} contact pairs ({} excluded)", problem.pairing.size(),
-            problem.pairing.excluded.size());
+  log->info("{}", robin::describe_contact(problem.pairing, problem.bodies[0]->name(),
+                                          problem.bodies[1]->name()));
   for (const std::string& line : problem.pairing.excluded) log->warn("{}", line);
   if (const std::string overlap = robin::overlap_warning(problem.pairing); !overlap.empty())
     log->warn("{}", overlap);

@@ -61,6 +61,8 @@ def _check_sizes(message, body_name):
             raise _invalid(body_name, field, "has %d values for %d entries (values)" %
                            (len(getattr(message, field)), entries))
     rows = len(offsets) - 1
+    if rows < 1:
+        raise _invalid(body_name, "row_offsets", "describes no constraint (at least one is needed)")
     if len(message.weights) != rows:
         raise _invalid(body_name, "weights", "has %d values for %d constraints (row_offsets)" %
                        (len(message.weights), rows))

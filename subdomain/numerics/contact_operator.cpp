@@ -79,10 +79,12 @@ void check_row(const ContactOperator& contact, int row, const std::vector<int>& 
     seen.emplace_back(node, contact.components[k]);
   }
   std::sort(seen.begin(), seen.end());
-  if (std::adjacent_find(seen.begin(), seen.end()) != seen.end()) {
+  const auto repeated = std::adjacent_find(seen.begin(), seen.end());
+  if (repeated != seen.end()) {
     throw InputError(context + ": AssignContact constraint " + std::to_string(row) +
-                     " names node id " + std::to_string(seen.front().first) +
-                     " component twice (each (node, component) at most once per row)");
+                     " names component " + std::to_string(repeated->second) + " of node id " +
+                     std::to_string(repeated->first) +
+                     " twice (each (node, component) at most once per row)");
   }
   const double weight = contact.weights[row];
   if (!std::isfinite(weight) || weight <= 0.0) {

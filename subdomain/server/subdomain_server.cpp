@@ -82,8 +82,8 @@ Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& va
   if (values.size() != contact_size) {
     throw RequestError(protocol::INVALID_ARGUMENT,
                        field + " has " + std::to_string(values.size()) + " values for the " +
-                           std::to_string(contact_size) + " contact nodes of body '" + body_name +
-                           "' (pair order of AssignContact)");
+                           std::to_string(contact_size) + " contact constraints of body '" +
+                           body_name + "' (the rows of AssignContact)");
   }
   for (int i = 0; i < values.size(); ++i) {
     if (!std::isfinite(values[i])) {
@@ -378,12 +378,14 @@ void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
   require_same_run(request, "AssignContact");
   require_state(ServerState::awaiting_assignment, "AssignContact");
   const ContactOperator contact = decoded_operator(request.assign_contact(), body_->name());
-  state_ = ServerState::awaiting_assignment;  // until the body accepted the assignment
   try {
-    body_->assign_contact(contact);
+    // Checked before anything changes: a refused assignment keeps the state and the previous B.
+    check_contact_operator(contact, interface_nodes_, "body '" + body_->name() + "'");
   } catch (const InputError& error) {
     throw RequestError(protocol::INVALID_ARGUMENT, error.what());
   }
+  state_ = ServerState::awaiting_assignment;  // until the body accepted the assignment
+  body_->assign_contact(contact);
   state_ = ServerState::ready;
   acknowledge(reply);
 }

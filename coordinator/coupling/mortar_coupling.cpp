@@ -1,0 +1,467 @@
+#include "coupling/mortar_coupling.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <unordered_map>
+
+#include "numerics/errors.hpp"
+#include "numerics/finite_element.hpp"
+
+namespace robin {
+namespace {
+
+/// One contact boundary: its interface description seen as segments.
+struct Side {
+  const InterfaceDescription* interface = nullptr;
+  std::string name;
+  int body = 0;  // 0 or 1
+
+  int nodes_per_segment() const { return nodes_per_edge(interface->segment_type); }
+  int segment_count() const {
+    return static_cast<int>(interface->segments.size()) / nodes_per_segment();
+  }
+  /// Position (into node_ids) of local node `local` of `segment`.
+  int node(int segment, int local) const {
+    return interface->segments[static_cast<std::size_t>(segment * nodes_per_segment() + local)];
+  }
+  const Eigen::Vector2d& coordinates(int position) const {
+    return interface->coordinates[static_cast<std::size_t>(position)];
+  }
+};
+
+struct SegmentPoint {
+  Eigen::VectorXd values;   // shape functions at the point
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  Eigen::Vector2d tangent = Eigen::Vector2d::Zero();  // dx/dxi
+};
+
+SegmentPoint evaluate(const Side& side, int segment, double reference) {
+  SegmentPoint point;
+  Eigen::VectorXd derivatives;
+  edge_shape_functions(side.interface->segment_type, reference, point.values, derivatives);
+  for (int a = 0; a < side.nodes_per_segment(); ++a) {
+    point.position += point.values[a] * side.coordinates(side.node(segment, a));
+    point.tangent += derivatives[a] * side.coordinates(side.node(segment, a));
+  }
+  return point;
+}
+
+/// The non-mortar normal field: the shape-function interpolation of the averaged nodal
+/// normals, normalised.
+Eigen::Vector2d normal_field(const Side& side, int segment, const Eigen::VectorXd& values) {
+  Eigen::Vector2d normal = Eigen::Vector2d::Zero();
+  for (int a = 0; a < side.nodes_per_segment(); ++a) {
+    normal += values[a] * side.interface->normals[static_cast<std::size_t>(side.node(segment, a))];
+  }
+  return normal.normalized();
+}
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+/// The parameter eta of the point of the mortar `segment` on the line through `point` along
+/// `direction` (Newton on cross(x(eta) - point, direction) = 0, from the midpoint; exact in one
+/// step for straight segments). NaN when Newton fails (a segment parallel to the direction).
+double project_along(const Side& side, int segment, const Eigen::Vector2d& point,
+                     const Eigen::Vector2d& direction) {
+  double eta = 0.0;
+  for (int step = 0; step < 30; ++step) {
+    const SegmentPoint at = evaluate(side, segment, eta);
+    const double residual = cross(at.position - point, direction);
+    const double slope = cross(at.tangent, direction);
+    if (std::abs(slope) < 1e-14 * at.tangent.norm()) return std::nan("");
+    const double change = residual / slope;
+    eta -= change;
+    if (std::abs(change) < 1e-14) return eta;
+  }
+  return std::nan("");
+}
+
+/// The parameter xi of the non-mortar `segment` whose normal line passes through `point`
+/// (Newton with a central-difference slope on cross(x(xi) - point, n(xi)) = 0).
+double project_onto_normal_field(const Side& side, int segment, const Eigen::Vector2d& point) {
+  const auto residual = [&](double xi) {
+    const SegmentPoint at = evaluate(side, segment, xi);
+    return cross(at.position - point, normal_field(side, segment, at.values));
+  };
+  double xi = 0.0;
+  for (int step = 0; step < 40; ++step) {
+    constexpr double delta = 1e-7;
+    const double slope = (residual(xi + delta) - residual(xi - delta)) / (2.0 * delta);
+    if (!(std::abs(slope) > 0.0)) return std::nan("");
+    const double change = residual(xi) / slope;
+    xi -= change;
+    if (std::abs(change) < 1e-13) return xi;
+  }
+  return std::nan("");
+}
+
+/// Integrals of one non-mortar node's row, in the dual and the standard basis.
+struct RowIntegrals {
+  std::map<int, double> dual_nonmortar, standard_nonmortar;  // by non-mortar position
+  std::map<int, double> dual_mortar, standard_mortar;        // by mortar position
+  double dual_gap = 0.0, standard_gap = 0.0;
+  double covered = 0.0;  // int over the overlap of phi_j
+};
+
+/// Dual basis coefficients A = diag(int phi) M_e^{-1} of a non-mortar segment (psi = A phi).
+Eigen::MatrixXd dual_coefficients(const Side& side, int segment) {
+  const int count = side.nodes_per_segment();
+  Eigen::MatrixXd mass = Eigen::MatrixXd::Zero(count, count);
+  for (const QuadraturePoint& gauss : edge_quadrature(8)) {
+    const SegmentPoint at = evaluate(side, segment, gauss.reference.x());
+    mass += gauss.weight * at.tangent.norm() * at.values * at.values.transpose();
+  }
+  const Eigen::VectorXd integrals = mass.rowwise().sum();
+  return integrals.asDiagonal() * mass.inverse();
+}
+
+/// A uniform grid of the mortar segments' bounding boxes: the candidates near a box.
+class SegmentGrid {
+ public:
+  SegmentGrid(const Side& side, double cell) : cell_(cell) {
+    for (int segment = 0; segment < side.segment_count(); ++segment) {
+      const auto [low, high] = box(side, segment);
+      for (long i = key(low.x()); i <= key(high.x()); ++i) {
+        for (long j = key(low.y()); j <= key(high.y()); ++j) cells_[{i, j}].push_back(segment);
+      }
+    }
+  }
+  std::vector<int> near(const Eigen::Vector2d& low, const Eigen::Vector2d& high) const {
+    std::vector<int> found;
+    for (long i = key(low.x()); i <= key(high.x()); ++i) {
+      for (long j = key(low.y()); j <= key(high.y()); ++j) {
+        const auto cell = cells_.find({i, j});
+        if (cell != cells_.end()) found.insert(found.end(), cell->second.begin(), cell->second.end());
+      }
+    }
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end()), found.end());
+    return found;
+  }
+  static std::pair<Eigen::Vector2d, Eigen::Vector2d> box(const Side& side, int segment) {
+    Eigen::Vector2d low = side.coordinates(side.node(segment, 0)), high = low;
+    for (int a = 1; a < side.nodes_per_segment(); ++a) {
+      low = low.cwiseMin(side.coordinates(side.node(segment, a)));
+      high = high.cwiseMax(side.coordinates(side.node(segment, a)));
+    }
+    return {low, high};
+  }
+
+ private:
+  long key(double value) const { return static_cast<long>(std::floor(value / cell_)); }
+  struct PairHash {
+    std::size_t operator()(const std::pair<long, long>& k) const {
+      return std::hash<long>()(k.first * 1000003L) ^ std::hash<long>()(k.second);
+    }
+  };
+  double cell_;
+  std::unordered_map<std::pair<long, long>, std::vector<int>, PairHash> cells_;
+};
+
+double segment_length(const Side& side, int segment) {
+  double length = 0.0;
+  for (const QuadraturePoint& gauss : edge_quadrature(8)) {
+    length += gauss.weight * evaluate(side, segment, gauss.reference.x()).tangent.norm();
+  }
+  return length;
+}
+
+double mean_segment_length(const Side& side) {
+  double total = 0.0;
+  for (int segment = 0; segment < side.segment_count(); ++segment) {
+    total += segment_length(side, segment);
+  }
+  return side.segment_count() > 0 ? total / side.segment_count() : 0.0;
+}
+
+/// How far from the non-mortar side a mortar segment may be and still be coupled: four of
+/// the longest segments, or a twentieth of the two boundaries' extent if that is larger.
+double search_distance(const Side& first, const Side& second) {
+  double longest = 0.0;
+  Eigen::Vector2d low = first.coordinates(0), high = low;
+  for (const Side* side : {&first, &second}) {
+    for (int segment = 0; segment < side->segment_count(); ++segment) {
+      longest = std::max(longest, segment_length(*side, segment));
+      const auto [box_low, box_high] = SegmentGrid::box(*side, segment);
+      low = low.cwiseMin(box_low);
+      high = high.cwiseMax(box_high);
+    }
+  }
+  return std::max(4.0 * longest, 0.05 * (high - low).norm());
+}
+
+/// What the projection found, for the error when nothing faces.
+struct Coupling {
+  std::vector<RowIntegrals> rows;  // by non-mortar position
+  int facing_candidates = 0;       // mortar segments in reach whose normal opposes
+  int same_direction_candidates = 0;
+};
+
+/// Segment-to-segment integration over the overlap of non-mortar `segment` and mortar
+/// segment `other`, added to `coupling`.
+void integrate_overlap(const Side& nonmortar, int segment, const Eigen::MatrixXd& dual,
+                       const Side& mortar, int other, const GapFunction* gap, Coupling& coupling) {
+  const int ends = 2;  // the endpoints are local nodes 0 and 1 for line2 and line3
+  double low = 2.0, high = -2.0;
+  for (int end = 0; end < ends; ++end) {
+    const double xi =
+        project_onto_normal_field(nonmortar, segment, mortar.coordinates(mortar.node(other, end)));
+    if (std::isnan(xi)) return;
+    low = std::min(low, xi);
+    high = std::max(high, xi);
+  }
+  low = std::max(low, -1.0);
+  high = std::min(high, 1.0);
+  if (high - low < 1e-12) return;
+  const int count = nonmortar.nodes_per_segment();
+  for (const QuadraturePoint& gauss : edge_quadrature(10)) {
+    const double xi = low + 0.5 * (gauss.reference.x() + 1.0) * (high - low);
+    const SegmentPoint at = evaluate(nonmortar, segment, xi);
+    const Eigen::Vector2d normal = normal_field(nonmortar, segment, at.values);
+    const double eta = project_along(mortar, other, at.position, normal);
+    if (std::isnan(eta) || std::abs(eta) > 1.0 + 1e-9) continue;
+    const SegmentPoint target = evaluate(mortar, other, eta);
+    double distance = (target.position - at.position).dot(normal);
+    if (gap != nullptr) distance += (*gap)(at.position.x(), at.position.y());
+    const double measure = 0.5 * gauss.weight * (high - low) * at.tangent.norm();
+    const Eigen::VectorXd dual_values = dual * at.values;
+    for (int a = 0; a < count; ++a) {
+      RowIntegrals& row = coupling.rows[static_cast<std::size_t>(nonmortar.node(segment, a))];
+      row.covered += measure * at.values[a];
+      row.dual_gap += measure * dual_values[a] * distance;
+      row.standard_gap += measure * at.values[a] * distance;
+      for (int b = 0; b < count; ++b) {
+        row.dual_nonmortar[nonmortar.node(segment, b)] += measure * dual_values[a] * at.values[b];
+        row.standard_nonmortar[nonmortar.node(segment, b)] +=
+            measure * at.values[a] * at.values[b];
+      }
+      for (int l = 0; l < mortar.nodes_per_segment(); ++l) {
+        row.dual_mortar[mortar.node(other, l)] += measure * dual_values[a] * target.values[l];
+        row.standard_mortar[mortar.node(other, l)] += measure * at.values[a] * target.values[l];
+      }
+    }
+  }
+}
+
+/// True when mortar segment `other` faces non-mortar segment `segment`: outward normals
+/// opposed (taken at the midpoints; each segment has its body on the left).
+bool facing(const Side& nonmortar, int segment, const Side& mortar, int other) {
+  const Eigen::Vector2d tangent = evaluate(nonmortar, segment, 0.0).tangent;
+  const Eigen::Vector2d other_tangent = evaluate(mortar, other, 0.0).tangent;
+  const Eigen::Vector2d outward(tangent.y(), -tangent.x());
+  const Eigen::Vector2d other_outward(other_tangent.y(), -other_tangent.x());
+  return outward.dot(other_outward) < 0.0;
+}
+
+Coupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
+  Coupling coupling;
+  coupling.rows.resize(nonmortar.interface->node_ids.size());
+  const double reach = search_distance(nonmortar, mortar);
+  const SegmentGrid grid(mortar, reach);
+  const Eigen::Vector2d margin(reach, reach);
+  for (int segment = 0; segment < nonmortar.segment_count(); ++segment) {
+    const Eigen::MatrixXd dual = dual_coefficients(nonmortar, segment);
+    const auto [low, high] = SegmentGrid::box(nonmortar, segment);
+    for (const int other : grid.near(low - margin, high + margin)) {
+      if (!facing(nonmortar, segment, mortar, other)) {
+        ++coupling.same_direction_candidates;
+        continue;
+      }
+      ++coupling.facing_candidates;
+      integrate_overlap(nonmortar, segment, dual, mortar, other, gap, coupling);
+    }
+  }
+  return coupling;
+}
+
+/// Node-to-segment collocation: row j from the projection of node j along n_j.
+Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
+  Coupling coupling;
+  coupling.rows.resize(nonmortar.interface->node_ids.size());
+  const double reach = search_distance(nonmortar, mortar);
+  const SegmentGrid grid(mortar, reach);
+  const Eigen::Vector2d margin(reach, reach);
+  for (std::size_t j = 0; j < coupling.rows.size(); ++j) {
+    const Eigen::Vector2d& point = nonmortar.interface->coordinates[j];
+    const Eigen::Vector2d& normal = nonmortar.interface->normals[j];
+    double best = std::numeric_limits<double>::infinity();
+    for (const int other : grid.near(point - margin, point + margin)) {
+      const double eta = project_along(mortar, other, point, normal);
+      if (std::isnan(eta) || std::abs(eta) > 1.0 + 1e-9) continue;
+      const SegmentPoint target = evaluate(mortar, other, eta);
+      const double distance = (target.position - point).dot(normal);
+      if (std::abs(distance) >= best) continue;
+      best = std::abs(distance);
+      RowIntegrals row;
+      row.covered = nonmortar.interface->weights[j];
+      row.dual_nonmortar[static_cast<int>(j)] = row.covered;
+      for (int l = 0; l < mortar.nodes_per_segment(); ++l) {
+        row.dual_mortar[mortar.node(other, l)] = row.covered * target.values[l];
+      }
+      row.dual_gap = row.covered * (distance + (gap ? (*gap)(point.x(), point.y()) : 0.0));
+      coupling.rows[j] = row;
+    }
+    if (std::isfinite(best)) ++coupling.facing_candidates;
+  }
+  return coupling;
+}
+
+bool normal_is_prescribed(const InterfaceDescription& side, int position,
+                          const Eigen::Vector2d& normal) {
+  constexpr double aligned = 1e-12;
+  const bool x_fixed = side.x_fixed[static_cast<std::size_t>(position)];
+  const bool y_fixed = side.y_fixed[static_cast<std::size_t>(position)];
+  return (x_fixed && y_fixed) || (x_fixed && std::abs(normal.y()) < aligned) ||
+         (y_fixed && std::abs(normal.x()) < aligned);
+}
+
+/// Appends `coefficients` (by position of `side`) times `normal` to the row under
+/// construction of `contact`, dropping round-off entries.
+void add_entries(ContactOperator& contact, const Side& side, const std::map<int, double>& values,
+                 double scale, const Eigen::Vector2d& normal) {
+  double largest = 0.0;
+  for (const auto& [position, value] : values) largest = std::max(largest, std::abs(value));
+  for (const auto& [position, value] : values) {
+    if (std::abs(value) <= 1e-13 * largest) continue;
+    const int node = side.interface->node_ids[static_cast<std::size_t>(position)];
+    for (int component = 0; component < 2; ++component) {
+      if (normal[component] != 0.0) {
+        contact.add_entry(node, component, value / scale * normal[component]);
+      }
+    }
+  }
+}
+
+std::string describe(const Side& side, int position) {
+  const Eigen::Vector2d& point = side.coordinates(position);
+  return "body '" + side.name + "' contact node (tag " +
+         std::to_string(side.interface->node_tags[static_cast<std::size_t>(position)]) +
+         ") at (" + std::to_string(point.x()) + ", " + std::to_string(point.y()) + ")";
+}
+
+bool completely_covered(const Side& nonmortar, const Coupling& coupling, int position) {
+  const double full = nonmortar.interface->weights[static_cast<std::size_t>(position)];
+  return std::abs(coupling.rows[static_cast<std::size_t>(position)].covered - full) <= 1e-9 * full;
+}
+
+/// The constraint of non-mortar node `position` (before its operator rows are written).
+ContactPair constraint_of(const Side& nonmortar, const Coupling& coupling, int position) {
+  const RowIntegrals& integrals = coupling.rows[static_cast<std::size_t>(position)];
+  const bool complete = completely_covered(nonmortar, coupling, position);
+  ContactPair pair;
+  pair.normal = (nonmortar.body == 0 ? 1.0 : -1.0) *
+                nonmortar.interface->normals[static_cast<std::size_t>(position)];
+  // Both at the non-mortar node: where the constraint is (contact.csv, clearance checks).
+  pair.position = nonmortar.coordinates(position);
+  pair.position2 = pair.position;
+  pair.weight = complete ? integrals.dual_nonmortar.at(position) : integrals.covered;
+  pair.gap = (complete ? integrals.dual_gap : integrals.standard_gap) / pair.weight;
+  const int node = nonmortar.interface->node_ids[static_cast<std::size_t>(position)];
+  (nonmortar.body == 0 ? pair.node1 : pair.node2) = node;
+  return pair;
+}
+
+/// Writes row `position` into both operators: the dual row (the node itself, and -M/m on
+/// the mortar side) when the mortar side covers the node's support, else the standard one.
+void write_rows(const Side& nonmortar, const Side& mortar, const Coupling& coupling, int position,
+                double weight, ContactPairing& pairing) {
+  const RowIntegrals& integrals = coupling.rows[static_cast<std::size_t>(position)];
+  const Eigen::Vector2d& normal = nonmortar.interface->normals[static_cast<std::size_t>(position)];
+  ContactOperator& own = pairing.operators[static_cast<std::size_t>(nonmortar.body)];
+  ContactOperator& other = pairing.operators[static_cast<std::size_t>(mortar.body)];
+  if (completely_covered(nonmortar, coupling, position)) {
+    add_entries(own, nonmortar, {{position, 1.0}}, 1.0, normal);
+    add_entries(other, mortar, integrals.dual_mortar, -weight, normal);
+  } else {
+    add_entries(own, nonmortar, integrals.standard_nonmortar, weight, normal);
+    add_entries(other, mortar, integrals.standard_mortar, -weight, normal);
+  }
+  own.finish_row(weight);
+  other.finish_row(weight);
+}
+
+/// The rows of `coupling` as a ContactPairing: the covered non-mortar nodes (covered over more
+/// than a thousandth of their support) ordered along the zone, those with a prescribed normal
+/// displacement excluded.
+ContactPairing assemble_rows(const Side& nonmortar, const Side& mortar, const Coupling& coupling) {
+  ContactPairing pairing;
+  std::vector<int> constrained;
+  std::vector<Eigen::Vector2d> points;
+  for (std::size_t j = 0; j < coupling.rows.size(); ++j) {
+    const int position = static_cast<int>(j);
+    if (!(coupling.rows[j].covered > 1e-3 * nonmortar.interface->weights[j])) continue;
+    const Eigen::Vector2d& normal = nonmortar.interface->normals[j];
+    if (normal_is_prescribed(*nonmortar.interface, position, normal)) {
+      pairing.excluded.push_back(describe(nonmortar, position) +
+                                 ": normal displacement prescribed by a Dirichlet condition; "
+                                 "constraint excluded from contact");
+      pairing.excluded_pairs.push_back(constraint_of(nonmortar, coupling, position));
+      continue;
+    }
+    constrained.push_back(position);
+    points.push_back(nonmortar.coordinates(position));
+  }
+  for (const std::size_t k : order_along_zone(points)) {
+    const ContactPair pair = constraint_of(nonmortar, coupling, constrained[k]);
+    write_rows(nonmortar, mortar, coupling, constrained[k], pair.weight, pairing);
+    pairing.pairs.push_back(pair);
+  }
+  return pairing;
+}
+
+void require_segments(const Side& side) {
+  if (side.interface->segments.empty() || side.interface->node_ids.empty()) {
+    throw InputError("mortar coupling: the contact boundary of body '" + side.name +
+                     "' has no segments");
+  }
+}
+
+}  // namespace
+
+int finer_side(const InterfaceDescription& body1, const InterfaceDescription& body2) {
+  const Side first{&body1, "", 0}, second{&body2, "", 1};
+  return mean_segment_length(second) < mean_segment_length(first) ? 1 : 0;
+}
+
+ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const std::string& name1,
+                                     const InterfaceDescription& body2, const std::string& name2,
+                                     const GapFunction* gap, const MortarOptions& options) {
+  const std::array<Side, 2> sides = {Side{&body1, name1, 0}, Side{&body2, name2, 1}};
+  for (const Side& side : sides) require_segments(side);
+  const int nonmortar_body =
+      options.non_mortar_body >= 0 ? options.non_mortar_body : finer_side(body1, body2);
+  const Side& nonmortar = sides[static_cast<std::size_t>(nonmortar_body)];
+  const Side& mortar = sides[static_cast<std::size_t>(1 - nonmortar_body)];
+  const Coupling coupling = options.integration == MortarIntegration::segment_to_segment
+                                ? integrate(nonmortar, mortar, gap)
+                                : collocate(nonmortar, mortar, gap);
+  ContactPairing pairing = assemble_rows(nonmortar, mortar, coupling);
+  if (pairing.pairs.empty() && pairing.excluded.empty()) {
+    const std::string reason =
+        coupling.same_direction_candidates > 0 && coupling.facing_candidates == 0
+            ? "their outward normals point the same way (check which side of each body the "
+              "contact boundary is on)"
+            : "no point of one projects onto the other along its normals within reach (check "
+              "that the two contact boundaries lie opposite each other)";
+    throw InputError("mortar coupling: the contact boundaries of bodies '" + name1 + "' and '" +
+                     name2 + "' do not face each other: " + reason);
+  }
+  if (pairing.pairs.empty()) {
+    throw InputError("mortar coupling of bodies '" + name1 + "' and '" + name2 + "': all " +
+                     std::to_string(pairing.excluded.size()) +
+                     " constraints have their normal displacement prescribed by Dirichlet "
+                     "conditions (first: " +
+                     pairing.excluded.front() + "); the contact boundary must not be a "
+                     "Dirichlet boundary");
+  }
+  pairing.non_mortar_body = nonmortar_body;
+  pairing.uncovered = static_cast<int>(nonmortar.interface->node_ids.size()) -
+                      static_cast<int>(pairing.pairs.size() + pairing.excluded.size());
+  return pairing;
+}
+
+}  // namespace robin
