@@ -62,6 +62,10 @@ double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
 
+/// Newton steps on a reference coordinate (dimensionless, O(1)) stop below this change: round-off
+/// of the coordinates (about 1e-16 of their magnitude) bounds what more steps could gain.
+constexpr double parameter_tolerance = 1e-12;
+
 /// The parameter eta of the point of the mortar `segment` on the line through `point` along
 /// `direction` (Newton on cross(x(eta) - point, direction) = 0, from the midpoint; exact in one
 /// step for straight segments). NaN when Newton fails (a segment parallel to the direction).
@@ -75,7 +79,7 @@ double project_along(const Side& side, int segment, const Eigen::Vector2d& point
     if (std::abs(slope) < 1e-14 * at.tangent.norm()) return std::nan("");
     const double change = residual / slope;
     eta -= change;
-    if (std::abs(change) < 1e-14) return eta;
+    if (std::abs(change) < parameter_tolerance) return eta;
   }
   return std::nan("");
 }
@@ -94,7 +98,7 @@ double project_onto_normal_field(const Side& side, int segment, const Eigen::Vec
     if (!(std::abs(slope) > 0.0)) return std::nan("");
     const double change = residual(xi) / slope;
     xi -= change;
-    if (std::abs(change) < 1e-13) return xi;
+    if (std::abs(change) < parameter_tolerance) return xi;
   }
   return std::nan("");
 }
