@@ -3,8 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
-#include <unordered_map>
 
 #include "numerics/errors.hpp"
 #include "numerics/finite_element.hpp"
@@ -62,9 +62,13 @@ double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
 
-/// Newton steps on a reference coordinate (dimensionless, O(1)) stop below this change: round-off
-/// of the coordinates (about 1e-16 of their magnitude) bounds what more steps could gain.
-constexpr double parameter_tolerance = 1e-12;
+/// Newton steps on a reference coordinate (dimensionless, O(1)) stop below 1e-12 or below the
+/// round-off of the coordinates seen in that coordinate (a few ulps of |x| over |dx/dxi|),
+/// whichever is larger: small segments far from the origin cannot resolve more.
+double parameter_tolerance(const Eigen::Vector2d& point, const SegmentPoint& at) {
+  const double magnitude = point.cwiseAbs().maxCoeff() + at.position.cwiseAbs().maxCoeff();
+  return 1e-12 + 64.0 * std::numeric_limits<double>::epsilon() * magnitude / at.tangent.norm();
+}
 
 /// The parameter eta of the point of the mortar `segment` on the line through `point` along
 /// `direction` (Newton on cross(x(eta) - point, direction) = 0, from the midpoint; exact in one
@@ -79,7 +83,7 @@ double project_along(const Side& side, int segment, const Eigen::Vector2d& point
     if (std::abs(slope) < 1e-14 * at.tangent.norm()) return std::nan("");
     const double change = residual / slope;
     eta -= change;
-    if (std::abs(change) < parameter_tolerance) return eta;
+    if (std::abs(change) < parameter_tolerance(point, at)) return eta;
   }
   return std::nan("");
 }
@@ -98,7 +102,7 @@ double project_onto_normal_field(const Side& side, int segment, const Eigen::Vec
     if (!(std::abs(slope) > 0.0)) return std::nan("");
     const double change = residual(xi) / slope;
     xi -= change;
-    if (std::abs(change) < parameter_tolerance) return xi;
+    if (std::abs(change) < parameter_tolerance(point, evaluate(side, segment, xi))) return xi;
   }
   return std::nan("");
 }
@@ -123,47 +127,94 @@ Eigen::MatrixXd dual_coefficients(const Side& side, int segment) {
   return integrals.asDiagonal() * mass.inverse();
 }
 
-/// A uniform grid of the mortar segments' bounding boxes: the candidates near a box.
-class SegmentGrid {
- public:
-  SegmentGrid(const Side& side, double cell) : cell_(cell) {
-    for (int segment = 0; segment < side.segment_count(); ++segment) {
-      const auto [low, high] = box(side, segment);
-      for (long i = key(low.x()); i <= key(high.x()); ++i) {
-        for (long j = key(low.y()); j <= key(high.y()); ++j) cells_[{i, j}].push_back(segment);
-      }
-    }
+using Box = std::pair<Eigen::Vector2d, Eigen::Vector2d>;  // lower and upper corners
+
+Box segment_box(const Side& side, int segment) {
+  Eigen::Vector2d low = side.coordinates(side.node(segment, 0)), high = low;
+  for (int a = 1; a < side.nodes_per_segment(); ++a) {
+    low = low.cwiseMin(side.coordinates(side.node(segment, a)));
+    high = high.cwiseMax(side.coordinates(side.node(segment, a)));
   }
-  std::vector<int> near(const Eigen::Vector2d& low, const Eigen::Vector2d& high) const {
+  return {low, high};
+}
+
+bool overlaps(const Box& a, const Box& b) {
+  return (a.first.array() <= b.second.array()).all() && (b.first.array() <= a.second.array()).all();
+}
+
+/// A bounding-box tree of the mortar segments (median splits along the longer axis): the
+/// segments whose box meets a query box in O(log n + k).
+class SegmentTree {
+ public:
+  explicit SegmentTree(const Side& side) {
+    for (int segment = 0; segment < side.segment_count(); ++segment) {
+      boxes_.push_back(segment_box(side, segment));
+      order_.push_back(segment);
+    }
+    if (!order_.empty()) build(0, static_cast<int>(order_.size()));
+  }
+
+  std::vector<int> near(const Box& query) const {
     std::vector<int> found;
-    for (long i = key(low.x()); i <= key(high.x()); ++i) {
-      for (long j = key(low.y()); j <= key(high.y()); ++j) {
-        const auto cell = cells_.find({i, j});
-        if (cell != cells_.end()) found.insert(found.end(), cell->second.begin(), cell->second.end());
+    if (nodes_.empty()) return found;
+    std::vector<int> pending{0};
+    while (!pending.empty()) {
+      const Node& node = nodes_[static_cast<std::size_t>(pending.back())];
+      pending.pop_back();
+      if (!overlaps(node.box, query)) continue;
+      if (node.left < 0) {
+        for (int k = node.begin; k < node.end; ++k) {
+          const int segment = order_[static_cast<std::size_t>(k)];
+          if (overlaps(boxes_[static_cast<std::size_t>(segment)], query)) found.push_back(segment);
+        }
+        continue;
       }
+      pending.push_back(node.left);
+      pending.push_back(node.right);
     }
     std::sort(found.begin(), found.end());
-    found.erase(std::unique(found.begin(), found.end()), found.end());
     return found;
-  }
-  static std::pair<Eigen::Vector2d, Eigen::Vector2d> box(const Side& side, int segment) {
-    Eigen::Vector2d low = side.coordinates(side.node(segment, 0)), high = low;
-    for (int a = 1; a < side.nodes_per_segment(); ++a) {
-      low = low.cwiseMin(side.coordinates(side.node(segment, a)));
-      high = high.cwiseMax(side.coordinates(side.node(segment, a)));
-    }
-    return {low, high};
   }
 
  private:
-  long key(double value) const { return static_cast<long>(std::floor(value / cell_)); }
-  struct PairHash {
-    std::size_t operator()(const std::pair<long, long>& k) const {
-      return std::hash<long>()(k.first * 1000003L) ^ std::hash<long>()(k.second);
-    }
+  struct Node {
+    Box box;
+    int begin = 0, end = 0;    // the segments order_[begin, end)
+    int left = -1, right = -1;  // children; -1 for a leaf
   };
-  double cell_;
-  std::unordered_map<std::pair<long, long>, std::vector<int>, PairHash> cells_;
+
+  int build(int begin, int end) {
+    Node node;
+    node.begin = begin;
+    node.end = end;
+    node.box = boxes_[static_cast<std::size_t>(order_[static_cast<std::size_t>(begin)])];
+    for (int k = begin + 1; k < end; ++k) {
+      const Box& box = boxes_[static_cast<std::size_t>(order_[static_cast<std::size_t>(k)])];
+      node.box = {node.box.first.cwiseMin(box.first), node.box.second.cwiseMax(box.second)};
+    }
+    const int index = static_cast<int>(nodes_.size());
+    nodes_.push_back(node);
+    constexpr int leaf_size = 4;
+    if (end - begin <= leaf_size) return index;
+    const Eigen::Vector2d extent = node.box.second - node.box.first;
+    const int axis = extent.x() >= extent.y() ? 0 : 1;
+    const int middle = begin + (end - begin) / 2;
+    const auto centre = [&](int segment) {
+      const Box& box = boxes_[static_cast<std::size_t>(segment)];
+      return box.first[axis] + box.second[axis];
+    };
+    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                     [&](int a, int b) { return centre(a) < centre(b); });
+    const int left = build(begin, middle);
+    const int right = build(middle, end);
+    nodes_[static_cast<std::size_t>(index)].left = left;
+    nodes_[static_cast<std::size_t>(index)].right = right;
+    return index;
+  }
+
+  std::vector<Box> boxes_;
+  std::vector<int> order_;
+  std::vector<Node> nodes_;
 };
 
 double segment_length(const Side& side, int segment) {
@@ -182,21 +233,43 @@ double mean_segment_length(const Side& side) {
   return side.segment_count() > 0 ? total / side.segment_count() : 0.0;
 }
 
-/// How far from the non-mortar side a mortar segment may be and still be coupled: four of
-/// the longest segments, or a twentieth of the two boundaries' extent if that is larger.
-double search_distance(const Side& first, const Side& second) {
-  double longest = 0.0;
-  Eigen::Vector2d low = first.coordinates(0), high = low;
-  for (const Side* side : {&first, &second}) {
-    for (int segment = 0; segment < side->segment_count(); ++segment) {
-      longest = std::max(longest, segment_length(*side, segment));
-      const auto [box_low, box_high] = SegmentGrid::box(*side, segment);
-      low = low.cwiseMin(box_low);
-      high = high.cwiseMax(box_high);
+/// Where to look for the mortar segments of a non-mortar segment or node: along the normals
+/// out to `reach` on both sides (four of the longest segments, or a twentieth of the two
+/// boundaries' extent if that is larger), and one longest segment tangentially, so that a query
+/// sees the segments near the normal rays only, whatever the boundaries' extent.
+struct SearchRange {
+  double reach = 0.0;
+  double slack = 0.0;  // the longest segment of either side
+
+  SearchRange(const Side& nonmortar, const Side& mortar) {
+    Eigen::Vector2d low = nonmortar.coordinates(0), high = low;
+    for (const Side* side : {&nonmortar, &mortar}) {
+      for (int segment = 0; segment < side->segment_count(); ++segment) {
+        const double length = segment_length(*side, segment);
+        slack = std::max(slack, length);
+        const auto [box_low, box_high] = segment_box(*side, segment);
+        low = low.cwiseMin(box_low);
+        high = high.cwiseMax(box_high);
+      }
     }
+    reach = std::max(4.0 * slack, 0.05 * (high - low).norm());
   }
-  return std::max(4.0 * longest, 0.05 * (high - low).norm());
-}
+
+  /// The box swept by the normal rays of `points` (with their `normals`) out to +-reach, widened
+  /// by the slack.
+  Box box(const std::vector<Eigen::Vector2d>& points,
+          const std::vector<Eigen::Vector2d>& normals) const {
+    Eigen::Vector2d low = points.front(), high = low;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      for (const double distance : {-reach, reach}) {
+        low = low.cwiseMin(points[k] + distance * normals[k]);
+        high = high.cwiseMax(points[k] + distance * normals[k]);
+      }
+    }
+    const Eigen::Vector2d margin(slack, slack);
+    return {low - margin, high + margin};
+  }
+};
 
 /// What the projection found, for the error when nothing faces.
 struct Coupling {
@@ -264,13 +337,17 @@ bool facing(const Side& nonmortar, int segment, const Side& mortar, int other) {
 Coupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
   Coupling coupling;
   coupling.rows.resize(nonmortar.interface->node_ids.size());
-  const double reach = search_distance(nonmortar, mortar);
-  const SegmentGrid grid(mortar, reach);
-  const Eigen::Vector2d margin(reach, reach);
+  const SearchRange range(nonmortar, mortar);
+  const SegmentTree tree(mortar);
   for (int segment = 0; segment < nonmortar.segment_count(); ++segment) {
     const Eigen::MatrixXd dual = dual_coefficients(nonmortar, segment);
-    const auto [low, high] = SegmentGrid::box(nonmortar, segment);
-    for (const int other : grid.near(low - margin, high + margin)) {
+    std::vector<Eigen::Vector2d> points, normals;
+    for (int a = 0; a < nonmortar.nodes_per_segment(); ++a) {
+      const int position = nonmortar.node(segment, a);
+      points.push_back(nonmortar.coordinates(position));
+      normals.push_back(nonmortar.interface->normals[static_cast<std::size_t>(position)]);
+    }
+    for (const int other : tree.near(range.box(points, normals))) {
       if (!facing(nonmortar, segment, mortar, other)) {
         ++coupling.same_direction_candidates;
         continue;
@@ -286,14 +363,13 @@ Coupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction*
 Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
   Coupling coupling;
   coupling.rows.resize(nonmortar.interface->node_ids.size());
-  const double reach = search_distance(nonmortar, mortar);
-  const SegmentGrid grid(mortar, reach);
-  const Eigen::Vector2d margin(reach, reach);
+  const SearchRange range(nonmortar, mortar);
+  const SegmentTree tree(mortar);
   for (std::size_t j = 0; j < coupling.rows.size(); ++j) {
     const Eigen::Vector2d& point = nonmortar.interface->coordinates[j];
     const Eigen::Vector2d& normal = nonmortar.interface->normals[j];
     double best = std::numeric_limits<double>::infinity();
-    for (const int other : grid.near(point - margin, point + margin)) {
+    for (const int other : tree.near(range.box({point}, {normal}))) {
       const double eta = project_along(mortar, other, point, normal);
       if (std::isnan(eta) || std::abs(eta) > 1.0 + 1e-9) continue;
       const SegmentPoint target = evaluate(mortar, other, eta);
