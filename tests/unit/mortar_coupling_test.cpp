@@ -103,6 +103,26 @@ TEST(MortarCoupling, NonMatchingRowsReproduceLinearFieldsExactly) {
   EXPECT_NEAR(total_weight, 1.0, 1e-12);
 }
 
+TEST(MortarCoupling, SmallSegmentsFarFromTheOriginKeepEveryRow) {
+  // 2000 and 2800 segments on [1000, 1001]: a segment is 5e-4 long at coordinates of 1e3, so the
+  // projections resolve the reference coordinate only to about 1e-11 (round-off).
+  const InterfaceDescription lower = straight_boundary({1000.0, 0.0}, {1001.0, 0.0}, 2000,
+                                                       {0.0, 1.0}, 0);
+  const InterfaceDescription upper = straight_boundary({1000.0, 0.02}, {1001.0, 0.02}, 2800,
+                                                       {0.0, -1.0}, 10000);
+  MortarOptions options;
+  options.non_mortar_body = 0;
+  const ContactPairing pairing = build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
+  ASSERT_EQ(pairing.size(), 2001u);
+  EXPECT_EQ(pairing.uncovered, 0);
+  double total_weight = 0.0;
+  for (const ContactPair& pair : pairing.pairs) {
+    total_weight += pair.weight;
+    EXPECT_NEAR(pair.gap, 0.02, 1e-10);
+  }
+  EXPECT_NEAR(total_weight, 1.0, 1e-9);
+}
+
 TEST(MortarCoupling, TheFinerSideCarriesTheMultipliersUnlessChosen) {
   const InterfaceDescription lower = lower_edge(0.0, 1.0, 3);
   const InterfaceDescription upper = upper_edge(0.0, 0.0, 1.0, 0.0, 8);
