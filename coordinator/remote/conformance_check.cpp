@@ -94,6 +94,7 @@ class ServerChecks {
   std::string end_run();
   std::string second_run();
   std::string voigt_material();
+  std::string general_rows();
   std::string set_up_again(const protocol::SetupBody& body, const std::string& what);
   std::string setup_body_in_ready_state();
   std::string other_run_refused();
@@ -790,6 +791,7 @@ void ServerChecks::run_run_control_checks() {
   session_.run("end_run", [this] { return end_run(); });
   session_.run("second_run", [this] { return second_run(); });
   session_.run("voigt_material", [this] { return voigt_material(); });
+  session_.run("general_rows", [this] { return general_rows(); });
   session_.run("setup_body_in_ready_state", [this] { return setup_body_in_ready_state(); });
   if (!capabilities_known_) {
     session_.run("other_run_refused", []() -> std::string {
@@ -909,6 +911,68 @@ std::string ServerChecks::voigt_material() {
            "up to " + number(difference) + " (max |w(r)| " + number(scale) + ")" + convention;
   }
   return "";
+}
+
+/// Protocol 2.0's general constraint operator: rows of two nodes each,
+/// (T u)_j = (u_y(x_j) + u_y(x_{j+1})) / 2 over consecutive contact nodes. Since F_T = T F T' with
+/// F the node-to-node compliance, the correction for r must equal T w(T' r), w the node-to-node
+/// CorrectionResult. The node-to-node assignment is restored afterwards.
+std::string ServerChecks::general_rows() {
+  require_assignment();
+  if (const std::string problem = set_up_again(square_body(), "node-to-node rows");
+      !problem.empty()) {
+    return problem;
+  }
+  const long rows = contact_count() - 1;
+  Eigen::MatrixXd averaging = Eigen::MatrixXd::Zero(rows, contact_count());
+  Eigen::VectorXd force(rows);
+  for (long j = 0; j < rows; ++j) {
+    averaging(j, j) = averaging(j, j + 1) = 0.5;
+    force(j) = 1.0 - 0.3 * static_cast<double>(j);
+  }
+  Eigen::VectorXd node_response;
+  if (const std::string problem =
+          correction(averaging.transpose() * force, "CorrectionRequest with r = T' s", node_response);
+      !problem.empty()) {
+    return problem;
+  }
+  Envelope assign;
+  protocol::AssignContact& rows_message = *assign.mutable_assign_contact();
+  rows_message.add_row_offsets(0);
+  for (long j = 0; j < rows; ++j) {
+    for (const long k : {j, j + 1}) {
+      rows_message.add_node_ids(nodes_[static_cast<std::size_t>(k)].id);
+      rows_message.add_components(1);
+      rows_message.add_values(0.5);
+    }
+    rows_message.add_row_offsets(static_cast<std::uint64_t>(rows_message.values_size()));
+    rows_message.add_weights(1.0);
+  }
+  const std::string what = "AssignContact with rows (u_y(x_j) + u_y(x_j+1)) / 2";
+  if (const std::string problem = expect_acknowledge(session_.request(assign, what), "ready");
+      !problem.empty()) {
+    return what + ": " + problem;
+  }
+  Eigen::VectorXd row_response;
+  const std::string correction_what = "CorrectionRequest with s (" + what + ")";
+  std::string problem = in_context(correction_what, read_correction(session_.request(
+      correction_request(force), correction_what), rows, row_response));
+  if (problem.empty()) {
+    const Eigen::VectorXd expected = averaging * node_response;
+    const double scale = std::max(expected.cwiseAbs().maxCoeff(), 1e-300);
+    const double difference = (row_response - expected).cwiseAbs().maxCoeff();
+    if (difference > tolerance_ * scale) {
+      problem = correction_what + ": normal_trace differs from T w(T' s) (w the node-to-node " +
+                "correction) by up to " + number(difference) + " (max " + number(scale) +
+                "): the server does not apply the rows of B as sent";
+    }
+  }
+  // Restore the node-to-node assignment for the checks that follow.
+  const Exchange restore = session_.request(assign_request(nodes_), "AssignContact (node-to-node again)");
+  if (const std::string restored = expect_acknowledge(restore, "ready"); problem.empty()) {
+    problem = restored.empty() ? "" : "AssignContact (node-to-node again): " + restored;
+  }
+  return problem;
 }
 
 /// SetupBody is valid in every state and discards the body: a solve is then refused.

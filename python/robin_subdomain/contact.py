@@ -193,11 +193,17 @@ def solve_bound_qp(matrix, right_hand_side, start, tolerance, max_iterations, no
 class ContactInterface:
     """B, e, F and the warm start of one contact assignment (a ContactOperator) of `body`:
     trace = B on the free dofs (rows x free), prescribed_trace = B u_p (rows),
-    full_operator = B on all dofs (rows x 2n), free_trace e, compliance F."""
+    full_operator = B on all dofs (rows x 2n), free_trace e, compliance F.
+
+    It keeps the body's factor and reduced load, not the body: the body holds its
+    ContactInterface (Body.contact), and a reference back would make each body a reference
+    cycle, freed (with its factor and matrices) only by an occasional full garbage collection,
+    which lets a server's memory grow run after run."""
 
     def __init__(self, body, operator):
         start = time.perf_counter()
-        self.body = body
+        self.factor = body.factor                 # K^-1 of the body (its sparse LU)
+        self.reduced_load = body.reduced_load     # f_f - K_fp u_p
         self.operator = operator
         count = operator.row_count
         dofs = operator.dofs()
@@ -229,7 +235,7 @@ class ContactInterface:
         compliance = np.empty((count, count))
         for first in range(0, count, COLUMN_BLOCK):
             loads = transpose[:, first:first + COLUMN_BLOCK].toarray()
-            compliance[:, first:first + COLUMN_BLOCK] = self.trace @ self.body.factor.solve(loads)
+            compliance[:, first:first + COLUMN_BLOCK] = self.trace @ self.factor.solve(loads)
         return 0.5 * (compliance + compliance.T)
 
     def size(self):
@@ -260,5 +266,5 @@ class ContactInterface:
         """The Neumann solve (since protocol 1.1): u_N = B u with K u = f - B' lambda, u = u_p
         on the prescribed dofs. One solve with the body's factor, not e - F lambda (so that it
         is an independent check of F and e)."""
-        load = self.body.reduced_load - self.trace.T @ contact_force
-        return self.trace @ self.body.factor.solve(load) + self.prescribed_trace
+        load = self.reduced_load - self.trace.T @ contact_force
+        return self.trace @ self.factor.solve(load) + self.prescribed_trace

@@ -9,11 +9,13 @@ run rule of 1.2, FieldsRequest.write_directory confined to the output root, SOLV
 of a non-finite reply. After every error the server answers a following Hello.
 """
 
+import gc
 import os
 import pathlib
 import shutil
 import tempfile
 import unittest
+import weakref
 from unittest import mock
 
 import numpy as np
@@ -290,6 +292,28 @@ class StateMachine(ServerTestCase):
         self.assertEqual(self.server.state, "awaiting_assignment")
         self.expect_error(request(setup_body=setup_body(young_modulus=-1.0)), "BAD_INPUT",
                           "awaiting_setup")
+
+    def test_a_discarded_body_is_freed_without_the_garbage_collector(self):
+        # A body in a reference cycle (and its factor) waits for a full collection: a server
+        # serving many runs then grows (benchmarks/soak_benchmark.py).
+        gc.collect()
+        gc.disable()
+        try:
+            for finish in (request(end_run=protocol.EndRun()), request(setup_body=setup_body())):
+                interface = self.set_up_and_assign()
+                count = len(interface.node_ids)
+                self.ask(request(contact_solve=protocol.ContactSolveRequest(
+                    obstacle=[0.0] * count)))
+                self.ask(request(correction=protocol.CorrectionRequest(
+                    interface_force=[1.0] * count)))
+                self.ask(request(neumann_solve=protocol.NeumannSolveRequest(
+                    contact_force=[1.0] * count)))
+                self.ask(request(fields=protocol.FieldsRequest(contact_force=[1.0] * count)))
+                body = weakref.ref(self.server.body)
+                self.ask(finish)
+                self.assertIsNone(body(), "the body outlived its run")
+        finally:
+            gc.enable()
 
 
 class BadBodies(ServerTestCase):
