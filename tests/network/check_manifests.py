@@ -5,8 +5,9 @@ only reveal at run time: the coordinator connects to the names and ports the ser
 the StatefulSet's pods get DNS names from a headless Service, the ConfigMap holds the shipped
 case verbatim and mounts its meshes where the case expects them, labels and selectors agree,
 and every container with a read-only root file system that runs a program writing to the
-temporary directory (robin-subdomain writes each received mesh there; robin-run starts
-robin-subdomain) has a writable /tmp: a tmpfs in compose, an emptyDir in Kubernetes.
+temporary directory (robin-coordinator and robin-run mesh each .geo body there; robin-run starts
+robin-subdomain, whose libraries may write there) has a writable /tmp: a tmpfs in compose, an
+emptyDir in Kubernetes.
 Prints one line per file; exits 1 with the list of problems.
 """
 import pathlib
@@ -30,7 +31,7 @@ def load_documents(path):
 
 # Programs that write to the temporary directory (TMPDIR, else /tmp), and the image's default
 # command (deploy/Dockerfile's CMD), which a container without `command` runs.
-WRITES_TEMPORARY_FILES = {"robin-subdomain", "robin-run"}
+WRITES_TEMPORARY_FILES = {"robin-subdomain", "robin-run", "robin-coordinator"}
 IMAGE_DEFAULT_PROGRAM = "robin-subdomain"
 
 
