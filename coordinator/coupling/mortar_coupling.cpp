@@ -1,5 +1,7 @@
 #include "coupling/mortar_coupling.hpp"
 
+#include "coupling/box_tree.hpp"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -127,7 +129,8 @@ Eigen::MatrixXd dual_coefficients(const Side& side, int segment) {
   return integrals.asDiagonal() * mass.inverse();
 }
 
-using Box = std::pair<Eigen::Vector2d, Eigen::Vector2d>;  // lower and upper corners
+/// The bounding-box tree of a side's segments (indices = segment numbers).
+BoxTree segment_tree(const Side& side);
 
 Box segment_box(const Side& side, int segment) {
   Eigen::Vector2d low = side.coordinates(side.node(segment, 0)), high = low;
@@ -138,84 +141,13 @@ Box segment_box(const Side& side, int segment) {
   return {low, high};
 }
 
-bool overlaps(const Box& a, const Box& b) {
-  return (a.first.array() <= b.second.array()).all() && (b.first.array() <= a.second.array()).all();
+BoxTree segment_tree(const Side& side) {
+  std::vector<Box> boxes;
+  for (int segment = 0; segment < side.segment_count(); ++segment) {
+    boxes.push_back(segment_box(side, segment));
+  }
+  return BoxTree(std::move(boxes));
 }
-
-/// A bounding-box tree of the mortar segments (median splits along the longer axis): the
-/// segments whose box meets a query box in O(log n + k).
-class SegmentTree {
- public:
-  explicit SegmentTree(const Side& side) {
-    for (int segment = 0; segment < side.segment_count(); ++segment) {
-      boxes_.push_back(segment_box(side, segment));
-      order_.push_back(segment);
-    }
-    if (!order_.empty()) build(0, static_cast<int>(order_.size()));
-  }
-
-  std::vector<int> near(const Box& query) const {
-    std::vector<int> found;
-    if (nodes_.empty()) return found;
-    std::vector<int> pending{0};
-    while (!pending.empty()) {
-      const Node& node = nodes_[static_cast<std::size_t>(pending.back())];
-      pending.pop_back();
-      if (!overlaps(node.box, query)) continue;
-      if (node.left < 0) {
-        for (int k = node.begin; k < node.end; ++k) {
-          const int segment = order_[static_cast<std::size_t>(k)];
-          if (overlaps(boxes_[static_cast<std::size_t>(segment)], query)) found.push_back(segment);
-        }
-        continue;
-      }
-      pending.push_back(node.left);
-      pending.push_back(node.right);
-    }
-    std::sort(found.begin(), found.end());
-    return found;
-  }
-
- private:
-  struct Node {
-    Box box;
-    int begin = 0, end = 0;    // the segments order_[begin, end)
-    int left = -1, right = -1;  // children; -1 for a leaf
-  };
-
-  int build(int begin, int end) {
-    Node node;
-    node.begin = begin;
-    node.end = end;
-    node.box = boxes_[static_cast<std::size_t>(order_[static_cast<std::size_t>(begin)])];
-    for (int k = begin + 1; k < end; ++k) {
-      const Box& box = boxes_[static_cast<std::size_t>(order_[static_cast<std::size_t>(k)])];
-      node.box = {node.box.first.cwiseMin(box.first), node.box.second.cwiseMax(box.second)};
-    }
-    const int index = static_cast<int>(nodes_.size());
-    nodes_.push_back(node);
-    constexpr int leaf_size = 4;
-    if (end - begin <= leaf_size) return index;
-    const Eigen::Vector2d extent = node.box.second - node.box.first;
-    const int axis = extent.x() >= extent.y() ? 0 : 1;
-    const int middle = begin + (end - begin) / 2;
-    const auto centre = [&](int segment) {
-      const Box& box = boxes_[static_cast<std::size_t>(segment)];
-      return box.first[axis] + box.second[axis];
-    };
-    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
-                     [&](int a, int b) { return centre(a) < centre(b); });
-    const int left = build(begin, middle);
-    const int right = build(middle, end);
-    nodes_[static_cast<std::size_t>(index)].left = left;
-    nodes_[static_cast<std::size_t>(index)].right = right;
-    return index;
-  }
-
-  std::vector<Box> boxes_;
-  std::vector<int> order_;
-  std::vector<Node> nodes_;
-};
 
 double segment_length(const Side& side, int segment) {
   double length = 0.0;
@@ -338,7 +270,7 @@ Coupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction*
   Coupling coupling;
   coupling.rows.resize(nonmortar.interface->node_ids.size());
   const SearchRange range(nonmortar, mortar);
-  const SegmentTree tree(mortar);
+  const BoxTree tree = segment_tree(mortar);
   for (int segment = 0; segment < nonmortar.segment_count(); ++segment) {
     const Eigen::MatrixXd dual = dual_coefficients(nonmortar, segment);
     std::vector<Eigen::Vector2d> points, normals;
@@ -364,7 +296,7 @@ Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction*
   Coupling coupling;
   coupling.rows.resize(nonmortar.interface->node_ids.size());
   const SearchRange range(nonmortar, mortar);
-  const SegmentTree tree(mortar);
+  const BoxTree tree = segment_tree(mortar);
   for (std::size_t j = 0; j < coupling.rows.size(); ++j) {
     const Eigen::Vector2d& point = nonmortar.interface->coordinates[j];
     const Eigen::Vector2d& normal = nonmortar.interface->normals[j];
