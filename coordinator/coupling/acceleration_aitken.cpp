@@ -1,8 +1,9 @@
 #include "coupling/acceleration_aitken.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "coupling/acceleration_relaxation.hpp"
 
@@ -13,7 +14,11 @@ AitkenAcceleration::AitkenAcceleration(int size, AitkenParameters parameters)
 
 Eigen::VectorXd AitkenAcceleration::next(const Eigen::VectorXd& iterate,
                                          const Eigen::VectorXd& mapped) {
-  assert(iterate.size() == size_ && mapped.size() == size_);
+  if (iterate.size() != size_ || mapped.size() != size_) {
+    throw std::invalid_argument("Aitken acceleration of size " + std::to_string(size_) +
+                                " given vectors of sizes " + std::to_string(iterate.size()) +
+                                " and " + std::to_string(mapped.size()));
+  }
   // r_k = H(x_k) - x_k
   const Eigen::VectorXd residual = mapped - iterate;
   if (!has_previous_) {

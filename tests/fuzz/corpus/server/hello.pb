@@ -1,0 +1,3 @@
+
+R/
+robin-fuzz-make-corpusfieldsneumann_solve
