@@ -4,11 +4,11 @@
 // corrupts one aspect of its replies or requests), and through the robin-coordinator command
 // line. Each deviation must fail the checks that judge it, with an explanation naming the
 // message, and the checker must keep to its deadlines. The optional Neumann solve (protocol
-// 1.1) is checked when announced; a server without it (robin-subdomain --protocol-minor 0
-// --without-capability neumann_solve, as a 1.0 server) conforms. The run rule of protocol 1.2
-// (Envelope.run_id: another run's requests are WRONG_STATE) is judged only for servers of minor
-// version 2 or later: a server playing 1.1 ignores run_id and still conforms, and a proxy that
-// strips run_id fails the check.
+// 1.1) is checked when announced; a server without it (robin-subdomain --without-capability
+// neumann_solve) conforms. The run rule of protocol 1.2 (Envelope.run_id: another run's requests
+// are WRONG_STATE) holds for every 2.x server and is judged on each (also one announcing minor
+// version 1), and a proxy that strips run_id fails the check; a 1.x server (major version 1)
+// cannot conform to 2.0 and is not judged on run ids.
 
 #include "remote/conformance_check.hpp"
 
@@ -293,8 +293,8 @@ TEST_F(ConformanceTest, ServerThatDropsOversizedMessagesConformsAndShutsDown) {
 }
 
 TEST_F(ConformanceTest, ServerWithoutTheOptionalNeumannSolveConforms) {
-  // As a protocol 1.0 server: minor version 0, no "neumann_solve", its request UNSUPPORTED.
-  testing::TemporaryDirectory directory("conformance-1.0");
+  // A 2.0 server without the optional "neumann_solve": its request UNSUPPORTED.
+  testing::TemporaryDirectory directory("conformance-2.0-no-neumann");
   ServerLaunchOptions launch = testing::server_options(directory.path());
   launch.extra_arguments = {"--protocol-minor", "0", "--without-capability", "neumann_solve"};
   SubdomainServer server("old", launch);
@@ -311,29 +311,44 @@ TEST_F(ConformanceTest, ServerWithoutTheOptionalNeumannSolveConforms) {
   }
   EXPECT_NE(format_report(report).find("PASS neumann_solve_capability (not announced"),
             std::string::npos);
-  EXPECT_NE(format_report(report).find("PASS other_run_refused (not applicable: the server "
-                                       "speaks protocol 1.0"),
-            std::string::npos)
-      << format_report(report);
+  // run_id is honoured by every 2.x server: the check is made, and passed.
+  EXPECT_TRUE(passes(report, "other_run_refused"));
+  const ConformanceCheck* run_check = find_check(report, "other_run_refused");
+  ASSERT_NE(run_check, nullptr);
+  EXPECT_EQ(run_check->explanation.find("not applicable"), std::string::npos)
+      << run_check->explanation;
 }
 
-TEST_F(ConformanceTest, ServerOfProtocol11IsNotJudgedOnRunIds) {
-  // robin-subdomain --protocol-minor 1 ignores Envelope.run_id, as a 1.1 server does: it would
-  // fail 'other_run_refused', which must therefore not judge it.
-  testing::TemporaryDirectory directory("conformance-1.1");
+TEST_F(ConformanceTest, ServerOfMinorVersion1IsJudgedOnRunIds) {
+  // robin-subdomain --protocol-minor 1 announces 2.1: within 2.x the run rule always holds (a
+  // minor version only adds), so 'other_run_refused' judges it, and it honours run_id.
+  testing::TemporaryDirectory directory("conformance-2.1");
   ServerLaunchOptions launch = testing::server_options(directory.path());
   launch.extra_arguments = {"--protocol-minor", "1"};
-  SubdomainServer server("old", launch);
+  SubdomainServer server("minor1", launch);
   server.await_listening();
   const ConformanceReport report = check_server(server.endpoint(), quick_options());
   EXPECT_TRUE(report.conforms()) << failed_checks(report);
-  const ConformanceCheck* note = find_check(report, "other_run_refused");
-  ASSERT_NE(note, nullptr);
-  EXPECT_TRUE(note->passed);
-  EXPECT_NE(note->explanation.find("not applicable: the server speaks protocol 1.1"),
-            std::string::npos)
-      << note->explanation;
-  EXPECT_TRUE(passes(report, "neumann_solve_equation"));  // 1.1 has the Neumann solve
+  const ConformanceCheck* check = find_check(report, "other_run_refused");
+  ASSERT_NE(check, nullptr);
+  EXPECT_TRUE(check->passed) << check->explanation;
+  EXPECT_EQ(check->explanation.find("not applicable"), std::string::npos) << check->explanation;
+  EXPECT_TRUE(passes(report, "neumann_solve_equation"));
+}
+
+TEST_F(ConformanceTest, ServerOfProtocol11IsNotJudgedOnRunIds) {
+  // robin-subdomain --protocol-major 1 --protocol-minor 1 plays a 1.1 server (which ignores
+  // Envelope.run_id): a 2.0 checker cannot talk to it, every check fails on VERSION_MISMATCH,
+  // and the run rule is not judged (the checker has no HelloReply to learn the version from).
+  testing::TemporaryDirectory directory("conformance-1.1");
+  ServerLaunchOptions launch = testing::server_options(directory.path());
+  launch.extra_arguments = {"--protocol-major", "1", "--protocol-minor", "1"};
+  SubdomainServer server("old", launch);
+  server.await_listening();
+  const ConformanceReport report = check_server(server.endpoint(), quick_options());
+  EXPECT_FALSE(report.conforms());
+  EXPECT_TRUE(fails_with(report, "hello", {"VERSION_MISMATCH", "this server 1.1"}));
+  EXPECT_TRUE(fails_with(report, "other_run_refused", {"not checked"}));
 }
 
 // --- Servers that do not conform ----------------------------------------------------------------
@@ -347,8 +362,10 @@ TEST_F(ConformanceTest, HelloOnlyServerFailsEveryOtherMessage) {
   EXPECT_TRUE(passes(report, "hello"));
   EXPECT_TRUE(fails_with(report, "end_run_before_checks",
                          {"EndRun", "expected Acknowledge", "HelloReply"}));
-  EXPECT_TRUE(fails_with(report, "version_mismatch",
-                         {"Hello with version 2.0", "Error{VERSION_MISMATCH}", "HelloReply"}));
+  EXPECT_TRUE(
+      fails_with(report, "version_mismatch",
+                 {"Hello with version " + std::to_string(protocol::protocol_major + 1) + ".0",
+                  "Error{VERSION_MISMATCH}", "HelloReply"}));
   EXPECT_TRUE(fails_with(report, "garbage_bytes", {"ff ff ff", "MALFORMED_MESSAGE"}));
   EXPECT_TRUE(fails_with(report, "contact_solve_before_setup",
                          {"ContactSolveRequest before SetupBody", "WRONG_STATE", "HelloReply"}));
@@ -495,11 +512,12 @@ Deviation errors_without_version() {
             if (reply.has_error()) reply.clear_version();
           },
           {{"version_on_every_reply",
-            {"the Error{VERSION_MISMATCH} reply to Hello with version 2.0 carries no Version"}}}};
+            {"the Error{VERSION_MISMATCH} reply to Hello with version " +
+             std::to_string(protocol::protocol_major + 1) + ".0 carries no Version"}}}};
 }
 
 Deviation dropped_run_ids() {
-  // The server never sees run_id (as a 1.1 server ignores it) but announces 1.2.
+  // The server never sees run_id (as a 1.1 server ignores it) but announces 2.0.
   return {"DroppedRunIds",
           [](Envelope& request) { request.clear_run_id(); },
           {},

@@ -39,8 +39,11 @@ using testing::server_options;
 using testing::TemporaryDirectory;
 using testing::vectors_close;
 
+/// examples/two_blocks.toml with both meshes loaded (SubdomainPort::setup sends the mesh).
 CaseDefinition two_blocks() {
-  return read_case_file(example("two_blocks.toml"));
+  CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  load_meshes(definition);
+  return definition;
 }
 
 /// The in-process run of two_blocks.toml, computed once.

@@ -30,8 +30,11 @@ using testing::server_options;
 using testing::TemporaryDirectory;
 using testing::vectors_close;
 
+/// examples/two_blocks.toml with both meshes loaded (SubdomainPort::setup needs them).
 CaseDefinition two_blocks() {
-  return read_case_file(example("two_blocks.toml"));
+  CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  load_meshes(definition);
+  return definition;
 }
 
 RemotePortOptions port_options() {
@@ -67,18 +70,25 @@ Eigen::VectorXd varying_force(Eigen::Index size) {
 }
 
 /// u(node_i) . n_i of body `alpha` under the contact force lambda, from the full displacement of
-/// a BodySolver built here.
+/// a BodySolver built here. The pairing's operator is node-to-node: row i holds the components
+/// (n_x, n_y) of the assigned normal n_i at node_i, read back here.
 Eigen::VectorXd displacement_trace(const CaseDefinition& definition, int alpha,
-                                   const ContactAssignment& assignment,
+                                   const ContactOperator& assignment,
                                    const Eigen::VectorXd& force) {
   BodySolver body(load_body(definition.bodies[alpha]), definition.solver.body);
   body.assign_contact(assignment);
   const Eigen::VectorXd displacement = body.displacement(force);
   Eigen::VectorXd trace(force.size());
   for (Eigen::Index i = 0; i < force.size(); ++i) {
-    const int node = assignment.node_ids[static_cast<std::size_t>(i)];
-    trace[i] =
-        displacement.segment<2>(2 * node).dot(assignment.normals[static_cast<std::size_t>(i)]);
+    const std::size_t first = assignment.row_offsets[static_cast<std::size_t>(i)];
+    EXPECT_EQ(assignment.row_offsets[static_cast<std::size_t>(i) + 1], first + 2);
+    EXPECT_EQ(assignment.nodes[first], assignment.nodes[first + 1]);
+    EXPECT_EQ(assignment.components[first], 0);
+    EXPECT_EQ(assignment.components[first + 1], 1);
+    const int node = assignment.nodes[first];
+    const Eigen::Vector2d normal(assignment.values[first], assignment.values[first + 1]);
+    EXPECT_NEAR(normal.norm(), 1.0, 1e-12);
+    trace[i] = displacement.segment<2>(2 * node).dot(normal);
   }
   return trace;
 }
@@ -96,7 +106,8 @@ TEST(NeumannSolveRemote, CppServerEqualsInProcessPortAndTheDisplacementTrace) {
   const ContactPairing pairing = set_up_pair(definition, {&remote1, &remote2});
   const ContactPairing local_pairing = set_up_pair(definition, {&local1, &local2});
   ASSERT_EQ(pairing.size(), local_pairing.size());
-  ASSERT_EQ(pairing.assignment(0).node_ids, local_pairing.assignment(0).node_ids);
+  ASSERT_EQ(pairing.assignment(0).nodes, local_pairing.assignment(0).nodes);
+  ASSERT_EQ(pairing.assignment(1).values, local_pairing.assignment(1).values);
   EXPECT_TRUE(remote1.offers("neumann_solve"));
   const std::array<PortTimings, 2> before = {remote1.timings(), remote2.timings()};
 

@@ -2,7 +2,9 @@
 //  - materials travel exactly: an isotropic plane-strain material as (E, nu) from which the
 //    server's make_isotropic_material rebuilds the same C bit for bit; any other material as
 //    its row-major C;
-//  - SetupBody of examples/two_blocks.toml carries the mesh file's bytes and the case's values;
+//  - SetupBody of examples/two_blocks.toml carries the mesh as MeshData (protocol 2.0: never the
+//    file's bytes or a script), which decodes to the mesh read from the file, and the case's
+//    values; AssignContact carries the constraint operator B in compressed rows;
 //  - a hand-written two-triangle FieldsReply decodes to the expected mesh and fields, and
 //    inconsistent replies are refused.
 
@@ -13,7 +15,9 @@
 #include <iterator>
 #include <limits>
 
+#include "mesh_codec.hpp"
 #include "numerics/errors.hpp"
+#include "numerics/gmsh_reader.hpp"
 #include "remote/reply_decoding.hpp"
 #include "remote/setup_encoding.hpp"
 #include "remote_test_support.hpp"
@@ -68,19 +72,39 @@ TEST(MaterialEncoding, OutOfPlaneFactorWithoutIsotropyIsRefused) {
 }
 
 TEST(SetupEncoding, TwoBlocksBodiesCarryTheCaseValues) {
-  const CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  load_meshes(definition);
   const BodyCase& upper = definition.bodies[1];
-  const protocol::SetupBody message = encode_setup_body(upper, definition.solver);
-  std::ifstream file(example("meshes/block_upper.geo"), std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const protocol::SetupBody message =
+      encode_setup_body(upper.definition, upper.context, definition.solver);
   EXPECT_EQ(message.body_name(), "upper");
-  EXPECT_EQ(message.mesh_content(), bytes);
-  EXPECT_EQ(message.mesh_extension(), ".geo");
-  EXPECT_EQ(message.mesh_size(), 0.1);
+  // The mesh as data: the mesh Gmsh makes of block_upper.geo with the case's h = 0.1, node for
+  // node and element for element; the 1.x fields (mesh_content, mesh_extension) are gone.
+  const Mesh file_mesh = read_gmsh_mesh(example("meshes/block_upper.geo"), {.size = 0.1});
+  ASSERT_TRUE(message.has_mesh());
+  EXPECT_EQ(message.mesh().dimension(), 2u);
+  EXPECT_EQ(message.mesh().source(), example("meshes/block_upper.geo").string());
+  EXPECT_TRUE(message.GetReflection()->GetUnknownFields(message).empty());
+  EXPECT_EQ(message.mesh_path(), "");
+  const Mesh sent = decode_mesh(message.mesh(), "test");
+  EXPECT_EQ(sent.nodes, file_mesh.nodes);
+  EXPECT_EQ(sent.node_tags, file_mesh.node_tags);
+  ASSERT_EQ(sent.blocks.size(), file_mesh.blocks.size());
+  for (std::size_t b = 0; b < sent.blocks.size(); ++b) {
+    EXPECT_EQ(sent.blocks[b].type, file_mesh.blocks[b].type);
+    EXPECT_EQ(sent.blocks[b].connectivity, file_mesh.blocks[b].connectivity);
+    EXPECT_EQ(sent.blocks[b].tags, file_mesh.blocks[b].tags);
+  }
+  ASSERT_EQ(sent.boundaries.size(), file_mesh.boundaries.size());
+  for (const auto& [name, group] : file_mesh.boundaries) {
+    EXPECT_EQ(sent.boundary(name).type, group.type) << name;
+    EXPECT_EQ(sent.boundary(name).connectivity, group.connectivity) << name;
+  }
   EXPECT_EQ(message.model(), protocol::PLANE_STRAIN);
   EXPECT_EQ(message.young_modulus(), 1000.0);
   EXPECT_EQ(message.poisson_ratio(), 0.3);
-  EXPECT_EQ(message.contact_boundary(), "contact");
+  ASSERT_EQ(message.contact_boundaries_size(), 1);
+  EXPECT_EQ(message.contact_boundaries(0), "contact");
   ASSERT_EQ(message.dirichlet_size(), 1);
   EXPECT_EQ(message.dirichlet(0).boundary(), "top");
   EXPECT_EQ(message.dirichlet(0).x(), 0.0);
@@ -89,6 +113,28 @@ TEST(SetupEncoding, TwoBlocksBodiesCarryTheCaseValues) {
   ASSERT_EQ(message.body_force_size(), 2);
   EXPECT_EQ(message.body_force(1), 0.0);
   EXPECT_EQ(message.solver().qp_tolerance(), definition.solver.qp.relative_tolerance);
+}
+
+TEST(SetupEncoding, ConstraintOperatorTravelsInCompressedRows) {
+  ContactOperator contact;
+  contact.add_entry(4, 0, 0.6);
+  contact.add_entry(4, 1, -0.8);
+  contact.finish_row(0.25);
+  contact.add_entry(7, 1, 0.5);
+  contact.add_entry(9, 1, 0.5);
+  contact.add_entry(9, 0, 1e-3);
+  contact.finish_row(0.5);
+  const protocol::AssignContact message = encode_contact_operator(contact);
+  EXPECT_EQ(std::vector<std::uint64_t>(message.row_offsets().begin(), message.row_offsets().end()),
+            (std::vector<std::uint64_t>{0, 2, 5}));
+  EXPECT_EQ(std::vector<std::int64_t>(message.node_ids().begin(), message.node_ids().end()),
+            (std::vector<std::int64_t>{4, 4, 7, 9, 9}));
+  EXPECT_EQ(std::vector<std::uint32_t>(message.components().begin(), message.components().end()),
+            (std::vector<std::uint32_t>{0, 1, 1, 1, 0}));
+  EXPECT_EQ(std::vector<double>(message.values().begin(), message.values().end()),
+            (std::vector<double>{0.6, -0.8, 0.5, 0.5, 1e-3}));
+  EXPECT_EQ(std::vector<double>(message.weights().begin(), message.weights().end()),
+            (std::vector<double>{0.25, 0.5}));
 }
 
 /// Two linear triangles on the unit square: nodes (0,0), (1,0), (1,1), (0,1).

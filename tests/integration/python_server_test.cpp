@@ -26,6 +26,7 @@
 
 #include "coupling/coupled_run.hpp"
 #include "coupling/in_process_port.hpp"
+#include "protocol_version.hpp"
 #include "remote/conformance_check.hpp"
 #include "remote/remote_port.hpp"
 #include "remote_test_support.hpp"
@@ -154,15 +155,18 @@ TEST(PythonServer, AsymmetricPairTwoPythonServersEqualsAllCpp) {
 }
 
 /// Every contact node of `boundary` by descending x, with `sign` times the normal that
-/// `normals_from` (the same body on another server) gives at the same position.
-ContactAssignment assignment_by_position(const InterfaceDescription& boundary,
-                                         const InterfaceDescription& normals_from, double sign) {
+/// `normals_from` (the same body on another server) gives at the same position: node-to-node
+/// rows, each weighted by the node's boundary weight.
+ContactOperator assignment_by_position(const InterfaceDescription& boundary,
+                                       const InterfaceDescription& normals_from, double sign) {
   std::vector<std::size_t> order(boundary.node_ids.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return boundary.coordinates[a].x() > boundary.coordinates[b].x();
   });
-  ContactAssignment assignment;
+  std::vector<int> nodes;
+  std::vector<Eigen::Vector2d> normals;
+  std::vector<double> weights;
   for (const std::size_t k : order) {
     std::size_t nearest = 0;
     for (std::size_t j = 0; j < normals_from.coordinates.size(); ++j) {
@@ -172,15 +176,17 @@ ContactAssignment assignment_by_position(const InterfaceDescription& boundary,
       }
     }
     EXPECT_LT((normals_from.coordinates[nearest] - boundary.coordinates[k]).norm(), 1e-12);
-    assignment.node_ids.push_back(boundary.node_ids[k]);
-    assignment.normals.push_back(sign * normals_from.normals[nearest]);
+    nodes.push_back(boundary.node_ids[k]);
+    normals.push_back(sign * normals_from.normals[nearest]);
+    weights.push_back(normals_from.weights[nearest]);
   }
-  return assignment;
+  return node_to_node_operator(nodes, normals, weights);
 }
 
 TEST(PythonServer, NeumannSolveEqualsTheCppServers) {
   const TemporaryDirectory logs("python-server-neumann");
-  const CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  load_meshes(definition);  // SubdomainPort::setup sends the loaded mesh
   SubdomainServer cpp_server("cpp", server_options(logs.path()));
   SubdomainServer python_server("python", python_server_options(logs.path()));
   cpp_server.await_listening();
@@ -196,13 +202,12 @@ TEST(PythonServer, NeumannSolveEqualsTheCppServers) {
     ASSERT_EQ(cpp_boundary.node_ids.size(), python_boundary.node_ids.size());
     EXPECT_TRUE(python.offers("neumann_solve")) << python.server_name();
     const double sign = alpha == 0 ? 1.0 : -1.0;  // body 2 receives n2 = -n1
-    const ContactAssignment cpp_assignment =
-        assignment_by_position(cpp_boundary, cpp_boundary, sign);
-    const ContactAssignment python_assignment =
+    const ContactOperator cpp_assignment = assignment_by_position(cpp_boundary, cpp_boundary, sign);
+    const ContactOperator python_assignment =
         assignment_by_position(python_boundary, cpp_boundary, sign);
     cpp.assign_contact(cpp_assignment);
     python.assign_contact(python_assignment);
-    Eigen::VectorXd force(static_cast<Eigen::Index>(cpp_assignment.node_ids.size()));
+    Eigen::VectorXd force(cpp_assignment.row_count());
     for (Eigen::Index i = 0; i < force.size(); ++i) {  // by position: both use descending x
       force[i] = 1.0 + 0.5 * std::cos(1.3 * static_cast<double>(i));
     }
@@ -255,13 +260,13 @@ protocol::Envelope exchange(zmq::socket_t& socket, const std::vector<std::string
   EXPECT_TRUE(socket.recv(message));
   protocol::Envelope reply;
   EXPECT_TRUE(reply.ParseFromArray(message.data(), static_cast<int>(message.size())));
-  EXPECT_EQ(reply.version().major(), 1u);
+  EXPECT_EQ(reply.version().major(), protocol::protocol_major);
   return reply;
 }
 
 std::string hello_request(std::uint64_t request_id) {
   protocol::Envelope request;
-  request.mutable_version()->set_major(1);
+  request.mutable_version()->set_major(protocol::protocol_major);
   request.set_request_id(request_id);
   request.mutable_hello()->set_client_name("python_server_test");
   return request.SerializeAsString();

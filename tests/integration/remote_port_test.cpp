@@ -40,8 +40,11 @@ using testing::server_options;
 using testing::TemporaryDirectory;
 using testing::vectors_close;
 
+/// examples/two_blocks.toml with both meshes loaded (SubdomainPort::setup needs them).
 CaseDefinition two_blocks() {
-  return read_case_file(example("two_blocks.toml"));
+  CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  load_meshes(definition);
+  return definition;
 }
 
 RemotePortOptions port_options(double timeout_seconds) {
@@ -337,20 +340,20 @@ TEST(RemotePort, ReplyWithoutVersionOrWithAnotherRequestIdIsNamed) {
 TEST(RemotePort, ServerOfAnotherMajorVersionIsRefused) {
   const TemporaryDirectory logs("remote-port-version");
   ServerLaunchOptions options = server_options(logs.path());
-  options.extra_arguments = {"--protocol-major", "2"};
+  options.extra_arguments = {"--protocol-major", "3"};
   SubdomainServer server("lower", options);
   server.await_listening();
   const CaseDefinition definition = two_blocks();
   RemotePort port(server.endpoint(), "lower", port_options(5.0));
   try {
     port.setup(definition.bodies[0], definition.solver);
-    FAIL() << "a protocol 2 server was accepted";
+    FAIL() << "a protocol 3 server was accepted";
   } catch (const PortError& error) {
     const std::string message = error.what();
     std::cout << message << "\n";
     EXPECT_NE(message.find("server " + server.endpoint()), std::string::npos) << message;
-    EXPECT_NE(message.find("speaks protocol 2."), std::string::npos) << message;
-    EXPECT_NE(message.find("this coordinator speaks 1.2"), std::string::npos) << message;
+    EXPECT_NE(message.find("speaks protocol 3."), std::string::npos) << message;
+    EXPECT_NE(message.find("this coordinator speaks 2.0"), std::string::npos) << message;
   }
 }
 
@@ -361,9 +364,8 @@ TEST(RemotePort, SecondCoordinatorTakingTheServerOverFailsTheFirstRun) {
   server.await_listening();
   RemotePort first(server.endpoint(), "lower", port_options(10.0));
   const InterfaceDescription interface = first.setup(definition.bodies[0], definition.solver);
-  ContactAssignment assignment;
-  assignment.node_ids = interface.node_ids;
-  assignment.normals = interface.normals;
+  const ContactOperator assignment =
+      node_to_node_operator(interface.node_ids, interface.normals, interface.weights);
   first.assign_contact(assignment);
   const Eigen::VectorXd obstacle =
       Eigen::VectorXd::Constant(static_cast<Eigen::Index>(interface.node_ids.size()), 1.0);

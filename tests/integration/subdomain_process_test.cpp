@@ -2,7 +2,13 @@
 // on a pipe: the "listening on" line, error replies that leave it running, Shutdown and
 // signals (exit code 0), ipc:// endpoints, bind failures (exit code 1 and a message naming the
 // endpoint), the hidden --protocol-major flag, --max-message-size, and one contact solve over
-// the wire compared with a BodySolver built in this process.
+// the wire compared with a BodySolver built in this process (the mesh read by the server from
+// its --data-directory).
+// The attacks of issue 11 against the real process, which each fail to run or read anything
+// and leave the server answering Hello: a 1.x .geo script with a shell command in the removed
+// SetupBody.mesh_content (hand-encoded wire bytes), mesh_path reads outside --data-directory,
+// write_directory writes outside --output-root (also through a symbolic link at the target),
+// a 100,000-character body name and an inverted cell.
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -17,11 +23,14 @@
 #include <fstream>
 #include <optional>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <zmq.hpp>
 
+#include "mesh_codec.hpp"
 #include "numerics/body_solver.hpp"
+#include "numerics/contact_operator.hpp"
 #include "numerics/gmsh_reader.hpp"
 #include "numerics/material.hpp"
 #include "protocol_version.hpp"
@@ -189,20 +198,34 @@ protocol::Envelope shutdown(std::uint64_t id) {
   return envelope;
 }
 
-/// Body 1 of examples/two_blocks.toml, the mesh given as a path on the server's file system.
+/// Body 1 of examples/two_blocks.toml, the mesh given as a path relative to the server's
+/// --data-directory (examples/meshes, where block_lower.geo's own h is 0.1, the case's size).
 protocol::Envelope lower_block_setup(std::uint64_t id) {
   protocol::Envelope setup = request(id);
   protocol::SetupBody& body = *setup.mutable_setup_body();
   body.set_body_name("lower");
-  body.set_mesh_path(lower_geo.string());
-  body.set_mesh_size(0.1);
+  body.set_mesh_path(lower_geo.filename().string());
   body.set_model(protocol::PLANE_STRAIN);
   body.set_young_modulus(1000.0);
   body.set_poisson_ratio(0.3);
   body.add_dirichlet()->set_boundary("bottom");
   body.mutable_dirichlet(0)->set_x(0.0);
   body.mutable_dirichlet(0)->set_y(0.0);
-  body.set_contact_boundary("contact");
+  body.add_contact_boundaries("contact");
+  return setup;
+}
+
+/// block_lower.geo meshed in this process with its own h = 0.1, once.
+const Mesh& lower_mesh() {
+  static const Mesh mesh = read_gmsh_mesh(lower_geo);
+  return mesh;
+}
+
+/// lower_block_setup with the mesh sent as MeshData instead.
+protocol::Envelope lower_block_data_setup(std::uint64_t id) {
+  protocol::Envelope setup = lower_block_setup(id);
+  setup.mutable_setup_body()->clear_mesh_path();
+  *setup.mutable_setup_body()->mutable_mesh() = encode_mesh(lower_mesh());
   return setup;
 }
 
@@ -210,9 +233,7 @@ protocol::Envelope lower_block_setup(std::uint64_t id) {
 BodyDefinition lower_block_definition() {
   BodyDefinition definition;
   definition.name = "lower";
-  MeshReadOptions options;
-  options.size = 0.1;
-  definition.mesh = read_gmsh_mesh(lower_geo, options);
+  definition.mesh = lower_mesh();
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
   definition.dirichlet.push_back({"bottom", 0.0, 0.0});
   definition.contact_boundary = "contact";
@@ -276,7 +297,8 @@ TEST(SubdomainProcess, SigtermAndSigintStopTheServerWithExitZero) {
 
 TEST(SubdomainProcess, IpcEndpointServesAContactSolveEqualToADirectSolve) {
   const std::string endpoint = "ipc://" + temporary_path("ipc").string();
-  ServerProcess server({"--listen", endpoint, "--log-level", "warn"});
+  ServerProcess server({"--listen", endpoint, "--log-level", "warn", "--data-directory",
+                        lower_geo.parent_path().string()});
   ASSERT_EQ(server.endpoint(), endpoint) << server.stderr_text();
   zmq::context_t context;
   zmq::socket_t socket = connect(context, endpoint);
@@ -287,14 +309,22 @@ TEST(SubdomainProcess, IpcEndpointServesAContactSolveEqualToADirectSolve) {
   const InterfaceDescription interface = reference.contact_boundary();
   ASSERT_EQ(interface_reply.interface().node_ids_size(),
             static_cast<int>(interface.node_ids.size()));
-  ContactAssignment assignment{interface.node_ids, {}};
+  // Node-to-node rows with the normal (0, 1): entries (node, x) = 0 and (node, y) = 1.
+  const ContactOperator assignment = node_to_node_operator(
+      interface.node_ids, std::vector<Eigen::Vector2d>(interface.node_ids.size(), {0.0, 1.0}),
+      interface.weights);
   protocol::Envelope assign = request(2);
-  for (int node : interface.node_ids) {
-    assign.mutable_assign_contact()->add_node_ids(node);
-    assign.mutable_assign_contact()->add_normals(0.0);
-    assign.mutable_assign_contact()->add_normals(1.0);
-    assignment.normals.emplace_back(0.0, 1.0);
+  for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
+    protocol::AssignContact& message = *assign.mutable_assign_contact();
+    message.add_row_offsets(2 * i);
+    for (const int component : {0, 1}) {
+      message.add_node_ids(interface.node_ids[i]);
+      message.add_components(static_cast<std::uint32_t>(component));
+      message.add_values(component == 0 ? 0.0 : 1.0);
+    }
+    message.add_weights(interface.weights[i]);
   }
+  assign.mutable_assign_contact()->add_row_offsets(2 * interface.node_ids.size());
   ASSERT_TRUE(exchange(socket, assign).has_acknowledge());
   reference.assign_contact(assignment);
 
@@ -339,19 +369,19 @@ TEST(SubdomainProcess, BindingAnEndpointInUseFailsWithExitOneNamingIt) {
 }
 
 TEST(SubdomainProcess, HiddenProtocolMajorFlagProvokesAVersionMismatch) {
-  ServerProcess server({"--listen", "tcp://127.0.0.1:*", "--protocol-major", "2"});
+  ServerProcess server({"--listen", "tcp://127.0.0.1:*", "--protocol-major", "3"});
   zmq::context_t context;
   zmq::socket_t socket = connect(context, server.endpoint());
   const protocol::Envelope reply = exchange(socket, hello(1));
   ASSERT_TRUE(reply.has_error());
   EXPECT_EQ(reply.error().code(), protocol::VERSION_MISMATCH);
-  EXPECT_EQ(reply.version().major(), 2u);
-  // "the request speaks 1.2, this server 2.2": the flag changes the major version only.
+  EXPECT_EQ(reply.version().major(), 3u);
+  // "the request speaks 2.0, this server 3.0": the flag changes the major version only.
   EXPECT_NE(
-      reply.error().message().find("this server 2." + std::to_string(protocol::protocol_minor)),
+      reply.error().message().find("this server 3." + std::to_string(protocol::protocol_minor)),
       std::string::npos)
       << reply.error().message();
-  EXPECT_TRUE(exchange(socket, hello(2, 2)).has_hello_reply());
+  EXPECT_TRUE(exchange(socket, hello(2, 3)).has_hello_reply());
 }
 
 TEST(SubdomainProcess, OversizedMessageIsDroppedWithoutReplyAndTheServerStaysUp) {
@@ -366,6 +396,356 @@ TEST(SubdomainProcess, OversizedMessageIsDroppedWithoutReplyAndTheServerStaysUp)
   }
   zmq::socket_t socket = connect(context, endpoint);
   EXPECT_TRUE(exchange(socket, hello(2)).has_hello_reply());
+}
+
+// --- Issue 11: the attacks against the real process --------------------------------------
+
+std::string file_text(const std::filesystem::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  std::ostringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream stream(path, std::ios::binary);
+  stream << text;
+}
+
+/// A fresh directory (temporary_path), removed with its content at destruction.
+class ScratchDirectory {
+ public:
+  explicit ScratchDirectory(const std::string& label) : path_(temporary_path(label)) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchDirectory(const ScratchDirectory&) = delete;
+  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// The names under `directory` (recursively, relative; links not followed).
+std::set<std::string> listing(const std::filesystem::path& directory) {
+  std::set<std::string> names;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(directory)) {
+    names.insert(entry.path().lexically_relative(directory).string());
+  }
+  return names;
+}
+
+/// Hello is answered: the server is up and serving.
+void expect_hello(zmq::socket_t& socket, std::uint64_t id) {
+  const protocol::Envelope reply = exchange(socket, hello(id));
+  EXPECT_TRUE(reply.has_hello_reply()) << reply.DebugString();
+}
+
+void expect_error(const protocol::Envelope& reply, protocol::ErrorCode code,
+                  const std::string& expected) {
+  ASSERT_TRUE(reply.has_error()) << reply.DebugString();
+  EXPECT_EQ(protocol::ErrorCode_Name(reply.error().code()), protocol::ErrorCode_Name(code))
+      << reply.error().message();
+  EXPECT_NE(reply.error().message().find(expected), std::string::npos) << reply.error().message();
+}
+
+/// The protobuf wire encoding of a varint.
+std::string varint(std::uint64_t value) {
+  std::string bytes;
+  while (value >= 0x80) {
+    bytes.push_back(static_cast<char>((value & 0x7f) | 0x80));
+    value >>= 7;
+  }
+  bytes.push_back(static_cast<char>(value));
+  return bytes;
+}
+
+/// Field `number` of wire type 2 (length-delimited) holding `payload`.
+std::string length_delimited(std::uint32_t number, const std::string& payload) {
+  return varint(std::uint64_t{number} << 3 | 2) + varint(payload.size()) + payload;
+}
+
+/// The bytes of a 1.x SetupBody request: `setup` (its other fields) with, written by hand,
+/// field 2 (mesh_content) = `script` and field 3 (mesh_extension) = ".geo" inside
+/// Envelope.setup_body (field 12; protobuf merges the two occurrences of the message).
+std::string with_1x_script(const protocol::Envelope& setup, const std::string& script) {
+  return setup.SerializeAsString() +
+         length_delimited(12, length_delimited(2, script) + length_delimited(3, ".geo"));
+}
+
+/// A servers' data directory and output root with the links of the attacks, in a scratch
+/// directory:
+///   data/square.msh        tests/data/mesh_square_v41.msh
+///   data/inverted.msh      tests/data/mesh_square_inverted_v22.msh (triangle 13 reversed)
+///   data/passwd.msh     -> /etc/passwd
+///   data/outside.msh    -> x.msh (outside the data directory, a valid mesh)
+///   data/up             -> the scratch directory
+///   x.msh                  a valid mesh
+///   root/out/lower.vtu  -> outside/victim.txt ("precious")
+///   root/linked         -> outside
+///   outside/victim.txt
+struct AttackFiles {
+  ScratchDirectory scratch{"attack"};
+  std::filesystem::path data = scratch.path() / "data";
+  std::filesystem::path root = scratch.path() / "root";
+  std::filesystem::path outside = scratch.path() / "outside";
+  std::filesystem::path victim = outside / "victim.txt";
+
+  AttackFiles() {
+    const std::filesystem::path test_data = ROBIN_TEST_DATA;
+    std::filesystem::create_directories(data);
+    std::filesystem::create_directories(root / "out");
+    std::filesystem::create_directories(outside);
+    std::filesystem::copy_file(test_data / "mesh_square_v41.msh", data / "square.msh");
+    std::filesystem::copy_file(test_data / "mesh_square_inverted_v22.msh", data / "inverted.msh");
+    std::filesystem::copy_file(test_data / "mesh_square_v41.msh", scratch.path() / "x.msh");
+    std::filesystem::create_symlink("/etc/passwd", data / "passwd.msh");
+    std::filesystem::create_symlink(scratch.path() / "x.msh", data / "outside.msh");
+    std::filesystem::create_symlink(scratch.path(), data / "up");
+    write_text(victim, "precious\n");
+    std::filesystem::create_symlink(victim, root / "out/lower.vtu");
+    std::filesystem::create_symlink(outside, root / "linked");
+  }
+};
+
+/// A body on the unit square read from `mesh_path`: clamped "bottom", contact boundary "top".
+protocol::Envelope square_path_setup(std::uint64_t id, const std::string& mesh_path) {
+  protocol::Envelope setup = request(id);
+  protocol::SetupBody& body = *setup.mutable_setup_body();
+  body.set_body_name("square");
+  body.set_mesh_path(mesh_path);
+  body.set_model(protocol::PLANE_STRAIN);
+  body.set_young_modulus(1000.0);
+  body.set_poisson_ratio(0.3);
+  body.add_dirichlet()->set_boundary("bottom");
+  body.mutable_dirichlet(0)->set_x(0.0);
+  body.mutable_dirichlet(0)->set_y(0.0);
+  body.add_contact_boundaries("top");
+  return setup;
+}
+
+/// A robin-subdomain started on an ephemeral port with `arguments` added, and a socket to it.
+struct ConnectedServer {
+  explicit ConnectedServer(std::vector<std::string> arguments)
+      : process([&] {
+          arguments.insert(arguments.begin(),
+                           {"--listen", "tcp://127.0.0.1:*", "--log-level", "warn"});
+          return arguments;
+        }()),
+        endpoint(process.endpoint()),
+        socket(connect(context, endpoint)) {}
+  ServerProcess process;
+  std::string endpoint;
+  zmq::context_t context;
+  zmq::socket_t socket;
+};
+
+// Issue 11 (a): the wire bytes of a 1.x SetupBody with a .geo script in mesh_content (field 2)
+// and ".geo" in mesh_extension (field 3), the script running "touch WITNESS" by SystemCall or by
+// an ExternalProcess mesh size field. robin-subdomain 2.0 runs no script: without MeshData or
+// mesh_path the body is BAD_INPUT, with a valid MeshData the script is ignored; the witness
+// file never appears and the server answers Hello after each request.
+TEST(SubdomainProcess, Version1GeoScriptIsNeverRun) {
+  ConnectedServer server({});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  std::uint64_t id = 1;
+  for (const bool external_process : {false, true}) {
+    const std::filesystem::path witness = temporary_path("witness");
+    std::filesystem::remove(witness);
+    std::string script = file_text(lower_geo);
+    script += external_process ? "\nField[1] = ExternalProcess;\nField[1].CommandLine = \"touch " +
+                                     witness.string() + "\";\nBackground Field = 1;\n"
+                               : "\nSystemCall \"touch " + witness.string() + "\";\n";
+    protocol::Envelope without_mesh = lower_block_setup(id++);
+    without_mesh.mutable_setup_body()->clear_mesh_path();
+    const std::string bytes = with_1x_script(without_mesh, script);
+    // The bytes parse, with the script kept as unknown fields of the SetupBody.
+    protocol::Envelope parsed;
+    ASSERT_TRUE(parsed.ParseFromString(bytes));
+    ASSERT_FALSE(
+        parsed.setup_body().GetReflection()->GetUnknownFields(parsed.setup_body()).empty());
+    const std::optional<protocol::Envelope> reply = exchange_bytes(server.socket, bytes);
+    ASSERT_TRUE(reply);
+    expect_error(*reply, protocol::BAD_INPUT,
+                 "body 'lower': SetupBody.mesh and SetupBody.mesh_path are both absent");
+    expect_hello(server.socket, id++);
+
+    const std::optional<protocol::Envelope> with_mesh =
+        exchange_bytes(server.socket, with_1x_script(lower_block_data_setup(id++), script));
+    ASSERT_TRUE(with_mesh);
+    EXPECT_TRUE(with_mesh->has_interface()) << with_mesh->DebugString();
+    expect_hello(server.socket, id++);
+    EXPECT_FALSE(std::filesystem::exists(witness)) << "the script ran";
+  }
+  ASSERT_TRUE(exchange(server.socket, shutdown(id)).has_acknowledge());
+  EXPECT_EQ(server.process.wait_for_exit(), 0) << server.process.stderr_text();
+}
+
+// Issue 11 (b): mesh_path "/etc/passwd", "../x.msh", links in the data directory to
+// /etc/passwd, to a mesh outside and to a directory outside are BAD_INPUT and no reply holds a
+// line of /etc/passwd; square.msh inside is read and gives the body built here from the same
+// file; a server without --data-directory refuses every mesh_path.
+TEST(SubdomainProcess, MeshPathOutsideTheDataDirectoryIsRefusedUnread) {
+  const AttackFiles files;
+  std::vector<std::string> secret;
+  {
+    std::ifstream passwd("/etc/passwd");
+    for (std::string line; std::getline(passwd, line);) {
+      if (!line.empty()) secret.push_back(line);
+    }
+  }
+  ConnectedServer server({"--data-directory", files.data.string()});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  std::uint64_t id = 1;
+  for (const auto& [path, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"/etc/passwd", "is absolute"},
+           {"../x.msh", "contains '..'"},
+           {"passwd.msh", "leads out of the data directory"},
+           {"outside.msh", "leads out of the data directory"},
+           {"up/x.msh", "leads out of the data directory"}}) {
+    const protocol::Envelope reply = exchange(server.socket, square_path_setup(id++, path));
+    expect_error(reply, protocol::BAD_INPUT, "body 'square': SetupBody.mesh_path");
+    expect_error(reply, protocol::BAD_INPUT, expected);
+    const std::string bytes = reply.SerializeAsString();
+    for (const std::string& line : secret) {
+      EXPECT_EQ(bytes.find(line), std::string::npos) << "the reply shows '" << line << "'";
+    }
+    expect_hello(server.socket, id++);
+  }
+
+  const protocol::Envelope reply = exchange(server.socket, square_path_setup(id++, "square.msh"));
+  ASSERT_TRUE(reply.has_interface()) << reply.DebugString();
+  BodyDefinition definition;
+  definition.name = "square";
+  definition.mesh = read_gmsh_mesh(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_v41.msh");
+  definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
+  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  definition.contact_boundary = "top";
+  const BodySolver reference(definition);
+  const InterfaceDescription expected = reference.contact_boundary();
+  ASSERT_EQ(reply.interface().node_ids_size(), static_cast<int>(expected.node_ids.size()));
+  for (std::size_t i = 0; i < expected.node_ids.size(); ++i) {
+    const int k = static_cast<int>(i);
+    EXPECT_EQ(reply.interface().node_ids(k), expected.node_ids[i]);
+    EXPECT_EQ(reply.interface().node_tags(k), static_cast<std::int64_t>(expected.node_tags[i]));
+    EXPECT_EQ(reply.interface().coordinates(2 * k), expected.coordinates[i].x());
+    EXPECT_EQ(reply.interface().coordinates(2 * k + 1), expected.coordinates[i].y());
+  }
+  EXPECT_EQ(reply.interface().dof_count(), static_cast<std::uint64_t>(reference.free_dof_count()));
+
+  ConnectedServer without_directory({});
+  for (const std::string& path :
+       {std::string("square.msh"), (files.data / "square.msh").string()}) {
+    expect_error(exchange(without_directory.socket, square_path_setup(id++, path)),
+                 protocol::BAD_INPUT, "this server was started without --data-directory");
+  }
+  expect_hello(without_directory.socket, id++);
+}
+
+/// A FieldsRequest for 21 contact forces of 0.5, written to `write_directory`.
+protocol::Envelope fields_request(std::uint64_t id, const std::string& write_directory) {
+  protocol::Envelope envelope = request(id);
+  envelope.mutable_fields()->mutable_contact_force()->Resize(21, 0.5);
+  envelope.mutable_fields()->set_write_directory(write_directory);
+  return envelope;
+}
+
+/// Sets the lower block up (MeshData) and assigns its 21 contact nodes, normal (0, 1).
+void set_up_lower_block(zmq::socket_t& socket, std::uint64_t& id) {
+  const protocol::Envelope interface = exchange(socket, lower_block_data_setup(id++));
+  ASSERT_TRUE(interface.has_interface()) << interface.DebugString();
+  ASSERT_EQ(interface.interface().node_ids_size(), 21);
+  protocol::Envelope assign = request(id++);
+  protocol::AssignContact& message = *assign.mutable_assign_contact();
+  message.add_row_offsets(0);
+  for (int i = 0; i < 21; ++i) {
+    message.add_node_ids(interface.interface().node_ids(i));
+    message.add_components(1);
+    message.add_values(1.0);
+    message.add_row_offsets(static_cast<std::uint64_t>(i + 1));
+    message.add_weights(interface.interface().weights(i));
+  }
+  ASSERT_TRUE(exchange(socket, assign).has_acknowledge());
+}
+
+// Issue 11 (c): root/out/lower.vtu is a link to a file outside --output-root: FieldsRequest
+// with write_directory "out" replaces the link by the VTU and leaves the outside file as it
+// was; absolute, ".." and symbolically linked write directories are INVALID_ARGUMENT and create
+// nothing outside the root; a server without --output-root refuses every write_directory.
+TEST(SubdomainProcess, WriteDirectoryOutsideTheOutputRootIsRefusedUnwritten) {
+  const AttackFiles files;
+  ConnectedServer server({"--output-root", files.root.string()});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  std::uint64_t id = 1;
+  set_up_lower_block(server.socket, id);
+
+  const protocol::Envelope written = exchange(server.socket, fields_request(id++, "out"));
+  ASSERT_TRUE(written.has_fields_reply()) << written.DebugString();
+  EXPECT_EQ(written.fields_reply().written_file(),
+            (std::filesystem::canonical(files.root) / "out/lower.vtu").string());
+  EXPECT_EQ(file_text(files.victim), "precious\n");
+  EXPECT_FALSE(std::filesystem::is_symlink(files.root / "out/lower.vtu"));
+  EXPECT_NE(file_text(files.root / "out/lower.vtu").find("<VTKFile"), std::string::npos);
+  expect_hello(server.socket, id++);
+
+  for (const auto& [directory, expected] :
+       std::vector<std::pair<std::string, std::string>>{{files.outside.string(), "is absolute"},
+                                                        {"../outside", "contains '..'"},
+                                                        {"out/../../outside/sub", "contains '..'"},
+                                                        {"linked", "is a symbolic link"},
+                                                        {"linked/sub", "is a symbolic link"}}) {
+    expect_error(exchange(server.socket, fields_request(id++, directory)),
+                 protocol::INVALID_ARGUMENT, expected);
+    expect_hello(server.socket, id++);
+  }
+  EXPECT_EQ(listing(files.outside), (std::set<std::string>{"victim.txt"}));
+  EXPECT_EQ(file_text(files.victim), "precious\n");
+  EXPECT_EQ(listing(files.root), (std::set<std::string>{"linked", "out", "out/lower.vtu"}));
+
+  ConnectedServer without_root({});
+  set_up_lower_block(without_root.socket, id);
+  expect_error(exchange(without_root.socket, fields_request(id++, "out")),
+               protocol::INVALID_ARGUMENT, "this server was started without --output-root");
+  expect_hello(without_root.socket, id++);
+}
+
+// Issue 11 (d) and (e): a 100,000-character body name is BAD_INPUT (at most 64), not echoed;
+// a MeshData triangle with two nodes swapped is BAD_INPUT naming its tag, and so is the .msh
+// in the data directory with one triangle reversed against its surface.
+TEST(SubdomainProcess, HugeNameAndInvertedCellsAreBadInput) {
+  const AttackFiles files;
+  ConnectedServer server({"--data-directory", files.data.string()});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  std::uint64_t id = 1;
+  protocol::Envelope huge = lower_block_data_setup(id++);
+  huge.mutable_setup_body()->set_body_name(std::string(100000, 'a'));
+  protocol::Envelope reply = exchange(server.socket, huge);
+  expect_error(reply, protocol::BAD_INPUT, "SetupBody.body_name has 100000 characters: at most 64");
+  EXPECT_LT(reply.ByteSizeLong(), 1000u);
+  expect_hello(server.socket, id++);
+
+  protocol::Envelope inverted = lower_block_data_setup(id++);
+  protocol::CellBlock& cells = *inverted.mutable_setup_body()->mutable_mesh()->mutable_cells(0);
+  ASSERT_EQ(cells.type(), protocol::TRIANGLE3);
+  ASSERT_GT(cells.tags_size(), 5);
+  const std::uint32_t second = cells.connectivity(16), third = cells.connectivity(17);
+  cells.set_connectivity(16, third);  // triangle 5 (zero-based): its last two nodes swapped
+  cells.set_connectivity(17, second);
+  reply = exchange(server.socket, inverted);
+  expect_error(reply, protocol::BAD_INPUT,
+               "body 'lower': SetupBody.mesh: element tag " + std::to_string(cells.tags(5)) + " ");
+  expect_error(reply, protocol::BAD_INPUT, "is inverted or folded");
+  expect_hello(server.socket, id++);
+
+  reply = exchange(server.socket, square_path_setup(id++, "inverted.msh"));
+  expect_error(reply, protocol::BAD_INPUT, "element tag 13 ");
+  expect_error(reply, protocol::BAD_INPUT, "inverted");
+  expect_hello(server.socket, id++);
+  EXPECT_TRUE(exchange(server.socket, lower_block_data_setup(id++)).has_interface());
 }
 
 }  // namespace

@@ -12,6 +12,10 @@
 // force and a traction on the right side; contact edge "top" with outward normal (0, 1).
 // Every interface operator of BodySolver is checked: dense F from the factor's trailing block,
 // dense F by blocked solves, and F applied through the factor.
+// The constraint operator B is general (protocol 2.0): besides the node-to-node rows
+// (node_to_node_operator, (B u)_i = u(node_i) . n_i), rows that combine two nodes and both
+// components (as mortar coupling sends them) are checked against the same independent solve,
+// also with a row that touches a prescribed dof (its value enters the trace as B u_p).
 
 #include <gtest/gtest.h>
 
@@ -25,6 +29,7 @@
 #include <vector>
 
 #include "numerics/body_solver.hpp"
+#include "numerics/contact_operator.hpp"
 #include "numerics/elasticity.hpp"
 #include "numerics/material.hpp"
 #include "numerics/rectangle_mesher.hpp"
@@ -51,21 +56,46 @@ BodyDefinition test_body() {
   return body;
 }
 
-/// Every node of the contact edge with its geometric normal (0, 1), in ascending node order.
-ContactAssignment top_assignment(const Mesh& mesh) {
-  ContactAssignment assignment;
-  assignment.node_ids = mesh.boundary("top").nodes();
-  assignment.normals.assign(assignment.node_ids.size(), Eigen::Vector2d(0.0, 1.0));
-  return assignment;
+/// Every node of the contact edge with its geometric normal (0, 1), in ascending node order,
+/// as node-to-node rows (weights: the nodes' boundary weights).
+ContactOperator top_assignment(const Mesh& mesh) {
+  const std::vector<int> nodes = mesh.boundary("top").nodes();
+  const Eigen::VectorXd weights = boundary_weights(mesh, mesh.boundary("top"));
+  std::vector<double> node_weights;
+  for (int node : nodes) node_weights.push_back(weights[node]);
+  return node_to_node_operator(nodes, std::vector<Eigen::Vector2d>(nodes.size(), {0.0, 1.0}),
+                               node_weights);
+}
+
+/// A general operator on the nodes of `boundary` (ascending): for each pair of consecutive
+/// nodes (a, b) the row 0.5 u_y(a) + 0.5 u_y(b), then every third pair also the row
+/// 0.6 u_x(a) - 0.3 u_y(a) + 0.8 u_y(b) (both components of one node, and another node).
+ContactOperator two_node_operator(const Mesh& mesh, const std::string& boundary) {
+  const std::vector<int> nodes = mesh.boundary(boundary).nodes();
+  ContactOperator contact;
+  for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+    contact.add_entry(nodes[i], 1, 0.5);
+    contact.add_entry(nodes[i + 1], 1, 0.5);
+    contact.finish_row(0.1);
+    if (i % 3 == 0) {
+      contact.add_entry(nodes[i], 0, 0.6);
+      contact.add_entry(nodes[i], 1, -0.3);
+      contact.add_entry(nodes[i + 1], 1, 0.8);
+      contact.finish_row(0.2);
+    }
+  }
+  return contact;
 }
 
 /// The body reduced to its free dofs and factorized here, independently of BodySolver.
 /// S selects the free dofs (free x total), u_p holds the prescribed values:
 ///   K_ff = S K S',  f_f = S (f - K u_p),  u = u_p + S' u_f,
-///   B' lambda = S (sum_i lambda_i n_i at node_i),  (B u)_i = u(node_i) . n_i.
+///   B' lambda = S (sum_j lambda_j sum_k b_jk e_k),  (B u)_j = sum_k b_jk u_k,
+/// with b_jk the entries of the constraint operator over the dofs k = 2 node + component
+/// (node-to-node rows: (B u)_i = u(node_i) . n_i).
 class ReferenceBody {
  public:
-  ReferenceBody(const BodyDefinition& body, const ContactAssignment& assignment)
+  ReferenceBody(const BodyDefinition& body, const ContactOperator& assignment)
       : assignment_(assignment) {
     const Mesh& mesh = body.mesh;
     const Eigen::Index total = 2 * static_cast<Eigen::Index>(mesh.node_count());
@@ -100,21 +130,27 @@ class ReferenceBody {
   /// B' lambda on the free dofs.
   Eigen::VectorXd transpose_trace(const Eigen::VectorXd& force) const {
     Eigen::VectorXd load = Eigen::VectorXd::Zero(prescribed_.size());
-    for (std::size_t i = 0; i < assignment_.node_ids.size(); ++i) {
-      load.segment<2>(2 * assignment_.node_ids[i]) +=
-          force[static_cast<Eigen::Index>(i)] * assignment_.normals[i];
+    for (int row = 0; row < assignment_.row_count(); ++row) {
+      for (std::size_t k = assignment_.row_offsets[row]; k < assignment_.row_offsets[row + 1];
+           ++k) {
+        load[2 * assignment_.nodes[k] + assignment_.components[k]] +=
+            force[row] * assignment_.values[k];
+      }
     }
     return selection_ * load;
   }
 
-  /// (B u)_i for the full field u = u_p + S' u_f of free values u_f.
+  /// (B u)_j for the full field u = u_p + S' u_f of free values u_f.
   Eigen::VectorXd trace(const Eigen::VectorXd& free_values, bool with_prescribed) const {
     Eigen::VectorXd full = selection_.transpose() * free_values;
     if (with_prescribed) full += prescribed_;
-    Eigen::VectorXd result(static_cast<Eigen::Index>(assignment_.node_ids.size()));
-    for (std::size_t i = 0; i < assignment_.node_ids.size(); ++i) {
-      result[static_cast<Eigen::Index>(i)] =
-          full.segment<2>(2 * assignment_.node_ids[i]).dot(assignment_.normals[i]);
+    Eigen::VectorXd result = Eigen::VectorXd::Zero(assignment_.row_count());
+    for (int row = 0; row < assignment_.row_count(); ++row) {
+      for (std::size_t k = assignment_.row_offsets[row]; k < assignment_.row_offsets[row + 1];
+           ++k) {
+        result[row] +=
+            assignment_.values[k] * full[2 * assignment_.nodes[k] + assignment_.components[k]];
+      }
     }
     return result;
   }
@@ -130,7 +166,7 @@ class ReferenceBody {
   }
 
  private:
-  ContactAssignment assignment_;
+  ContactOperator assignment_;
   SparseMatrix selection_;
   Eigen::VectorXd prescribed_;
   Eigen::VectorXd free_load_;
@@ -149,12 +185,15 @@ std::vector<OperatorChoice> operator_choices() {
           {InterfaceOperatorKind::factor, true, "F through the factor"}};
 }
 
-std::unique_ptr<BodySolver> make_solver(const OperatorChoice& choice) {
+std::unique_ptr<BodySolver> make_solver(const OperatorChoice& choice,
+                                        const std::string& contact_boundary = "top") {
   BodySolverOptions options;
   options.interface_operator = choice.kind;
   options.contact_unknowns_last = choice.contact_unknowns_last;
-  auto solver = std::make_unique<BodySolver>(test_body(), options);
-  solver->assign_contact(top_assignment(solver->mesh()));
+  BodyDefinition body = test_body();
+  body.contact_boundary = contact_boundary;
+  auto solver = std::make_unique<BodySolver>(std::move(body), options);
+  if (contact_boundary == "top") solver->assign_contact(top_assignment(solver->mesh()));
   return solver;
 }
 
@@ -188,7 +227,8 @@ Eigen::VectorXd middle_obstacle(const BodySolver& solver) {
   EXPECT_GT(free_trace.minCoeff(), 0.0) << "the loads must lift the whole contact edge";
   Eigen::VectorXd obstacle(free_trace.size());
   for (int i = 0; i < solver.contact_size(); ++i) {
-    const double x = solver.mesh().nodes[solver.contact_nodes()[i]].x();
+    const ContactOperator& contact = solver.contact_operator();
+    const double x = solver.mesh().nodes[contact.nodes[contact.row_offsets[i]]].x();
     obstacle[i] = free_trace[i] * (0.4 + 0.8 * std::abs(x - 1.0));
   }
   return obstacle;
@@ -224,6 +264,138 @@ TEST(BodySolver, ContactSolveSatisfiesSignoriniWithTheIndependentSolve) {
               << " closed, trace error " << trace_error << ", penetration " << penetration
               << " (displacement scale " << displacement_scale << "), complementarity "
               << complementarity << "\n";
+  }
+}
+
+/// A varying interface force of the size of the operator's rows (deterministic).
+Eigen::VectorXd varying_force(Eigen::Index size) {
+  Eigen::VectorXd force(size);
+  for (Eigen::Index i = 0; i < size; ++i) {
+    force[i] = 1.0 + 0.5 * std::cos(1.3 * static_cast<double>(i));
+  }
+  return force;
+}
+
+// Issue 11 (g): a general B, whose rows combine two nodes (0.5 u_y(a) + 0.5 u_y(b)) and both
+// components of a node, gives the Neumann solve u_N = B K^{-1}(f - B' lambda) + B u_p and the
+// correction w_N = B K^{-1} B' r of the independent solve, to 1e-12 relative, with every
+// interface operator. On "right" the first row touches the bottom-right corner, whose u_x and
+// u_y are prescribed (u_y = bottom_lift): the prescribed value enters the trace.
+TEST(BodySolver, GeneralOperatorEqualsTheIndependentSolve) {
+  for (const std::string boundary : {"top", "right"}) {
+    BodyDefinition body = test_body();
+    body.contact_boundary = boundary;
+    const ContactOperator contact = two_node_operator(body.mesh, boundary);
+    const ReferenceBody reference(body, contact);
+    if (boundary == "right") {
+      // The corner (2, 0) is the first node of "right" in ascending order and is prescribed.
+      const int corner = contact.nodes[0];
+      ASSERT_EQ(body.mesh.nodes[corner], Eigen::Vector2d(2.0, 0.0));
+    }
+    for (const OperatorChoice& choice : operator_choices()) {
+      const std::string label = choice.label + " on '" + boundary + "'";
+      const auto solver = make_solver(choice, boundary);
+      solver->assign_contact(contact);
+      ASSERT_EQ(solver->contact_size(), contact.row_count()) << label;
+
+      const Eigen::VectorXd force = varying_force(contact.row_count());
+      const Eigen::VectorXd expected_correction = reference.correction(force);
+      EXPECT_GT(largest(expected_correction), 1e-4) << label << ": r must move the boundary";
+      const double correction_error =
+          largest(solver->solve_correction(force) - expected_correction) /
+          largest(expected_correction);
+      EXPECT_LE(correction_error, 1e-12) << label;
+
+      const Eigen::VectorXd expected_neumann = reference.contact_trace(force);
+      const double neumann_error =
+          largest(solver->solve_neumann(force) - expected_neumann) / largest(expected_neumann);
+      EXPECT_LE(neumann_error, 1e-12) << label;
+
+      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(contact.row_count());
+      const Eigen::VectorXd expected_free = reference.contact_trace(zero);
+      const double free_error =
+          largest(solver->free_trace() - expected_free) / largest(expected_free);
+      EXPECT_LE(free_error, 1e-12) << label;
+      if (boundary == "right") {
+        // Row 0 = 0.5 u_y(corner) + 0.5 u_y(next): the prescribed half is bottom_lift / 2.
+        EXPECT_GT(std::abs(expected_free[0]), 0.25 * bottom_lift) << label;
+      }
+      std::cout << label << ": correction " << correction_error << ", Neumann " << neumann_error
+                << ", free trace " << free_error << " relative error\n";
+
+      // The contact force field is -B' lambda, entry by entry.
+      const Eigen::VectorXd field = solver->contact_force_field(force);
+      Eigen::VectorXd expected_field = Eigen::VectorXd::Zero(field.size());
+      for (int row = 0; row < contact.row_count(); ++row) {
+        for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
+          expected_field[2 * contact.nodes[k] + contact.components[k]] -=
+              contact.values[k] * force[row];
+        }
+      }
+      EXPECT_LE(largest(field - expected_field), 1e-15 * largest(expected_field)) << label;
+    }
+  }
+}
+
+// Issue 11 (g): node_to_node_operator gives the node-to-node B of protocol 1.x, one row
+// (n_x at (node, x), n_y at (node, y)) per node in the given order with the given weights, and
+// BodySolver with it gives the trace, correction and Neumann solve of the 1.x definition
+// (B u)_i = u(node_i) . n_i computed independently here, to 1e-12, for tilted unit normals, the
+// nodes in reversed order and on the boundary "right" whose first node is prescribed.
+TEST(BodySolver, NodeToNodeOperatorIsTheNodeNormalTrace) {
+  BodyDefinition body = test_body();
+  body.contact_boundary = "right";
+  std::vector<int> nodes = body.mesh.boundary("right").nodes();
+  std::reverse(nodes.begin(), nodes.end());
+  std::vector<Eigen::Vector2d> normals;
+  std::vector<double> weights;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const double angle = 0.1 * static_cast<double>(i) - 0.4;
+    normals.emplace_back(std::cos(angle), std::sin(angle));
+    weights.push_back(0.5 + static_cast<double>(i));
+  }
+  const ContactOperator contact = node_to_node_operator(nodes, normals, weights);
+  ASSERT_EQ(contact.row_count(), static_cast<int>(nodes.size()));
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    ASSERT_EQ(contact.row_offsets[i], 2 * i);
+    EXPECT_EQ(contact.nodes[2 * i], nodes[i]);
+    EXPECT_EQ(contact.nodes[2 * i + 1], nodes[i]);
+    EXPECT_EQ(contact.components[2 * i], 0);
+    EXPECT_EQ(contact.components[2 * i + 1], 1);
+    EXPECT_EQ(contact.values[2 * i], normals[i].x());
+    EXPECT_EQ(contact.values[2 * i + 1], normals[i].y());
+    EXPECT_EQ(contact.weights[i], weights[i]);
+  }
+  EXPECT_EQ(contact.row_offsets.back(), 2 * nodes.size());
+
+  // The 1.x trace, written with the normals: u_N,i = u(node_i) . n_i, on a full field.
+  const auto node_normal_trace = [&](const Eigen::VectorXd& full) {
+    Eigen::VectorXd trace(static_cast<Eigen::Index>(nodes.size()));
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      trace[static_cast<Eigen::Index>(i)] = full.segment<2>(2 * nodes[i]).dot(normals[i]);
+    }
+    return trace;
+  };
+  for (const OperatorChoice& choice : operator_choices()) {
+    const auto solver = make_solver(choice, "right");
+    solver->assign_contact(contact);
+    const Eigen::VectorXd force = varying_force(solver->contact_size());
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(solver->contact_size());
+    const Eigen::VectorXd expected_free = node_normal_trace(solver->displacement(zero));
+    const Eigen::VectorXd expected_neumann = node_normal_trace(solver->displacement(force));
+    EXPECT_LE(largest(solver->free_trace() - expected_free), 1e-12 * largest(expected_free))
+        << choice.label;
+    EXPECT_LE(largest(solver->solve_neumann(force) - expected_neumann),
+              1e-12 * largest(expected_neumann))
+        << choice.label;
+    // The contact force field of the 1.x code: -lambda_i n_i at node i.
+    Eigen::VectorXd expected_field = Eigen::VectorXd::Zero(2 * body.mesh.node_count());
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      expected_field.segment<2>(2 * nodes[i]) -= force[static_cast<Eigen::Index>(i)] * normals[i];
+    }
+    EXPECT_LE(largest(solver->contact_force_field(force) - expected_field),
+              1e-15 * largest(expected_field))
+        << choice.label;
   }
 }
 

@@ -46,9 +46,24 @@ TEST(ContactPairing, MatchingFlatInterfacesWithGeometricAndAnalyticGap) {
     // Weights: lower node k has 1 + k, upper node k has 1 + k; the pair averages both sides.
     EXPECT_DOUBLE_EQ(pair.weight, 0.5 * (lower.weights[pair.node1] + upper.weights[pair.node2]));
   }
-  const ContactAssignment second = pairing.assignment(1);
-  EXPECT_DOUBLE_EQ(second.normals[0].y(), -1.0);
-  EXPECT_EQ(second.node_ids[0], 2);  // upper node at x = 0
+  // Body 2's node-to-node operator: one row per pair, (x, y) entries of -n1 at node2.
+  const ContactOperator second = pairing.assignment(1);
+  ASSERT_EQ(second.row_count(), 3);
+  ASSERT_EQ(second.entry_count(), 6u);
+  EXPECT_EQ(second.row_offsets, (std::vector<std::size_t>{0, 2, 4, 6}));
+  EXPECT_EQ(second.nodes[0], 2);  // upper node at x = 0
+  EXPECT_EQ(second.nodes[1], 2);
+  EXPECT_EQ(second.components[0], 0);
+  EXPECT_EQ(second.components[1], 1);
+  EXPECT_DOUBLE_EQ(second.values[0], 0.0);
+  EXPECT_DOUBLE_EQ(second.values[1], -1.0);
+  for (int row = 0; row < 3; ++row) {
+    EXPECT_DOUBLE_EQ(second.weights[row], pairing.pairs[row].weight);
+  }
+  const ContactOperator first = pairing.assignment(0);
+  ASSERT_EQ(first.row_count(), 3);
+  EXPECT_EQ(first.nodes[0], 1);  // lower node at x = 0
+  EXPECT_DOUBLE_EQ(first.values[1], 1.0);
 }
 
 TEST(ContactPairing, NonMatchingMeshesNameTheFirstUnmatchedNode) {

@@ -123,7 +123,7 @@ Mesh unit_triangle() {
   Mesh mesh;
   mesh.nodes = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
   mesh.node_tags = {1, 2, 3};
-  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}});
+  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
   mesh.boundaries["bottom"] = {EdgeType::line2, {0, 1}};
   return mesh;
 }
@@ -299,7 +299,7 @@ TEST(Normals, CornerOfTwoSidesInOneGroupAveragesByLength) {
   Mesh mesh;
   mesh.nodes = {{0.0, 0.0}, {2.0, 0.0}, {2.0, 1.0}};
   mesh.node_tags = {1, 2, 3};
-  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}});
+  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
   mesh.boundaries["corner"] = {EdgeType::line2, {0, 1, 1, 2}};
   const std::vector<Eigen::Vector2d> normals = boundary_node_normals(mesh, mesh.boundary("corner"));
   ASSERT_EQ(normals.size(), 3u);

@@ -1,6 +1,7 @@
-// Gmsh reader: .msh 2.2 and 4.1 files, .geo scripts meshed on the fly, meshes given as
-// text, element orientation, boundary names and the errors for bad input. Expected
-// numbers come from the geometry (areas, lengths) or from the files themselves.
+// Gmsh reader: .msh 2.2 and 4.1 files, .geo scripts meshed on the fly (also several at once,
+// in child processes), element orientation and refusal of inverted elements, boundary names and the
+// errors for bad input. Expected numbers come from the geometry (areas, lengths) or from the files
+// themselves.
 
 #include <gtest/gtest.h>
 
@@ -81,13 +82,6 @@ std::map<std::size_t, Eigen::Vector2d> nodes_of_msh22(const std::filesystem::pat
     nodes[tag] = {x, y};
   }
   return nodes;
-}
-
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream stream(path);
-  std::stringstream buffer;
-  buffer << stream.rdbuf();
-  return buffer.str();
 }
 
 /// The message of the InputError thrown by `call`, or "" when nothing is thrown.
@@ -276,54 +270,138 @@ std::string small_msh22(int physical, double z = 0.0, int edge_physical = 5) {
          p + " 1 2 3 4\n$EndElements\n";
 }
 
+/// A private directory under the temporary directory, removed on destruction.
+class ScratchDirectory {
+ public:
+  explicit ScratchDirectory(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("robin-mesh-reader-test-" + name + "-" + std::to_string(std::random_device{}()))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDirectory() {
+    std::error_code error;
+    std::filesystem::remove_all(path_, error);
+  }
+  ScratchDirectory(const ScratchDirectory&) = delete;
+  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  /// Writes `content` to <directory>/<name>; returns the path.
+  std::filesystem::path write(const std::string& name, const std::string& content) const {
+    const std::filesystem::path file = path_ / name;
+    std::ofstream stream(file, std::ios::binary);
+    stream << content;
+    return file;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
 TEST(MeshReader, HandWrittenMeshIsCompactedAndReoriented) {
-  const Mesh mesh = read_gmsh_mesh_from_text(small_msh22(7), ".msh", "hand mesh");
+  const ScratchDirectory directory("hand");
+  const Mesh mesh = read_gmsh_mesh(directory.write("hand.msh", small_msh22(7)));
   ASSERT_EQ(mesh.node_count(), 4u);  // node 9 is in no element
   EXPECT_EQ(mesh.node_tags, (std::vector<std::size_t>{1, 2, 3, 4}));
   EXPECT_EQ(mesh.nodes[1], Eigen::Vector2d(2.0, 0.0));
   ASSERT_EQ(mesh.blocks.size(), 1u);
-  // Element (1, 3, 2) is clockwise: reordered to (1, 2, 3); (2, 3, 4) is counter-clockwise.
+  // Both triangles, (1, 3, 2) and (2, 3, 4), are clockwise, like their surface: each is
+  // reordered, to (1, 2, 3) and (2, 4, 3).
   EXPECT_EQ(mesh.blocks[0].connectivity, (std::vector<int>{0, 1, 2, 1, 3, 2}));
+  EXPECT_EQ(mesh.blocks[0].tags, (std::vector<std::size_t>{2, 3}));
   EXPECT_NEAR(checked_area(mesh), 2.0, 1e-15);
   EXPECT_EQ(mesh.boundary("5").connectivity, (std::vector<int>{0, 1}));
 }
 
 TEST(MeshReader, WithoutSurfaceGroupsTheHandWrittenTrianglesAreStillRead) {
-  const Mesh mesh = read_gmsh_mesh_from_text(small_msh22(0), ".msh", "hand mesh");
+  const ScratchDirectory directory("no-groups");
+  const Mesh mesh = read_gmsh_mesh(directory.write("hand.msh", small_msh22(0)));
   EXPECT_EQ(mesh.element_count(), 2u);
   EXPECT_NEAR(checked_area(mesh), 2.0, 1e-15);
 }
 
 TEST(MeshReader, HandWrittenMeshErrors) {
+  const ScratchDirectory directory("errors");
   // Physical tag 0 everywhere means no physical group at all.
-  std::string message = input_error_message(
-      [] { read_gmsh_mesh_from_text(small_msh22(0, 0.0, 0), ".msh", "body 'upper': mesh"); });
-  EXPECT_EQ(message.rfind("body 'upper': mesh", 0), 0u) << message;
+  const std::filesystem::path ungrouped = directory.write("upper.msh", small_msh22(0, 0.0, 0));
+  std::string message = input_error_message([&] { read_gmsh_mesh(ungrouped); });
+  EXPECT_EQ(message.rfind("mesh file '" + ungrouped.string() + "'", 0), 0u) << message;
   EXPECT_NE(message.find("physical"), std::string::npos) << message;
-  message =
-      input_error_message([] { read_gmsh_mesh_from_text(small_msh22(7, 0.5), ".msh", "tilted"); });
+  const std::filesystem::path tilted = directory.write("tilted.msh", small_msh22(7, 0.5));
+  message = input_error_message([&] { read_gmsh_mesh(tilted); });
   EXPECT_NE(message.find("z = 0"), std::string::npos) << message;
-  EXPECT_THROW(read_gmsh_mesh_from_text(small_msh22(7), ".vtk", "label"), InputError);
+  EXPECT_NE(message.find(tilted.string()), std::string::npos) << message;
+  EXPECT_THROW(read_gmsh_mesh(directory.write("label.vtk", small_msh22(7))), InputError);
 }
 
-TEST(MeshReader, TextInputMatchesFileInputAndErrorsNameTheLabel) {
-  const std::filesystem::path path = data_directory / "mesh_square_v22.msh";
-  const Mesh from_file = read_gmsh_mesh(path);
-  const Mesh from_text = read_gmsh_mesh_from_text(read_text(path), ".msh", "upper mesh");
-  EXPECT_EQ(from_text.node_tags, from_file.node_tags);
-  EXPECT_EQ(from_text.blocks[0].connectivity, from_file.blocks[0].connectivity);
-  const Mesh geo = read_gmsh_mesh_from_text(read_text(data_directory / "mesh_square.geo"), ".geo",
-                                            "upper geo", {.size = 0.25});
-  expect_unit_square_with_named_sides(geo);
+// Issue 11 (e): mesh_square_inverted_v22.msh is mesh_square_v22.msh with two nodes of
+// triangle 13 swapped (5 2 12 -> 2 5 12), so that it is inverted against the other triangles of
+// its surface (a tangled mesh). The reader refuses it naming the element tag; before 2.0 it
+// silently reoriented the triangle, folding it over its neighbours.
+TEST(MeshReader, TriangleInvertedAgainstItsSurfaceIsRefusedNamingItsTag) {
+  const std::filesystem::path path = data_directory / "mesh_square_inverted_v22.msh";
+  std::string message = input_error_message([&] { read_gmsh_mesh(path); });
+  EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("element tag 13 "), std::string::npos) << message;
+  EXPECT_NE(message.find("inverted"), std::string::npos) << message;
+  // The file it was made from is read, every element counter-clockwise, with its tag.
+  const Mesh mesh = read_gmsh_mesh(data_directory / "mesh_square_v22.msh");
+  ASSERT_EQ(mesh.blocks.size(), 1u);
+  ASSERT_EQ(mesh.blocks[0].tags.size(), mesh.blocks[0].element_count());
+  EXPECT_EQ(mesh.blocks[0].tags.front(), 9u);
+  EXPECT_NEAR(checked_area(mesh), 1.0, 1e-12);
+  // read_gmsh_meshes refuses it in the same way.
+  message = input_error_message([&] { read_gmsh_meshes({{path, {}}}); });
+  EXPECT_NE(message.find("element tag 13 "), std::string::npos) << message;
+}
+
+TEST(MeshReader, ZeroAreaTriangleIsRefusedNamingItsTag) {
+  // small_msh22 with node 3 moved onto the line through nodes 1 and 2: triangle 2 has zero area.
+  std::string text = small_msh22(7);
+  const std::string node3 = "3 0 1 " + std::to_string(0.0);
+  ASSERT_NE(text.find(node3), std::string::npos);
+  text.replace(text.find(node3), node3.size(), "3 1 0 " + std::to_string(0.0));
+  const ScratchDirectory directory("zero-area");
+  const std::string message =
+      input_error_message([&] { read_gmsh_mesh(directory.write("flat.msh", text)); });
+  EXPECT_NE(message.find("element tag 2 "), std::string::npos) << message;
+  EXPECT_NE(message.find("zero area"), std::string::npos) << message;
+}
+
+// read_gmsh_meshes, which replaced the reading of mesh text (a server no longer meshes what it
+// receives: the coordinator meshes its user's .geo files, each in a child process), gives the
+// meshes read_gmsh_mesh gives, and names the file of the first failure.
+TEST(MeshReader, ReadGmshMeshesMatchesReadGmshMeshAndErrorsNameTheFile) {
+  const std::filesystem::path msh = data_directory / "mesh_square_v22.msh";
+  const std::filesystem::path geo = data_directory / "mesh_square.geo";
+  const std::vector<Mesh> meshes =
+      read_gmsh_meshes({{msh, {}}, {geo, {.size = 0.25}}, {geo, {.size = 0.5}}});
+  ASSERT_EQ(meshes.size(), 3u);
+  const Mesh from_file = read_gmsh_mesh(msh);
+  EXPECT_EQ(meshes[0].node_tags, from_file.node_tags);
+  EXPECT_EQ(meshes[0].nodes, from_file.nodes);
+  EXPECT_EQ(meshes[0].blocks[0].connectivity, from_file.blocks[0].connectivity);
+  EXPECT_EQ(meshes[0].source, msh.string());
+  for (const auto& [index, size] : {std::pair{1, 0.25}, std::pair{2, 0.5}}) {
+    const Mesh& meshed = meshes[static_cast<std::size_t>(index)];
+    expect_unit_square_with_named_sides(meshed);
+    EXPECT_EQ(meshed.source, geo.string());
+    const Mesh direct = read_gmsh_mesh(geo, {.size = size});
+    EXPECT_EQ(meshed.node_count(), direct.node_count()) << size;
+    EXPECT_EQ(meshed.element_count(), direct.element_count()) << size;
+    EXPECT_EQ(boundary_names(meshed), boundary_names(direct)) << size;
+  }
+  EXPECT_GT(meshes[1].node_count(), meshes[2].node_count());
+
+  const std::filesystem::path broken = data_directory / "mesh_syntax_error.geo";
   const std::string message = input_error_message([&] {
-    read_gmsh_mesh_from_text(read_text(data_directory / "mesh_syntax_error.geo"), ".geo",
-                             "case.toml: body 'lower'");
+    read_gmsh_meshes({{geo, {}}, {broken, {}}});
   });
-  EXPECT_EQ(message.rfind("case.toml: body 'lower'", 0), 0u) << message;
+  EXPECT_EQ(message.rfind("mesh file '" + broken.string() + "'", 0), 0u) << message;
+  EXPECT_NE(message.find("line 3"), std::string::npos) << message;
   EXPECT_EQ(message.find("robin-mesh-"), std::string::npos) << message;
 }
 
-TEST(MeshReader, TextInputLeavesNoTemporaryFile) {
+TEST(MeshReader, ReadGmshMeshesLeavesNoTemporaryFile) {
   // A private temporary directory (through TMPDIR) so that other processes do not interfere.
   const std::filesystem::path directory =
       std::filesystem::temp_directory_path() /
@@ -332,8 +410,12 @@ TEST(MeshReader, TextInputLeavesNoTemporaryFile) {
   const char* previous = std::getenv("TMPDIR");
   const std::string saved = previous ? previous : "";
   ::setenv("TMPDIR", directory.c_str(), 1);
-  read_gmsh_mesh_from_text(read_text(data_directory / "mesh_square_v41.msh"), ".msh", "mesh");
-  EXPECT_THROW(read_gmsh_mesh_from_text("garbage", ".msh", "mesh"), InputError);
+  const std::filesystem::path geo = data_directory / "mesh_square.geo";
+  read_gmsh_meshes({{geo, {}}, {data_directory / "mesh_square_v41.msh", {}}});
+  EXPECT_THROW(read_gmsh_meshes({{geo, {}}, {data_directory / "mesh_syntax_error.geo", {}}}),
+               InputError);
+  EXPECT_THROW(read_gmsh_meshes({{geo, {}}, {data_directory / "mesh_garbage.msh", {}}}),
+               InputError);
   const bool empty = std::filesystem::is_empty(directory);
   if (previous) {
     ::setenv("TMPDIR", saved.c_str(), 1);

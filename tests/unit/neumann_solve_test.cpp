@@ -15,6 +15,7 @@
 
 #include "coupling/case_file.hpp"
 #include "numerics/body_solver.hpp"
+#include "numerics/contact_operator.hpp"
 
 namespace robin {
 namespace {
@@ -25,6 +26,7 @@ CaseDefinition two_blocks() {
 
 /// The body of `body_case` with a body force and a traction on its "right" side added.
 BodyDefinition loaded_body(const BodyCase& body_case) {
+  // load_body reads the mesh (the case file leaves definition.mesh empty until then).
   BodyDefinition definition = load_body(body_case);
   definition.body_force = Eigen::Vector2d(3.0, -20.0);
   TractionCondition traction;
@@ -34,19 +36,26 @@ BodyDefinition loaded_body(const BodyCase& body_case) {
   return definition;
 }
 
+/// Contact nodes with the normal to use at each (pair order), as the 1.x assignment held them.
+struct NodeNormals {
+  std::vector<int> node_ids;
+  std::vector<Eigen::Vector2d> normals;
+  std::vector<double> weights;
+};
+
 /// Every contact boundary node, in descending id order, with `sign` times its geometric normal.
-ContactAssignment reversed_assignment(const InterfaceDescription& boundary, double sign) {
-  ContactAssignment assignment;
+NodeNormals reversed_assignment(const InterfaceDescription& boundary, double sign) {
+  NodeNormals assignment;
   for (std::size_t k = boundary.node_ids.size(); k-- > 0;) {
     assignment.node_ids.push_back(boundary.node_ids[k]);
     assignment.normals.push_back(sign * boundary.normals[k]);
+    assignment.weights.push_back(boundary.weights[k]);
   }
   return assignment;
 }
 
 /// u(node_i) . n_i of a full displacement vector (2 values per node).
-Eigen::VectorXd normal_trace(const Eigen::VectorXd& displacement,
-                             const ContactAssignment& assignment) {
+Eigen::VectorXd normal_trace(const Eigen::VectorXd& displacement, const NodeNormals& assignment) {
   Eigen::VectorXd trace(static_cast<Eigen::Index>(assignment.node_ids.size()));
   for (std::size_t i = 0; i < assignment.node_ids.size(); ++i) {
     const int node = assignment.node_ids[i];
@@ -80,9 +89,10 @@ TEST(NeumannSolve, EqualsTheNormalTraceOfTheDisplacement) {
       options.interface_operator = kind;
       options.contact_unknowns_last = contact_last;
       BodySolver body(body_definition, options);
-      const ContactAssignment assignment =
+      const NodeNormals assignment =
           reversed_assignment(body.contact_boundary(), alpha == 0 ? 1.0 : -1.0);
-      body.assign_contact(assignment);
+      body.assign_contact(
+          node_to_node_operator(assignment.node_ids, assignment.normals, assignment.weights));
       const Eigen::VectorXd force = varying_force(body.contact_size());
       const std::string label =
           body.name() +

@@ -219,7 +219,8 @@ TEST(BodyVtu, UniaxialCompressionFieldsMatchTheAnalyticSolution) {
   BodySolver body(Block::definition());
   const InterfaceDescription top = body.contact_boundary();
   ASSERT_EQ(top.node_ids.size(), 5u);
-  body.assign_contact({top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1))});
+  body.assign_contact(node_to_node_operator(
+      top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1)), top.weights));
   Eigen::VectorXd lambda(5);
   for (int i = 0; i < 5; ++i)
     lambda[i] = Block::pressure * Block::face_weight(top.coordinates[i].x());
@@ -277,7 +278,8 @@ TEST(BodyVtu, UniaxialCompressionFieldsMatchTheAnalyticSolution) {
 TEST(BodyVtu, ContactForceOfTheWrongSizeIsRejectedNamingTheFile) {
   BodySolver body(CompressedBlock::definition());
   const InterfaceDescription top = body.contact_boundary();
-  body.assign_contact({top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1))});
+  body.assign_contact(node_to_node_operator(
+      top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1)), top.weights));
   const TemporaryDirectory directory("result_files");
   expect_error_naming([&] { write_body_vtu(directory.path(), body, Eigen::VectorXd::Zero(3)); },
                       {(directory.path() / "block.vtu").string(), "block", "5", "3"});

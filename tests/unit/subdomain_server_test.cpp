@@ -6,6 +6,14 @@
 // withholds it (as a protocol 1.0 server would not know it). The run rule of protocol 1.2
 // (Envelope.run_id): requests of another run than the body's are WRONG_STATE and change nothing,
 // the body's run and requests without run_id are served, and a server playing 1.1 ignores it.
+// Protocol 2.0: the mesh travels as MeshData, AssignContact carries a general constraint
+// operator B (rows over (node, component) pairs), InterfaceDescription describes the contact
+// surface with its segments. The attacks of issue 11 each fail to run or read anything, and the
+// server answers a Hello after each: a 1.x .geo script in the removed mesh_content field (a
+// command that would create a file), mesh_path outside the data directory (absolute, "..", a
+// symbolic link), write_directory outside the output root (absolute, "..", a symbolic link, a
+// link at the target file), a huge body name, inverted and degenerate cells, and results that
+// overflow to infinities (SOLVER_FAILURE, never a reply carrying NaN or Inf).
 
 #include "server/subdomain_server.hpp"
 
@@ -13,11 +21,17 @@
 
 #include <unistd.h>
 
+#include <google/protobuf/unknown_field_set.h>
+
+#include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
+#include "mesh_codec.hpp"
 #include "numerics/body_output.hpp"
+#include "numerics/contact_operator.hpp"
 #include "numerics/gmsh_reader.hpp"
 #include "numerics/material.hpp"
 #include "robin.pb.h"
@@ -35,14 +49,46 @@ std::string file_text(const std::filesystem::path& path) {
   return text.str();
 }
 
-/// Body 1 of examples/two_blocks.toml: block_lower.geo with h = 0.1, plane strain, E = 1000,
-/// nu = 0.3, clamped bottom, contact boundary "contact".
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream stream(path, std::ios::binary);
+  stream << text;
+}
+
+/// A fresh empty directory under the temporary directory, removed at destruction.
+class TemporaryDirectory {
+ public:
+  explicit TemporaryDirectory(const std::string& label) {
+    static std::atomic<int> counter{0};
+    path_ = std::filesystem::temp_directory_path() /
+            ("robin-server-test-" + label + "-" + std::to_string(getpid()) + "-" +
+             std::to_string(counter++));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TemporaryDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  TemporaryDirectory(const TemporaryDirectory&) = delete;
+  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// block_lower.geo meshed with h = 0.1, once per process.
+const Mesh& lower_mesh() {
+  static const Mesh mesh = read_gmsh_mesh(lower_geo, {.size = 0.1});
+  return mesh;
+}
+
+/// Body 1 of examples/two_blocks.toml: block_lower.geo with h = 0.1 (sent as MeshData), plane
+/// strain, E = 1000, nu = 0.3, clamped bottom, contact boundary "contact".
 protocol::SetupBody lower_block_setup() {
   protocol::SetupBody setup;
   setup.set_body_name("lower");
-  setup.set_mesh_content(file_text(lower_geo));
-  setup.set_mesh_extension(".geo");
-  setup.set_mesh_size(0.1);
+  *setup.mutable_mesh() = encode_mesh(lower_mesh());
   setup.set_model(protocol::PLANE_STRAIN);
   setup.set_young_modulus(1000.0);
   setup.set_poisson_ratio(0.3);
@@ -50,7 +96,7 @@ protocol::SetupBody lower_block_setup() {
   bottom.set_boundary("bottom");
   bottom.set_x(0.0);
   bottom.set_y(0.0);
-  setup.set_contact_boundary("contact");
+  setup.add_contact_boundaries("contact");
   return setup;
 }
 
@@ -58,9 +104,7 @@ protocol::SetupBody lower_block_setup() {
 BodyDefinition lower_block_definition() {
   BodyDefinition definition;
   definition.name = "lower";
-  MeshReadOptions options;
-  options.size = 0.1;
-  definition.mesh = read_gmsh_mesh(lower_geo, options);
+  definition.mesh = lower_mesh();
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
   definition.dirichlet.push_back({"bottom", 0.0, 0.0});
   definition.contact_boundary = "contact";
@@ -99,15 +143,30 @@ protocol::Envelope contact_solve_request(std::uint64_t id, const Eigen::VectorXd
   return envelope;
 }
 
-/// Every contact boundary node of `interface`, with the normal (0, 1), in ascending id order.
-protocol::Envelope assign_all_request(std::uint64_t id, const InterfaceDescription& interface) {
+/// AssignContact with the constraint operator `contact`, written here field by field.
+protocol::Envelope assign_request(std::uint64_t id, const ContactOperator& contact) {
   protocol::Envelope envelope = request(id);
-  for (int node : interface.node_ids) {
-    envelope.mutable_assign_contact()->add_node_ids(node);
-    envelope.mutable_assign_contact()->add_normals(0.0);
-    envelope.mutable_assign_contact()->add_normals(1.0);
+  protocol::AssignContact& assign = *envelope.mutable_assign_contact();
+  for (const std::size_t offset : contact.row_offsets) assign.add_row_offsets(offset);
+  for (std::size_t k = 0; k < contact.entry_count(); ++k) {
+    assign.add_node_ids(contact.nodes[k]);
+    assign.add_components(static_cast<std::uint32_t>(contact.components[k]));
+    assign.add_values(contact.values[k]);
   }
+  for (const double weight : contact.weights) assign.add_weights(weight);
   return envelope;
+}
+
+ContactOperator assign_all(const InterfaceDescription& interface) {
+  return node_to_node_operator(interface.node_ids,
+                               std::vector<Eigen::Vector2d>(interface.node_ids.size(), {0.0, 1.0}),
+                               interface.weights);
+}
+
+/// Every contact boundary node of `interface`, with the normal (0, 1), in ascending id order:
+/// one row per node, entries (node, x) = 0 and (node, y) = 1, weight m_i.
+protocol::Envelope assign_all_request(std::uint64_t id, const InterfaceDescription& interface) {
+  return assign_request(id, assign_all(interface));
 }
 
 /// NeumannSolveRequest (protocol 1.1) with the contact force `force`.
@@ -116,13 +175,6 @@ protocol::Envelope neumann_solve_request(std::uint64_t id, const Eigen::VectorXd
   envelope.mutable_neumann_solve()->set_iteration(static_cast<unsigned>(id));
   envelope.mutable_neumann_solve()->mutable_contact_force()->Assign(force.begin(), force.end());
   return envelope;
-}
-
-ContactAssignment assign_all(const InterfaceDescription& interface) {
-  ContactAssignment assignment;
-  assignment.node_ids = interface.node_ids;
-  assignment.normals.assign(interface.node_ids.size(), Eigen::Vector2d(0.0, 1.0));
-  return assignment;
 }
 
 Eigen::VectorXd to_vector(const google::protobuf::RepeatedField<double>& values) {
@@ -163,12 +215,16 @@ ServerSettings quiet_settings() {
 
 /// Checks the InterfaceDescription against the directly built solver, and against the
 /// geometry of block_lower.geo: 21 nodes on y = 0 from x = -1 to 1, normals (0, 1), weights
-/// summing to the edge length 2, none of them fixed (only the bottom is clamped).
+/// summing to the edge length 2, none of them fixed (only the bottom is clamped), and the
+/// contact surface "contact": 20 segments covering the edge, each oriented with the body on its
+/// left (the block lies below the edge, so each segment runs towards -x).
 void expect_interface(const protocol::InterfaceDescription& message,
                       const InterfaceDescription& expected, const BodySolver& reference) {
   EXPECT_EQ(message.body_name(), "lower");
+  EXPECT_EQ(message.dimension(), 2u);
   ASSERT_EQ(message.node_ids_size(), 21);
   ASSERT_EQ(expected.node_ids.size(), 21u);
+  ASSERT_EQ(message.fixed_size(), 42);
   double weight_sum = 0.0;
   for (int i = 0; i < 21; ++i) {
     EXPECT_EQ(message.node_ids(i), expected.node_ids[i]);
@@ -178,11 +234,33 @@ void expect_interface(const protocol::InterfaceDescription& message,
     EXPECT_NEAR(message.normals(2 * i), 0.0, 1e-12);
     EXPECT_NEAR(message.normals(2 * i + 1), 1.0, 1e-12);
     EXPECT_NEAR(message.weights(i), expected.weights[i], 1e-12);
-    EXPECT_FALSE(message.x_fixed(i));
-    EXPECT_FALSE(message.y_fixed(i));
+    EXPECT_FALSE(message.fixed(2 * i));
+    EXPECT_FALSE(message.fixed(2 * i + 1));
     weight_sum += message.weights(i);
   }
   EXPECT_NEAR(weight_sum, 2.0, 1e-12);
+  ASSERT_EQ(message.surfaces_size(), 1);
+  const protocol::ContactSurface& surface = message.surfaces(0);
+  EXPECT_EQ(surface.boundary(), "contact");
+  EXPECT_EQ(surface.segment_type(), protocol::LINE2);
+  ASSERT_EQ(surface.segments_size(), 40);
+  EXPECT_EQ(std::vector<int>(surface.segments().begin(), surface.segments().end()),
+            expected.segments);
+  std::set<std::uint32_t> covered;
+  double length = 0.0;
+  for (int e = 0; e < 20; ++e) {
+    const std::uint32_t first = surface.segments(2 * e), second = surface.segments(2 * e + 1);
+    ASSERT_LT(first, 21u);
+    ASSERT_LT(second, 21u);
+    const double from = message.coordinates(static_cast<int>(2 * first));
+    const double to = message.coordinates(static_cast<int>(2 * second));
+    EXPECT_LT(to, from) << "segment " << e << " is not oriented with the body on its left";
+    length += from - to;
+    covered.insert(first);
+    covered.insert(second);
+  }
+  EXPECT_EQ(covered.size(), 21u);
+  EXPECT_NEAR(length, 2.0, 1e-12);
   EXPECT_EQ(message.dof_count(), static_cast<std::uint64_t>(reference.free_dof_count()));
   EXPECT_GT(message.setup_seconds(), 0.0);
 }
@@ -253,11 +331,12 @@ void expect_fields(const protocol::FieldsReply& message, const BodySolver& refer
   EXPECT_NEAR(message.reaction_resultant(1), total_contact_force, 1e-9 * total_contact_force);
 }
 
-/// A correction (r_i = 1 + x_i) and the fields for `contact_force`, written to a temporary
-/// directory, compared with `reference`.
+/// A correction (r_i = 1 + x_i) and the fields for `contact_force`, written to the directory
+/// "fields/run" under the server's output root `output_root`, compared with `reference`.
 void expect_correction_and_fields(SubdomainServer& server, const BodySolver& reference,
                                   const InterfaceDescription& interface,
-                                  const Eigen::VectorXd& contact_force) {
+                                  const Eigen::VectorXd& contact_force,
+                                  const std::filesystem::path& output_root) {
   protocol::Envelope correction = request(5);
   Eigen::VectorXd interface_force(21);
   for (int i = 0; i < 21; ++i) interface_force[i] = 1.0 + interface.coordinates[i].x();
@@ -268,22 +347,27 @@ void expect_correction_and_fields(SubdomainServer& server, const BodySolver& ref
   expect_equal_vectors(to_vector(reply.correction_result().normal_trace()),
                        reference.solve_correction(interface_force));
 
-  const std::filesystem::path directory = std::filesystem::temp_directory_path() /
-                                          ("subdomain_server_test_" + std::to_string(getpid()));
+  const std::filesystem::path directory = std::filesystem::canonical(output_root) / "fields/run";
   protocol::Envelope fields = request(6);
   fields.mutable_fields()->mutable_contact_force()->Assign(contact_force.begin(),
                                                            contact_force.end());
-  fields.mutable_fields()->set_write_directory(directory.string());
+  fields.mutable_fields()->set_write_directory("fields/run");
   reply = exchange(server, fields);
   ASSERT_TRUE(reply.has_fields_reply()) << reply.DebugString();
   expect_fields(reply.fields_reply(), reference, contact_force);
   EXPECT_EQ(reply.fields_reply().written_file(), (directory / "lower.vtu").string());
   EXPECT_TRUE(std::filesystem::is_regular_file(directory / "lower.vtu"));
-  std::filesystem::remove_all(directory);
+  // Written to a temporary name and renamed: nothing else is left in the directory.
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(directory),
+                          std::filesystem::directory_iterator()),
+            1);
 }
 
 TEST(SubdomainServer, FullRunMatchesADirectlyBuiltBodySolver) {
-  SubdomainServer server(quiet_settings());
+  const TemporaryDirectory output_root("output");
+  ServerSettings settings = quiet_settings();
+  settings.output_root = output_root.path();
+  SubdomainServer server(settings);
   BodySolver reference(lower_block_definition());
   const InterfaceDescription interface = reference.contact_boundary();
 
@@ -319,7 +403,8 @@ TEST(SubdomainServer, FullRunMatchesADirectlyBuiltBodySolver) {
     expect_contact_result(reply.contact_result(), expected, obstacle);
   }
 
-  expect_correction_and_fields(server, reference, interface, expected.contact_force);
+  expect_correction_and_fields(server, reference, interface, expected.contact_force,
+                               output_root.path());
 
   protocol::Envelope end_run = request(7);
   end_run.mutable_end_run();
@@ -402,9 +487,11 @@ TEST(SubdomainServer, RequestTypeUnknownToThisVersionIsUnsupported) {
 
 TEST(SubdomainServer, OtherMajorVersionIsAMismatchNamingBothVersions) {
   SubdomainServer server(quiet_settings());
-  const protocol::Envelope reply = exchange(server, hello_request(9, 2));
+  ASSERT_EQ(protocol::protocol_major, 2u);
+  const protocol::Envelope reply = exchange(server, hello_request(9, 1));  // a 1.x coordinator
   expect_error(reply, protocol::VERSION_MISMATCH, "awaiting_setup");
-  EXPECT_NE(reply.error().message().find("2.0"), std::string::npos) << reply.error().message();
+  EXPECT_NE(reply.error().message().find("the request speaks 1.0"), std::string::npos)
+      << reply.error().message();
   const std::string ours =
       std::to_string(protocol::protocol_major) + "." + std::to_string(protocol::protocol_minor);
   EXPECT_NE(reply.error().message().find("this server " + ours), std::string::npos)
@@ -442,8 +529,9 @@ TEST_F(ReadyServer, ObstacleOfWrongLengthIsInvalidAndTheStateIsKept) {
   const protocol::Envelope reply =
       exchange(server, contact_solve_request(3, Eigen::VectorXd::Zero(20)));
   expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
-  EXPECT_NE(reply.error().message().find("20 values for the 21 contact nodes of body 'lower'"),
-            std::string::npos)
+  EXPECT_NE(
+      reply.error().message().find("20 values for the 21 contact constraints of body 'lower'"),
+      std::string::npos)
       << reply.error().message();
   Eigen::VectorXd not_finite = Eigen::VectorXd::Zero(21);
   not_finite[4] = std::numeric_limits<double>::quiet_NaN();
@@ -486,7 +574,7 @@ TEST_F(ReadyServer, NeumannSolveOfWrongLengthOrNonFiniteIsInvalidAndTheStateIsKe
   protocol::Envelope reply = exchange(server, neumann_solve_request(3, Eigen::VectorXd::Ones(22)));
   expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
   EXPECT_NE(reply.error().message().find("NeumannSolveRequest.contact_force has 22 values for the "
-                                         "21 contact nodes of body 'lower'"),
+                                         "21 contact constraints of body 'lower'"),
             std::string::npos)
       << reply.error().message();
   for (const double bad :
@@ -631,14 +719,24 @@ TEST(SubdomainServer, BodySetUpWithoutRunIdServesEveryRun) {
                   .has_contact_result());
 }
 
+/// `envelope` sent as protocol `major`.`minor`.
+protocol::Envelope as_version(protocol::Envelope envelope, unsigned major, unsigned minor) {
+  envelope.mutable_version()->set_major(major);
+  envelope.mutable_version()->set_minor(minor);
+  return envelope;
+}
+
 TEST(SubdomainServer, ServerPlayingProtocol11IgnoresRunId) {
   ServerSettings settings = quiet_settings();
+  settings.protocol_major = 1;
   settings.protocol_minor = 1;
   SubdomainServer server(settings);
   const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
   const auto handle = [&server](const protocol::Envelope& envelope) {
     protocol::Envelope reply;
-    EXPECT_TRUE(reply.ParseFromString(server.handle(envelope.SerializeAsString())));
+    EXPECT_TRUE(
+        reply.ParseFromString(server.handle(as_version(envelope, 1, 1).SerializeAsString())));
+    EXPECT_EQ(reply.version().major(), 1u);
     EXPECT_EQ(reply.version().minor(), 1u);
     return reply;
   };
@@ -648,30 +746,90 @@ TEST(SubdomainServer, ServerPlayingProtocol11IgnoresRunId) {
                   .has_contact_result());
 }
 
+// run_id is honoured from 1.2 on: a server playing 1.2 refuses another run's requests as a 2.0
+// server does.
+TEST(SubdomainServer, ServerPlayingProtocol12HonoursRunId) {
+  ServerSettings settings = quiet_settings();
+  settings.protocol_major = 1;
+  settings.protocol_minor = 2;
+  SubdomainServer server(settings);
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  const auto handle = [&server](const protocol::Envelope& envelope) {
+    protocol::Envelope reply;
+    EXPECT_TRUE(
+        reply.ParseFromString(server.handle(as_version(envelope, 1, 2).SerializeAsString())));
+    return reply;
+  };
+  ASSERT_TRUE(handle(of_run(setup_request(1, lower_block_setup()), "a")).has_interface());
+  expect_other_run(handle(of_run(assign_all_request(2, interface), "b")), "awaiting_assignment");
+  ASSERT_TRUE(handle(of_run(assign_all_request(3, interface), "a")).has_acknowledge());
+  expect_other_run(handle(of_run(contact_solve_request(4, Eigen::VectorXd::Ones(21)), "b")),
+                   "ready");
+  EXPECT_TRUE(handle(of_run(contact_solve_request(5, Eigen::VectorXd::Ones(21)), "a"))
+                  .has_contact_result());
+}
+
+// Protocol 2.0 checks the structure of B instead of node ids and unit normals (a general row
+// need not be a unit normal): every malformed operator is INVALID_ARGUMENT naming the body and
+// the field, and keeps the state and the previous assignment (21 rows).
 TEST_F(ReadyServer, BadAssignmentsAreInvalidAndKeepThePreviousAssignment) {
-  protocol::Envelope unknown = assign_all_request(3, interface);
-  unknown.mutable_assign_contact()->set_node_ids(0, 1000000);
-  protocol::Envelope repeated = assign_all_request(4, interface);
-  repeated.mutable_assign_contact()->set_node_ids(1, interface.node_ids[0]);
-  protocol::Envelope not_unit = assign_all_request(5, interface);
-  not_unit.mutable_assign_contact()->set_normals(1, 1.1);
-  protocol::Envelope short_normals = assign_all_request(6, interface);
-  short_normals.mutable_assign_contact()->mutable_normals()->RemoveLast();
-  for (const protocol::Envelope& bad : {unknown, repeated, not_unit, short_normals}) {
+  const auto modified = [this](std::uint64_t id, const auto& change) {
+    protocol::Envelope envelope = assign_all_request(id, interface);
+    change(*envelope.mutable_assign_contact());
+    return envelope;
+  };
+  using Assign = protocol::AssignContact;
+  const std::vector<std::pair<protocol::Envelope, std::string>> cases = {
+      {modified(3, [](Assign& a) { a.set_node_ids(0, 1000000); }),
+       "AssignContact.node_ids[0] = 1000000 is not a node of the contact boundary"},
+      {modified(4, [](Assign& a) { a.set_node_ids(0, -5); }), "AssignContact.node_ids[0]"},
+      {modified(5, [](Assign& a) { a.set_components(0, 1); }),
+       "AssignContact constraint 0 names component 1 of node id " +
+           std::to_string(interface.node_ids[0]) + " twice"},
+      {modified(6, [](Assign& a) { a.set_components(1, 2); }),
+       "AssignContact.components[1] = 2, expected 0 (x) or 1 (y)"},
+      {modified(7, [](Assign& a) { a.set_values(1, std::numeric_limits<double>::quiet_NaN()); }),
+       "AssignContact.values[1] is not a finite number"},
+      {modified(8, [](Assign& a) { a.set_values(1, std::numeric_limits<double>::infinity()); }),
+       "AssignContact.values[1] is not a finite number"},
+      {modified(9, [](Assign& a) { a.set_weights(3, 0.0); }),
+       "AssignContact.weights[3] is not a finite positive number"},
+      {modified(10, [](Assign& a) { a.set_weights(3, -1.0); }), "AssignContact.weights[3]"},
+      {modified(11, [](Assign& a) { a.mutable_values()->RemoveLast(); }),
+       "42 node_ids, 42 components and 41 values"},
+      {modified(12, [](Assign& a) { a.mutable_weights()->RemoveLast(); }),
+       "22 row_offsets and 20 weights"},
+      {modified(13, [](Assign& a) { a.set_row_offsets(1, 0); }),
+       "AssignContact.row_offsets [1] leaves constraint 0 without entries"},
+      {modified(14, [](Assign& a) { a.set_row_offsets(0, 1); }),
+       "AssignContact.row_offsets must start with 0"},
+      {modified(15, [](Assign& a) { a.set_row_offsets(21, 40); }),
+       "AssignContact.row_offsets ends at 40, expected the entry count 42"},
+      {modified(16, [](Assign& a) { a.set_row_offsets(5, 1000); }), "AssignContact.row_offsets"},
+      {modified(17, [](Assign& a) { a.Clear(); }), "AssignContact"}};
+  for (const auto& [bad, expected] : cases) {
     const protocol::Envelope reply = exchange(server, bad);
     expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
-    EXPECT_NE(reply.error().message().find("body 'lower'"), std::string::npos);
+    EXPECT_NE(reply.error().message().find("body 'lower'"), std::string::npos)
+        << reply.error().message();
+    EXPECT_NE(reply.error().message().find(expected), std::string::npos) << reply.error().message();
+    EXPECT_EQ(server.state(), ServerState::ready) << expected;
   }
-  EXPECT_NE(exchange(server, unknown).error().message().find("node id 1000000"), std::string::npos);
+  // The previous assignment (21 rows) still holds.
+  expect_error(exchange(server, contact_solve_request(18, Eigen::VectorXd::Zero(20))),
+               protocol::INVALID_ARGUMENT, "ready");
   EXPECT_TRUE(
-      exchange(server, contact_solve_request(7, Eigen::VectorXd::Zero(21))).has_contact_result());
+      exchange(server, contact_solve_request(19, Eigen::VectorXd::Zero(21))).has_contact_result());
+  // A row that is not a unit normal is a valid general row (protocol 2.0), e.g. (0, 1.1).
+  protocol::Envelope scaled = assign_all_request(20, interface);
+  scaled.mutable_assign_contact()->set_values(1, 1.1);
+  EXPECT_TRUE(exchange(server, scaled).has_acknowledge());
 }
 
 TEST(SubdomainServer, BadBodyDefinitionsAreBadInputNamingTheBodyAndField) {
   SubdomainServer server(quiet_settings());
   protocol::SetupBody bad_mesh = lower_block_setup();
-  bad_mesh.set_mesh_content("this is not a mesh");
-  bad_mesh.set_mesh_extension(".msh");
+  bad_mesh.mutable_mesh()->mutable_coordinates()->RemoveLast();  // an odd number of values
   protocol::SetupBody unknown_boundary = lower_block_setup();
   unknown_boundary.mutable_dirichlet(0)->set_boundary("botom");
   protocol::SetupBody short_voigt = lower_block_setup();
@@ -681,7 +839,7 @@ TEST(SubdomainServer, BadBodyDefinitionsAreBadInputNamingTheBodyAndField) {
   protocol::SetupBody no_model = lower_block_setup();
   no_model.clear_model();
   const std::vector<std::pair<protocol::SetupBody, std::string>> cases = {
-      {bad_mesh, "SetupBody.mesh_content"},
+      {bad_mesh, "SetupBody.mesh.coordinates has"},
       {unknown_boundary, "SetupBody.dirichlet[0].boundary 'botom' is not a boundary of the mesh"},
       {short_voigt, "SetupBody.voigt has 4 values, expected 9"},
       {no_model, "SetupBody.model is unspecified"}};
@@ -693,36 +851,491 @@ TEST(SubdomainServer, BadBodyDefinitionsAreBadInputNamingTheBodyAndField) {
   }
 }
 
-// A .geo sent over the protocol is a Gmsh script: one that would run a shell command on the
-// server is refused before Gmsh sees it, and the command does not run (the file it would create
-// does not appear). The same script with the command only in a comment and a string meshes.
-TEST(SubdomainServer, GeoScriptThatRunsACommandIsRefusedUnrun) {
-  SubdomainServer server(quiet_settings());
-  const std::filesystem::path witness =
-      std::filesystem::temp_directory_path() / ("robin-geo-witness-" + std::to_string(::getpid()));
-  std::filesystem::remove(witness);
-  protocol::SetupBody hostile = lower_block_setup();
-  hostile.set_mesh_content(hostile.mesh_content() + "\nSystemCall \"touch " + witness.string() +
-                           "\";\n");
-  const protocol::Envelope reply = exchange(server, setup_request(1, hostile));
-  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
-  const std::string& message = reply.error().message();
-  EXPECT_NE(message.find("body 'lower': SetupBody.mesh_content line"), std::string::npos)
-      << message;
-  EXPECT_NE(message.find("'SystemCall' is refused"), std::string::npos) << message;
-  EXPECT_FALSE(std::filesystem::exists(witness));
-
-  protocol::SetupBody harmless = lower_block_setup();
-  harmless.set_mesh_content(harmless.mesh_content() +
-                            "\n// SystemCall \"touch x\";\nDummy = StrCat(\"Include\");\n");
-  EXPECT_TRUE(exchange(server, setup_request(2, harmless)).has_interface());
+/// Hello still gets its reply: the server is up and serving.
+void expect_hello(SubdomainServer& server, std::uint64_t id) {
+  const protocol::Envelope reply = exchange(server, hello_request(id));
+  EXPECT_TRUE(reply.has_hello_reply()) << reply.DebugString();
 }
 
+/// A Gmsh script that, if a server ran it, would create `witness` with a shell command:
+/// block_lower.geo followed by SystemCall "touch WITNESS"; (or, `external_process`, by a mesh
+/// size field that runs the command).
+std::string hostile_geo(const std::filesystem::path& witness, bool external_process) {
+  std::string script = file_text(lower_geo);
+  if (external_process) {
+    script += "\nField[1] = ExternalProcess;\nField[1].CommandLine = \"touch " + witness.string() +
+              "\";\nBackground Field = 1;\n";
+  } else {
+    script += "\nSystemCall \"touch " + witness.string() + "\";\n";
+  }
+  return script;
+}
+
+/// `setup` with the 1.x fields 2 (mesh_content) = `script` and 3 (mesh_extension) = ".geo",
+/// which 2.0 reserves: written as unknown fields, as a 1.x coordinator would send them.
+protocol::SetupBody with_1x_script(protocol::SetupBody setup, const std::string& script) {
+  google::protobuf::UnknownFieldSet& unknown = *setup.GetReflection()->MutableUnknownFields(&setup);
+  unknown.AddLengthDelimited(2, script);
+  unknown.AddLengthDelimited(3, ".geo");
+  unknown.AddFixed64(5, 0x3fb999999999999aULL);  // 1.x mesh_size = 0.1
+  return setup;
+}
+
+/// A path for a witness file that must never appear.
+std::filesystem::path witness_path(const std::string& label) {
+  static int counter = 0;
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("robin-witness-" + label + "-" + std::to_string(getpid()) + "-" + std::to_string(counter++));
+  std::filesystem::remove(path);
+  return path;
+}
+
+// Issue 11 (a), remote command execution: a 1.x SetupBody carrying a .geo script in
+// mesh_content (field 2) with mesh_extension ".geo" (field 3). A 2.0 server does not know these
+// fields, runs no script and, with no MeshData and no mesh_path, refuses the body as BAD_INPUT;
+// the command's file does not appear. Both ways a script can run a command are tried: SystemCall
+// and a mesh size field of type ExternalProcess. Sent together with a valid MeshData, the
+// script is ignored as well: the body is set up from the MeshData and nothing runs.
+TEST(SubdomainServer, Version1GeoScriptInMeshContentIsNeverRun) {
+  SubdomainServer server(quiet_settings());
+  std::uint64_t id = 1;
+  for (const bool external_process : {false, true}) {
+    const std::filesystem::path witness = witness_path("geo");
+    const std::string script = hostile_geo(witness, external_process);
+    protocol::SetupBody without_mesh = lower_block_setup();
+    without_mesh.clear_mesh();
+    const protocol::SetupBody hostile = with_1x_script(without_mesh, script);
+    // The bytes do carry the script (fields 2 and 3), as a 1.x coordinator sends it.
+    const std::string bytes = setup_request(id, hostile).SerializeAsString();
+    ASSERT_NE(bytes.find("touch " + witness.string()), std::string::npos);
+    protocol::Envelope reply;
+    ASSERT_TRUE(reply.ParseFromString(server.handle(bytes)));
+    expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+    EXPECT_NE(reply.error().message().find(
+                  "body 'lower': SetupBody.mesh and SetupBody.mesh_path are both absent"),
+              std::string::npos)
+        << reply.error().message();
+    EXPECT_FALSE(std::filesystem::exists(witness)) << "the script ran";
+    expect_hello(server, ++id);
+
+    const protocol::Envelope with_mesh =
+        exchange(server, setup_request(++id, with_1x_script(lower_block_setup(), script)));
+    EXPECT_TRUE(with_mesh.has_interface()) << with_mesh.DebugString();
+    EXPECT_FALSE(std::filesystem::exists(witness)) << "the script ran";
+    expect_hello(server, ++id);
+    ++id;
+  }
+}
+
+/// A body on the unit square of tests/data/mesh_square_v41.msh read from `mesh_path`: clamped
+/// "bottom", contact boundary "top".
+protocol::SetupBody square_path_setup(const std::string& mesh_path) {
+  protocol::SetupBody setup;
+  setup.set_body_name("square");
+  setup.set_mesh_path(mesh_path);
+  setup.set_model(protocol::PLANE_STRAIN);
+  setup.set_young_modulus(1000.0);
+  setup.set_poisson_ratio(0.3);
+  protocol::Dirichlet& bottom = *setup.add_dirichlet();
+  bottom.set_boundary("bottom");
+  bottom.set_x(0.0);
+  bottom.set_y(0.0);
+  setup.add_contact_boundaries("top");
+  return setup;
+}
+
+const std::filesystem::path square_msh =
+    std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_v41.msh";
+
+/// The lines of /etc/passwd (none when it cannot be read).
+std::vector<std::string> passwd_lines() {
+  std::ifstream stream("/etc/passwd");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(stream, line);) {
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+/// A BAD_INPUT reply naming SetupBody.mesh_path that contains no line of `secret` (a file's
+/// lines) anywhere in its bytes.
+void expect_refused_path(const protocol::Envelope& reply, const std::vector<std::string>& secret,
+                         const std::string& expected) {
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  EXPECT_NE(reply.error().message().find("body 'square': SetupBody.mesh_path"), std::string::npos)
+      << reply.error().message();
+  EXPECT_NE(reply.error().message().find(expected), std::string::npos) << reply.error().message();
+  const std::string bytes = reply.SerializeAsString();
+  for (const std::string& line : secret) {
+    EXPECT_EQ(bytes.find(line), std::string::npos) << "the reply shows the line '" << line << "'";
+  }
+}
+
+// Issue 11 (b), file reads through mesh_path. The data directory holds square.msh, a symbolic
+// link to /etc/passwd, a link to a valid mesh outside it and a link to a directory outside it;
+// next to it (outside) lies x.msh, also a valid mesh. Absolute paths, "..", and every link that
+// leads out are BAD_INPUT, and no reply contains a line of /etc/passwd; the mesh inside is
+// read and gives the body built from the same file in this process. Without a data directory
+// every mesh_path is refused, also one naming a valid mesh.
+TEST(SubdomainServer, MeshPathOutsideTheDataDirectoryIsRefusedUnread) {
+  const TemporaryDirectory base("data");
+  const std::filesystem::path data = base.path() / "data";
+  std::filesystem::create_directories(data / "meshes");
+  std::filesystem::copy_file(square_msh, data / "meshes/square.msh");
+  std::filesystem::copy_file(square_msh, base.path() / "x.msh");
+  std::filesystem::create_symlink("/etc/passwd", data / "passwd.msh");
+  std::filesystem::create_symlink(base.path() / "x.msh", data / "outside.msh");
+  std::filesystem::create_symlink(base.path(), data / "up");
+  const std::vector<std::string> secret = passwd_lines();
+
+  ServerSettings settings = quiet_settings();
+  settings.data_directory = data;
+  SubdomainServer server(settings);
+  std::uint64_t id = 1;
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"/etc/passwd", "is absolute"},
+      {(base.path() / "x.msh").string(), "is absolute"},
+      {"../x.msh", "contains '..'"},
+      {"meshes/../../x.msh", "contains '..'"},
+      {"passwd.msh", "leads out of the data directory"},
+      {"outside.msh", "leads out of the data directory"},
+      {"up/x.msh", "leads out of the data directory"},
+      {"up/data/passwd.msh", "leads out of the data directory"},
+      {"missing.msh", "does not exist under the data directory"},
+      {"meshes", "is not a regular file"}};
+  for (const auto& [path, expected] : refused) {
+    expect_refused_path(exchange(server, setup_request(id++, square_path_setup(path))), secret,
+                        expected);
+    expect_hello(server, id++);
+  }
+
+  const protocol::Envelope reply =
+      exchange(server, setup_request(id++, square_path_setup("meshes/square.msh")));
+  ASSERT_TRUE(reply.has_interface()) << reply.DebugString();
+  BodyDefinition definition;
+  definition.name = "square";
+  definition.mesh = read_gmsh_mesh(square_msh);
+  definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
+  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  definition.contact_boundary = "top";
+  const BodySolver reference(definition);
+  const InterfaceDescription expected = reference.contact_boundary();
+  ASSERT_EQ(reply.interface().node_ids_size(), static_cast<int>(expected.node_ids.size()));
+  for (std::size_t i = 0; i < expected.node_ids.size(); ++i) {
+    const int k = static_cast<int>(i);
+    EXPECT_EQ(reply.interface().node_ids(k), expected.node_ids[i]);
+    EXPECT_EQ(reply.interface().node_tags(k), static_cast<std::int64_t>(expected.node_tags[i]));
+    EXPECT_EQ(reply.interface().coordinates(2 * k), expected.coordinates[i].x());
+    EXPECT_EQ(reply.interface().coordinates(2 * k + 1), 1.0);
+    EXPECT_NEAR(reply.interface().weights(k), expected.weights[i], 1e-15);
+  }
+  EXPECT_EQ(reply.interface().dof_count(), static_cast<std::uint64_t>(reference.free_dof_count()));
+
+  SubdomainServer without_directory(quiet_settings());
+  for (const std::string& path : {std::string("meshes/square.msh"), square_msh.string()}) {
+    expect_refused_path(exchange(without_directory, setup_request(id++, square_path_setup(path))),
+                        secret, "this server was started without --data-directory");
+  }
+  expect_hello(without_directory, id++);
+}
+
+/// A server with the lower block set up and assigned (node-to-node rows, normal (0, 1)).
+std::unique_ptr<SubdomainServer> ready_server(const ServerSettings& settings) {
+  auto server = std::make_unique<SubdomainServer>(settings);
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  EXPECT_TRUE(exchange(*server, setup_request(1, lower_block_setup())).has_interface());
+  EXPECT_TRUE(exchange(*server, assign_all_request(2, interface)).has_acknowledge());
+  return server;
+}
+
+protocol::Envelope fields_request(std::uint64_t id, const std::string& write_directory) {
+  protocol::Envelope envelope = request(id);
+  envelope.mutable_fields()->mutable_contact_force()->Resize(21, 0.5);
+  envelope.mutable_fields()->set_write_directory(write_directory);
+  return envelope;
+}
+
+/// The names in `directory` (recursively, relative), for "nothing was created" checks.
+std::set<std::string> listing(const std::filesystem::path& directory) {
+  std::set<std::string> names;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(directory)) {
+    names.insert(entry.path().lexically_relative(directory).string());
+  }
+  return names;
+}
+
+// Issue 11 (c), writes through write_directory. Under the output root, out/lower.vtu is a
+// symbolic link to an existing file outside the root: FieldsRequest replaces the link by the
+// VTU file and leaves the outside file unchanged. A write_directory that is absolute, contains
+// "..", or passes through a symbolically linked directory is INVALID_ARGUMENT and creates
+// nothing outside the root; without an output root every write_directory is refused.
+TEST(SubdomainServer, WriteDirectoryOutsideTheOutputRootIsRefusedUnwritten) {
+  const TemporaryDirectory base("output");
+  const std::filesystem::path root = base.path() / "root", outside = base.path() / "outside";
+  std::filesystem::create_directories(root / "out");
+  std::filesystem::create_directories(outside);
+  const std::filesystem::path victim = outside / "victim.txt";
+  write_text(victim, "precious\n");
+  std::filesystem::create_symlink(victim, root / "out/lower.vtu");
+  std::filesystem::create_symlink(outside, root / "linked");
+
+  ServerSettings settings = quiet_settings();
+  settings.output_root = root;
+  const std::unique_ptr<SubdomainServer> server = ready_server(settings);
+  std::uint64_t id = 3;
+  protocol::Envelope reply = exchange(*server, fields_request(id++, "out"));
+  ASSERT_TRUE(reply.has_fields_reply()) << reply.DebugString();
+  EXPECT_EQ(reply.fields_reply().written_file(),
+            (std::filesystem::canonical(root) / "out/lower.vtu").string());
+  EXPECT_EQ(file_text(victim), "precious\n");
+  EXPECT_FALSE(std::filesystem::is_symlink(root / "out/lower.vtu"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(root / "out/lower.vtu"));
+  EXPECT_NE(file_text(root / "out/lower.vtu").find("<VTKFile"), std::string::npos);
+  EXPECT_EQ(listing(root / "out"), (std::set<std::string>{"lower.vtu"}));
+  expect_hello(*server, id++);
+
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {outside.string(), "is absolute"},
+      {(outside / "sub").string(), "is absolute"},
+      {"../outside", "contains '..'"},
+      {"out/../../outside/sub", "contains '..'"},
+      {"linked", "'linked' is a symbolic link"},
+      {"linked/sub", "'linked' is a symbolic link"},
+      {"out/lower.vtu", "exists and is not a directory"}};
+  for (const auto& [directory, expected] : refused) {
+    reply = exchange(*server, fields_request(id++, directory));
+    expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
+    EXPECT_NE(reply.error().message().find("body 'lower': FieldsRequest.write_directory"),
+              std::string::npos)
+        << reply.error().message();
+    EXPECT_NE(reply.error().message().find(expected), std::string::npos) << reply.error().message();
+    expect_hello(*server, id++);
+  }
+  EXPECT_EQ(listing(outside), (std::set<std::string>{"victim.txt"}));
+  EXPECT_EQ(file_text(victim), "precious\n");
+  EXPECT_EQ(listing(base.path()),
+            (std::set<std::string>{"outside", "outside/victim.txt", "root", "root/linked",
+                                   "root/out", "root/out/lower.vtu"}));
+
+  const std::unique_ptr<SubdomainServer> without_root = ready_server(quiet_settings());
+  reply = exchange(*without_root, fields_request(id++, "out"));
+  expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
+  EXPECT_NE(reply.error().message().find("this server was started without --output-root"),
+            std::string::npos)
+      << reply.error().message();
+  // Without write_directory the fields are only returned.
+  reply = exchange(*without_root, fields_request(id++, ""));
+  EXPECT_TRUE(reply.has_fields_reply());
+  EXPECT_EQ(reply.fields_reply().written_file(), "");
+  expect_hello(*without_root, id++);
+}
+
+// Issue 11 (d): a body name of 100,000 characters is BAD_INPUT (at most 64) and is not echoed
+// back; 64 characters are accepted, 65 are not.
+TEST(SubdomainServer, HugeBodyNameIsBadInput) {
+  SubdomainServer server(quiet_settings());
+  protocol::SetupBody huge = lower_block_setup();
+  huge.set_body_name(std::string(100000, 'a'));
+  protocol::Envelope reply = exchange(server, setup_request(1, huge));
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  EXPECT_NE(reply.error().message().find("SetupBody.body_name has 100000 characters: at most 64"),
+            std::string::npos)
+      << reply.error().message().substr(0, 200);
+  EXPECT_LT(reply.ByteSizeLong(), 1000u);
+  expect_hello(server, 2);
+  protocol::SetupBody longest = lower_block_setup();
+  longest.set_body_name(std::string(64, 'b'));
+  EXPECT_TRUE(exchange(server, setup_request(3, longest)).has_interface());
+  longest.set_body_name(std::string(65, 'b'));
+  expect_error(exchange(server, setup_request(4, longest)), protocol::BAD_INPUT, "awaiting_setup");
+  expect_hello(server, 5);
+}
+
+/// A unit square of two counter-clockwise triangles with tags 7 and 8, boundaries "bottom",
+/// "right", "top" and "left", as MeshData built by hand.
+protocol::MeshData square_mesh_data() {
+  protocol::MeshData mesh;
+  mesh.set_dimension(2);
+  for (const double value : {0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0}) mesh.add_coordinates(value);
+  for (const std::uint64_t tag : {11, 12, 13, 14}) mesh.add_node_tags(tag);
+  protocol::CellBlock& cells = *mesh.add_cells();
+  cells.set_type(protocol::TRIANGLE3);
+  for (const std::uint32_t node : {0, 1, 2, 0, 2, 3}) cells.add_connectivity(node);
+  cells.add_tags(7);
+  cells.add_tags(8);
+  const std::vector<std::pair<std::string, std::pair<int, int>>> sides = {
+      {"bottom", {0, 1}}, {"right", {1, 2}}, {"top", {2, 3}}, {"left", {3, 0}}};
+  for (const auto& [name, nodes] : sides) {
+    protocol::NamedBoundary& boundary = *mesh.add_boundaries();
+    boundary.set_name(name);
+    boundary.mutable_segments()->set_type(protocol::LINE2);
+    boundary.mutable_segments()->add_connectivity(static_cast<std::uint32_t>(nodes.first));
+    boundary.mutable_segments()->add_connectivity(static_cast<std::uint32_t>(nodes.second));
+  }
+  mesh.set_source("square.msh");
+  return mesh;
+}
+
+protocol::SetupBody square_data_setup(const protocol::MeshData& mesh) {
+  protocol::SetupBody setup = square_path_setup("");
+  setup.clear_mesh_path();
+  *setup.mutable_mesh() = mesh;
+  return setup;
+}
+
+// Issue 11 (e), tangled meshes: the hand-built square is accepted; with one triangle reversed
+// (two nodes swapped: inverted) it is BAD_INPUT naming that cell's tag; with a zero-area
+// triangle it is BAD_INPUT naming that cell as degenerate. Through mesh_path, a .msh with one
+// triangle reversed against its surface is BAD_INPUT naming its element tag.
+TEST(SubdomainServer, InvertedOrDegenerateCellsAreBadInputNamingTheirTag) {
+  const TemporaryDirectory data("tangled");
+  std::filesystem::copy_file(
+      std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_inverted_v22.msh",
+      data.path() / "inverted.msh");
+  ServerSettings settings = quiet_settings();
+  settings.data_directory = data.path();
+  SubdomainServer server(settings);
+  EXPECT_TRUE(
+      exchange(server, setup_request(1, square_data_setup(square_mesh_data()))).has_interface());
+
+  protocol::MeshData reversed = square_mesh_data();
+  reversed.mutable_cells(0)->set_connectivity(4, 3);  // triangle 8: (0, 2, 3) -> (0, 3, 2)
+  reversed.mutable_cells(0)->set_connectivity(5, 2);
+  protocol::Envelope reply = exchange(server, setup_request(2, square_data_setup(reversed)));
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  std::string message = reply.error().message();
+  EXPECT_NE(message.find("body 'square': SetupBody.mesh: element tag 8 (triangle3 at node tags "
+                         "11, 14, 13) is inverted or folded"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("mesh 'square.msh'"), std::string::npos) << message;
+  expect_hello(server, 3);
+
+  protocol::MeshData degenerate = square_mesh_data();
+  degenerate.add_coordinates(0.5);  // node 4 at (0.5, 0), on the line through nodes 0 and 1
+  degenerate.add_coordinates(0.0);
+  degenerate.add_node_tags(15);
+  for (const std::uint32_t node : {0, 1, 4}) degenerate.mutable_cells(0)->add_connectivity(node);
+  degenerate.mutable_cells(0)->add_tags(9);
+  reply = exchange(server, setup_request(4, square_data_setup(degenerate)));
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  message = reply.error().message();
+  EXPECT_NE(message.find("element tag 9 (triangle3 at node tags 11, 12, 15) is degenerate"),
+            std::string::npos)
+      << message;
+  expect_hello(server, 5);
+
+  reply = exchange(server, setup_request(6, square_path_setup("inverted.msh")));
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  message = reply.error().message();
+  EXPECT_NE(message.find("body 'square': SetupBody.mesh_path"), std::string::npos) << message;
+  EXPECT_NE(message.find("element tag 13 "), std::string::npos) << message;
+  EXPECT_NE(message.find("inverted"), std::string::npos) << message;
+  expect_hello(server, 7);
+}
+
+/// SOLVER_FAILURE naming `what` and the body: an Error, so no NaN or infinity is sent.
+void expect_solver_failure(const protocol::Envelope& reply, const std::string& what) {
+  expect_error(reply, protocol::SOLVER_FAILURE, "ready");
+  EXPECT_EQ(reply.error().message().rfind(what, 0), 0u) << reply.error().message();
+  EXPECT_NE(
+      reply.error().message().find(" of body 'lower' has a value that is not a finite number"),
+      std::string::npos)
+      << reply.error().message();
+  EXPECT_FALSE(reply.has_correction_result() || reply.has_neumann_result() ||
+               reply.has_fields_reply() || reply.has_contact_result());
+}
+
+// Issue 11 (f), non-finite results: two rows on the same u_y with the coefficient 1e300 (finite,
+// so accepted) make F = B K^-1 B' overflow (1e600 x compliance): the correction and the Neumann
+// solve are then infinite or NaN, and the fields for forces of 1 give stresses near 1e300 whose
+// von Mises stress overflows. With moderate coefficients (1e10), forces near 1e300 overflow the
+// nodal contact force field. Each reply is SOLVER_FAILURE naming the body, never a reply
+// carrying NaN or Inf, and the server stays up and in its state.
+TEST(SubdomainServer, NonFiniteResultsAreSolverFailureNamingTheBody) {
+  SubdomainServer server(quiet_settings());
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  ASSERT_TRUE(exchange(server, setup_request(1, lower_block_setup())).has_interface());
+  const int node = interface.node_ids[10];
+  std::uint64_t id = 2;
+  for (const double coefficient : {1e300, 1e10}) {
+    ContactOperator contact;
+    contact.add_entry(node, 1, coefficient);
+    contact.finish_row(0.1);
+    contact.add_entry(node, 1, coefficient);
+    contact.finish_row(0.1);
+    ASSERT_TRUE(exchange(server, assign_request(id++, contact)).has_acknowledge());
+    const double force = coefficient > 1e100 ? 1.0 : 1e300;
+
+    protocol::Envelope correction = request(id++);
+    correction.mutable_correction()->add_interface_force(force);
+    correction.mutable_correction()->add_interface_force(force);
+    protocol::Envelope neumann = request(id++);
+    neumann.mutable_neumann_solve()->add_contact_force(force);
+    neumann.mutable_neumann_solve()->add_contact_force(force);
+    protocol::Envelope fields = request(id++);
+    fields.mutable_fields()->add_contact_force(force);
+    fields.mutable_fields()->add_contact_force(force);
+
+    if (coefficient > 1e100) {
+      expect_solver_failure(exchange(server, correction), "CorrectionResult.normal_trace");
+      expect_solver_failure(exchange(server, neumann), "NeumannSolveResult.normal_trace");
+    }
+    expect_solver_failure(exchange(server, fields), "FieldsReply point field");
+    expect_hello(server, id++);
+    EXPECT_EQ(server.state(), ServerState::ready);
+  }
+  // Finite requests are still served.
+  protocol::Envelope fields = request(id++);
+  fields.mutable_fields()->add_contact_force(1.0);
+  fields.mutable_fields()->add_contact_force(1.0);
+  EXPECT_TRUE(exchange(server, fields).has_fields_reply());
+}
+
+// Issue 11 (g) through the server: AssignContact rows that combine two nodes,
+// 0.5 u_y(a) + 0.5 u_y(b) for neighbouring contact nodes, give the correction and the Neumann
+// solve of a BodySolver built in this process with the same operator.
+TEST(SubdomainServer, GeneralOperatorMatchesADirectlyBuiltBodySolver) {
+  SubdomainServer server(quiet_settings());
+  BodySolver reference(lower_block_definition());
+  const InterfaceDescription interface = reference.contact_boundary();
+  ASSERT_TRUE(exchange(server, setup_request(1, lower_block_setup())).has_interface());
+  ContactOperator contact;
+  for (std::size_t i = 0; i + 1 < interface.node_ids.size(); ++i) {
+    contact.add_entry(interface.node_ids[i], 1, 0.5);
+    contact.add_entry(interface.node_ids[i + 1], 1, 0.5);
+    contact.finish_row(0.5 * (interface.weights[i] + interface.weights[i + 1]));
+  }
+  ASSERT_TRUE(exchange(server, assign_request(2, contact)).has_acknowledge());
+  reference.assign_contact(contact);
+  Eigen::VectorXd force(20);
+  for (int i = 0; i < 20; ++i) force[i] = 1.0 + 0.5 * std::cos(1.3 * i);
+
+  protocol::Envelope correction = request(3);
+  correction.mutable_correction()->mutable_interface_force()->Assign(force.begin(), force.end());
+  protocol::Envelope reply = exchange(server, correction);
+  ASSERT_TRUE(reply.has_correction_result()) << reply.DebugString();
+  expect_equal_vectors(to_vector(reply.correction_result().normal_trace()),
+                       reference.solve_correction(force));
+  reply = exchange(server, neumann_solve_request(4, force));
+  ASSERT_TRUE(reply.has_neumann_result()) << reply.DebugString();
+  const Eigen::VectorXd neumann = to_vector(reply.neumann_result().normal_trace());
+  expect_equal_vectors(neumann, reference.solve_neumann(force));
+  // The same as the average of the node-wise traces of the displacement.
+  const Eigen::VectorXd displacement = reference.displacement(force);
+  for (int i = 0; i < 20; ++i) {
+    const double expected = 0.5 * (displacement[2 * interface.node_ids[i] + 1] +
+                                   displacement[2 * interface.node_ids[i + 1] + 1]);
+    EXPECT_NEAR(neumann[i], expected, 1e-12 * (1.0 + std::abs(expected))) << i;
+  }
+}
 TEST(SubdomainServer, FailedSetupDiscardsThePreviousBody) {
   SubdomainServer server(quiet_settings());
   ASSERT_TRUE(exchange(server, setup_request(1, lower_block_setup())).has_interface());
   protocol::SetupBody bad = lower_block_setup();
-  bad.set_contact_boundary("nowhere");
+  bad.clear_contact_boundaries();
+  bad.add_contact_boundaries("nowhere");
   expect_error(exchange(server, setup_request(2, bad)), protocol::BAD_INPUT, "awaiting_setup");
   protocol::Envelope assign = request(3);
   assign.mutable_assign_contact();

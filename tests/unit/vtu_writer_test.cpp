@@ -50,9 +50,9 @@ Mesh make_mixed_mesh() {
   Mesh mesh;
   mesh.nodes = {{0, 0}, {1, 0}, {1, 1},   {0, 1},     {2, 0},
                 {2, 1}, {3, 0}, {2.5, 0}, {2.5, 0.5}, {2, 0.5}};
-  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2, 0, 2, 3}});
-  mesh.blocks.push_back({ElementType::quadrilateral4, {1, 4, 5, 2}});
-  mesh.blocks.push_back({ElementType::triangle6, {4, 6, 5, 7, 8, 9}});
+  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2, 0, 2, 3}, {}});
+  mesh.blocks.push_back({ElementType::quadrilateral4, {1, 4, 5, 2}, {}});
+  mesh.blocks.push_back({ElementType::triangle6, {4, 6, 5, 7, 8, 9}, {}});
   return mesh;
 }
 
@@ -170,7 +170,7 @@ TEST(VtuWriter, NumbersRoundTripExactly) {
   const TemporaryDirectory directory("vtu_writer");
   Mesh mesh;
   mesh.nodes = {{0.1, 0.7}, {1.0 / 3.0, -2.0 / 7.0}, {std::numbers::pi, 1e-17}};
-  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}});
+  mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
   const std::vector<double> values = {0.1,
                                       1.0 / 3.0,
                                       -2.0 / 7.0,
