@@ -163,6 +163,9 @@ void RemotePort::handshake() {
 
 InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions& solver) {
   body_label_ = body.definition.name;
+  if (body.definition.mesh.node_count() == 0) {
+    fail("setup", "body '" + body_label_ + "' has no mesh (load_meshes first)");
+  }
   run_id_ = new_run_id();  // a new run: this port's requests carry it from now on
   if (server_name_.empty()) handshake();
   Envelope request;

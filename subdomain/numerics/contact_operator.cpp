@@ -36,13 +36,13 @@ namespace {
 
 void check_offsets(const ContactOperator& contact, const std::string& context) {
   const auto fail = [&](const std::string& problem) {
-    throw InputError(context + ": AssignContact.row_offsets " + problem);
+    throw InputError(context + ": AssignContact.row_offsets" + problem);
   };
   if (contact.row_offsets.empty() || contact.row_offsets.front() != 0) {
-    fail("must start with 0 (one more entry than there are constraints)");
+    fail(" must start with 0 (one more entry than there are constraints)");
   }
   if (contact.row_offsets.back() != contact.entry_count()) {
-    fail("ends at " + std::to_string(contact.row_offsets.back()) + ", expected the entry count " +
+    fail(" ends at " + std::to_string(contact.row_offsets.back()) + ", expected the entry count " +
          std::to_string(contact.entry_count()));
   }
   for (int row = 0; row < contact.row_count(); ++row) {
@@ -53,7 +53,7 @@ void check_offsets(const ContactOperator& contact, const std::string& context) {
       fail(problem.str());
     }
   }
-  if (contact.row_count() < 1) fail("describes no constraint");
+  if (contact.row_count() < 1) fail(" describes no constraint");
 }
 
 void check_row(const ContactOperator& contact, int row, const std::vector<int>& contact_nodes,

@@ -491,10 +491,11 @@ void SubdomainServer::acknowledge(protocol::Envelope& reply) const {
 }
 
 void SubdomainServer::log(const RequestRecord& record) const {
-  const std::string body = record.body.empty() ? "" : " body '" + record.body + "'";
+  const std::string body =
+      record.body.empty() ? "" : " body '" + printable_for_log(record.body, 80) + "'";
   settings_.logger->log(record.failed ? spdlog::level::warn : spdlog::level::info,
                         "{}{}{}: {} ({:.3f} ms)", record.type, body, record.iteration,
-                        record.outcome, 1e3 * record.seconds);
+                        printable_for_log(record.outcome), 1e3 * record.seconds);
 }
 
 }  // namespace robin

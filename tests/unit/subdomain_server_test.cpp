@@ -800,7 +800,7 @@ TEST_F(ReadyServer, BadAssignmentsAreInvalidAndKeepThePreviousAssignment) {
       {modified(12, [](Assign& a) { a.mutable_weights()->RemoveLast(); }),
        "22 row_offsets and 20 weights"},
       {modified(13, [](Assign& a) { a.set_row_offsets(1, 0); }),
-       "AssignContact.row_offsets [1] leaves constraint 0 without entries"},
+       "AssignContact.row_offsets[1] leaves constraint 0 without entries"},
       {modified(14, [](Assign& a) { a.set_row_offsets(0, 1); }),
        "AssignContact.row_offsets must start with 0"},
       {modified(15, [](Assign& a) { a.set_row_offsets(21, 40); }),
