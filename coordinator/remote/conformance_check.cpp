@@ -757,8 +757,8 @@ std::string ServerChecks::fields_equilibrium() {
          "), expected 0 (sum lambda_i = " + number(total) + ")";
 }
 /// The pair order, seen through positions: a unit contact force at pair index k must push the
-/// node at (x_k, 1) down most. (On this mesh F = B K^-1 B' is diagonally dominant by columns,
-/// by 26 % or more.) Answers indexed by the pair order cannot show a server that uses its own
+/// node at (x_k, 1) down most (on this mesh the largest entry of every column of F = B K^-1 B' is
+/// on the diagonal: both shipped servers pass). Answers indexed by the pair order cannot show a server that uses its own
 /// order instead: they are consistently relabelled. The FieldsReply's coordinates can.
 std::string ServerChecks::fields_pair_order() {
   require_assignment();

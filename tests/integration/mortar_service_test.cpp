@@ -19,16 +19,10 @@ namespace robin {
 namespace {
 
 using testing::example;
+using testing::python_server_options;
 using testing::server_options;
 using testing::TemporaryDirectory;
 
-ServerLaunchOptions python_server_options(const std::filesystem::path& log_directory) {
-  ServerLaunchOptions options = server_options(log_directory);
-  options.executable = std::filesystem::path(ROBIN_EXAMPLES) / "../python/robin-subdomain-py";
-  options.command_prefix = {"/usr/bin/python3"};
-  options.startup_timeout_seconds = 60.0;
-  return options;
-}
 
 /// The patch test's exact pressure (examples/non_matching_blocks.toml).
 double exact_patch_pressure() {

@@ -36,20 +36,12 @@ namespace robin {
 namespace {
 
 using testing::example;
+using testing::python_server_options;
 using testing::server_options;
 using testing::TemporaryDirectory;
 using testing::vectors_close;
 
 constexpr double tolerance = 1e-6;  // relative, two independent implementations
-
-/// Launch options of the Python server (same command line as robin-subdomain).
-ServerLaunchOptions python_server_options(const std::filesystem::path& log_directory) {
-  ServerLaunchOptions options = server_options(log_directory);
-  options.executable = std::filesystem::path(ROBIN_EXAMPLES) / "../python/robin-subdomain-py";
-  options.command_prefix = {"/usr/bin/python3"};
-  options.startup_timeout_seconds = 60.0;
-  return options;
-}
 
 Eigen::VectorXd point_field(const BodyOutput& output, const std::string& name) {
   for (const OutputField& field : output.point_fields) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "remote/child_process.hpp"
+#include "../test_files.hpp"
 #include "remote/server_launcher.hpp"
 
 namespace robin::testing {
@@ -26,26 +27,6 @@ inline std::filesystem::path tool(const std::string& name) {
   return std::filesystem::path(ROBIN_BINARY_DIR) / "bin" / name;
 }
 
-/// A fresh empty directory under the system's temporary directory, removed at destruction.
-class TemporaryDirectory {
- public:
-  explicit TemporaryDirectory(const std::string& label) {
-    static std::atomic<int> counter{0};
-    path_ = std::filesystem::temp_directory_path() /
-            ("robin-" + label + "-" + std::to_string(getpid()) + "-" + std::to_string(counter++));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TemporaryDirectory() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
 /// Options to start build/bin/robin-subdomain on `listen`, logging into `log_directory`.
 inline ServerLaunchOptions server_options(const std::filesystem::path& log_directory,
                                           const std::string& listen = "tcp://127.0.0.1:*") {
@@ -54,6 +35,16 @@ inline ServerLaunchOptions server_options(const std::filesystem::path& log_direc
   options.log_directory = log_directory;
   options.listen = listen;
   options.log_level = "warn";
+  return options;
+}
+
+/// Options to start the Python server python/robin-subdomain-py (same command line as
+/// robin-subdomain) under /usr/bin/python3.
+inline ServerLaunchOptions python_server_options(const std::filesystem::path& log_directory) {
+  ServerLaunchOptions options = server_options(log_directory);
+  options.executable = std::filesystem::path(ROBIN_EXAMPLES) / "../python/robin-subdomain-py";
+  options.command_prefix = {"/usr/bin/python3"};
+  options.startup_timeout_seconds = 60.0;
   return options;
 }
 

@@ -28,6 +28,7 @@
 #include <thread>
 #include <zmq.hpp>
 
+#include "../test_files.hpp"
 #include "mesh_codec.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/contact_operator.hpp"
@@ -400,35 +401,9 @@ TEST(SubdomainProcess, OversizedMessageIsDroppedWithoutReplyAndTheServerStaysUp)
 
 // --- Issue 11: the attacks against the real process --------------------------------------
 
-std::string file_text(const std::filesystem::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream stream(path, std::ios::binary);
-  stream << text;
-}
-
-/// A fresh directory (temporary_path), removed with its content at destruction.
-class ScratchDirectory {
- public:
-  explicit ScratchDirectory(const std::string& label) : path_(temporary_path(label)) {
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchDirectory() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  ScratchDirectory(const ScratchDirectory&) = delete;
-  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using testing::file_text;
+using testing::write_text;
+using ScratchDirectory = testing::TemporaryDirectory;
 
 /// The names under `directory` (recursively, relative; links not followed).
 std::set<std::string> listing(const std::filesystem::path& directory) {

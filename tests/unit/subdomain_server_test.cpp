@@ -29,6 +29,7 @@
 #include <set>
 #include <sstream>
 
+#include "../test_files.hpp"
 #include "mesh_codec.hpp"
 #include "numerics/body_output.hpp"
 #include "numerics/contact_operator.hpp"
@@ -42,40 +43,9 @@ namespace {
 const std::filesystem::path lower_geo =
     std::filesystem::path(ROBIN_EXAMPLES) / "meshes/block_lower.geo";
 
-std::string file_text(const std::filesystem::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream stream(path, std::ios::binary);
-  stream << text;
-}
-
-/// A fresh empty directory under the temporary directory, removed at destruction.
-class TemporaryDirectory {
- public:
-  explicit TemporaryDirectory(const std::string& label) {
-    static std::atomic<int> counter{0};
-    path_ = std::filesystem::temp_directory_path() /
-            ("robin-server-test-" + label + "-" + std::to_string(getpid()) + "-" +
-             std::to_string(counter++));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TemporaryDirectory() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  TemporaryDirectory(const TemporaryDirectory&) = delete;
-  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using testing::file_text;
+using testing::TemporaryDirectory;
+using testing::write_text;
 
 /// block_lower.geo meshed with h = 0.1, once per process.
 const Mesh& lower_mesh() {
