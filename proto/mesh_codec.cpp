@@ -69,10 +69,10 @@ std::vector<int> decode_connectivity(const protocol::CellBlock& block, int nodes
                                      const std::string& field) {
   const auto& connectivity = block.connectivity();
   if (connectivity.empty() || connectivity.size() % nodes_per_cell != 0) {
-    errors.fail(field + ".connectivity",
-                "has " + std::to_string(connectivity.size()) + " entries, expected a positive " +
-                    "multiple of " + std::to_string(nodes_per_cell) + " (nodes per " +
-                    cell_type_name(block.type()) + ")");
+    errors.fail(field + ".connectivity", "has " + std::to_string(connectivity.size()) +
+                                             " entries, expected a positive " + "multiple of " +
+                                             std::to_string(nodes_per_cell) + " (nodes per " +
+                                             cell_type_name(block.type()) + ")");
   }
   for (int k = 0; k < connectivity.size(); ++k) {
     if (connectivity[k] >= node_count) {
@@ -84,12 +84,12 @@ std::vector<int> decode_connectivity(const protocol::CellBlock& block, int nodes
   return std::vector<int>(connectivity.begin(), connectivity.end());
 }
 
-std::vector<std::size_t> decode_cell_tags(const protocol::CellBlock& block,
-                                          std::size_t cell_count, const MeshErrors& errors,
-                                          const std::string& field) {
+std::vector<std::size_t> decode_cell_tags(const protocol::CellBlock& block, std::size_t cell_count,
+                                          const MeshErrors& errors, const std::string& field) {
   if (block.tags_size() != 0 && static_cast<std::size_t>(block.tags_size()) != cell_count) {
     errors.fail(field + ".tags", "has " + std::to_string(block.tags_size()) + " tags for " +
-                                     std::to_string(cell_count) + " cells (give one per cell or none)");
+                                     std::to_string(cell_count) +
+                                     " cells (give one per cell or none)");
   }
   return std::vector<std::size_t>(block.tags().begin(), block.tags().end());
 }

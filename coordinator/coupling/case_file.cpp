@@ -278,8 +278,8 @@ CaseDefinition read_case_file(const std::filesystem::path& path) {
       definition.contact.non_mortar != definition.bodies[0].definition.name &&
       definition.contact.non_mortar != definition.bodies[1].definition.name) {
     const auto table = root.optional_table("contact", contact_keys);
-    table->fail("non_mortar", "'" + definition.contact.non_mortar +
-                                  "' is not the name of a body (nor \"auto\")");
+    table->fail("non_mortar",
+                "'" + definition.contact.non_mortar + "' is not the name of a body (nor \"auto\")");
   }
   return definition;
 }

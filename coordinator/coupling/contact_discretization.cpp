@@ -15,8 +15,8 @@ MortarOptions mortar_options(const ContactOptions& options, const std::string& n
   } else if (options.non_mortar == name2) {
     mortar.non_mortar_body = 1;
   } else {
-    throw InputError("contact.non_mortar: '" + options.non_mortar + "' is not a body (the bodies are '" +
-                     name1 + "' and '" + name2 + "')");
+    throw InputError("contact.non_mortar: '" + options.non_mortar +
+                     "' is not a body (the bodies are '" + name1 + "' and '" + name2 + "')");
   }
   return mortar;
 }

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "coupling/gap_function.hpp"
-#include "numerics/errors.hpp"
 #include "numerics/body_solver.hpp"
+#include "numerics/errors.hpp"
 
 namespace robin {
 
@@ -64,8 +64,9 @@ class UnmatchedContactNodes : public InputError {
 /// Pairs the two interfaces. `gap` may be null. A body-1 node matches the body-2 node whose
 /// offset from it is, up to the normal component, shorter than relative_tolerance times the
 /// shortest contact edge; every node of both sides must be matched. Throws
-/// UnmatchedContactNodes naming the first unmatched node (body, mesh node tag, coordinates), or when every pair is excluded
-/// (the contact boundary is a Dirichlet boundary: nothing is left for contact).
+/// UnmatchedContactNodes naming the first unmatched node (body, mesh node tag, coordinates), or
+/// when every pair is excluded (the contact boundary is a Dirichlet boundary: nothing is left for
+/// contact).
 ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::string& name1,
                                   const InterfaceDescription& body2, const std::string& name2,
                                   const GapFunction* gap, double relative_tolerance);

@@ -165,9 +165,8 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
     summary["joint_state_residuals"] = residuals_json(iteration.history.back());
   }
   summary["contact_pairs"] = result.pairing.size();
-  summary["contact_discretization"] =
-      describe_contact(result.pairing, definition.bodies[0].definition.name,
-                       definition.bodies[1].definition.name);
+  summary["contact_discretization"] = describe_contact(
+      result.pairing, definition.bodies[0].definition.name, definition.bodies[1].definition.name);
   summary["excluded_pairs"] = result.pairing.excluded;
   summary["excluded_pair_penetration"] = result.excluded_clearance.relative_penetration;
   summary["initial_overlap"] = overlap_warning(result.pairing);
@@ -229,9 +228,9 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   const std::string& name1 = definition.bodies[0].definition.name;
   const std::string& name2 = definition.bodies[1].definition.name;
   const auto coupling_start = Clock::now();
-  result.pairing = discretize_contact(result.interfaces[0], name1, result.interfaces[1], name2,
-                                      gap.get(), definition.contact,
-                                      definition.solver.pairing_tolerance);
+  result.pairing =
+      discretize_contact(result.interfaces[0], name1, result.interfaces[1], name2, gap.get(),
+                         definition.contact, definition.solver.pairing_tolerance);
   result.coupling_seconds = seconds_since(coupling_start);
   report_stage(observer, describe_contact(result.pairing, name1, name2));
   for (const std::string& line : result.pairing.excluded) report_stage(observer, line);

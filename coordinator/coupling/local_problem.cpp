@@ -17,7 +17,8 @@ LocalProblem prepare_local_problem(const CaseDefinition& definition) {
   const auto start = std::chrono::steady_clock::now();
   CaseDefinition loaded = definition;
   load_meshes(loaded);
-  problem.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  problem.mesh_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (int alpha = 0; alpha < 2; ++alpha) {
     problem.bodies[alpha] = std::make_unique<BodySolver>(std::move(loaded.bodies[alpha].definition),
                                                          definition.solver.body);

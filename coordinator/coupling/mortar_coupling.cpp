@@ -34,7 +34,7 @@ struct Side {
 };
 
 struct SegmentPoint {
-  Eigen::VectorXd values;   // shape functions at the point
+  Eigen::VectorXd values;  // shape functions at the point
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
   Eigen::Vector2d tangent = Eigen::Vector2d::Zero();  // dx/dxi
 };
@@ -245,8 +245,7 @@ void integrate_overlap(const Side& nonmortar, int segment, const Eigen::MatrixXd
       row.standard_gap += measure * at.values[a] * distance;
       for (int b = 0; b < count; ++b) {
         row.dual_nonmortar[nonmortar.node(segment, b)] += measure * dual_values[a] * at.values[b];
-        row.standard_nonmortar[nonmortar.node(segment, b)] +=
-            measure * at.values[a] * at.values[b];
+        row.standard_nonmortar[nonmortar.node(segment, b)] += measure * at.values[a] * at.values[b];
       }
       for (int l = 0; l < mortar.nodes_per_segment(); ++l) {
         row.dual_mortar[mortar.node(other, l)] += measure * dual_values[a] * target.values[l];
@@ -351,8 +350,8 @@ void add_entries(ContactOperator& contact, const Side& side, const std::map<int,
 std::string describe(const Side& side, int position) {
   const Eigen::Vector2d& point = side.coordinates(position);
   return "body '" + side.name + "' contact node (tag " +
-         std::to_string(side.interface->node_tags[static_cast<std::size_t>(position)]) +
-         ") at (" + std::to_string(point.x()) + ", " + std::to_string(point.y()) + ")";
+         std::to_string(side.interface->node_tags[static_cast<std::size_t>(position)]) + ") at (" +
+         std::to_string(point.x()) + ", " + std::to_string(point.y()) + ")";
 }
 
 bool completely_covered(const Side& nonmortar, const Coupling& coupling, int position) {
@@ -467,7 +466,8 @@ ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const st
                      std::to_string(pairing.excluded.size()) +
                      " constraints have their normal displacement prescribed by Dirichlet "
                      "conditions (first: " +
-                     pairing.excluded.front() + "); the contact boundary must not be a "
+                     pairing.excluded.front() +
+                     "); the contact boundary must not be a "
                      "Dirichlet boundary");
   }
   pairing.non_mortar_body = nonmortar_body;

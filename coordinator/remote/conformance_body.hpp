@@ -3,12 +3,12 @@
 // replies (internal to robin_remote; see conformance_check.hpp).
 //
 // The body: the unit square [0, 1]^2 (sent as MeshData: a structured mesh of 4 x 4 squares,
-// each split into two linear triangles), isotropic plane strain (E = 1000, nu = 0.3), its bottom edge prescribed to
-// u = (0, lift), no load, its top edge y = 1 the contact boundary with outward normal (0, 1).
-// Without contact it translates rigidly: u = (0, lift) everywhere, no stress, so the free
-// normal trace is e_i = lift at every contact node. On this mesh F = B K^-1 B' is
-// such that a unit force at a node moves that node most (the largest entry of each column is on the
-// diagonal; both shipped servers pass the check that relies on it).
+// each split into two linear triangles), isotropic plane strain (E = 1000, nu = 0.3), its bottom
+// edge prescribed to u = (0, lift), no load, its top edge y = 1 the contact boundary with outward
+// normal (0, 1). Without contact it translates rigidly: u = (0, lift) everywhere, no stress, so the
+// free normal trace is e_i = lift at every contact node. On this mesh F = B K^-1 B' is such that a
+// unit force at a node moves that node most (the largest entry of each column is on the diagonal;
+// both shipped servers pass the check that relies on it).
 //
 // Every judging function returns plain-words problems ("" or an empty list when the reply is
 // right), naming the field and the node.

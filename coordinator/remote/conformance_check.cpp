@@ -758,8 +758,9 @@ std::string ServerChecks::fields_equilibrium() {
 }
 /// The pair order, seen through positions: a unit contact force at pair index k must push the
 /// node at (x_k, 1) down most (on this mesh the largest entry of every column of F = B K^-1 B' is
-/// on the diagonal: both shipped servers pass). Answers indexed by the pair order cannot show a server that uses its own
-/// order instead: they are consistently relabelled. The FieldsReply's coordinates can.
+/// on the diagonal: both shipped servers pass). Answers indexed by the pair order cannot show a
+/// server that uses its own order instead: they are consistently relabelled. The FieldsReply's
+/// coordinates can.
 std::string ServerChecks::fields_pair_order() {
   require_assignment();
   for (long k = 0; k < contact_count(); ++k) {
@@ -931,8 +932,8 @@ std::string ServerChecks::general_rows() {
     force(j) = 1.0 - 0.3 * static_cast<double>(j);
   }
   Eigen::VectorXd node_response;
-  if (const std::string problem =
-          correction(averaging.transpose() * force, "CorrectionRequest with r = T' s", node_response);
+  if (const std::string problem = correction(averaging.transpose() * force,
+                                             "CorrectionRequest with r = T' s", node_response);
       !problem.empty()) {
     return problem;
   }
@@ -955,8 +956,9 @@ std::string ServerChecks::general_rows() {
   }
   Eigen::VectorXd row_response;
   const std::string correction_what = "CorrectionRequest with s (" + what + ")";
-  std::string problem = in_context(correction_what, read_correction(session_.request(
-      correction_request(force), correction_what), rows, row_response));
+  std::string problem = in_context(
+      correction_what, read_correction(session_.request(correction_request(force), correction_what),
+                                       rows, row_response));
   if (problem.empty()) {
     const Eigen::VectorXd expected = averaging * node_response;
     const double scale = std::max(expected.cwiseAbs().maxCoeff(), 1e-300);
@@ -968,7 +970,8 @@ std::string ServerChecks::general_rows() {
     }
   }
   // Restore the node-to-node assignment for the checks that follow.
-  const Exchange restore = session_.request(assign_request(nodes_), "AssignContact (node-to-node again)");
+  const Exchange restore =
+      session_.request(assign_request(nodes_), "AssignContact (node-to-node again)");
   if (const std::string restored = expect_acknowledge(restore, "ready"); problem.empty()) {
     problem = restored.empty() ? "" : "AssignContact (node-to-node again): " + restored;
   }

@@ -10,16 +10,17 @@
 // message.
 //
 // The body it sets up is built in: the unit square [0, 1]^2 (a structured mesh of 4 x 4 squares
-// split into triangles, sent as MeshData), isotropic plane strain, its bottom edge lifted by a prescribed displacement
-// u = (0, lift) and no load, its top edge the contact boundary. Its solution without contact is
-// the rigid translation u = (0, lift), so e_i = lift at every contact node and the expected
-// answers of the free solve and of the fields are known exactly. The numerical checks use only
-// that and identities every correct server satisfies: the Signorini conditions, u_N = e - F
-// lambda with F r the correction's reply, F linear, symmetric and positive definite, the global
-// force balance, and the same answer in a second run. Answers indexed by the pair order cannot
-// reveal a server that uses its own node order instead (they are consistently relabelled), so
-// the pair order is judged through positions: a unit force at pair index k must move the node
-// at x_k most, in the FieldsReply's 'displacement' field (that check needs the field).
+// split into triangles, sent as MeshData), isotropic plane strain, its bottom edge lifted by a
+// prescribed displacement u = (0, lift) and no load, its top edge the contact boundary. Its
+// solution without contact is the rigid translation u = (0, lift), so e_i = lift at every contact
+// node and the expected answers of the free solve and of the fields are known exactly. The
+// numerical checks use only that and identities every correct server satisfies: the Signorini
+// conditions, u_N = e - F lambda with F r the correction's reply, F linear, symmetric and positive
+// definite, the global force balance, and the same answer in a second run. Answers indexed by the
+// pair order cannot reveal a server that uses its own node order instead (they are consistently
+// relabelled), so the pair order is judged through positions: a unit force at pair index k must
+// move the node at x_k most, in the FieldsReply's 'displacement' field (that check needs the
+// field).
 //
 // The optional Neumann solve (protocol 1.1, capability "neumann_solve") is checked only when
 // HelloReply.capabilities announces it: WRONG_STATE before SetupBody and AssignContact,

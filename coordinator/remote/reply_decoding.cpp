@@ -126,7 +126,8 @@ ElementType element_type_of_vtk_cell(unsigned cell_type) {
 }
 
 /// The segments of the one contact surface (positions into node_ids, checked in range).
-void decode_surface(const protocol::InterfaceDescription& message, InterfaceDescription& interface) {
+void decode_surface(const protocol::InterfaceDescription& message,
+                    InterfaceDescription& interface) {
   if (message.surfaces_size() != 1) {
     throw MalformedReply("surfaces has " + std::to_string(message.surfaces_size()) +
                          " entries, expected one (the body's contact boundary)");

@@ -31,8 +31,8 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   summary["iterations"] = result.qp.iterations;
   summary["operator_applications"] = result.qp.operator_applications;
   summary["contact_pairs"] = problem.pairing.size();
-  summary["contact_discretization"] =
-      robin::describe_contact(problem.pairing, problem.bodies[0]->name(), problem.bodies[1]->name());
+  summary["contact_discretization"] = robin::describe_contact(
+      problem.pairing, problem.bodies[0]->name(), problem.bodies[1]->name());
   summary["excluded_pairs"] = problem.pairing.excluded;
   summary["initial_overlap"] = robin::overlap_warning(problem.pairing);
   summary["contact_force_resultant"] = {resultant.x(), resultant.y()};

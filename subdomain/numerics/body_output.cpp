@@ -38,9 +38,9 @@ Eigen::Vector2d resultant(const Eigen::VectorXd& nodal_vectors) {
 
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force) {
   if (contact_force.size() != body.contact_size()) {
-    throw std::invalid_argument("body '" + body.name() + "': " +
-                                std::to_string(contact_force.size()) + " contact forces for " +
-                                std::to_string(body.contact_size()) + " contact constraints");
+    throw std::invalid_argument(
+        "body '" + body.name() + "': " + std::to_string(contact_force.size()) +
+        " contact forces for " + std::to_string(body.contact_size()) + " contact constraints");
   }
   const Eigen::VectorXd displacement = body.displacement(contact_force);
   const StressField stress = recover_stress(body.mesh(), body.definition().material, displacement);

@@ -110,8 +110,8 @@ std::vector<int> oriented_segments(const Mesh& mesh, const BoundaryGroup& group,
     const std::size_t first = segments.size();
     for (int i = 0; i < count; ++i) {
       const int node = group.connectivity[e * count + i];
-      segments.push_back(static_cast<int>(
-          std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
+      segments.push_back(
+          static_cast<int>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
     }
     if (left.dot(outward) < 0.0) std::swap(segments[first], segments[first + 1]);
   }
@@ -227,9 +227,10 @@ void BodySolver::build_interface_operator() {
   const double dense_bytes = 8.0 * contact_size() * static_cast<double>(contact_size());
   const bool dense_fits =
       options_.maximum_factor_bytes <= 0.0 || dense_bytes <= options_.maximum_factor_bytes;
-  const bool dense = dense_fits && (options_.interface_operator == InterfaceOperatorKind::dense ||
-                                    (options_.interface_operator == InterfaceOperatorKind::automatic &&
-                                     contact_size() <= options_.dense_limit));
+  const bool dense =
+      dense_fits && (options_.interface_operator == InterfaceOperatorKind::dense ||
+                     (options_.interface_operator == InterfaceOperatorKind::automatic &&
+                      contact_size() <= options_.dense_limit));
   if (dense && factor_->has_trailing_block()) {
     compliance_ = std::make_unique<DenseOperator>(factor_->trailing_congruence(trace_));
   } else if (dense) {

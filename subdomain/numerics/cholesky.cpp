@@ -228,17 +228,16 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
 void CholeskyFactor::Implementation::check_memory_estimate() {
   if (memory_limit_bytes <= 0.0) return;
   const cholmod_factor& symbolic = *cholesky.factor();
-  const double entries = symbolic.is_super ? static_cast<double>(symbolic.xsize)
-                                           : cholesky.cholmod().lnz;
+  const double entries =
+      symbolic.is_super ? static_cast<double>(symbolic.xsize) : cholesky.cholmod().lnz;
   const double bytes = 8.0 * entries;
   if (bytes <= memory_limit_bytes) return;
   const auto gibibytes = [](double value) { return format_number(value / 1073741824.0) + " GiB"; };
-  throw ResourceLimitError("body '" + body_name + "': its Cholesky factor would need " +
-                           gibibytes(bytes) + " (symbolic analysis: " + format_number(entries) +
-                           " entries for " + std::to_string(size) +
-                           " unknowns), above this server's limit of " +
-                           gibibytes(memory_limit_bytes) +
-                           " (robin-subdomain --max-factor-memory MIB raises it)");
+  throw ResourceLimitError(
+      "body '" + body_name + "': its Cholesky factor would need " + gibibytes(bytes) +
+      " (symbolic analysis: " + format_number(entries) + " entries for " + std::to_string(size) +
+      " unknowns), above this server's limit of " + gibibytes(memory_limit_bytes) +
+      " (robin-subdomain --max-factor-memory MIB raises it)");
 }
 
 void CholeskyFactor::Implementation::locate_trailing(const std::vector<int>& trailing) {
@@ -271,8 +270,7 @@ void CholeskyFactor::Implementation::check_pivots() const {
 }
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
-                               const std::vector<int>& trailing_unknowns,
-                               double memory_limit_bytes)
+                               const std::vector<int>& trailing_unknowns, double memory_limit_bytes)
     : implementation_(std::make_unique<Implementation>()) {
   implementation_->body_name = body_name;
   implementation_->memory_limit_bytes = memory_limit_bytes;

@@ -65,9 +65,9 @@ void check_row(const ContactOperator& contact, int row, const std::vector<int>& 
     entry.push_back(']');
     const int node = contact.nodes[k];
     if (!std::binary_search(contact_nodes.begin(), contact_nodes.end(), node)) {
-      throw InputError(context + ": AssignContact.node_ids" + entry + " = " +
-                       std::to_string(node) +
-                       " is not a node of the contact boundary (see InterfaceDescription.node_ids)");
+      throw InputError(
+          context + ": AssignContact.node_ids" + entry + " = " + std::to_string(node) +
+          " is not a node of the contact boundary (see InterfaceDescription.node_ids)");
     }
     if (contact.components[k] != 0 && contact.components[k] != 1) {
       throw InputError(context + ": AssignContact.components" + entry + " = " +
@@ -110,7 +110,8 @@ void check_contact_operator(const ContactOperator& contact, const std::vector<in
                      std::to_string(contact.weights.size()) + " values for " +
                      std::to_string(contact.row_count()) + " constraints");
   }
-  for (int row = 0; row < contact.row_count(); ++row) check_row(contact, row, contact_nodes, context);
+  for (int row = 0; row < contact.row_count(); ++row)
+    check_row(contact, row, contact_nodes, context);
 }
 
 }  // namespace robin

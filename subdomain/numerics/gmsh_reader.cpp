@@ -287,7 +287,8 @@ void orient_counter_clockwise(const ErrorSource& source, Mesh& mesh, ElementBloc
   const int count = nodes_per_element(block.type);
   std::map<int, double> surface_area;
   for (std::size_t e = 0; e < block.element_count(); ++e) {
-    surface_area[surfaces[e]] += twice_signed_area(mesh, block.type, &block.connectivity[e * count]);
+    surface_area[surfaces[e]] +=
+        twice_signed_area(mesh, block.type, &block.connectivity[e * count]);
   }
   const std::vector<int>& order = reversed.at(block.type);
   for (std::size_t e = 0; e < block.element_count(); ++e) {
@@ -297,10 +298,10 @@ void orient_counter_clockwise(const ErrorSource& source, Mesh& mesh, ElementBloc
     if (area * orientation <= 0.0) {
       throw source.error(block.element_label(e) + " (" + to_string(block.type) + " at node tag " +
                          std::to_string(mesh.node_tags[nodes[0]]) + ") " +
-                         (area == 0.0 ? "has zero area"
-                                      : "is inverted against the other elements of surface " +
-                                            std::to_string(surfaces[e]) +
-                                            " (a folded or tangled mesh)"));
+                         (area == 0.0
+                              ? "has zero area"
+                              : "is inverted against the other elements of surface " +
+                                    std::to_string(surfaces[e]) + " (a folded or tangled mesh)"));
     }
     if (orientation > 0.0) continue;
     const std::vector<int> original(nodes, nodes + count);

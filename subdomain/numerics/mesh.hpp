@@ -62,5 +62,4 @@ struct Mesh {
   std::string boundary_label(const BoundaryGroup& group) const;
 };
 
-
 }  // namespace robin

@@ -10,8 +10,8 @@
 #include "numerics/body_output.hpp"
 #include "numerics/errors.hpp"
 #include "robin.pb.h"
-#include "server/reply_encoding.hpp"
 #include "server/file_access.hpp"
+#include "server/reply_encoding.hpp"
 #include "server/request_error.hpp"
 #include "server/server_logging.hpp"
 #include "server/setup_decoding.hpp"
@@ -123,10 +123,10 @@ ContactOperator decoded_operator(const protocol::AssignContact& message,
   for (int k = 0; k < entries; ++k) {
     const std::int64_t node = message.node_ids(k);
     // Out-of-range ids become -1, which check_contact_operator refuses as unknown nodes.
-    contact.nodes.push_back(node >= 0 && node <= std::numeric_limits<int>::max()
-                                ? static_cast<int>(node)
-                                : -1);
-    contact.components.push_back(static_cast<int>(std::min<std::uint32_t>(message.components(k), 1000)));
+    contact.nodes.push_back(
+        node >= 0 && node <= std::numeric_limits<int>::max() ? static_cast<int>(node) : -1);
+    contact.components.push_back(
+        static_cast<int>(std::min<std::uint32_t>(message.components(k), 1000)));
   }
   return contact;
 }
@@ -457,13 +457,13 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
   const BodyOutput output = make_body_output(*body_, contact_force);
   for (const OutputField& field : output.point_fields) {
-    require_finite(Eigen::Map<const Eigen::VectorXd>(field.values.data(),
-                                                     static_cast<Eigen::Index>(field.values.size())),
+    require_finite(Eigen::Map<const Eigen::VectorXd>(
+                       field.values.data(), static_cast<Eigen::Index>(field.values.size())),
                    "FieldsReply point field '" + field.name + "'", body_->name());
   }
   for (const OutputField& field : output.cell_fields) {
-    require_finite(Eigen::Map<const Eigen::VectorXd>(field.values.data(),
-                                                     static_cast<Eigen::Index>(field.values.size())),
+    require_finite(Eigen::Map<const Eigen::VectorXd>(
+                       field.values.data(), static_cast<Eigen::Index>(field.values.size())),
                    "FieldsReply cell field '" + field.name + "'", body_->name());
   }
   std::filesystem::path directory;

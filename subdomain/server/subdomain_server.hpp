@@ -13,8 +13,8 @@
 // shutdown_requested() becomes true. The body is factorized once per SetupBody; contact solves
 // warm-start from the previous converged solution of the same assignment.
 //
-// Runs (protocol 1.2 and later, Envelope.run_id): a successful SetupBody records its request's run_id
-// with the body (any previous body is discarded whichever run it belonged to: a new run may
+// Runs (protocol 1.2 and later, Envelope.run_id): a successful SetupBody records its request's
+// run_id with the body (any previous body is discarded whichever run it belonged to: a new run may
 // always take over a server whose coordinator died). While the body is held, AssignContact,
 // ContactSolveRequest, CorrectionRequest, NeumannSolveRequest, FieldsRequest and EndRun whose
 // run_id is non-empty and differs from a non-empty recorded one are refused with WRONG_STATE

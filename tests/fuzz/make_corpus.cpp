@@ -131,7 +131,8 @@ robin::protocol::SetupBody mesh_path_setup() {
 }
 
 /// Node-to-node rows: one per contact node, (B u)_i = u(node_i) . n_i, weight m_i.
-robin::protocol::AssignContact node_to_node(const robin::protocol::InterfaceDescription& interface) {
+robin::protocol::AssignContact node_to_node(
+    const robin::protocol::InterfaceDescription& interface) {
   robin::protocol::AssignContact assign;
   assign.add_row_offsets(0);
   for (int i = 0; i < interface.node_ids_size(); ++i) {
@@ -191,8 +192,8 @@ class SeedWriter {
 /// `individual`, every request is also written on its own (assign_contact.pb,
 /// contact_solve.pb, ...), and EndRun closes the run.
 void write_run(SeedWriter& writer, const std::string& setup_name,
-               const robin::protocol::SetupBody& setup, const std::string& run_id,
-               bool individual, bool session_seed = true) {
+               const robin::protocol::SetupBody& setup, const std::string& run_id, bool individual,
+               bool session_seed = true) {
   std::string session;
   const auto send = [&](const std::string& name, Envelope envelope, bool write) {
     envelope.set_run_id(run_id);

@@ -30,7 +30,8 @@ bool same_mesh(const robin::Mesh& a, const robin::Mesh& b) {
   }
   for (std::size_t k = 0; k < a.blocks.size(); ++k) {
     if (a.blocks[k].type != b.blocks[k].type ||
-        a.blocks[k].connectivity != b.blocks[k].connectivity || a.blocks[k].tags != b.blocks[k].tags) {
+        a.blocks[k].connectivity != b.blocks[k].connectivity ||
+        a.blocks[k].tags != b.blocks[k].tags) {
       return false;
     }
   }

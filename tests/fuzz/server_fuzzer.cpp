@@ -83,8 +83,8 @@ robin::SubdomainServer& fuzzed_server() {
     settings.output_root = directories.output;
     settings.maximum_dofs = 20000;
     settings.maximum_factor_bytes = 64.0 * 1024 * 1024;
-    settings.logger = std::make_shared<spdlog::logger>(
-        "fuzz", std::make_shared<spdlog::sinks::null_sink_mt>());
+    settings.logger =
+        std::make_shared<spdlog::logger>("fuzz", std::make_shared<spdlog::sinks::null_sink_mt>());
     return settings;
   }());
   return server;

@@ -24,7 +24,8 @@ std::filesystem::path write_case(const std::filesystem::path& directory,
   std::ifstream original(example("non_matching_blocks.toml"));
   std::string text((std::istreambuf_iterator<char>(original)), std::istreambuf_iterator<char>());
   const std::string meshes = (example("meshes")).string();
-  text = std::regex_replace(text, std::regex("meshes/patch_lower.geo"), meshes + "/patch_lower.geo");
+  text =
+      std::regex_replace(text, std::regex("meshes/patch_lower.geo"), meshes + "/patch_lower.geo");
   text = std::regex_replace(text, std::regex("meshes/patch_upper.geo"),
                             (directory / "upper.geo").string());
   std::ofstream(directory / "upper.geo") << upper_geo;

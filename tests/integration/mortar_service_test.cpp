@@ -23,7 +23,6 @@ using testing::python_server_options;
 using testing::server_options;
 using testing::TemporaryDirectory;
 
-
 /// The patch test's exact pressure (examples/non_matching_blocks.toml).
 double exact_patch_pressure() {
   return 0.01 / (0.5 * (1.0 - 0.3 * 0.3) / 1000.0 + 0.4 * (1.0 - 0.25 * 0.25) / 400.0);

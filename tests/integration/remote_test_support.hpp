@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "remote/child_process.hpp"
 #include "../test_files.hpp"
+#include "remote/child_process.hpp"
 #include "remote/server_launcher.hpp"
 
 namespace robin::testing {

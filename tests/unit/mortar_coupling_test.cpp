@@ -86,7 +86,8 @@ TEST(MortarCoupling, NonMatchingRowsReproduceLinearFieldsExactly) {
   const InterfaceDescription upper = upper_edge(0.0, 0.1, 1.0, 0.15, 5);
   MortarOptions options;
   options.non_mortar_body = 0;
-  const ContactPairing pairing = build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
+  const ContactPairing pairing =
+      build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
   ASSERT_EQ(pairing.size(), 8u);
   double total_weight = 0.0;
   for (int row = 0; row < 8; ++row) {
@@ -106,13 +107,14 @@ TEST(MortarCoupling, NonMatchingRowsReproduceLinearFieldsExactly) {
 TEST(MortarCoupling, SmallSegmentsFarFromTheOriginKeepEveryRow) {
   // 2000 and 2800 segments on [1000, 1001]: a segment is 5e-4 long at coordinates of 1e3, so the
   // projections resolve the reference coordinate only to about 1e-11 (round-off).
-  const InterfaceDescription lower = straight_boundary({1000.0, 0.0}, {1001.0, 0.0}, 2000,
-                                                       {0.0, 1.0}, 0);
-  const InterfaceDescription upper = straight_boundary({1000.0, 0.02}, {1001.0, 0.02}, 2800,
-                                                       {0.0, -1.0}, 10000);
+  const InterfaceDescription lower =
+      straight_boundary({1000.0, 0.0}, {1001.0, 0.0}, 2000, {0.0, 1.0}, 0);
+  const InterfaceDescription upper =
+      straight_boundary({1000.0, 0.02}, {1001.0, 0.02}, 2800, {0.0, -1.0}, 10000);
   MortarOptions options;
   options.non_mortar_body = 0;
-  const ContactPairing pairing = build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
+  const ContactPairing pairing =
+      build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
   ASSERT_EQ(pairing.size(), 2001u);
   EXPECT_EQ(pairing.uncovered, 0);
   double total_weight = 0.0;
@@ -139,7 +141,8 @@ TEST(MortarCoupling, NodesBeyondTheOtherBodyCarryNoConstraint) {
   const InterfaceDescription upper = upper_edge(0.3, 0.0, 0.7, 0.0, 3);
   MortarOptions options;
   options.non_mortar_body = 0;
-  const ContactPairing pairing = build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
+  const ContactPairing pairing =
+      build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
   // Covered: x = 0.2 .. 0.8 touch the covered part (x = 0.2 and 0.8 only at their support's
   // end: no measure); 0.3 .. 0.7 are constrained, 0.3 and 0.7 in part (standard rows).
   EXPECT_EQ(pairing.size(), 5u);
@@ -157,7 +160,8 @@ TEST(MortarCoupling, NodesBeyondTheOtherBodyCarryNoConstraint) {
 TEST(MortarCoupling, BoundariesThatDoNotFaceEachOtherAreErrors) {
   const InterfaceDescription lower = lower_edge(0.0, 1.0, 4);
   // Outward normals the same way: an "upper" edge whose body lies above... and below.
-  const InterfaceDescription same_way = straight_boundary({0.0, 0.1}, {1.0, 0.1}, 4, {0.0, 1.0}, 100);
+  const InterfaceDescription same_way =
+      straight_boundary({0.0, 0.1}, {1.0, 0.1}, 4, {0.0, 1.0}, 100);
   try {
     build_mortar_coupling(lower, "lower", same_way, "upper", nullptr, {});
     FAIL() << "expected an InputError";

@@ -67,7 +67,8 @@ TEST_P(MortarPatchTest, RobinIterationConvergesToTheMonolithicMortarSolution) {
   definition.contact.non_mortar = GetParam();
   definition.solver.qp.relative_tolerance = 1e-14;
   InProcessPort port1, port2;
-  const CoupledRunResult robin = run_coupled_case(definition, {&port1, &port2}, definition.coupling);
+  const CoupledRunResult robin =
+      run_coupled_case(definition, {&port1, &port2}, definition.coupling);
   ASSERT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
   std::printf("patch test, non-mortar side '%s': %zu iterations\n", GetParam().c_str(),
               robin.iteration.history.size());
@@ -78,16 +79,16 @@ TEST_P(MortarPatchTest, RobinIterationConvergesToTheMonolithicMortarSolution) {
             1e-8 * scale);
   EXPECT_LE((robin.iteration.contact_force2 - reference.contact_force).lpNorm<Eigen::Infinity>(),
             1e-8 * scale);
-  EXPECT_LE(largest_pressure_error(robin.pairing, robin.iteration.contact_force1,
-                                   exact_patch_pressure()),
-            1e-8);
+  EXPECT_LE(
+      largest_pressure_error(robin.pairing, robin.iteration.contact_force1, exact_patch_pressure()),
+      1e-8);
 }
 
 INSTANTIATE_TEST_SUITE_P(NonMortarSide, MortarPatchTest, ::testing::Values("", "lower", "upper"));
 
 TEST(MortarPatch, ExactOnFinerMeshesToo) {
-  // 51 against 72 contact nodes: many overlaps away from the origin, where the projections' round-off
-  // once lost Gauss points (a Newton tolerance below the coordinates' round-off).
+  // 51 against 72 contact nodes: many overlaps away from the origin, where the projections'
+  // round-off once lost Gauss points (a Newton tolerance below the coordinates' round-off).
   CaseDefinition definition = example("non_matching_blocks.toml");
   for (BodyCase& body : definition.bodies) body.mesh_options.size = 0.02;
   const LocalProblem problem = prepare_local_problem(definition);

@@ -44,7 +44,8 @@ HertzFit fit_pressure(const ContactPairing& pairing, const Eigen::VectorXd& forc
   const double largest = force.maxCoeff();
   for (std::size_t j = 0; j < pairing.size(); ++j) {
     const double value = force[static_cast<Eigen::Index>(j)];
-    if (value > 1e-9 * largest) loaded.emplace_back(pairing.pairs[j].position.x(), value / pairing.pairs[j].weight);
+    if (value > 1e-9 * largest)
+      loaded.emplace_back(pairing.pairs[j].position.x(), value / pairing.pairs[j].weight);
   }
   std::sort(loaded.begin(), loaded.end());
   const std::size_t first = 1, last = loaded.size() - 1;
@@ -64,8 +65,8 @@ TEST(MortarHertz, HalfWidthAndPeakPressureWithinTwoPercentOfHertz) {
   const CaseDefinition definition = hertz_cylinder(0.05);
   const LocalProblem problem = prepare_local_problem(definition);
   EXPECT_GE(problem.pairing.non_mortar_body, 0);  // mortar
-  const MonolithicResult result =
-      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing, definition.solver.qp);
+  const MonolithicResult result = solve_monolithic(*problem.bodies[0], *problem.bodies[1],
+                                                   problem.pairing, definition.solver.qp);
   ASSERT_EQ(result.qp.status, QpStatus::converged);
   const double load = std::abs(contact_resultant(problem.pairing, result.contact_force).y());
   const double effective = 1000.0 / (2.0 * (1.0 - 0.3 * 0.3));
@@ -81,7 +82,8 @@ TEST(MortarHertz, HalfWidthAndPeakPressureWithinTwoPercentOfHertz) {
 TEST(MortarHertz, RobinIterationConvergesToTheMonolithicMortarSolution) {
   const CaseDefinition definition = hertz_cylinder(0.1);
   InProcessPort port1, port2;
-  const CoupledRunResult robin = run_coupled_case(definition, {&port1, &port2}, definition.coupling);
+  const CoupledRunResult robin =
+      run_coupled_case(definition, {&port1, &port2}, definition.coupling);
   ASSERT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
   std::printf("Hertz cylinder, mortar: %zu iterations\n", robin.iteration.history.size());
   const LocalProblem problem = prepare_local_problem(definition);
