@@ -33,13 +33,6 @@ double shortest_spacing(const std::vector<Eigen::Vector2d>& points) {
   return std::isfinite(shortest) ? shortest : 1.0;
 }
 
-/// True when the prescribed components of a node fix its displacement along `normal`.
-bool normal_is_prescribed(bool x_fixed, bool y_fixed, const Eigen::Vector2d& normal) {
-  constexpr double aligned = 1e-12;
-  return (x_fixed && y_fixed) || (x_fixed && std::abs(normal.y()) < aligned) ||
-         (y_fixed && std::abs(normal.x()) < aligned);
-}
-
 /// Index of the body-2 node whose offset from `point`, less its component along `normal`, is
 /// the shortest and below `tolerance`; -1 if none.
 int find_partner(const Eigen::Vector2d& point, const Eigen::Vector2d& normal,
@@ -114,6 +107,12 @@ ExcludedPairClearance excluded_pair_clearance(const ContactPairing& pairing,
                             "prescribe the normal displacement of contact nodes)";
   }
   return clearance;
+}
+
+bool normal_is_prescribed(bool x_fixed, bool y_fixed, const Eigen::Vector2d& normal) {
+  constexpr double aligned = 1e-12;
+  return (x_fixed && y_fixed) || (x_fixed && std::abs(normal.y()) < aligned) ||
+         (y_fixed && std::abs(normal.x()) < aligned);
 }
 
 std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points) {

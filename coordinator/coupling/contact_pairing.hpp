@@ -71,6 +71,10 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
                                   const InterfaceDescription& body2, const std::string& name2,
                                   const GapFunction* gap, double relative_tolerance);
 
+/// True when the prescribed components of a contact node (x_fixed, y_fixed) fix its
+/// displacement along `normal`: its normal displacement is data, not a contact unknown.
+bool normal_is_prescribed(bool x_fixed, bool y_fixed, const Eigen::Vector2d& normal);
+
 /// The order of `points` along the principal direction of their spread (a curve parameter for
 /// flat and gently curved zones, so that contact.csv reads as a profile): indices into points.
 std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points);

@@ -321,13 +321,11 @@ Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction*
   return coupling;
 }
 
-bool normal_is_prescribed(const InterfaceDescription& side, int position,
-                          const Eigen::Vector2d& normal) {
-  constexpr double aligned = 1e-12;
-  const bool x_fixed = side.x_fixed[static_cast<std::size_t>(position)];
-  const bool y_fixed = side.y_fixed[static_cast<std::size_t>(position)];
-  return (x_fixed && y_fixed) || (x_fixed && std::abs(normal.y()) < aligned) ||
-         (y_fixed && std::abs(normal.x()) < aligned);
+/// normal_is_prescribed (coupling/contact_pairing.hpp) of the node at `position`.
+bool prescribed_along(const InterfaceDescription& side, int position,
+                      const Eigen::Vector2d& normal) {
+  return normal_is_prescribed(side.x_fixed[static_cast<std::size_t>(position)],
+                              side.y_fixed[static_cast<std::size_t>(position)], normal);
 }
 
 /// Appends `coefficients` (by position of `side`) times `normal` to the row under
@@ -406,7 +404,7 @@ ContactPairing assemble_rows(const Side& nonmortar, const Side& mortar, const Co
     const int position = static_cast<int>(j);
     if (!(coupling.rows[j].covered > 1e-3 * nonmortar.interface->weights[j])) continue;
     const Eigen::Vector2d& normal = nonmortar.interface->normals[j];
-    if (normal_is_prescribed(*nonmortar.interface, position, normal)) {
+    if (prescribed_along(*nonmortar.interface, position, normal)) {
       pairing.excluded.push_back(describe(nonmortar, position) +
                                  ": normal displacement prescribed by a Dirichlet condition; "
                                  "constraint excluded from contact");

@@ -157,6 +157,24 @@ TEST(MortarCoupling, NodesBeyondTheOtherBodyCarryNoConstraint) {
   EXPECT_NEAR(pairing.pairs.front().weight, 0.05, 1e-12);
 }
 
+TEST(MortarCoupling, ANonMortarNodeWithPrescribedNormalDisplacementIsExcluded) {
+  // The lower edge's first node is clamped (u_x and u_y prescribed), its second has only u_x
+  // prescribed, which leaves its normal (y) displacement free.
+  InterfaceDescription lower = lower_edge(0.0, 1.0, 4);
+  lower.x_fixed[0] = lower.y_fixed[0] = true;
+  lower.x_fixed[1] = true;
+  const InterfaceDescription upper = upper_edge(0.0, 0.0, 1.0, 0.0, 3);
+  MortarOptions options;
+  options.non_mortar_body = 0;
+  const ContactPairing pairing = build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
+  EXPECT_EQ(pairing.size(), 4u);
+  ASSERT_EQ(pairing.excluded.size(), 1u);
+  EXPECT_NE(pairing.excluded.front().find("body 'lower' contact node (tag 1)"), std::string::npos)
+      << pairing.excluded.front();
+  EXPECT_NEAR(pairing.excluded_pairs.front().position.x(), 0.0, 1e-15);
+  for (const ContactPair& pair : pairing.pairs) EXPECT_GT(pair.position.x(), 0.1);
+}
+
 TEST(MortarCoupling, BoundariesThatDoNotFaceEachOtherAreErrors) {
   const InterfaceDescription lower = lower_edge(0.0, 1.0, 4);
   // Outward normals the same way: an "upper" edge whose body lies above... and below.
