@@ -14,7 +14,11 @@ jobs=$(nproc 2>/dev/null || echo 2)
 ctest --test-dir build --output-on-failure -j "$jobs"
 
 ./deploy/build.sh --sanitize
-ctest --test-dir build-sanitize -L 'unit|verification' --output-on-failure -j "$jobs"
+# MortarHertz meshes circles with Gmsh, whose uninstrumented libgmsh frees an Eigen-aligned
+# block with free() in its curve intersection (fullMatrix::luSolve, from bowyerWatsonFrontal):
+# ASan reports "attempting free on address which was not malloc()-ed" inside libgmsh. The two
+# tests run (and pass) in the Release tier above.
+ctest --test-dir build-sanitize -L 'unit|verification' -E '^MortarHertz\.' --output-on-failure -j "$jobs"
 
 ./deploy/build.sh --fuzz
 ctest --test-dir build-fuzz -L fuzz --output-on-failure -j "$jobs"
