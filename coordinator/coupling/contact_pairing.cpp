@@ -115,6 +115,18 @@ bool normal_is_prescribed(bool x_fixed, bool y_fixed, const Eigen::Vector2d& nor
          (y_fixed && std::abs(normal.x()) < aligned);
 }
 
+void require_constraints_left(const ContactPairing& pairing, const std::string& method,
+                              const std::string& rows, const std::string& name1,
+                              const std::string& name2) {
+  if (!pairing.pairs.empty()) return;
+  throw InputError(method + " of bodies '" + name1 + "' and '" + name2 + "': all " +
+                   std::to_string(pairing.excluded.size()) + " " + rows +
+                   " have their normal displacement prescribed by Dirichlet conditions (first: " +
+                   pairing.excluded.front() +
+                   "), so no contact is left to solve; the contact boundary must not be a "
+                   "Dirichlet boundary (check contact_boundary and dirichlet of both bodies)");
+}
+
 std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points) {
   std::vector<std::size_t> order(points.size());
   std::iota(order.begin(), order.end(), 0);
@@ -206,15 +218,7 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
     }
     pairing.pairs.push_back(pair);
   }
-  if (pairing.pairs.empty()) {
-    throw InputError("contact pairing of bodies '" + name1 + "' and '" + name2 + "': all " +
-                     std::to_string(pairing.excluded.size()) +
-                     " node pairs have their normal displacement prescribed by Dirichlet "
-                     "conditions (first: " +
-                     pairing.excluded.front() +
-                     "), so no contact is left to solve; the contact boundary must not be a "
-                     "Dirichlet boundary (check contact_boundary and dirichlet of both bodies)");
-  }
+  require_constraints_left(pairing, "contact pairing", "node pairs", name1, name2);
   for (std::size_t j = 0; j < body2.node_ids.size(); ++j) {
     if (partner_of_second[j] < 0) {
       throw UnmatchedContactNodes(

@@ -75,6 +75,12 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
 /// displacement along `normal`: its normal displacement is data, not a contact unknown.
 bool normal_is_prescribed(bool x_fixed, bool y_fixed, const Eigen::Vector2d& normal);
 
+/// Throws InputError "<method> of bodies 'a' and 'b': all N <rows> have their normal
+/// displacement prescribed ..." when every constraint of `pairing` was excluded.
+void require_constraints_left(const ContactPairing& pairing, const std::string& method,
+                              const std::string& rows, const std::string& name1,
+                              const std::string& name2);
+
 /// The order of `points` along the principal direction of their spread (a curve parameter for
 /// flat and gently curved zones, so that contact.csv reads as a profile): indices into points.
 std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points);

@@ -459,15 +459,7 @@ ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const st
     throw InputError("mortar coupling: the contact boundaries of bodies '" + name1 + "' and '" +
                      name2 + "' do not face each other: " + reason);
   }
-  if (pairing.pairs.empty()) {
-    throw InputError("mortar coupling of bodies '" + name1 + "' and '" + name2 + "': all " +
-                     std::to_string(pairing.excluded.size()) +
-                     " constraints have their normal displacement prescribed by Dirichlet "
-                     "conditions (first: " +
-                     pairing.excluded.front() +
-                     "); the contact boundary must not be a "
-                     "Dirichlet boundary");
-  }
+  require_constraints_left(pairing, "mortar coupling", "constraints", name1, name2);
   pairing.non_mortar_body = nonmortar_body;
   pairing.uncovered = static_cast<int>(nonmortar.interface->node_ids.size()) -
                       static_cast<int>(pairing.pairs.size() + pairing.excluded.size());
