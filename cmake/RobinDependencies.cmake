@@ -10,6 +10,8 @@ find_package(nlohmann_json REQUIRED)
 find_package(Protobuf REQUIRED)
 find_package(cppzmq REQUIRED)
 find_package(PkgConfig REQUIRED)
+# zlib: compression of the binary .vtu output (vtkZLibDataCompressor layout).
+find_package(ZLIB REQUIRED)
 
 # SuiteSparse 5.12 on Debian 12 ships no CMake configuration for CHOLMOD.
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)

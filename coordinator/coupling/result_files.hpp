@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "coupling/contact_pairing.hpp"
 #include "numerics/body_solver.hpp"
@@ -29,11 +30,13 @@ struct InterfaceState {
 void write_contact_csv(const std::filesystem::path& path, const ContactPairing& pairing,
                        const InterfaceState& state);
 
-/// Nodal fields of one body: displacement (2), stress (3: xx, yy, xy, nodal average),
-/// von_mises, contact_pressure (lambda_i / m_i on contact nodes, 0 elsewhere), contact_force
-/// (2), reaction (2); cell fields: stress, von_mises. The file is "<body name>.vtu" in
-/// `directory`; contact_force is lambda in the body's assignment order (size contact_size()).
-/// 2-component fields are written with a zero z component (see numerics/vtu_writer.hpp).
+/// Nodal fields of one body: displacement (2), stress (6: XX, YY, ZZ, XY, YZ, XZ, nodal
+/// average; ZZ from the material's plane model), von_mises, contact_pressure (lambda_i / m_i on
+/// contact nodes, 0 elsewhere), contact_force (2), reaction (2); cell fields: stress, von_mises,
+/// boundary_id. The file is "<body name>.vtu" in `directory`, binary and zlib-compressed, with
+/// the named boundaries as line cells; contact_force is lambda in the body's assignment order
+/// (size contact_size()). 2-component fields are written with a zero z component (see
+/// numerics/vtu_writer.hpp).
 /// The fields are those of make_body_output (numerics/body_output.hpp), shared with the
 /// remote subdomain path.
 /// Returns the written file name (relative to `directory`).
@@ -43,6 +46,18 @@ std::string write_body_vtu(const std::filesystem::path& directory, const BodySol
 /// Writes solution.pvd naming both body files.
 void write_solution_pvd(const std::filesystem::path& directory, const std::string& file1,
                         const std::string& file2);
+
+/// One dataset of a ParaView collection: `file` (relative to the .pvd) at `timestep` as part
+/// `part` (the body: 0 for body 1, 1 for body 2).
+struct PvdDataSet {
+  double timestep = 0.0;
+  int part = 0;
+  std::string file;
+};
+
+/// Writes a time series as the collection `path` (solution.pvd of a run with load steps): one
+/// <DataSet timestep part file/> per entry, in the given order, timesteps as exact decimal text.
+void write_pvd_series(const std::filesystem::path& path, const std::vector<PvdDataSet>& datasets);
 
 /// Pretty-printed JSON (2-space indent) followed by a newline.
 void write_json(const std::filesystem::path& path, const nlohmann::json& document);

@@ -3,6 +3,7 @@
 #include <google/protobuf/repeated_field.h>
 
 #include <cmath>
+#include <map>
 
 namespace robin {
 
@@ -72,7 +73,46 @@ OutputField decode_field(const protocol::Field& message, long count, const std::
   expect_size(message.values(), field.components * count, where + " field '" + field.name + "'");
   field.values.assign(message.values().begin(), message.values().end());
   if (field.name == "stress" && field.components == 3) field.component_names = {"xx", "yy", "xy"};
+  if (field.name == "stress" && field.components == 6) {
+    field.component_names = stress_tensor_components();
+  }
   return field;
+}
+
+/// The named boundaries of the output mesh: names unique and non-empty, LINE2 or LINE3 segments,
+/// node indices checked against the nodes.
+std::map<std::string, BoundaryGroup> decode_boundaries(const protocol::FieldsReply& message,
+                                                       long node_count) {
+  std::map<std::string, BoundaryGroup> boundaries;
+  for (int g = 0; g < message.boundaries_size(); ++g) {
+    const protocol::NamedBoundary& boundary = message.boundaries(g);
+    const std::string what = "boundaries[" + std::to_string(g) + "]";
+    if (boundary.name().empty() || boundaries.count(boundary.name()) != 0) {
+      throw MalformedReply(what + " has an empty or repeated name '" + boundary.name() + "'");
+    }
+    const protocol::CellType type = boundary.segments().type();
+    if (type != protocol::LINE2 && type != protocol::LINE3) {
+      throw MalformedReply(what + " ('" + boundary.name() +
+                           "') has segments that are not LINE2 or LINE3");
+    }
+    BoundaryGroup group;
+    group.type = type == protocol::LINE3 ? EdgeType::line3 : EdgeType::line2;
+    const auto& connectivity = boundary.segments().connectivity();
+    if (connectivity.size() % nodes_per_edge(group.type) != 0) {
+      throw MalformedReply(
+          what + " ('" + boundary.name() + "') has " + std::to_string(connectivity.size()) +
+          " segment nodes, not a multiple of " + std::to_string(nodes_per_edge(group.type)));
+    }
+    for (const std::uint32_t node : connectivity) {
+      if (static_cast<long>(node) >= node_count) {
+        throw MalformedReply(what + " ('" + boundary.name() + "') refers to node " +
+                             std::to_string(node) + " of " + std::to_string(node_count));
+      }
+      group.connectivity.push_back(static_cast<int>(node));
+    }
+    boundaries.emplace(boundary.name(), std::move(group));
+  }
+  return boundaries;
 }
 
 /// Element blocks from cell types, offsets and connectivity; indices checked against the nodes.
@@ -229,6 +269,7 @@ BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string
   if (message.node_tags_size() != 0) expect_size(message.node_tags(), node_count, "node_tags");
   output.mesh.node_tags.assign(message.node_tags().begin(), message.node_tags().end());
   output.mesh.blocks = decode_blocks(message, node_count);
+  output.mesh.boundaries = decode_boundaries(message, node_count);
   const long element_count = static_cast<long>(output.mesh.element_count());
   for (const protocol::Field& field : message.point_fields()) {
     output.point_fields.push_back(decode_field(field, node_count, "point"));

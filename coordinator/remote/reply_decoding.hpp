@@ -35,9 +35,10 @@ CorrectionSolveResult decode_correction_result(const protocol::CorrectionResult&
 CorrectionSolveResult decode_neumann_result(const protocol::NeumannSolveResult& message,
                                             long contact_size);
 
-/// The body's mesh (nodes, tags, element blocks from the VTK cell types 5, 22, 9) and fields.
-/// The mesh has no boundary groups (they are not needed for output). Stress fields get the
-/// component names xx, yy, xy.
+/// The body's mesh (nodes, tags, element blocks from the VTK cell types 5, 22, 9, and the named
+/// boundaries when the reply has them) and fields. A 6-component stress field gets the component
+/// names XX, YY, ZZ, XY, YZ, XZ, a 3-component one (older servers) xx, yy, xy. Throws
+/// MalformedReply for a size, index, cell type or boundary name that does not fit.
 BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string& body_name);
 
 /// The element type of a VTK cell type number (5, 22 or 9); throws MalformedReply otherwise.

@@ -26,6 +26,21 @@ std::vector<double> nodal_contact_pressure(const BodySolver& body,
   return pressure;
 }
 
+/// Symmetric stress tensors in ParaView's order (XX, YY, ZZ, XY, YZ, XZ), from in-plane stresses
+/// (s_xx, s_yy, s_xy) per column: s_zz = out_of_plane_stress(material, s) (nu (s_xx + s_yy) for
+/// an isotropic plane-strain material, 0 in plane stress and for a Voigt material), and
+/// s_yz = s_xz = 0 (plane problem).
+std::vector<double> stress_tensors(const Material& material, const Eigen::Matrix3Xd& stresses) {
+  std::vector<double> values;
+  values.reserve(6 * static_cast<std::size_t>(stresses.cols()));
+  for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
+    const Eigen::Vector3d stress = stresses.col(k);
+    values.insert(values.end(), {stress(0), stress(1), out_of_plane_stress(material, stress),
+                                 stress(2), 0.0, 0.0});
+  }
+  return values;
+}
+
 Eigen::Vector2d resultant(const Eigen::VectorXd& nodal_vectors) {
   Eigen::Vector2d total = Eigen::Vector2d::Zero();
   for (Eigen::Index node = 0; node < nodal_vectors.size() / 2; ++node) {
@@ -36,32 +51,35 @@ Eigen::Vector2d resultant(const Eigen::VectorXd& nodal_vectors) {
 
 }  // namespace
 
+const std::vector<std::string>& stress_tensor_components() {
+  static const std::vector<std::string> names = {"XX", "YY", "ZZ", "XY", "YZ", "XZ"};
+  return names;
+}
+
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force) {
   if (contact_force.size() != body.contact_size()) {
     throw std::invalid_argument(
         "body '" + body.name() + "': " + std::to_string(contact_force.size()) +
         " contact forces for " + std::to_string(body.contact_size()) + " contact constraints");
   }
+  const Material& material = body.definition().material;
   const Eigen::VectorXd displacement = body.displacement(contact_force);
-  const StressField stress = recover_stress(body.mesh(), body.definition().material, displacement);
+  const StressField stress = recover_stress(body.mesh(), material, displacement);
   const Eigen::VectorXd reaction = body.reactions(displacement);
   const Eigen::VectorXd force_field = body.contact_force_field(contact_force);
-  const std::vector<std::string> stress_components = {"xx", "yy", "xy"};
 
   BodyOutput output;
   output.body_name = body.name();
   output.mesh = body.mesh();
   output.point_fields = {
       {"displacement", 2, to_values(displacement.data(), displacement.size())},
-      {"stress", 3, to_values(stress.nodal_stress.data(), stress.nodal_stress.size()),
-       stress_components},
+      {"stress", 6, stress_tensors(material, stress.nodal_stress), stress_tensor_components()},
       {"von_mises", 1, to_values(stress.nodal_von_mises.data(), stress.nodal_von_mises.size())},
       {"contact_pressure", 1, nodal_contact_pressure(body, force_field)},
       {"contact_force", 2, to_values(force_field.data(), force_field.size())},
       {"reaction", 2, to_values(reaction.data(), reaction.size())}};
   output.cell_fields = {
-      {"stress", 3, to_values(stress.element_stress.data(), stress.element_stress.size()),
-       stress_components},
+      {"stress", 6, stress_tensors(material, stress.element_stress), stress_tensor_components()},
       {"von_mises", 1,
        to_values(stress.element_von_mises.data(), stress.element_von_mises.size())}};
   output.reaction_resultant = resultant(reaction);
@@ -73,7 +91,8 @@ std::string write_body_output(const std::filesystem::path& directory, const Body
   const std::string file_name = output.body_name + ".vtu";
   if (output.body_name.empty() || std::filesystem::path(output.body_name).has_parent_path()) {
     throw std::runtime_error("cannot write '" + (directory / file_name).string() +
-                             "': body name '" + output.body_name + "' is not usable as a file name");
+                             "': body name '" + output.body_name +
+                             "' is not usable as a file name");
   }
   std::filesystem::create_directories(directory);
   // A fresh temporary file (mkstemp: O_EXCL, so never through an existing link), renamed into

@@ -13,20 +13,27 @@ namespace robin {
 struct BodyOutput {
   std::string body_name;
   Mesh mesh;
-  /// displacement (2), stress (3: xx, yy, xy; nodal average), von_mises, contact_pressure
-  /// (|B' lambda| / m_k at contact boundary nodes, 0 elsewhere), contact_force (2: -B' lambda),
-  /// reaction (2)
+  /// displacement (2), stress (6: XX, YY, ZZ, XY, YZ, XZ; nodal average), von_mises,
+  /// contact_pressure (|B' lambda| / m_k at contact boundary nodes, 0 elsewhere), contact_force
+  /// (2: -B' lambda), reaction (2)
   std::vector<OutputField> point_fields;
-  /// stress (3, at element centroids), von_mises
+  /// stress (6, at element centroids), von_mises
   std::vector<OutputField> cell_fields;
   Eigen::Vector2d reaction_resultant = Eigen::Vector2d::Zero();  // sum of reactions
   Eigen::Vector2d applied_force = Eigen::Vector2d::Zero();       // body forces + tractions
 };
 
+/// The stress field's component names in ParaView's symmetric-tensor order: XX, YY, ZZ, XY, YZ,
+/// XZ. The stress of a plane problem has YZ = XZ = 0 and ZZ = out_of_plane_stress(material,
+/// (XX, YY, XY)): nu (XX + YY) for an isotropic plane-strain material, 0 in plane stress and for
+/// a Voigt material (numerics/material.hpp); von_mises is of the same three-dimensional tensor.
+const std::vector<std::string>& stress_tensor_components();
+
 /// Fields of `body` under contact forces lambda (constraint order of its assignment).
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force);
 
-/// Writes <directory>/<body_name>.vtu; returns the file name.
+/// Writes <directory>/<body_name>.vtu (numerics/vtu_writer.hpp: binary zlib-compressed, with the
+/// mesh's named boundaries as line cells); returns the file name.
 std::string write_body_output(const std::filesystem::path& directory, const BodyOutput& output);
 
 }  // namespace robin

@@ -1,15 +1,24 @@
 #include "numerics/vtu_writer.hpp"
 
+#include <zlib.h>
+
 #include <array>
+#include <bit>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
-#include <locale>
+#include <limits>
 #include <stdexcept>
-#include <system_error>
+#include <unordered_map>
+#include <variant>
 
 namespace robin {
 namespace {
+
+/// Uncompressed bytes per zlib block (vtkZLibDataCompressor's default block size).
+constexpr std::size_t compression_block_size = 32768;
 
 /// Text escaped for an XML attribute value.
 std::string escape_xml(const std::string& text) {
@@ -94,100 +103,254 @@ void check_field(const OutputField& field, std::size_t count, const char* locati
   }
 }
 
-void write_field(std::ofstream& out, const OutputField& field, std::size_t count) {
-  const int components = written_components(field.components);
-  out << "        <DataArray type=\"Float64\" Name=\"" << escape_xml(field.name)
-      << "\" NumberOfComponents=\"" << components << '"';
-  for (std::size_t c = 0; c < field.component_names.size(); ++c) {
-    out << " ComponentName" << c << "=\"" << escape_xml(field.component_names[c]) << '"';
+void check_connectivity(const std::vector<int>& connectivity, int nodes_per_cell,
+                        const std::string& what, const Mesh& mesh,
+                        const std::filesystem::path& path) {
+  if (connectivity.size() % static_cast<std::size_t>(nodes_per_cell) != 0) {
+    throw std::runtime_error("cannot write '" + path.string() + "': " + what +
+                             " has a connectivity size that is not a multiple of " +
+                             std::to_string(nodes_per_cell));
   }
-  out << " format=\"ascii\">\n";
-  for (std::size_t k = 0; k < count; ++k) {
-    out << "         ";
-    for (int c = 0; c < components; ++c) {
-      const bool padding = c >= field.components;
-      out << ' ';
-      write_number(out, padding ? 0.0 : field.values[k * field.components + c]);
-    }
-    out << '\n';
-  }
-  out << "        </DataArray>\n";
-}
-
-void write_field_section(std::ofstream& out, const char* section,
-                         const std::vector<OutputField>& fields, std::size_t count) {
-  out << "      <" << section << ">\n";
-  for (const OutputField& field : fields) write_field(out, field, count);
-  out << "      </" << section << ">\n";
-}
-
-void write_points(std::ofstream& out, const Mesh& mesh) {
-  out << "      <Points>\n"
-      << "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" "
-         "format=\"ascii\">\n";
-  for (const Eigen::Vector2d& node : mesh.nodes) {
-    out << "          ";
-    write_number(out, node.x());
-    out << ' ';
-    write_number(out, node.y());
-    out << " 0\n";
-  }
-  out << "        </DataArray>\n"
-      << "      </Points>\n";
-}
-
-/// Connectivity, offsets (end of each cell in connectivity) and types, block after block.
-void write_cells(std::ofstream& out, const Mesh& mesh) {
-  out << "      <Cells>\n"
-      << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const ElementBlock& block : mesh.blocks) {
-    const std::size_t nodes = nodes_per_element(block.type);
-    for (std::size_t e = 0; e < block.element_count(); ++e) {
-      out << "         ";
-      for (std::size_t a = 0; a < nodes; ++a) {
-        out << ' ';
-        write_number(out, std::int64_t{block.connectivity[e * nodes + a]});
-      }
-      out << '\n';
+  for (int node : connectivity) {
+    if (node < 0 || static_cast<std::size_t>(node) >= mesh.node_count()) {
+      throw std::runtime_error("cannot write '" + path.string() + "': " + what +
+                               " has the node index " + std::to_string(node) + ", outside the " +
+                               std::to_string(mesh.node_count()) + " nodes");
     }
   }
-  out << "        </DataArray>\n"
-      << "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  std::int64_t offset = 0;
-  for (const ElementBlock& block : mesh.blocks) {
-    for (std::size_t e = 0; e < block.element_count(); ++e) {
-      offset += nodes_per_element(block.type);
-      out << "          ";
-      write_number(out, offset);
-      out << '\n';
-    }
-  }
-  out << "        </DataArray>\n"
-      << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (const ElementBlock& block : mesh.blocks) {
-    const int type = vtk_cell_type(block.type);
-    for (std::size_t e = 0; e < block.element_count(); ++e) out << "          " << type << '\n';
-  }
-  out << "        </DataArray>\n"
-      << "      </Cells>\n";
 }
 
-void check_connectivity(const Mesh& mesh, const std::filesystem::path& path) {
+void check_mesh(const Mesh& mesh, bool boundary_cells, const std::filesystem::path& path) {
   for (const ElementBlock& block : mesh.blocks) {
-    if (block.connectivity.size() % nodes_per_element(block.type) != 0) {
-      throw std::runtime_error("cannot write '" + path.string() + "': a " + to_string(block.type) +
-                               " block has a connectivity size that is not a multiple of " +
-                               std::to_string(nodes_per_element(block.type)));
+    check_connectivity(block.connectivity, nodes_per_element(block.type),
+                       "a " + to_string(block.type) + " block", mesh, path);
+  }
+  if (!boundary_cells) return;
+  for (const auto& [name, group] : mesh.boundaries) {
+    check_connectivity(group.connectivity, nodes_per_edge(group.type), "boundary '" + name + "'",
+                       mesh, path);
+  }
+}
+
+/// One DataArray: its XML attributes and its values.
+struct DataArray {
+  std::string type;  // Float64, Int64, Int32, UInt8 or String
+  std::string name;
+  int components = 1;
+  std::vector<std::string> component_names;
+  std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int32_t>,
+               std::vector<std::uint8_t>, std::vector<std::string>>
+      values;
+};
+
+/// The values of `field` for `count` items followed by `extra` items copied from the items
+/// `source[j]` (NaN where source[j] is -1), with 2 components padded to 3.
+DataArray field_array(const OutputField& field, std::size_t count,
+                      const std::vector<std::int64_t>& source = {}) {
+  const auto components = static_cast<std::size_t>(field.components);
+  const auto written = static_cast<std::size_t>(written_components(field.components));
+  std::vector<double> values((count + source.size()) * written, 0.0);
+  const auto copy_item = [&](std::size_t from, std::size_t to) {
+    for (std::size_t c = 0; c < components; ++c) {
+      values[to * written + c] = field.values[from * components + c];
     }
-    for (int node : block.connectivity) {
-      if (node < 0 || static_cast<std::size_t>(node) >= mesh.node_count()) {
-        throw std::runtime_error("cannot write '" + path.string() + "': element node index " +
-                                 std::to_string(node) + " is outside the " +
-                                 std::to_string(mesh.node_count()) + " nodes");
+  };
+  for (std::size_t k = 0; k < count; ++k) copy_item(k, k);
+  for (std::size_t j = 0; j < source.size(); ++j) {
+    if (source[j] >= 0) {
+      copy_item(static_cast<std::size_t>(source[j]), count + j);
+    } else {
+      for (std::size_t c = 0; c < written; ++c) {
+        values[(count + j) * written + c] = std::numeric_limits<double>::quiet_NaN();
       }
     }
   }
+  return {"Float64", field.name, static_cast<int>(written), field.component_names,
+          std::move(values)};
 }
+
+/// Key of the undirected edge between two nodes.
+std::uint64_t edge_key(int first, int second) {
+  const auto low = static_cast<std::uint64_t>(std::min(first, second));
+  const auto high = static_cast<std::uint64_t>(std::max(first, second));
+  return (low << 32) | high;
+}
+
+/// For every edge of every boundary (name order), the flat index of an area element that has it
+/// as a side (matched by its two end nodes), -1 when none has.
+std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
+  std::unordered_map<std::uint64_t, std::int64_t> element_of_side;
+  std::int64_t flat = 0;
+  for (const ElementBlock& block : mesh.blocks) {
+    const int nodes = nodes_per_element(block.type);
+    const int corners = block.type == ElementType::quadrilateral4 ? 4 : 3;
+    for (std::size_t e = 0; e < block.element_count(); ++e, ++flat) {
+      const int* element = block.connectivity.data() + e * static_cast<std::size_t>(nodes);
+      for (int a = 0; a < corners; ++a) {
+        element_of_side.emplace(edge_key(element[a], element[(a + 1) % corners]), flat);
+      }
+    }
+  }
+  std::vector<std::int64_t> adjacent;
+  for (const auto& [name, group] : mesh.boundaries) {
+    const auto nodes = static_cast<std::size_t>(nodes_per_edge(group.type));
+    for (std::size_t k = 0; k < group.edge_count(); ++k) {
+      const auto found = element_of_side.find(
+          edge_key(group.connectivity[k * nodes], group.connectivity[k * nodes + 1]));
+      adjacent.push_back(found == element_of_side.end() ? -1 : found->second);
+    }
+  }
+  return adjacent;
+}
+
+/// Points, connectivity, offsets (end of each cell in connectivity) and types: area elements
+/// block after block, then (with boundary cells) the boundary edges in name order.
+std::vector<DataArray> geometry_arrays(const Mesh& mesh, bool boundary_cells) {
+  std::vector<double> points;
+  points.reserve(3 * mesh.node_count());
+  for (const Eigen::Vector2d& node : mesh.nodes)
+    points.insert(points.end(), {node.x(), node.y(), 0.0});
+  std::vector<std::int64_t> connectivity, offsets;
+  std::vector<std::uint8_t> types;
+  const auto add_cells = [&](const std::vector<int>& nodes, int per_cell, int type) {
+    for (std::size_t k = 0; k < nodes.size(); k += static_cast<std::size_t>(per_cell)) {
+      connectivity.insert(connectivity.end(), nodes.begin() + static_cast<std::ptrdiff_t>(k),
+                          nodes.begin() + static_cast<std::ptrdiff_t>(k) + per_cell);
+      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+      types.push_back(static_cast<std::uint8_t>(type));
+    }
+  };
+  for (const ElementBlock& block : mesh.blocks) {
+    add_cells(block.connectivity, nodes_per_element(block.type), vtk_cell_type(block.type));
+  }
+  if (boundary_cells) {
+    for (const auto& [name, group] : mesh.boundaries) {
+      add_cells(group.connectivity, nodes_per_edge(group.type), vtk_cell_type(group.type));
+    }
+  }
+  std::vector<DataArray> arrays;
+  arrays.push_back({"Float64", "Points", 3, {}, std::move(points)});
+  arrays.push_back({"Int64", "connectivity", 1, {}, std::move(connectivity)});
+  arrays.push_back({"Int64", "offsets", 1, {}, std::move(offsets)});
+  arrays.push_back({"UInt8", "types", 1, {}, std::move(types)});
+  return arrays;
+}
+
+/// The array's values as bytes in the machine's byte order (strings: each followed by '\0').
+std::vector<unsigned char> to_bytes(const DataArray& array) {
+  return std::visit(
+      [](const auto& values) {
+        using Value = typename std::decay_t<decltype(values)>::value_type;
+        std::vector<unsigned char> bytes;
+        if constexpr (std::is_same_v<Value, std::string>) {
+          for (const std::string& text : values) {
+            bytes.insert(bytes.end(), text.begin(), text.end());
+            bytes.push_back(0);
+          }
+        } else {
+          bytes.resize(values.size() * sizeof(Value));
+          if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
+        }
+        return bytes;
+      },
+      array.values);
+}
+
+void append_header_word(std::string& blob, std::uint64_t word) {
+  std::array<char, sizeof word> bytes;
+  std::memcpy(bytes.data(), &word, sizeof word);
+  blob.append(bytes.data(), bytes.size());
+}
+
+/// The appended-data record of `bytes` in vtkZLibDataCompressor's layout (see the header).
+std::string compressed_record(const std::vector<unsigned char>& bytes,
+                              const std::filesystem::path& path) {
+  const std::size_t full_blocks = bytes.size() / compression_block_size;
+  const std::size_t last_block = bytes.size() % compression_block_size;
+  const std::size_t block_count = full_blocks + (last_block != 0 ? 1 : 0);
+  std::string data;
+  std::vector<std::uint64_t> compressed_sizes;
+  std::vector<Bytef> buffer(compressBound(compression_block_size));
+  for (std::size_t block = 0; block < block_count; ++block) {
+    const std::size_t begin = block * compression_block_size;
+    const std::size_t size = std::min(compression_block_size, bytes.size() - begin);
+    uLongf compressed_size = static_cast<uLongf>(buffer.size());
+    if (compress2(buffer.data(), &compressed_size, bytes.data() + begin, static_cast<uLong>(size),
+                  Z_DEFAULT_COMPRESSION) != Z_OK) {
+      throw std::runtime_error("cannot write '" + path.string() + "': zlib compression failed");
+    }
+    data.append(reinterpret_cast<const char*>(buffer.data()), compressed_size);
+    compressed_sizes.push_back(compressed_size);
+  }
+  std::string record;
+  append_header_word(record, block_count);
+  append_header_word(record, compression_block_size);
+  append_header_word(record, last_block);
+  for (std::uint64_t size : compressed_sizes) append_header_word(record, size);
+  return record + data;
+}
+
+/// Writes the array's values as text: numbers separated by spaces; a string as the codes of
+/// its characters followed by 0 (VTK's ASCII form of a string array).
+void write_ascii_values(std::ofstream& out, const DataArray& array) {
+  std::visit(
+      [&](const auto& values) {
+        using Value = typename std::decay_t<decltype(values)>::value_type;
+        const std::size_t per_line = static_cast<std::size_t>(array.components);
+        for (std::size_t k = 0; k < values.size(); ++k) {
+          out << (k % per_line == 0 ? "\n          " : " ");
+          if constexpr (std::is_same_v<Value, std::string>) {
+            for (char character : values[k]) {
+              write_number(out, std::int64_t{static_cast<unsigned char>(character)});
+              out << ' ';
+            }
+            out << '0';
+          } else if constexpr (std::is_same_v<Value, double>) {
+            write_number(out, values[k]);
+          } else {
+            write_number(out, static_cast<std::int64_t>(values[k]));
+          }
+        }
+        out << "\n        ";
+      },
+      array.values);
+}
+
+/// Writes DataArray elements; in binary mode their records are added to `appended`.
+class ArrayWriter {
+ public:
+  ArrayWriter(std::ofstream& out, VtuEncoding encoding, const std::filesystem::path& path)
+      : out_(out), encoding_(encoding), path_(path) {}
+
+  void write(const DataArray& array) {
+    out_ << "        <DataArray type=\"" << array.type << "\" Name=\"" << escape_xml(array.name)
+         << '"';
+    if (const auto* strings = std::get_if<std::vector<std::string>>(&array.values)) {
+      out_ << " NumberOfTuples=\"" << strings->size() << '"';
+    } else {
+      out_ << " NumberOfComponents=\"" << array.components << '"';
+    }
+    for (std::size_t c = 0; c < array.component_names.size(); ++c) {
+      out_ << " ComponentName" << c << "=\"" << escape_xml(array.component_names[c]) << '"';
+    }
+    if (encoding_ == VtuEncoding::ascii) {
+      out_ << " format=\"ascii\">";
+      write_ascii_values(out_, array);
+      out_ << "</DataArray>\n";
+      return;
+    }
+    out_ << " format=\"appended\" offset=\"" << appended_.size() << "\"/>\n";
+    appended_ += compressed_record(to_bytes(array), path_);
+  }
+
+  const std::string& appended() const { return appended_; }
+
+ private:
+  std::ofstream& out_;
+  VtuEncoding encoding_;
+  const std::filesystem::path& path_;
+  std::string appended_;
+};
 
 }  // namespace
 
@@ -203,30 +366,77 @@ int vtk_cell_type(ElementType type) {
   throw std::invalid_argument("vtk_cell_type: unknown element type");
 }
 
+int vtk_cell_type(EdgeType type) {
+  switch (type) {
+    case EdgeType::line2:
+      return 3;
+    case EdgeType::line3:
+      return 21;
+  }
+  throw std::invalid_argument("vtk_cell_type: unknown edge type");
+}
+
 void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
                const std::vector<OutputField>& point_fields,
-               const std::vector<OutputField>& cell_fields) {
+               const std::vector<OutputField>& cell_fields, const VtuOptions& options) {
   const std::size_t node_count = mesh.node_count();
-  std::size_t element_count = 0;
-  for (const ElementBlock& block : mesh.blocks) element_count += block.element_count();
-  check_connectivity(mesh, path);
+  const std::size_t element_count = mesh.element_count();
+  check_mesh(mesh, options.boundary_cells, path);
   for (const OutputField& field : point_fields) check_field(field, node_count, "point", path);
   for (const OutputField& field : cell_fields) check_field(field, element_count, "cell", path);
 
+  const std::vector<std::int64_t> adjacent =
+      options.boundary_cells ? adjacent_elements(mesh) : std::vector<std::int64_t>{};
+  std::vector<std::int32_t> boundary_id(element_count, 0);
+  std::vector<std::string> boundary_names;
+  if (options.boundary_cells) {
+    for (const auto& [name, group] : mesh.boundaries) {
+      boundary_names.push_back(name);
+      boundary_id.insert(boundary_id.end(), group.edge_count(),
+                         static_cast<std::int32_t>(boundary_names.size()));
+    }
+  }
+
   std::ofstream out = open_for_writing(path);
+  const bool binary = options.encoding == VtuEncoding::binary_zlib;
   out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-         "header_type=\"UInt64\">\n"
-      << "  <UnstructuredGrid>\n"
-      << "    <Piece NumberOfPoints=\"" << node_count << "\" NumberOfCells=\"" << element_count
-      << "\">\n";
-  write_field_section(out, "PointData", point_fields, node_count);
-  write_field_section(out, "CellData", cell_fields, element_count);
-  write_points(out, mesh);
-  write_cells(out, mesh);
-  out << "    </Piece>\n"
-      << "  </UnstructuredGrid>\n"
-      << "</VTKFile>\n";
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\""
+      << (std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian")
+      << "\" header_type=\"UInt64\"" << (binary ? " compressor=\"vtkZLibDataCompressor\"" : "")
+      << ">\n"
+      << "  <UnstructuredGrid>\n";
+  ArrayWriter writer(out, options.encoding, path);
+  if (!boundary_names.empty()) {
+    out << "    <FieldData>\n";
+    writer.write({"String", "boundary_names", 1, {}, boundary_names});
+    out << "    </FieldData>\n";
+  }
+  out << "    <Piece NumberOfPoints=\"" << node_count << "\" NumberOfCells=\"" << boundary_id.size()
+      << "\">\n"
+      << "      <PointData>\n";
+  for (const OutputField& field : point_fields) writer.write(field_array(field, node_count));
+  out << "      </PointData>\n"
+      << "      <CellData>\n";
+  for (const OutputField& field : cell_fields) {
+    writer.write(field_array(field, element_count, adjacent));
+  }
+  if (options.boundary_cells) writer.write({"Int32", "boundary_id", 1, {}, boundary_id});
+  out << "      </CellData>\n";
+  std::vector<DataArray> geometry = geometry_arrays(mesh, options.boundary_cells);
+  out << "      <Points>\n";
+  writer.write(geometry[0]);
+  out << "      </Points>\n"
+      << "      <Cells>\n";
+  for (std::size_t k = 1; k < geometry.size(); ++k) writer.write(geometry[k]);
+  out << "      </Cells>\n"
+      << "    </Piece>\n"
+      << "  </UnstructuredGrid>\n";
+  if (binary) {
+    out << "  <AppendedData encoding=\"raw\">\n   _";
+    out.write(writer.appended().data(), static_cast<std::streamsize>(writer.appended().size()));
+    out << "\n  </AppendedData>\n";
+  }
+  out << "</VTKFile>\n";
   finish_writing(out, path);
 }
 

@@ -1,17 +1,33 @@
 #pragma once
-// ParaView output: VTK XML unstructured grid (.vtu, ASCII) and collection (.pvd) files.
+// ParaView output: VTK XML unstructured grid (.vtu) and collection (.pvd) files.
 //
-// Format: VTKFile version 1.0, ASCII. Points are Float64 with z = 0; every real number is
-// written as the shortest decimal that reads back to the same double (at most max_digits10
-// significant digits), so values round-trip exactly. Cells follow the element order of
-// mesh.blocks with VTK types
-//   triangle3      -> VTK_TRIANGLE (5)
-//   triangle6      -> VTK_QUADRATIC_TRIANGLE (22)  (Gmsh order: corners, then the midpoints
-//                     of edges 01, 12, 20, which is VTK's order)
-//   quadrilateral4 -> VTK_QUAD (9)                  (counter-clockwise, as VTK)
+// Format: VTKFile version 1.0, header_type UInt64, byte_order of the machine. By default every
+// array is binary in the appended-data section (encoding "raw"), compressed with zlib as
+// vtkZLibDataCompressor writes it: per array, the UInt64 header [number of blocks, uncompressed
+// block size (32768 bytes), uncompressed size of the last block (0 when it is full), compressed
+// size of each block], then the zlib streams of the blocks. VtuEncoding::ascii writes every
+// array inline as text instead, each real number as the shortest decimal that reads back to the
+// same double. Either way the values read back are the doubles given here, bit for bit.
+//
+// Points are Float64 with z = 0. Cells are, in this order:
+//  - the area elements, block after block of mesh.blocks, with VTK types
+//      triangle3      -> VTK_TRIANGLE (5)
+//      triangle6      -> VTK_QUADRATIC_TRIANGLE (22)  (Gmsh order: corners, then the midpoints
+//                        of edges 01, 12, 20, which is VTK's order)
+//      quadrilateral4 -> VTK_QUAD (9)                  (counter-clockwise, as VTK)
+//  - with VtuOptions::boundary_cells, the edges of every named boundary of mesh.boundaries
+//    (in name order), as VTK_LINE (3) or VTK_QUADRATIC_EDGE (21) (Gmsh line3 order: the two
+//    endpoints, then the midpoint, which is VTK's order). An edge in two boundaries is written
+//    twice, once for each.
+// The writer adds the cell field "boundary_id" (Int32): 0 on area elements, k on the edges of
+// the k-th boundary (k = 1, 2, ... in name order), and, when there are boundary cells, the
+// field-data string array "boundary_names" whose entry k - 1 is the name of boundary k.
+// Cell fields are given per area element; on a boundary edge each cell field holds the values
+// of the area element that has that edge as a side (NaN when no element has it).
 //
 // A field of 2 components is written with 3 components, the third zero, so that ParaView
-// treats it as a vector (Warp By Vector, Glyph); all other component counts are written as is.
+// treats it as a vector (Warp By Vector, Glyph); all other component counts are written as is
+// (6 components with the names XX, YY, ZZ, XY, YZ, XZ are ParaView's symmetric tensor).
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -28,21 +44,37 @@ struct OutputField {
   std::string name;
   int components = 1;
   std::vector<double> values;
-  /// Optional names of the components (ParaView ComponentName attributes), e.g. "xx", "yy",
-  /// "xy"; empty for none, otherwise at most `components` entries.
+  /// Optional names of the components (ParaView ComponentName attributes), e.g. "XX", "YY",
+  /// "ZZ", "XY", "YZ", "XZ"; empty for none, otherwise at most `components` entries.
   std::vector<std::string> component_names = {};
+};
+
+/// How the arrays of a .vtu are stored.
+enum class VtuEncoding {
+  binary_zlib,  // appended raw binary, zlib-compressed blocks (the default)
+  ascii,        // inline decimal text, for reading by eye
+};
+
+struct VtuOptions {
+  VtuEncoding encoding = VtuEncoding::binary_zlib;
+  /// Write the edges of mesh.boundaries as line cells (with boundary_id and boundary_names).
+  bool boundary_cells = true;
 };
 
 /// The VTK cell type number of an element type (5, 22 or 9).
 int vtk_cell_type(ElementType type);
 
-/// Writes the mesh (z = 0) with point and cell fields. Cell fields follow the element order
-/// of mesh.blocks. The parent directory must exist. Throws std::runtime_error naming the
-/// path when it cannot be written, and naming the path and the field when a field is
-/// malformed (empty name, components < 1, values.size() != components * count).
+/// The VTK cell type number of an edge type (3 or 21).
+int vtk_cell_type(EdgeType type);
+
+/// Writes the mesh (z = 0) with point and cell fields as described above. Cell fields follow
+/// the element order of mesh.blocks (one value set per area element). The parent directory must
+/// exist. Throws std::runtime_error naming the path when it cannot be written, and naming the
+/// path and the field when a field is malformed (empty name, components < 1,
+/// values.size() != components * count) or a connectivity entry is out of range.
 void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
                const std::vector<OutputField>& point_fields,
-               const std::vector<OutputField>& cell_fields);
+               const std::vector<OutputField>& cell_fields, const VtuOptions& options = {});
 
 /// Writes a .pvd collection referencing `datasets` (paths relative to the .pvd), one part each
 /// (part = index, timestep 0). Throws std::runtime_error naming the path when it cannot be

@@ -30,6 +30,13 @@ void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
     for (int node : block.connectivity) message.add_connectivity(node);
     message.add_cell_offsets(static_cast<std::uint64_t>(message.connectivity_size()));
   }
+  for (const auto& [name, group] : mesh.boundaries) {
+    protocol::NamedBoundary& boundary = *message.add_boundaries();
+    boundary.set_name(name);
+    protocol::CellBlock& segments = *boundary.mutable_segments();
+    segments.set_type(group.type == EdgeType::line3 ? protocol::LINE3 : protocol::LINE2);
+    segments.mutable_connectivity()->Assign(group.connectivity.begin(), group.connectivity.end());
+  }
 }
 
 }  // namespace

@@ -24,7 +24,8 @@ protocol::SolveStatus to_protocol(QpStatus status);
 
 /// The body's mesh and fields: node coordinates and tags, one cell block per element block
 /// (VTK types 5, 22, 9; cell_offsets has blocks + 1 entries into connectivity), point and cell
-/// fields, reaction resultant and applied force.
+/// fields, reaction resultant and applied force, and the mesh's named boundaries (their segments
+/// as node indices, for the line cells of the output).
 void encode_fields(const BodyOutput& output, protocol::FieldsReply& message);
 
 /// A repeated double field as a vector.

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <numbers>
@@ -190,10 +192,15 @@ TEST(ResultFiles, UncreatableDirectoryGivesAnErrorNamingIt) {
                       {directory_target.string()});
 }
 
-/// The block [0, 2] x [0, 1] (4 x 2 bilinear cells, h = 0.5), plane stress, on rollers at its
-/// bottom (u_y = 0) and left (u_x = 0), pressed by nodal contact forces lambda_i = p m_i on its
-/// top face (n = (0, 1)). The exact solution is uniaxial compression, which Q1 reproduces:
-///   s_yy = -p, s_xx = s_xy = 0, u_x = nu p x / E, u_y = -p y / E, von Mises = p.
+/// The block [0, 2] x [0, 1] (4 x 2 bilinear cells, h = 0.5), on rollers at its bottom
+/// (u_y = 0) and left (u_x = 0), pressed by nodal contact forces lambda_i = p m_i on its top face
+/// (n = (0, 1)). The exact solution is uniaxial compression in the plane, which Q1 reproduces:
+///   s_xx = s_xy = 0, s_yy = -p, and
+///   plane stress: s_zz = 0,       u_x = nu p x / E,          u_y = -p y / E,
+///                 von Mises = p;
+///   plane strain: s_zz = -nu p,   u_x = nu (1 + nu) p x / E, u_y = -(1 - nu^2) p y / E,
+///                 von Mises = sqrt(((0 + p)^2 + (-p + nu p)^2 + (-nu p - 0)^2) / 2)
+///                           = p sqrt(1 - nu + nu^2).
 struct CompressedBlock {
   static constexpr double young = 200.0;
   static constexpr double poisson = 0.3;
@@ -201,11 +208,11 @@ struct CompressedBlock {
   static constexpr double width = 2.0;
   static constexpr double spacing = 0.5;
 
-  static BodyDefinition definition() {
+  static BodyDefinition definition(PlaneModel model = PlaneModel::plane_stress) {
     BodyDefinition body;
     body.name = "block";
     body.mesh = make_rectangle_mesh(0.0, 0.0, width, 1.0, 4, 2, ElementType::quadrilateral4);
-    body.material = make_isotropic_material(young, poisson, PlaneModel::plane_stress, "test");
+    body.material = make_isotropic_material(young, poisson, model, "test");
     body.dirichlet = {{"bottom", std::nullopt, 0.0}, {"left", 0.0, std::nullopt}};
     body.contact_boundary = "top";
     return body;
@@ -214,9 +221,19 @@ struct CompressedBlock {
   static double face_weight(double x) { return (x == 0.0 || x == width) ? spacing / 2 : spacing; }
 };
 
-TEST(BodyVtu, UniaxialCompressionFieldsMatchTheAnalyticSolution) {
+class BodyVtuModels : public ::testing::TestWithParam<PlaneModel> {};
+
+INSTANTIATE_TEST_SUITE_P(BodyVtu, BodyVtuModels,
+                         ::testing::Values(PlaneModel::plane_stress, PlaneModel::plane_strain),
+                         [](const auto& info) {
+                           return info.param == PlaneModel::plane_strain ? "PlaneStrain"
+                                                                         : "PlaneStress";
+                         });
+
+TEST_P(BodyVtuModels, UniaxialCompressionFieldsReadByVtkMatchTheAnalyticSolution) {
   using Block = CompressedBlock;
-  BodySolver body(Block::definition());
+  const bool plane_strain = GetParam() == PlaneModel::plane_strain;
+  BodySolver body(Block::definition(GetParam()));
   const InterfaceDescription top = body.contact_boundary();
   ASSERT_EQ(top.node_ids.size(), 5u);
   body.assign_contact(node_to_node_operator(
@@ -228,31 +245,44 @@ TEST(BodyVtu, UniaxialCompressionFieldsMatchTheAnalyticSolution) {
   const TemporaryDirectory directory("result_files");
   const auto output = directory.path() / "not_yet_created";
   EXPECT_EQ(write_body_vtu(output, body, lambda), "block.vtu");
-  const json piece = read_vtk_xml(output / "block.vtu")["pieces"][0];
-  ASSERT_EQ(piece["attributes"]["NumberOfPoints"], "15");
-  ASSERT_EQ(piece["attributes"]["NumberOfCells"], "8");
+  // The file is binary and compressed, and VTK's reader (ParaView's) reads it.
+  EXPECT_EQ(read_vtk_xml(output / "block.vtu")["root"]["compressor"], "vtkZLibDataCompressor");
+  const json grid = test::read_vtu_with_vtk(output / "block.vtu");
+  ASSERT_EQ(grid["points"].size(), 3u * 15u);
+  // 8 quadrilaterals, then the 12 boundary edges (bottom 4, left 2, right 2, top 4)
+  ASSERT_EQ(grid["types"].size(), 20u);
+  EXPECT_EQ(grid["field_data"]["boundary_names"], json({"bottom", "left", "right", "top"}));
 
-  const double p = Block::pressure, young = Block::young, tolerance = 1e-12;
-  const json& points = find_array(piece["Points"], "Points")["values"];
-  const json& displacement = find_array(piece["PointData"], "displacement");
-  const json& stress = find_array(piece["PointData"], "stress")["values"];
-  const json& von_mises = find_array(piece["PointData"], "von_mises")["values"];
-  const json& contact_pressure = find_array(piece["PointData"], "contact_pressure")["values"];
-  const json& contact_force = find_array(piece["PointData"], "contact_force")["values"];
-  const json& reaction = find_array(piece["PointData"], "reaction")["values"];
-  EXPECT_EQ(displacement["attributes"]["NumberOfComponents"], "3");
+  const double p = Block::pressure, young = Block::young, nu = Block::poisson;
+  const double tolerance = 1e-12;
+  const double strain_x = plane_strain ? nu * (1 + nu) * p / young : nu * p / young;
+  const double strain_y = plane_strain ? -(1 - nu * nu) * p / young : -p / young;
+  const double stress_zz = plane_strain ? -nu * p : 0.0;
+  const double expected_von_mises = plane_strain ? p * std::sqrt(1 - nu + nu * nu) : p;
+  const json& points = grid["points"];
+  const json& displacement = grid["point_data"]["displacement"];
+  const json& stress = grid["point_data"]["stress"];
+  const json& von_mises = grid["point_data"]["von_mises"]["values"];
+  const json& contact_pressure = grid["point_data"]["contact_pressure"]["values"];
+  const json& contact_force = grid["point_data"]["contact_force"]["values"];
+  const json& reaction = grid["point_data"]["reaction"]["values"];
+  EXPECT_EQ(displacement["components"], 3);
+  EXPECT_EQ(stress["components"], 6);
+  EXPECT_EQ(stress["component_names"], json({"XX", "YY", "ZZ", "XY", "YZ", "XZ"}));
   double total_reaction_y = 0.0;
   for (std::size_t k = 0; k < 15; ++k) {
     const double x = points[3 * k].get<double>(), y = points[3 * k + 1].get<double>();
     const bool on_top = y == 1.0, on_bottom = y == 0.0;
-    EXPECT_NEAR(displacement["values"][3 * k].get<double>(), Block::poisson * p * x / young,
-                tolerance);
-    EXPECT_NEAR(displacement["values"][3 * k + 1].get<double>(), -p * y / young, tolerance);
+    EXPECT_NEAR(displacement["values"][3 * k].get<double>(), strain_x * x, tolerance);
+    EXPECT_NEAR(displacement["values"][3 * k + 1].get<double>(), strain_y * y, tolerance);
     EXPECT_EQ(displacement["values"][3 * k + 2].get<double>(), 0.0);
-    EXPECT_NEAR(stress[3 * k].get<double>(), 0.0, tolerance * p);
-    EXPECT_NEAR(stress[3 * k + 1].get<double>(), -p, tolerance * p);
-    EXPECT_NEAR(stress[3 * k + 2].get<double>(), 0.0, tolerance * p);
-    EXPECT_NEAR(von_mises[k].get<double>(), p, tolerance * p);
+    // (XX, YY, ZZ, XY, YZ, XZ)
+    const std::array<double, 6> expected_stress = {0.0, -p, stress_zz, 0.0, 0.0, 0.0};
+    for (std::size_t c = 0; c < 6; ++c) {
+      EXPECT_NEAR(stress["values"][6 * k + c].get<double>(), expected_stress[c], tolerance * p)
+          << "node " << k << " component " << c;
+    }
+    EXPECT_NEAR(von_mises[k].get<double>(), expected_von_mises, tolerance * p);
     EXPECT_NEAR(contact_pressure[k].get<double>(), on_top ? p : 0.0, tolerance * p);
     // force on the body from the other one: -lambda_i n_i = (0, -p m_i)
     EXPECT_EQ(contact_force[3 * k].get<double>(), 0.0);
@@ -266,12 +296,14 @@ TEST(BodyVtu, UniaxialCompressionFieldsMatchTheAnalyticSolution) {
   }
   EXPECT_NEAR(total_reaction_y, p * Block::width, tolerance * p);
 
-  const json& cell_stress = find_array(piece["CellData"], "stress")["values"];
-  const json& cell_von_mises = find_array(piece["CellData"], "von_mises")["values"];
-  ASSERT_EQ(cell_stress.size(), 3u * 8u);
-  for (std::size_t e = 0; e < 8; ++e) {
-    EXPECT_NEAR(cell_stress[3 * e + 1].get<double>(), -p, tolerance * p);
-    EXPECT_NEAR(cell_von_mises[e].get<double>(), p, tolerance * p);
+  // Cell fields on all 20 cells: the boundary edges carry their quadrilateral's (uniform) values.
+  const json& cell_stress = grid["cell_data"]["stress"]["values"];
+  const json& cell_von_mises = grid["cell_data"]["von_mises"]["values"];
+  ASSERT_EQ(cell_stress.size(), 6u * 20u);
+  for (std::size_t e = 0; e < 20; ++e) {
+    EXPECT_NEAR(cell_stress[6 * e + 1].get<double>(), -p, tolerance * p);
+    EXPECT_NEAR(cell_stress[6 * e + 2].get<double>(), stress_zz, tolerance * p);
+    EXPECT_NEAR(cell_von_mises[e].get<double>(), expected_von_mises, tolerance * p);
   }
 }
 

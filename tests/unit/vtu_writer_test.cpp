@@ -1,5 +1,6 @@
-// write_vtu / write_pvd: the files are parsed back by an independent XML reader (Python's
-// xml.etree) and checked against hand-computed counts, cell types, offsets, geometry and values.
+// write_vtu / write_pvd: the files are parsed back by an independent reader (Python's xml.etree
+// and its own decoder of the appended zlib blocks) and by VTK's own reader (the one ParaView
+// uses), and checked against hand-computed counts, cell types, offsets, geometry and values.
 
 #include "numerics/vtu_writer.hpp"
 
@@ -73,11 +74,15 @@ TEST(VtuWriter, QuadrilateralRectangleWritesPointsCellsAndFields) {
   const json document = read_vtk_xml(path);
   EXPECT_EQ(document["root"]["type"], "UnstructuredGrid");
   EXPECT_EQ(document["root"]["version"], "1.0");
+  EXPECT_EQ(document["root"]["header_type"], "UInt64");
+  EXPECT_EQ(document["root"]["compressor"], "vtkZLibDataCompressor");
   ASSERT_EQ(document["pieces"].size(), 1u);
   const json& piece = document["pieces"][0];
   EXPECT_EQ(piece["attributes"]["NumberOfPoints"], "6");
-  EXPECT_EQ(piece["attributes"]["NumberOfCells"], "2");
+  // 2 quadrilaterals, then the 6 boundary edges: bottom (2), left (1), right (1), top (2)
+  EXPECT_EQ(piece["attributes"]["NumberOfCells"], "8");
   EXPECT_EQ(find_array(piece["Points"], "Points")["attributes"]["type"], "Float64");
+  EXPECT_EQ(find_array(piece["Points"], "Points")["attributes"]["format"], "appended");
 
   // every grid point of [0,2]x[0,1] with unit spacing appears, in the plane z = 0
   for (double x : {0.0, 1.0, 2.0}) {
@@ -88,12 +93,40 @@ TEST(VtuWriter, QuadrilateralRectangleWritesPointsCellsAndFields) {
       EXPECT_EQ(found, 1) << "grid point (" << x << ", " << y << ")";
     }
   }
-  EXPECT_EQ(find_array(piece["Cells"], "types")["values"], json({9, 9}));
-  EXPECT_EQ(find_array(piece["Cells"], "offsets")["values"], json({4, 8}));
-  EXPECT_EQ(find_array(piece["Cells"], "connectivity")["values"],
-            json(mesh.blocks[0].connectivity));
+  EXPECT_EQ(find_array(piece["Cells"], "types")["values"], json({9, 9, 3, 3, 3, 3, 3, 3}));
+  EXPECT_EQ(find_array(piece["Cells"], "offsets")["values"], json({4, 8, 10, 12, 14, 16, 18, 20}));
+  const json& connectivity = find_array(piece["Cells"], "connectivity")["values"];
+  EXPECT_EQ(std::vector<int>(connectivity.begin(), connectivity.begin() + 8),
+            mesh.blocks[0].connectivity);
   for (std::size_t cell = 0; cell < 2; ++cell) {
     EXPECT_DOUBLE_EQ(written_signed_area(piece, cell, 4), 1.0) << "cell " << cell;
+  }
+  // Boundary edges: boundary_id k names boundary_names[k - 1]; each edge lies on its side of
+  // [0,2]x[0,1], has unit length, and carries the cell field of the quadrilateral it bounds
+  // (the one containing its midpoint: index = floor(x of the midpoint)).
+  ASSERT_EQ(document["field_data"].size(), 1u);
+  EXPECT_EQ(document["field_data"][0]["attributes"]["Name"], "boundary_names");
+  const json& names = document["field_data"][0]["values"];
+  EXPECT_EQ(names, json({"bottom", "left", "right", "top"}));
+  const json& boundary_id = find_array(piece["CellData"], "boundary_id");
+  EXPECT_EQ(boundary_id["attributes"]["type"], "Int32");
+  EXPECT_EQ(boundary_id["values"], json({0, 0, 1, 1, 2, 3, 4, 4}));
+  const json& written_index = find_array(piece["CellData"], "index")["values"];
+  for (std::size_t cell = 2; cell < 8; ++cell) {
+    const Eigen::Vector3d a =
+        written_point(piece, connectivity[8 + 2 * (cell - 2)].get<std::size_t>());
+    const Eigen::Vector3d b =
+        written_point(piece, connectivity[8 + 2 * (cell - 2) + 1].get<std::size_t>());
+    const Eigen::Vector3d middle = 0.5 * (a + b);
+    EXPECT_DOUBLE_EQ((b - a).norm(), 1.0) << "cell " << cell;
+    const std::string side = names[boundary_id["values"][cell].get<int>() - 1];
+    const double on_side = side == "bottom" ? middle.y()
+                           : side == "top"  ? middle.y() - 1.0
+                           : side == "left" ? middle.x()
+                                            : middle.x() - 2.0;
+    EXPECT_EQ(on_side, 0.0) << "cell " << cell << " on " << side;
+    EXPECT_EQ(written_index[cell].get<double>(), std::floor(std::min(middle.x(), 1.5)))
+        << "cell " << cell;
   }
 
   const json& written_temperature = find_array(piece["PointData"], "temperature");
@@ -107,14 +140,15 @@ TEST(VtuWriter, QuadrilateralRectangleWritesPointsCellsAndFields) {
     EXPECT_EQ(written_displacement["values"][3 * k + 1].get<double>(), -point.y());
     EXPECT_EQ(written_displacement["values"][3 * k + 2].get<double>(), 0.0);
   }
-  EXPECT_EQ(find_array(piece["CellData"], "index")["values"], json({0.0, 1.0}));
+  EXPECT_EQ(written_index[0], 0.0);
+  EXPECT_EQ(written_index[1], 1.0);
 }
 
 TEST(VtuWriter, TriangleRectangleHasCounterClockwiseTrianglesCoveringTheArea) {
   const TemporaryDirectory directory("vtu_writer");
   const Mesh mesh = make_rectangle_mesh(0.0, 0.0, 3.0, 2.0, 3, 2, ElementType::triangle3);
   const auto path = directory.path() / "triangles.vtu";
-  write_vtu(path, mesh, {}, {});
+  write_vtu(path, mesh, {}, {}, {.boundary_cells = false});
 
   const json piece = read_vtk_xml(path)["pieces"][0];
   EXPECT_EQ(piece["attributes"]["NumberOfPoints"], "12");
@@ -166,7 +200,15 @@ TEST(VtuWriter, MixedBlocksGetTheirCellTypesInBlockOrder) {
   EXPECT_EQ(written_stress["values"], json(stress.values));
 }
 
-TEST(VtuWriter, NumbersRoundTripExactly) {
+class VtuEncodings : public ::testing::TestWithParam<VtuEncoding> {};
+
+INSTANTIATE_TEST_SUITE_P(VtuWriter, VtuEncodings,
+                         ::testing::Values(VtuEncoding::binary_zlib, VtuEncoding::ascii),
+                         [](const auto& info) {
+                           return info.param == VtuEncoding::ascii ? "Ascii" : "BinaryZlib";
+                         });
+
+TEST_P(VtuEncodings, NumbersRoundTripExactly) {
   const TemporaryDirectory directory("vtu_writer");
   Mesh mesh;
   mesh.nodes = {{0.1, 0.7}, {1.0 / 3.0, -2.0 / 7.0}, {std::numbers::pi, 1e-17}};
@@ -184,10 +226,13 @@ TEST(VtuWriter, NumbersRoundTripExactly) {
                                       6.02214076e23,
                                       42.0};
   const auto path = directory.path() / "numbers.vtu";
-  write_vtu(path, mesh, {{"four", 4, values}}, {{"single", 1, {std::numbers::sqrt2}}});
+  write_vtu(path, mesh, {{"four", 4, values}}, {{"single", 1, {std::numbers::sqrt2}}},
+            {.encoding = GetParam()});
 
   const json piece = read_vtk_xml(path)["pieces"][0];
   const json& written = find_array(piece["PointData"], "four");
+  EXPECT_EQ(written["attributes"]["format"],
+            GetParam() == VtuEncoding::ascii ? "ascii" : "appended");
   EXPECT_EQ(written["attributes"]["NumberOfComponents"], "4");
   ASSERT_EQ(written["values"].size(), values.size());
   for (std::size_t i = 0; i < values.size(); ++i) {
@@ -278,6 +323,127 @@ TEST(VtuWriter, CellTypeNumbersAreVtks) {
   EXPECT_EQ(vtk_cell_type(ElementType::triangle3), 5);
   EXPECT_EQ(vtk_cell_type(ElementType::triangle6), 22);
   EXPECT_EQ(vtk_cell_type(ElementType::quadrilateral4), 9);
+  EXPECT_EQ(vtk_cell_type(EdgeType::line2), 3);
+  EXPECT_EQ(vtk_cell_type(EdgeType::line3), 21);
+}
+
+/// A P2 mesh of [0,4]x[0,3] (4 x 3 cells, 2 triangle6 each) with its line3 boundaries,
+/// the point field f = (x + 2y, x y, x^2) and the cell field "cell" = its index.
+struct QuadraticCase {
+  Mesh mesh = make_rectangle_mesh(0.0, 0.0, 4.0, 3.0, 4, 3, ElementType::triangle6);
+  OutputField point_field{"f", 3, {}};
+  OutputField cell_field{"cell", 1, {}};
+  QuadraticCase() {
+    for (const Eigen::Vector2d& node : mesh.nodes) {
+      point_field.values.insert(
+          point_field.values.end(),
+          {node.x() + 2 * node.y(), node.x() * node.y(), node.x() * node.x()});
+    }
+    for (std::size_t e = 0; e < mesh.element_count(); ++e) {
+      cell_field.values.push_back(static_cast<double>(e));
+    }
+  }
+};
+
+TEST_P(VtuEncodings, VtkReadsQuadraticCellsBoundariesAndFields) {
+  const TemporaryDirectory directory("vtu_writer");
+  const QuadraticCase data;
+  ASSERT_EQ(data.mesh.element_count(), 24u);
+  const auto path = directory.path() / "quadratic.vtu";
+  write_vtu(path, data.mesh, {data.point_field}, {data.cell_field}, {.encoding = GetParam()});
+
+  const json grid = test::read_vtu_with_vtk(path);
+  // 24 quadratic triangles, then 4 + 3 + 3 + 4 quadratic edges (bottom, left, right, top)
+  const json& types = grid["types"];
+  ASSERT_EQ(types.size(), 38u);
+  for (std::size_t cell = 0; cell < 38; ++cell) EXPECT_EQ(types[cell], cell < 24 ? 22 : 21);
+  const json& boundary_id = grid["cell_data"]["boundary_id"]["values"];
+  EXPECT_EQ(grid["field_data"]["boundary_names"], json({"bottom", "left", "right", "top"}));
+  const std::vector<int> edges_per_boundary = {4, 3, 3, 4};
+  std::size_t cell = 24;
+  for (int id = 1; id <= 4; ++id) {
+    for (int k = 0; k < edges_per_boundary[id - 1]; ++k, ++cell) EXPECT_EQ(boundary_id[cell], id);
+  }
+  const json& points = grid["points"];
+  const json& connectivity = grid["connectivity"];
+  const json& offsets = grid["offsets"];
+  const auto point = [&](std::size_t index) {
+    const std::size_t node = connectivity[index].get<std::size_t>();
+    return Eigen::Vector3d(points[3 * node].get<double>(), points[3 * node + 1].get<double>(),
+                           points[3 * node + 2].get<double>());
+  };
+  const json& cell_values = grid["cell_data"]["cell"]["values"];
+  for (std::size_t edge = 24; edge < 38; ++edge) {
+    // VTK_QUADRATIC_EDGE: the endpoints, then the midpoint; unit length on the boundary
+    const std::size_t begin = offsets[edge].get<std::size_t>() - 3;
+    EXPECT_EQ(point(begin + 2), 0.5 * (point(begin) + point(begin + 1))) << "edge " << edge;
+    EXPECT_DOUBLE_EQ((point(begin + 1) - point(begin)).norm(), 1.0) << "edge " << edge;
+    // the cell value of the adjacent triangle: one whose corners include both endpoints
+    const auto element = static_cast<std::size_t>(cell_values[edge].get<double>());
+    ASSERT_LT(element, 24u) << "edge " << edge;
+    int shared = 0;
+    for (int a = 0; a < 3; ++a) {
+      const std::size_t corner = offsets[element].get<std::size_t>() - 6 + a;
+      shared += point(corner) == point(begin) || point(corner) == point(begin + 1);
+    }
+    EXPECT_EQ(shared, 2) << "edge " << edge;
+  }
+  // the point field, against its formula at the read points
+  const json& f = grid["point_data"]["f"]["values"];
+  ASSERT_EQ(f.size(), 3 * data.mesh.node_count());
+  for (std::size_t node = 0; node < data.mesh.node_count(); ++node) {
+    const double x = points[3 * node].get<double>(), y = points[3 * node + 1].get<double>();
+    EXPECT_EQ(f[3 * node].get<double>(), x + 2 * y);
+    EXPECT_EQ(f[3 * node + 1].get<double>(), x * y);
+    EXPECT_EQ(f[3 * node + 2].get<double>(), x * x);
+  }
+}
+
+TEST(VtuWriter, SixComponentFieldIsParaViewsSymmetricTensor) {
+  // A uniform symmetric tensor with distinct entries (XX, YY, ZZ, XY, YZ, XZ) =
+  // (1, 2, 3, 4, 5, 6) on every node: VTK reads it as 6 components in that order, with names.
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_rectangle_mesh(0.0, 0.0, 1.0, 1.0, 1, 1, ElementType::triangle3);
+  OutputField tensor{"stress", 6, {}, {"XX", "YY", "ZZ", "XY", "YZ", "XZ"}};
+  for (std::size_t node = 0; node < mesh.node_count(); ++node) {
+    tensor.values.insert(tensor.values.end(), {1, 2, 3, 4, 5, 6});
+  }
+  const auto path = directory.path() / "tensor.vtu";
+  write_vtu(path, mesh, {tensor}, {});
+  const json grid = test::read_vtu_with_vtk(path);
+  const json& stress = grid["point_data"]["stress"];
+  EXPECT_EQ(stress["components"], 6);
+  EXPECT_EQ(stress["component_names"], json({"XX", "YY", "ZZ", "XY", "YZ", "XZ"}));
+  for (std::size_t node = 0; node < mesh.node_count(); ++node) {
+    for (int c = 0; c < 6; ++c) EXPECT_EQ(stress["values"][6 * node + c], c + 1.0);
+  }
+}
+
+TEST(VtuWriter, CompressedArraysSpanSeveralBlocksAndAreSmallerThanText) {
+  // 61 x 41 nodes: the points alone are 60024 bytes, two zlib blocks of 32768 bytes.
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_rectangle_mesh(0.0, 0.0, 6.0, 4.0, 60, 40, ElementType::quadrilateral4);
+  OutputField field{"sine", 1, {}};
+  for (const Eigen::Vector2d& node : mesh.nodes) {
+    field.values.push_back(std::sin(node.x()) * std::cos(node.y()));
+  }
+  const auto binary = directory.path() / "binary.vtu";
+  const auto ascii = directory.path() / "ascii.vtu";
+  write_vtu(binary, mesh, {field}, {});
+  write_vtu(ascii, mesh, {field}, {}, {.encoding = VtuEncoding::ascii});
+  EXPECT_LT(std::filesystem::file_size(binary), std::filesystem::file_size(ascii) / 2);
+
+  const json independent = read_vtk_xml(binary)["pieces"][0];
+  const json from_text = read_vtk_xml(ascii)["pieces"][0];
+  const json vtk = test::read_vtu_with_vtk(binary);
+  const json& points = find_array(independent["Points"], "Points")["values"];
+  ASSERT_EQ(points.size(), 3 * mesh.node_count());
+  EXPECT_EQ(points, find_array(from_text["Points"], "Points")["values"]);
+  EXPECT_EQ(points, vtk["points"]);
+  const json& values = find_array(independent["PointData"], "sine")["values"];
+  EXPECT_EQ(values, json(field.values));
+  EXPECT_EQ(vtk["point_data"]["sine"]["values"], json(field.values));
+  EXPECT_EQ(find_array(independent["Cells"], "connectivity")["values"], vtk["connectivity"]);
 }
 
 }  // namespace
