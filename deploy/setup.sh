@@ -14,6 +14,7 @@ packages=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-scipy python3-matplotlib python3-zmq python3-protobuf
   iproute2 procps shellcheck python3-yaml
+  zlib1g-dev python3-vtk9
 )
 
 missing=()
