@@ -12,7 +12,8 @@ namespace robin {
 
 namespace {
 
-const std::vector<std::string> root_keys{"title", "gap", "solver", "coupling", "contact", "body"};
+const std::vector<std::string> root_keys{"title",   "gap",  "solver",   "coupling",
+                                         "contact", "body", "reference"};
 const std::vector<std::string> contact_keys{"method", "non_mortar"};
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
@@ -274,6 +275,7 @@ CaseDefinition read_case_file(const std::filesystem::path& path) {
   read_coupling(root, definition.coupling);
   read_contact(root, definition.contact);
   read_bodies(root, path.parent_path(), definition);
+  definition.reference = read_reference(root);  // after the bodies: their materials give E*
   if (!definition.contact.non_mortar.empty() &&
       definition.contact.non_mortar != definition.bodies[0].definition.name &&
       definition.contact.non_mortar != definition.bodies[1].definition.name) {

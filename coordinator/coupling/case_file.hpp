@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "coupling/acceleration.hpp"
+#include "coupling/case_file_reference.hpp"
 #include "coupling/contact_discretization.hpp"
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
@@ -82,6 +83,7 @@ struct CaseDefinition {
   SolverOptions solver;
   CouplingOptions coupling;
   ContactOptions contact;  // [contact]: node-to-node or mortar
+  std::optional<ReferenceSolution> reference;  // [reference]: an analytic solution, for plots
 };
 
 /// The acceleration options with the per-body relaxations resolved (relaxation1/2, else
