@@ -98,24 +98,31 @@ ExcludedPairClearance excluded_clearance(const CoupledRunResult& result) {
   return excluded_pair_clearance(result.pairing, displacement_of, scale);
 }
 
+/// history.csv, one row per iteration (docs/outputs.md describes every column): the joint
+/// state's residuals and counters, the largest residual of each obstacle sequence's complete
+/// state ("robin" only; empty otherwise), and what the stopping test compared with the
+/// tolerance: stopping_residual = IterationRecord::progress, the run converged at the first row
+/// where stopping_residual <= tolerance.
 void write_history_csv(const std::filesystem::path& path,
-                       const std::vector<IterationRecord>& history) {
+                       const std::vector<IterationRecord>& history,
+                       const CouplingOptions& options) {
   std::ofstream file(path);
   if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
   file << std::setprecision(std::numeric_limits<double>::max_digits10);
   file << "iteration,obstacle_change,penetration,force_balance,complementarity,correction,"
-          "active1,active2,qp_iterations1,qp_iterations2,seconds,sequence1,sequence2\n";
+          "active1,active2,qp_iterations1,qp_iterations2,seconds,sequence1,sequence2,"
+          "stopping_residual,tolerance\n";
+  const bool either_sequence = options.stopping == "either-sequence";
   for (const IterationRecord& record : history) {
     file << record.iteration << ',' << record.obstacle_change << ',' << record.penetration << ','
          << record.force_balance << ',' << record.complementarity << ',' << record.correction << ','
          << record.active1 << ',' << record.active2 << ',' << record.qp_iterations1 << ','
          << record.qp_iterations2 << ',' << record.seconds;
-    // The complete states of the obstacle sequences ("robin" only; empty otherwise).
     for (std::size_t k = 0; k < 2; ++k) {
       file << ',';
       if (k < record.sequences.size()) file << record.sequences[k].largest();
     }
-    file << '\n';
+    file << ',' << record.progress(either_sequence) << ',' << options.tolerance << '\n';
   }
   if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
 }
@@ -269,7 +276,7 @@ void write_coupled_outputs(const std::filesystem::path& directory, const CaseDef
   if (state.normal_trace1.size() == static_cast<Eigen::Index>(result.pairing.size())) {
     write_contact_csv(directory / "contact.csv", result.pairing, state);
   }
-  write_history_csv(directory / "history.csv", iteration.history);
+  write_history_csv(directory / "history.csv", iteration.history, result.options);
   write_json(directory / "summary.json", make_summary(definition, result));
 }
 

@@ -83,25 +83,68 @@ std::shared_ptr<spdlog::logger> coordinator_logger() {
   return log ? log : make_coordinator_logger("info");
 }
 
-RunObserver make_observer(const std::shared_ptr<spdlog::logger>& log) {
+RunObserver make_observer(const std::shared_ptr<spdlog::logger>& log,
+                          const CouplingOptions& options) {
   RunObserver observer;
   observer.stage = [log](const std::string& text) { log->info("{}", text); };
-  observer.iteration = [log](const IterationRecord& record) {
-    log->info("{}", progress_line(record));
+  observer.iteration = [log, options](const IterationRecord& record) {
+    log->info("{}", progress_line(record, options));
     throw_if_stop_requested();
   };
   return observer;
 }
 
+/// The value the stopping test compares with the tolerance (IterationRecord::progress) and the
+/// state it belongs to: "the joint state" or "obstacle sequence k".
+std::pair<double, std::string> stopping_value(const IterationRecord& record,
+                                              const CouplingOptions& options) {
+  std::pair<double, std::string> value{record.largest(), "the joint state"};
+  if (options.stopping != "either-sequence") return value;
+  for (std::size_t k = 0; k < record.sequences.size(); ++k) {
+    if (record.sequences[k].largest() < value.first) {
+      value = {record.sequences[k].largest(), "obstacle sequence " + std::to_string(k + 1)};
+    }
+  }
+  return value;
+}
+
 /// Logs how the run ended and where the results are; returns the exit code of its status.
+/// Converged: which state the stopping test accepted, its largest residual against the
+/// tolerance, and the residuals of that state (the one the result files hold).
 int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& settings,
                    spdlog::logger& log) {
   const RobinResult& iteration = result.iteration;
-  const double largest = iteration.final_largest_residual();
-  const std::string outcome = to_string(iteration.status) + " after " +
-                              std::to_string(iteration.history.size()) +
-                              " iterations (largest residual " + fmt::format("{:.2e}", largest) +
-                              ")" + (iteration.message.empty() ? "" : ": " + iteration.message);
+  const CouplingOptions& options = result.options;
+  const std::string stopping =
+      fmt::format("{} stopping, tolerance {:.0e}", options.stopping, options.tolerance);
+  std::string outcome =
+      fmt::format("{} after {} iterations", to_string(iteration.status), iteration.history.size());
+  if (iteration.history.empty()) {
+    outcome += " (" + stopping + ")" + (iteration.message.empty() ? "" : ": " + iteration.message);
+  } else if (iteration.status == IterationStatus::converged) {
+    const IterationRecord& last = iteration.history.back();
+    if (const SequenceResiduals* accepted = iteration.accepted_sequence()) {
+      outcome += fmt::format(
+          ": obstacle sequence {} reached {:.1e} < tolerance {:.0e} ({}; body {} takes its "
+          "contact force); final state: penetration {:.1e}, complementarity {:.1e}, obstacle "
+          "change {:.1e}, force error estimate {:.1e}",
+          iteration.completed_by_sequence, accepted->largest(), options.tolerance,
+          options.stopping + " stopping", 3 - iteration.completed_by_sequence,
+          accepted->penetration, accepted->complementarity, accepted->obstacle_change,
+          accepted->force_error);
+    } else {
+      outcome += fmt::format(
+          ": the joint state reached {:.1e} < tolerance {:.0e} ({} stopping); final state: "
+          "obstacle change {:.1e}, penetration {:.1e}, force balance {:.1e}, complementarity "
+          "{:.1e}, correction {:.1e}",
+          last.largest(), options.tolerance, options.stopping, last.obstacle_change,
+          last.penetration, last.force_balance, last.complementarity, last.correction);
+    }
+  } else {
+    const auto [value, state] = stopping_value(iteration.history.back(), options);
+    outcome += fmt::format(" ({}): the stopping test's last value {:.1e} ({}){}", stopping, value,
+                           state, iteration.message.empty() ? "" : "; " + iteration.message);
+  }
   int code = exit_code(iteration.status);
   if (code == 0) {
     log.info("{}", outcome);
@@ -225,20 +268,21 @@ std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level
   return log;
 }
 
-std::string progress_line(const IterationRecord& record) {
+std::string progress_line(const IterationRecord& record, const CouplingOptions& options) {
+  const auto [value, state] = stopping_value(record, options);
   std::string sequences;
   if (record.sequences.size() == 2) {
-    sequences = fmt::format("; sequences {:.2e}/{:.2e}", record.sequences[0].largest(),
+    sequences = fmt::format("; obstacle sequences {:.2e}/{:.2e}", record.sequences[0].largest(),
                             record.sequences[1].largest());
   }
   return fmt::format(
-      "iteration {}: obstacle change {:.2e}, penetration {:.2e}, force balance {:.2e}, "
-      "complementarity {:.2e}, correction {:.2e}; active {}/{}, QP iterations {}/{}, {:.3f} s; "
-      "{}{}",
-      record.iteration, record.obstacle_change, record.penetration, record.force_balance,
-      record.complementarity, record.correction, record.active1, record.active2,
-      record.qp_iterations1, record.qp_iterations2, record.seconds, record.acceleration_state,
-      sequences);
+      "iteration {}: stopping test {:.2e} ({}; tolerance {:.0e}){}; joint state: obstacle change "
+      "{:.2e}, penetration {:.2e}, force balance {:.2e}, complementarity {:.2e}, correction "
+      "{:.2e}; active {}/{}, QP iterations {}/{}, {:.3f} s; {}",
+      record.iteration, value, state, options.tolerance, sequences, record.obstacle_change,
+      record.penetration, record.force_balance, record.complementarity, record.correction,
+      record.active1, record.active2, record.qp_iterations1, record.qp_iterations2, record.seconds,
+      record.acceleration_state);
 }
 
 std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {
@@ -277,8 +321,8 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
       ports[alpha] = std::make_unique<RemotePort>(endpoints[alpha], body, port_options);
       log->info("body {} '{}' on server {}", alpha + 1, body, endpoints[alpha]);
     }
-    const CoupledRunResult result =
-        run_coupled_case(definition, {ports[0].get(), ports[1].get()}, options, make_observer(log));
+    const CoupledRunResult result = run_coupled_case(definition, {ports[0].get(), ports[1].get()},
+                                                     options, make_observer(log, options));
     write_coupled_outputs(settings.output_directory, definition, result);
     code = report_outcome(result, settings, *log);
   } catch (const InputError& error) {  // e.g. unmatched contact nodes: name the case file

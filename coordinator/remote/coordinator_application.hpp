@@ -60,8 +60,12 @@ CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
 /// default logger. Throws std::invalid_argument for an unknown level.
 std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level);
 
-/// One line per iteration: the residuals (%.2e), the active set sizes, QP iterations, seconds.
-std::string progress_line(const IterationRecord& record);
+/// One line per iteration: the value the stopping test compares with the tolerance (the
+/// smallest of the joint state's and the obstacle sequences' largest residuals with
+/// "either-sequence" stopping, the joint state's otherwise) and whose it is, each obstacle
+/// sequence's largest residual, the joint state's residuals (%.2e), the active set sizes, QP
+/// iterations, seconds and the acceleration's state.
+std::string progress_line(const IterationRecord& record, const CouplingOptions& options);
 
 /// Reads the case file; logs the error (an InputError naming file, line and field) and returns
 /// nullopt when it is unusable.

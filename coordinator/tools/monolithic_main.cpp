@@ -110,11 +110,16 @@ int run(const std::filesystem::path& case_path, const std::filesystem::path& out
                                                           problem.pairing, definition.solver.qp);
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The outcome, worded as robin-coordinator's: what the stopping test looked at, then the
+  // residuals of the final state (one contact force for both bodies: no force balance).
   log->info(
-      "MPRGP {}: {} iterations, {} operator products, {:.3f} s; residuals penetration {:.2e}, "
-      "complementarity {:.2e}",
+      "{} after {} MPRGP iterations ({} operator products, {:.3f} s): projected gradient {:.1e} "
+      "against qp_tolerance {:.0e} relative to ||F|| ||lambda||; final state: penetration {:.1e}, "
+      "complementarity {:.1e}",
       robin::to_string(result.qp.status), result.qp.iterations, result.qp.operator_applications,
-      result.solve_seconds, result.residuals.penetration, result.residuals.complementarity);
+      result.solve_seconds, result.qp.projected_gradient_norm,
+      definition.solver.qp.relative_tolerance, result.residuals.penetration,
+      result.residuals.complementarity);
   nlohmann::json summary = make_summary(problem, result, total);
   const robin::ExcludedPairClearance clearance = excluded_pair_clearance(problem, result);
   summary["excluded_pair_penetration"] = clearance.relative_penetration;

@@ -1,0 +1,280 @@
+"""robin-plot and the convergence outputs of a coupled run, through the real tools of a build.
+
+robin-run solves examples/hertz.toml (two robin-subdomain processes, the default
+either-sequence stopping); the test then reads history.csv and summary.json itself and checks
+that the numbers say how the run converged: the accepted obstacle sequence's residual in its
+last row is below the tolerance of summary.json, so is every residual of the accepted state,
+stopping_residual is the smallest of the joint state's and the sequences' largest residuals and
+first drops below the tolerance in the last row. robin-plot then writes the PNG files, exits 0,
+and its figures carry the numbers: the tolerance line, the accepted state, integer iteration
+ticks, the title naming the status, and the analytic Hertz curve with the half-width
+a = sqrt(4PR/(pi E*)) and peak pressure p0 = 2P/(pi a) computed here from the case's
+materials and the run's contact resultant. Its command line: --help, --version (the project
+version), exit status 2 for a bad command line and 1 for a directory without results.
+
+The tools are those of the build directory named by ROBIN_CONTACT_BIN (set by CTest), default
+build/bin. Needs Debian's matplotlib and numpy (/usr/bin/python3).
+"""
+
+import csv
+import importlib.machinery
+import importlib.util
+import json
+import math
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+REPOSITORY = pathlib.Path(__file__).resolve().parents[2]
+BIN = pathlib.Path(os.environ.get("ROBIN_CONTACT_BIN", REPOSITORY / "build" / "bin"))
+HERTZ = REPOSITORY / "examples" / "hertz.toml"
+SOURCE_PLOT = REPOSITORY / "coordinator" / "tools" / "robin-plot"
+
+# examples/hertz.toml: both bodies E = 1000, nu = 0.3, plane strain, gap x^2 / (2 R), R = 1.
+YOUNG, POISSON, RADIUS = 1000.0, 0.3, 1.0
+
+
+def run(*arguments, cwd=None):
+    completed = subprocess.run([str(argument) for argument in arguments], capture_output=True,
+                               text=True, timeout=600, check=False, cwd=cwd,
+                               stdin=subprocess.DEVNULL)
+    return completed.returncode, completed.stdout, completed.stderr
+
+
+def read_csv(path):
+    with open(path, newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def load_plot_module():
+    """The build's robin-plot as a module (it has no .py suffix), for its figures."""
+    loader = importlib.machinery.SourceFileLoader("robin_plot", str(BIN / "robin-plot"))
+    spec = importlib.util.spec_from_loader("robin_plot", loader)
+    module = importlib.util.module_from_spec(spec)
+    loader.exec_module(module)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    return module
+
+
+def project_version():
+    """The product version, read from the sources as CMake does (VERSION, else project())."""
+    version_file = REPOSITORY / "VERSION"
+    if version_file.exists():
+        return version_file.read_text().split()[0]
+    text = (REPOSITORY / "CMakeLists.txt").read_text()
+    return re.search(r"project\(robin_contact VERSION ([0-9.]+)", text).group(1)
+
+
+@unittest.skipUnless((BIN / "robin-run").exists(), f"no robin-run in {BIN}: build it first")
+class HertzRun(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-plot-test-"))
+        cls.directory = cls.scratch / "hertz"
+        cls.status, _, cls.log = run(BIN / "robin-run", HERTZ, "--output", cls.directory)
+        cls.summary = json.loads((cls.directory / "summary.json").read_text())
+        cls.history = read_csv(cls.directory / "history.csv")
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.scratch, ignore_errors=True)
+
+    def test_run_converged_by_one_obstacle_sequence(self):
+        self.assertEqual(self.status, 0, self.log)
+        self.assertEqual(self.summary["status"], "converged")
+        self.assertEqual(self.summary["stopping"], "either-sequence")
+        self.assertIn(self.summary["completed_by_sequence"], (1, 2))
+
+    def test_accepted_sequence_column_ends_below_the_tolerance(self):
+        tolerance = self.summary["tolerance"]
+        self.assertEqual(tolerance, 1e-8)  # examples/hertz.toml [coupling] tolerance
+        column = f"sequence{self.summary['completed_by_sequence']}"
+        last = float(self.history[-1][column])
+        self.assertLess(last, tolerance)
+        self.assertEqual(len(self.history), self.summary["iterations"])
+        for row in self.history:
+            self.assertEqual(float(row["tolerance"]), tolerance)
+
+    def test_accepted_state_residuals_are_below_the_tolerance(self):
+        tolerance = self.summary["tolerance"]
+        residuals = self.summary["final_residuals"]
+        for name in ("obstacle_change", "penetration", "complementarity",
+                     "force_error_estimate"):
+            self.assertLess(residuals[name], tolerance, name)
+        self.assertEqual(residuals["force_balance"], 0.0)  # one contact force for both bodies
+        self.assertEqual(residuals["correction"], 0.0)
+
+    def test_stopping_residual_is_what_the_stopping_test_compared(self):
+        tolerance = self.summary["tolerance"]
+        joint = ("obstacle_change", "penetration", "force_balance", "complementarity",
+                 "correction")
+        for index, row in enumerate(self.history):
+            largest_joint = max(float(row[name]) for name in joint)
+            expected = min([largest_joint, float(row["sequence1"]), float(row["sequence2"])])
+            self.assertEqual(float(row["stopping_residual"]), expected, f"row {index + 1}")
+            if index + 1 < len(self.history):
+                self.assertGreater(expected, tolerance, f"row {index + 1} would have stopped")
+        self.assertLessEqual(float(self.history[-1]["stopping_residual"]), tolerance)
+
+    def test_final_log_line_says_how_the_run_converged(self):
+        sequence = self.summary["completed_by_sequence"]
+        line = next(line for line in self.log.splitlines() if "converged after" in line)
+        self.assertIn(f"converged after {len(self.history)} iterations: obstacle sequence "
+                      f"{sequence} reached", line)
+        self.assertIn("< tolerance 1e-08", line)
+        self.assertIn("force error estimate", line)
+        progress = [line for line in self.log.splitlines() if "] iteration " in line]
+        self.assertEqual(len(progress), len(self.history))
+        self.assertIn(f"stopping test {float(self.history[-1]['stopping_residual']):.2e} "
+                      f"(obstacle sequence {sequence}; tolerance 1e-08)", progress[-1])
+
+    def test_robin_plot_writes_both_figures(self):
+        directory = self.scratch / "plots"
+        shutil.copytree(self.directory, directory)
+        status, stdout, stderr = run(BIN / "robin-plot", directory)
+        self.assertEqual(status, 0, stderr)
+        for name in ("contact.png", "history.png"):
+            with open(directory / name, "rb") as handle:
+                self.assertEqual(handle.read(8), b"\x89PNG\r\n\x1a\n", name)
+        self.assertIn("history.png: converged after", stdout)
+        self.assertIn("contact.png: Hertz p0 =", stdout)
+
+    def test_history_figure_shows_the_stopping_test(self):
+        plot = load_plot_module()
+        columns = plot.read_columns(self.directory / "history.csv")
+        figure, _ = plot.history_figure(columns, self.summary)
+        axis = figure.axes[0]
+        labels = [text.get_text() for text in axis.get_legend().get_texts()]
+        self.assertIn("tolerance 1e-08", labels)
+        tolerance_line = next(line for line in axis.get_lines()
+                              if line.get_label() == "tolerance 1e-08")
+        self.assertEqual(list(tolerance_line.get_ydata()), [1e-8, 1e-8])
+        sequence = self.summary["completed_by_sequence"]
+        accepted_value = max(self.summary["final_residuals"].values())
+        accepted = [label for label in labels if label.startswith("accepted:")]
+        self.assertEqual(accepted, [f"accepted: obstacle sequence {sequence}, largest residual "
+                                    f"{accepted_value:.1e}"])
+        for k in (1, 2):
+            line = next(line for line in axis.get_lines()
+                        if line.get_label().startswith(f"obstacle sequence {k}:"))
+            expected = [max(float(row[f"sequence{k}"]), 1e-17) for row in self.history]
+            self.assertEqual(list(line.get_ydata()), expected)
+        self.assertIn(f"converged after {len(self.history)} iterations", axis.get_title())
+        self.assertIn("either-sequence stopping", axis.get_title())
+        ticks = [tick for tick in axis.get_xticks()
+                 if 1 <= tick <= len(self.history)]
+        self.assertTrue(ticks)
+        self.assertTrue(all(float(tick).is_integer() for tick in ticks), ticks)
+
+    def test_contact_figure_overlays_hertz(self):
+        resultant = self.summary["contact_force_resultant"]
+        load = math.hypot(*resultant)
+        modulus = YOUNG / (2.0 * (1.0 - POISSON ** 2))  # 1/E* = 2 (1 - nu^2) / E
+        half_width = math.sqrt(4.0 * load * RADIUS / (math.pi * modulus))
+        peak = 2.0 * load / (math.pi * half_width)
+        plot = load_plot_module()
+        columns = plot.read_columns(self.directory / "contact.csv")
+        reference = plot.read_reference(HERTZ, self.summary)
+        figure, lines, comparison = plot.contact_figure(columns, self.summary, reference)
+        self.assertAlmostEqual(comparison["half_width"], half_width, delta=1e-12 * half_width)
+        self.assertAlmostEqual(comparison["peak_pressure"], peak, delta=1e-12 * peak)
+        axis = figure.axes[0]
+        hertz = next(line for line in axis.get_lines() if line.get_label().startswith("Hertz"))
+        self.assertIn(f"p0 = {peak:.4g}, a = {half_width:.4g}", hertz.get_label())
+        x, p = np.asarray(hertz.get_xdata()), np.asarray(hertz.get_ydata())
+        self.assertAlmostEqual(p.max(), peak, delta=1e-9 * peak)
+        self.assertAlmostEqual(x.min(), -half_width, delta=1e-12)  # center = [0, 0]
+        self.assertAlmostEqual(x.max(), half_width, delta=1e-12)
+        # The computed p0 and a: the least-squares fit of p^2 = p0^2 (1 - x^2/a^2) to the loaded
+        # pairs of contact.csv, the outermost on each side left out, done here with polyfit.
+        rows = read_csv(self.directory / "contact.csv")
+        loaded = sorted((float(row["x"]), float(row["pressure"])) for row in rows
+                        if float(row["pressure"]) > 0.0)[1:-1]
+        slope, intercept = np.polyfit([x ** 2 for x, _ in loaded],
+                                      [p ** 2 for _, p in loaded], 1)
+        fitted_peak, fitted_half_width = math.sqrt(intercept), math.sqrt(-intercept / slope)
+        self.assertAlmostEqual(comparison["computed_peak_pressure"], fitted_peak,
+                               delta=1e-9 * fitted_peak)
+        self.assertAlmostEqual(comparison["computed_half_width"], fitted_half_width,
+                               delta=1e-9 * fitted_half_width)
+        peak_error, half_width_error = fitted_peak / peak - 1.0, fitted_half_width / half_width - 1
+        labels = [text.get_text() for text in axis.get_legend().get_texts()]
+        self.assertIn(f"p0 {peak_error:+.2%}, a {half_width_error:+.2%} against Hertz",
+                      " ".join(labels))
+        # The solution itself: within 2 % of Hertz at the shipped mesh (docs/verification.md).
+        self.assertLess(abs(peak_error), 0.02)
+        self.assertLess(abs(half_width_error), 0.02)
+        self.assertTrue(any("from the computed contact resultant" in line for line in lines))
+
+    def test_explicit_load_of_the_reference_table(self):
+        case = self.scratch / "hertz_load.toml"
+        text = HERTZ.read_text().replace('kind = "hertz_cylinder"',
+                                         'kind = "hertz_cylinder"\nload = 2.5\n'
+                                         'contact_modulus = 600.0')
+        text = text.replace('"meshes/', f'"{REPOSITORY / "examples" / "meshes"}/')
+        case.write_text(text)
+        status, stdout, stderr = run(BIN / "robin-plot", "--case", case, self.directory)
+        self.assertEqual(status, 0, stderr)
+        half_width = math.sqrt(4.0 * 2.5 * 1.0 / (math.pi * 600.0))
+        peak = 2.0 * 2.5 / (math.pi * half_width)
+        self.assertIn(f"Hertz p0 = {peak:.6g}, a = {half_width:.6g} (P = 2.5 from reference.load)",
+                      stdout)
+
+
+@unittest.skipUnless((BIN / "robin-plot").exists(), f"no robin-plot in {BIN}")
+class CommandLine(unittest.TestCase):
+    def test_help(self):
+        status, stdout, _ = run(BIN / "robin-plot", "--help")
+        self.assertEqual(status, 0)
+        self.assertIn("usage: robin-plot", stdout)
+        self.assertIn("Exit status", stdout)
+
+    def test_version_is_the_project_version(self):
+        status, stdout, _ = run(BIN / "robin-plot", "--version")
+        self.assertEqual(status, 0)
+        self.assertEqual(stdout.strip(), f"robin-plot (robin-contact) {project_version()}")
+
+    def test_usage_errors_exit_2(self):
+        for arguments in ([], ["a", "b"], ["--no-such-option", "a"]):
+            status, _, stderr = run(BIN / "robin-plot", *arguments)
+            self.assertEqual(status, 2, arguments)
+            self.assertIn("usage: robin-plot", stderr)
+
+    def test_directory_without_results_exits_1(self):
+        with tempfile.TemporaryDirectory() as directory:
+            status, stdout, stderr = run(BIN / "robin-plot", directory)
+            self.assertEqual(status, 1)
+            self.assertEqual(stdout, "")
+            self.assertIn(f"{directory} holds no results of a run: contact.csv is missing",
+                          stderr)
+            status, _, stderr = run(BIN / "robin-plot", os.path.join(directory, "absent"))
+            self.assertEqual(status, 1)
+            self.assertIn("no such directory", stderr)
+
+
+@unittest.skipUnless((BIN / "robin-monolithic").exists(), f"no robin-monolithic in {BIN}")
+class MonolithicRun(unittest.TestCase):
+    def test_contact_plot_only_and_final_line(self):
+        with tempfile.TemporaryDirectory() as scratch:
+            directory = pathlib.Path(scratch) / "monolithic"
+            status, _, log = run(BIN / "robin-monolithic", HERTZ, "--output", directory)
+            self.assertEqual(status, 0, log)
+            self.assertRegex(log, r"converged after \d+ MPRGP iterations .*final state: "
+                                  r"penetration")
+            status, stdout, stderr = run(BIN / "robin-plot", directory)
+            self.assertEqual(status, 0, stderr)
+            self.assertTrue((directory / "contact.png").exists())
+            self.assertFalse((directory / "history.png").exists())
+            self.assertIn("contact.png: Hertz p0 =", stdout)
+
+
+if __name__ == "__main__":
+    unittest.main()
