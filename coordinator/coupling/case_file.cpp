@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "coupling/case_file_body.hpp"
+#include "coupling/case_file_overrides.hpp"
 #include "coupling/case_file_table.hpp"
 #include "coupling/gap_function.hpp"
 #include "numerics/errors.hpp"
@@ -221,7 +222,7 @@ void read_bodies(const CheckedTable& root, const std::filesystem::path& director
     const int line = entries.size() > 2      ? line_of(*entries[2].table)
                      : root.contains("body") ? root.line("body")
                                              : 0;
-    throw InputError(CaseContext{root.context().file, ""}.prefix(line) +
+    throw InputError(root.context().prefix(line) +
                      ": expected exactly two [[body]] tables, found " +
                      std::to_string(entries.size()));
   }
@@ -229,7 +230,8 @@ void read_bodies(const CheckedTable& root, const std::filesystem::path& director
     definition.bodies[index] = read_body_case(entries[index], root.context(), directory);
   }
   if (definition.bodies[0].definition.name == definition.bodies[1].definition.name) {
-    const CaseContext second{root.context().file, definition.bodies[1].definition.name};
+    CaseContext second = root.context();
+    second.body = definition.bodies[1].definition.name;
     throw InputError(second.prefix(line_of(*(*entries[1].table).get("name"))) +
                      ": body[2].name: duplicates the name of body[1]; body names must differ");
   }
@@ -263,12 +265,17 @@ AccelerationOptions effective_acceleration(const CouplingOptions& options) {
   return acceleration;
 }
 
-CaseDefinition read_case_file(const std::filesystem::path& path) {
+/// read_case_file without the mention of the overrides in its errors.
+static CaseDefinition read_case_document(const std::filesystem::path& path,
+                                         const std::vector<std::string>& overrides) {
   const std::string label = path.string();
-  const toml::table document = parse_toml(path, label);
-  const CheckedTable root(document, "", CaseContext{label, ""}, root_keys);
+  toml::table document = parse_toml(path, label);
+  CaseContext context{label, ""};
+  context.override_lines = apply_case_overrides(document, path, overrides);  // --set KEY=VALUE
+  const CheckedTable root(document, "", context, root_keys);
   CaseDefinition definition;
   definition.file = path;
+  definition.overrides = overrides;
   definition.title = root.optional_string("title").value_or(path.stem().string());
   read_gap(root, definition);
   read_solver(root, definition.solver);
@@ -284,6 +291,15 @@ CaseDefinition read_case_file(const std::filesystem::path& path) {
                 "'" + definition.contact.non_mortar + "' is not the name of a body (nor \"auto\")");
   }
   return definition;
+}
+
+CaseDefinition read_case_file(const std::filesystem::path& path,
+                              const std::vector<std::string>& overrides) {
+  try {
+    return read_case_document(path, overrides);
+  } catch (const InputError& error) {
+    throw InputError(mention_overrides(error.what(), overrides));
+  }
 }
 
 namespace {

@@ -83,6 +83,9 @@ struct CaseDefinition {
   SolverOptions solver;
   CouplingOptions coupling;
   ContactOptions contact;  // [contact]: node-to-node or mortar
+  /// The command-line overrides applied to the file, in order, as given ("KEY=VALUE", see
+  /// case_file_overrides.hpp); empty when the file is read as it is.
+  std::vector<std::string> overrides;
   std::optional<ReferenceSolution> reference;  // [reference]: an analytic solution, for plots
 };
 
@@ -98,8 +101,11 @@ std::string in_case_file(const std::filesystem::path& case_file, const std::stri
 /// Parses and validates a case file (without reading meshes): every key, type and range,
 /// the materials, the existence of the mesh files, and the gap expression (parsed and
 /// evaluated once). Throws InputError naming the file, line and field (and the body).
-/// The title defaults to the file's stem.
-CaseDefinition read_case_file(const std::filesystem::path& path);
+/// The title defaults to the file's stem. `overrides` ("KEY=VALUE", case_file_overrides.hpp)
+/// are applied to the parsed file first, so every check applies to their values; errors about
+/// them name the override, other errors list the overrides.
+CaseDefinition read_case_file(const std::filesystem::path& path,
+                              const std::vector<std::string>& overrides = {});
 
 /// Reads the body's mesh and checks every boundary name against it; returns the complete
 /// definition. Throws InputError naming the case file, body, field and mesh file and listing

@@ -25,7 +25,9 @@ bool is_valid_body_name(const std::string& name) {
 
 /// "FILE:LINE" of `key` in `table`, without the body part.
 std::string file_location(const CheckedTable& table, std::string_view key) {
-  return CaseContext{table.context().file, ""}.prefix(table.line(key));
+  CaseContext context = table.context();
+  context.body.clear();
+  return context.prefix(table.line(key));
 }
 
 /// A non-empty boundary name, recorded for the check against the mesh in load_body.
@@ -158,7 +160,8 @@ BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
                         const std::filesystem::path& directory) {
   // The name goes into every later message, so it is looked at before the keys are checked.
   const auto name_node = (*entry.table)["name"].value<std::string>();
-  CaseContext context{file.file, name_node.value_or("")};
+  CaseContext context = file;
+  context.body = name_node.value_or("");
   const CheckedTable table(*entry.table, entry.path, context, body_keys);
   BodyCase body;
   BodyDefinition& definition = body.definition;

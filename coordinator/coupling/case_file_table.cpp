@@ -57,7 +57,11 @@ int line_of(const toml::node& node) {
 
 std::string CaseContext::prefix(int line) const {
   std::string text = file;
-  if (line > 0) text.append(":").append(std::to_string(line));
+  if (override_lines && override_lines->count(line) != 0) {
+    text = override_lines->at(line);  // a value given on the command line
+  } else if (line > 0) {
+    text.append(":").append(std::to_string(line));
+  }
   if (!body.empty()) text.append(": body '").append(body).append("'");
   return text;
 }

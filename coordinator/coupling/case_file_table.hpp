@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -23,6 +24,9 @@ namespace robin {
 struct CaseContext {
   std::string file;
   std::string body;  // empty outside a [[body]] table
+  /// Lines that hold values of command-line overrides, and the overrides' labels
+  /// (case_file_overrides.hpp): prefix() names the override instead of FILE:LINE.
+  std::shared_ptr<const std::map<int, std::string>> override_lines = nullptr;
   /// "FILE:LINE: body 'NAME'" (without ":LINE" when line <= 0, without the body part when
   /// the body is unknown).
   std::string prefix(int line) const;

@@ -14,6 +14,7 @@
 #include <string_view>
 #include <utility>
 
+#include "command_line.hpp"
 #include "protocol_version.hpp"
 #include "remote/conformance_body.hpp"
 #include "remote/conformance_session.hpp"
@@ -1173,11 +1174,8 @@ int server_check_main(int argc, const char* const* argv) {
   app.footer(
       "Exit codes: 0 the server conforms, 1 it does not (or a key file is unusable), 2 bad "
       "command line.");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    return app.exit(error) == 0 ? 0 : 2;
-  }
+  add_version_option(app, "robin-coordinator --check-server");
+  if (const auto code = parse_command_line(app, argc, argv)) return *code;
   if (const std::string problem = curve_options_problem(curve, 1); !problem.empty()) {
     std::cerr << "robin-coordinator --check-server: " << problem << "\n";
     return 2;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <vector>
 
+#include "coupling/case_file_overrides.hpp"
 #include "coupling/coupled_run.hpp"
 #include "numerics/errors.hpp"
 #include "remote/remote_port.hpp"
@@ -216,18 +217,12 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
                  "deadline of the mesh-sized requests (body setup: meshing, assembly, "
                  "factorization; fields), in seconds; default from the case file, 3600")
       ->check(positive());
-  app.add_option("--log-level", settings.log_level, "trace, debug, info, warn, error, off")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  CLI::Option* log_level =
+      app.add_option("--log-level", settings.log_level, "trace, debug, info, warn, error, off")
+          ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.add_flag("--quiet,-q", settings.quiet, "log only warnings and errors")->excludes(log_level);
+  add_override_option(app, settings.overrides);
   app.footer(exit_code_footer);
-}
-
-std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv) {
-  try {
-    app.parse(argc, argv);
-    return std::nullopt;
-  } catch (const CLI::ParseError& error) {
-    return app.exit(error) == 0 ? 0 : 2;
-  }
 }
 
 CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
@@ -287,7 +282,7 @@ std::string progress_line(const IterationRecord& record, const CouplingOptions& 
 
 std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {
   try {
-    return read_case_file(settings.case_file);
+    return read_case_file(settings.case_file, settings.overrides);
   } catch (const std::exception& error) {
     coordinator_logger()->error("{}", error.what());
     return std::nullopt;

@@ -14,7 +14,9 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "command_line.hpp"  // parse_command_line, add_version_option
 #include "coupling/case_file.hpp"
 #include "coupling/robin_iteration.hpp"
 #include "remote/request_channel.hpp"
@@ -42,15 +44,15 @@ struct CoordinatorSettings {
   std::optional<double> timeout_seconds;        // deadline of each interface-sized request
   std::optional<double> setup_timeout_seconds;  // deadline of the setup and fields requests
   std::string log_level = "info";
+  bool quiet = false;  // --quiet: the coordinator logs only warnings and errors
+  /// --set KEY=VALUE: overrides of case-file keys, in order (coupling/case_file_overrides.hpp).
+  std::vector<std::string> overrides;
 };
 
 /// Adds CASE, --output, --relaxation, --tolerance, --max-iterations, --initial-obstacle,
-/// --timeout, --setup-timeout and --log-level to `app`, and the exit codes to its footer.
+/// --timeout, --setup-timeout, --log-level, --quiet and --set to `app`, and the exit codes to
+/// its footer.
 void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings);
-
-/// Parses the command line; nullopt to go on, otherwise the exit code (0 after --help, 2 for
-/// a bad command line, the message printed).
-std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv);
 
 /// The case's [coupling] options with the command-line overrides applied.
 CouplingOptions merged_coupling_options(const CouplingOptions& from_case,

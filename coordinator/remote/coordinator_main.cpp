@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   robin::CoordinatorSettings settings;
   std::vector<std::string> subdomains;
   robin::add_coordinator_options(app, settings);
+  robin::add_version_option(app, "robin-coordinator");
   app.add_option("--subdomain", subdomains,
                  "endpoint of a robin-subdomain server (e.g. tcp://host:5555); give it twice, "
                  "the first serves body 1")
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
     std::cerr << "robin-coordinator: " << problem << "\nRun with --help for more information.\n";
     return 2;
   }
-  const auto log = robin::make_coordinator_logger(settings.log_level);
+  const auto log = robin::make_coordinator_logger(settings.quiet ? "warn" : settings.log_level);
   robin::install_stop_signal_handlers();
   std::vector<std::optional<robin::CurveClientKeys>> curve_keys;
   try {

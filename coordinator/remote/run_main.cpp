@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
       "robin-subdomain servers"};
   robin::CoordinatorSettings settings;
   robin::add_coordinator_options(app, settings);
+  robin::add_version_option(app, "robin-run");
   bool curve = false;
   app.add_flag("--curve", curve,
                "encrypt the connections to the local servers with CurveZMQ, with keys made for "
@@ -139,7 +140,8 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  robin::make_coordinator_logger(settings.log_level);
+  // --quiet quietens this terminal; the servers' log files keep --log-level.
+  robin::make_coordinator_logger(settings.quiet ? "warn" : settings.log_level);
   robin::install_stop_signal_handlers();
   const auto definition = robin::load_case(settings);
   if (!definition) return 1;

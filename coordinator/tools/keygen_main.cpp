@@ -2,12 +2,12 @@
 // Generates a CurveZMQ key pair (zmq_curve_keypair) for the encrypted transport
 // (docs/security.md) and writes PREFIX.public (the public key: give it to the peers) and
 // PREFIX.secret (public and secret key, mode 0600: keep it). Prints the public key.
-// Exit codes: 0 written; 1 CURVE unavailable or a file cannot be written (or exists without
-// --force); 2 bad command line.
+// Exit codes: 0 written (or --help, --version); 1 CURVE unavailable or a file cannot be written
+// (or exists without --force); 2 bad command line.
 
-#include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "command_line.hpp"
 #include "curve_keys.hpp"
 
 int main(int argc, char** argv) {
@@ -24,11 +24,8 @@ int main(int argc, char** argv) {
   app.footer(
       "Exit codes: 0 written; 1 CURVE unavailable or a file cannot be written; 2 bad command "
       "line.");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    return app.exit(error) == 0 ? 0 : 2;
-  }
+  robin::add_version_option(app, "robin-keygen");
+  if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
   try {
     if (!robin::curve_available()) {
       throw std::runtime_error("this libzmq is built without CURVE (zmq_has(\"curve\") is false)");

@@ -1,15 +1,19 @@
-// robin-monolithic CASE --output DIR
+// robin-monolithic CASE --output DIR [--set KEY=VALUE ...] [--quiet]
 // The single-process reference solver of the whole two-body contact problem (paper (5)).
-// Exit codes: 0 converged, 1 bad input or failure (also: a Dirichlet condition drives an excluded
-// contact pair into penetration; the results are written), 2 the QP did not converge.
+// Exit codes: 0 converged (or --help, --version); 1 bad input or failure (also: a Dirichlet
+// condition drives an excluded contact pair into penetration; the results are written); 2 bad
+// command line; 3 the contact QP did not converge (the results are written).
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <filesystem>
+#include <string>
+#include <vector>
 
+#include "command_line.hpp"
+#include "coupling/case_file_overrides.hpp"
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
 #include "coupling/result_files.hpp"
@@ -26,6 +30,7 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   const Eigen::Vector2d resultant = robin::contact_resultant(problem.pairing, result.contact_force);
   summary["method"] = "monolithic";
   summary["case"] = problem.definition.file.string();
+  summary["overrides"] = problem.definition.overrides;  // --set KEY=VALUE, in order
   summary["converged"] = result.qp.status == robin::QpStatus::converged;
   summary["qp_status"] = robin::to_string(result.qp.status);
   summary["iterations"] = result.qp.iterations;
@@ -89,10 +94,11 @@ void write_outputs(const std::filesystem::path& directory, const LocalProblem& p
   robin::write_json(directory / "summary.json", summary);
 }
 
-int run(const std::filesystem::path& case_path, const std::filesystem::path& output) {
+int run(const std::filesystem::path& case_path, const std::vector<std::string>& overrides,
+        const std::filesystem::path& output) {
   auto log = spdlog::get("monolithic");
   const auto start = std::chrono::steady_clock::now();
-  const robin::CaseDefinition definition = robin::read_case_file(case_path);
+  const robin::CaseDefinition definition = robin::read_case_file(case_path, overrides);
   log->info("case {}: bodies '{}' and '{}'", case_path.string(),
             definition.bodies[0].definition.name, definition.bodies[1].definition.name);
   const LocalProblem problem = robin::prepare_local_problem(definition);
@@ -127,7 +133,7 @@ int run(const std::filesystem::path& case_path, const std::filesystem::path& out
   log->info("results in {} (open solution.pvd in ParaView)", output.string());
   if (result.qp.status != robin::QpStatus::converged) {
     log->error("the contact QP did not converge: {}", result.qp.message);
-    return 2;
+    return 3;
   }
   if (clearance.relative_penetration > robin::excluded_pair_penetration_limit) {
     log->error("{}", clearance.description);
@@ -142,17 +148,26 @@ int main(int argc, char** argv) {
   CLI::App app{"robin-monolithic: single-process reference solve of a two-body contact case"};
   std::filesystem::path case_path, output;
   std::string level = "info";
+  bool quiet = false;
+  std::vector<std::string> overrides;
   app.add_option("case", case_path, "case file (TOML, see docs/case-format.md)")->required();
   app.add_option("--output,-o", output, "directory for the result files")->required();
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, off")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
-  CLI11_PARSE(app, argc, argv);
+  CLI::Option* log_level =
+      app.add_option("--log-level", level, "trace, debug, info, warn, error, off")
+          ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.add_flag("--quiet,-q", quiet, "log only warnings and errors")->excludes(log_level);
+  robin::add_override_option(app, overrides);
+  robin::add_version_option(app, "robin-monolithic");
+  app.footer(
+      "Exit codes: 0 converged; 1 bad input or a failure; 2 bad command line; 3 the contact QP "
+      "did not converge (results are written).");
+  if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
 
   auto log = spdlog::stderr_color_mt("monolithic");
   log->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%^%l%$] %v");
-  log->set_level(spdlog::level::from_str(level));
+  log->set_level(spdlog::level::from_str(quiet ? "warn" : level));
   try {
-    return run(case_path, output);
+    return run(case_path, overrides, output);
   } catch (const robin::InputError& error) {
     log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const robin::SingularBodyError& error) {

@@ -25,7 +25,7 @@ import sys
 import time
 
 from .proto_module import load_protocol
-from .protocol import PROTOCOL_MAJOR, SubdomainProtocol
+from .protocol import PROTOCOL_MAJOR, PROTOCOL_MINOR, SubdomainProtocol
 
 LOG_LEVELS = {"trace": 5, "debug": logging.DEBUG, "info": logging.INFO, "warn": logging.WARNING,
               "error": logging.ERROR, "critical": logging.CRITICAL, "off": logging.CRITICAL + 10}
@@ -42,6 +42,18 @@ CURVE_REFUSAL = (
     "(--listen tcp://127.0.0.1:PORT) and reach it through an SSH tunnel "
     "(ssh -L PORT:127.0.0.1:PORT HOST), or run it only on a network you trust; see "
     "docs/security.md, 'What is not protected'. For CurveZMQ, use robin-subdomain.")
+
+
+def product_version():
+    """The product version: the file VERSION at the top of the repository (the one place it is
+    kept, also read by CMake), or "unknown" when the server runs outside the repository."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir,
+                        "VERSION")
+    try:
+        with open(path, encoding="utf-8") as file:
+            return file.readline().strip() or "unknown"
+    except OSError:
+        return "unknown"
 
 
 def curve_option(arguments):
@@ -80,6 +92,10 @@ def parse_arguments(arguments):
                         help="directory under which FieldsRequest.write_directory is created "
                              "(relative paths, no symbolic links); without it every "
                              "write_directory is refused")
+    parser.add_argument("--version", action="version",
+                        version="robin-subdomain-py %s (protocol %d.%d)" %
+                        (product_version(), PROTOCOL_MAJOR, PROTOCOL_MINOR),
+                        help="print the product and protocol versions and exit")
     parser.add_argument("--send-timeout-ms", type=int, default=10000, help=argparse.SUPPRESS)
     # Testing only: announce and accept another protocol major version.
     parser.add_argument("--protocol-major", type=int, default=PROTOCOL_MAJOR,

@@ -5,18 +5,18 @@
 // Exit codes: 0 after Shutdown, SIGINT or SIGTERM (between requests: after the loop's clean
 // shutdown; during a request, such as a long setup: at once, the request abandoned, since the
 // run it belongs to is being stopped); 1 when the endpoint cannot be bound, the
-// transport fails, or the CURVE options or key files are unusable; CLI11's codes for bad
-// command lines.
+// transport fails, or the CURVE options or key files are unusable; 2 for a bad command line
+// (0 after --help and --version).
 
 #include <spdlog/spdlog.h>
 #include <unistd.h>
-#include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
 
+#include "command_line.hpp"
 #include "curve_keys.hpp"
 #include "protocol_version.hpp"
 #include "server/server_logging.hpp"
@@ -157,7 +157,8 @@ int main(int argc, char** argv) {
   CLI::App app{"robin-subdomain: serves one elastic body of a robin-contact run over ZeroMQ"};
   CommandLine command_line;
   add_options(app, command_line);
-  CLI11_PARSE(app, argc, argv);
+  robin::add_version_option(app, "robin-subdomain");
+  if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
 
   const auto logger = robin::subdomain_logger();
   logger->set_level(spdlog::level::from_str(command_line.log_level));
