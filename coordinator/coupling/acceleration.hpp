@@ -3,9 +3,9 @@
 //
 // The iteration is a fixed-point map x -> H(x) on the stacked obstacles x = (g^1, g^2), with
 //   H^1(g) = w^2_N - u^2_N + d,   H^2(g) = w^1_N - u^1_N + d,
-// and residual r(x) = H(x) - x. In the all-active regime the two blocks are independent linear
-// maps (docs: algorithm.md, "Structure worth knowing"), which is why every method can run per
-// body. Methods:
+// and residual r(x) = H(x) - x. The two blocks are independent maps, H^1 depending on g^1 only and
+// H^2 on g^2 only (docs/method.md, "Either sequence alone"; in the all-active regime they are
+// linear, "Choosing delta"), which is why every method can run per body. Methods:
 //   "none"    x_{k+1} = (1 - delta_a) x_k + delta_a H(x_k) per body: exactly the paper's update;
 //   "aitken"  the same with a dynamic factor omega per body (Irons-Tuck / Aitken);
 //   "iqn-ils" Anderson mixing / interface quasi-Newton with inverse least squares, on each
@@ -20,10 +20,9 @@
 namespace robin {
 
 struct AccelerationOptions {
-  /// "none", "aitken" or "iqn-ils". Default "iqn-ils" (per body, full mixing): with the
-  /// "either-sequence" stopping of the Robin loop it reaches 1e-8 on every case of the
-  /// iteration study in at most 13 iterations at every h (docs/iteration-study.md); Aitken
-  /// needs up to 43 on the asymmetric pair.
+  /// "none", "aitken" or "iqn-ils". Default "iqn-ils" (per body, full mixing); with the
+  /// "either-sequence" stopping of the Robin loop its iteration count does not grow with the
+  /// mesh on the cases of docs/iteration-study.md, which lists the counts of every method.
   std::string method = "iqn-ils";
   /// delta per body: the step of "none", and the first step (and every restart) of "iqn-ils".
   double relaxation1 = 0.5, relaxation2 = 0.5;
@@ -44,9 +43,10 @@ struct AccelerationOptions {
   /// sequence must converge; for it "full" leaves the modes outside the secant space multiplied
   /// by about -F^b (F^a)^-1, small, while the secant estimate of "aitken" follows the few
   /// large eigenvalues the history already captures (a cantilever's bending) and freezes the
-  /// rest: 12-13 iterations at every h on the asymmetric pair with "full", 15 -> 30 from h to
-  /// h/8 with "aitken" (docs/iteration-study.md). "aitken" keeps a truncated history of a badly
-  /// conditioned sequence convergent where "full" may not (tests/unit/acceleration_test.cpp).
+  /// rest, so that its count grows with mesh refinement where that of "full" does not
+  /// (docs/iteration-study.md, "IQN-ILS mixing on the asymmetric pair"). "aitken" keeps a
+  /// truncated history of a badly conditioned sequence convergent where "full" may not
+  /// (tests/unit/acceleration_test.cpp).
   std::string mixing = "full";
   /// "iqn-ils": an independent IQN-ILS on each body's block (true), or one on (g^1, g^2).
   /// Per body is the default: the blocks are independent maps, and an ill-conditioned block

@@ -329,7 +329,7 @@ TEST(FilteredQr, FactorsIndependentColumnsAndDropsADependentOne) {
 
 // --- Two bodies with compliance ratio c --------------------------------------------------------
 
-/// The all-active Robin iteration (algorithm.md, "Structure worth knowing"): with interface
+/// The all-active Robin iteration (docs/method.md, "Choosing delta"): with interface
 /// compliances F^1 and F^2,
 ///   H^1(g^1) = -F^2 (F^1)^{-1} g^1 + c^1,   H^2(g^2) = -F^1 (F^2)^{-1} g^2 + c^2,
 /// so the error of g^1 is multiplied by I - delta (I + F^2 (F^1)^{-1}) and that of g^2 by
@@ -460,7 +460,7 @@ int first_below(const std::vector<double>& errors, double tolerance) {
 }
 
 TEST(TwoBodies, PerBodyQuasiNewtonIsolatesTheGoodSequenceFromANoisyOne) {
-  // Either sequence alone fixes the solution (algorithm.md), so the good one must not be held
+  // Either sequence alone fixes the solution (docs/method.md), so the good one must not be held
   // back by the other. Per body, body 1's iterates do not depend on H^2 at all.
   std::mt19937 generator(7);
   const int size = 16;
