@@ -82,7 +82,7 @@ def _replace_file(directory, file_name, text):
     descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644,
                          dir_fd=directory)
     try:
-        with os.fdopen(descriptor, "w") as stream:
+        with os.fdopen(descriptor, "wb" if isinstance(text, bytes) else "w") as stream:
             stream.write(text)
         os.replace(temporary, file_name, src_dir_fd=directory, dst_dir_fd=directory)
     except BaseException:

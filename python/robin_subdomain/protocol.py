@@ -50,7 +50,7 @@ from . import SERVER_NAME
 from .assignment import decode_assign_contact
 from .body import Body
 from .errors import InputError, RequestError, SingularBodyError
-from .fields import body_fields, vtu_text
+from .fields import body_fields, vtu_bytes
 from .mesh import LINE2, VTK_CELL_TYPE
 from .mesh_data import quoted
 from .paths import PathRefused, check_output_directory, write_under_root
@@ -383,7 +383,7 @@ class SubdomainProtocol:
         self._fill_fields_reply(fields, reply.fields_reply)
         self._require_finite(reply.fields_reply, "FieldsRequest", record)
         if message.write_directory:
-            text = vtu_text(self.body.mesh, fields)
+            text = vtu_bytes(self.body.mesh, fields)
             path = self._output_refusal(
                 lambda: write_under_root(self.output_root, message.write_directory,
                                          self.body.name + ".vtu", text),
@@ -412,6 +412,13 @@ class SubdomainProtocol:
             out.cell_types.append(VTK_CELL_TYPE[block.type])
             out.connectivity.extend(int(node) for node in block.connectivity.ravel())
             out.cell_offsets.append(len(out.connectivity))
+        for name in sorted(mesh.boundaries):  # since 2.1: the named boundaries, for the output
+            boundary = out.boundaries.add()
+            boundary.name = name
+            group = mesh.boundaries[name]
+            boundary.segments.type = (self.protocol.LINE2 if group.type == LINE2
+                                      else self.protocol.LINE3)
+            boundary.segments.connectivity.extend(int(node) for node in group.connectivity.ravel())
         for target, source in ((out.point_fields, fields.point_fields),
                                (out.cell_fields, fields.cell_fields)):
             for name, components, values in source:

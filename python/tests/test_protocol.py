@@ -603,7 +603,49 @@ class FieldsOutput(ServerTestCase):
         reply = self.ask(self.fields("results/run-1")).fields_reply
         expected = self.root / "results" / "run-1" / "lower.vtu"
         self.assertEqual(reply.written_file, str(expected))
-        self.assertTrue(expected.read_text().startswith('<?xml version="1.0"?>'))
+        self.assertTrue(expected.read_bytes().startswith(b'<?xml version="1.0"?>'))
+
+    def test_the_file_holds_the_reply_fields_as_vtk_reads_them(self):
+        """The written .vtu read by VTK's reader (python3-vtk9, ParaView's): binary and
+        zlib-compressed; the reply's points and fields; the stress as (XX, YY, ZZ, XY, YZ, XZ)
+        with ZZ = nu (XX + YY) (plane strain, nu = 0.3) and YZ = XZ = 0; the reply's named
+        boundaries as line cells (VTK_LINE) with boundary_id k naming boundary_names[k - 1]."""
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+        from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+        message = request(fields=protocol.FieldsRequest(contact_force=[1.0] * self.count,
+                                                        write_directory="run"))
+        reply = self.ask(message).fields_reply
+        path = self.root / "run" / "lower.vtu"
+        self.assertIn(b'compressor="vtkZLibDataCompressor"', path.read_bytes()[:400])
+        reader = vtkXMLUnstructuredGridReader()
+        reader.SetFileName(str(path))
+        reader.Update()
+        grid = reader.GetOutput()
+        points = vtk_to_numpy(grid.GetPoints().GetData())
+        np.testing.assert_array_equal(points[:, :2],
+                                      np.reshape(reply.node_coordinates, (-1, 2)))
+        fields = {field.name: np.reshape(field.values, (-1, field.components))
+                  for field in reply.point_fields}
+        displacement = vtk_to_numpy(grid.GetPointData().GetArray("displacement"))
+        np.testing.assert_array_equal(displacement[:, :2], fields["displacement"])
+        self.assertGreater(np.abs(displacement).max(), 0.0)
+        stress = vtk_to_numpy(grid.GetPointData().GetArray("stress"))
+        np.testing.assert_array_equal(stress, fields["stress"])
+        np.testing.assert_allclose(stress[:, 2], 0.3 * (stress[:, 0] + stress[:, 1]),
+                                   rtol=1e-15, atol=1e-15 * np.abs(stress).max())
+        np.testing.assert_array_equal(stress[:, 4:], 0.0)
+        names = grid.GetFieldData().GetAbstractArray("boundary_names")
+        self.assertEqual([names.GetValue(k) for k in range(names.GetNumberOfValues())],
+                         sorted(boundary.name for boundary in reply.boundaries))
+        self.assertEqual(sorted(boundary.name for boundary in reply.boundaries),
+                         ["bottom", "contact", "left", "right"])
+        boundary_id = vtk_to_numpy(grid.GetCellData().GetArray("boundary_id"))
+        types = np.array([grid.GetCellType(k) for k in range(grid.GetNumberOfCells())])
+        element_count = len(reply.connectivity) // 3
+        np.testing.assert_array_equal(boundary_id[:element_count], 0)
+        np.testing.assert_array_equal(types[element_count:], 3)
+        segments = sum(len(boundary.segments.connectivity) // 2 for boundary in reply.boundaries)
+        self.assertEqual(len(types), element_count + segments)
 
     def test_a_symbolic_link_at_the_target_is_replaced_not_followed(self):
         victim = self.elsewhere / "victim.txt"
@@ -614,7 +656,7 @@ class FieldsOutput(ServerTestCase):
         self.assertEqual(victim.read_text(), "untouched")
         target = self.root / "out" / "lower.vtu"
         self.assertFalse(target.is_symlink())
-        self.assertIn("<VTKFile", target.read_text())
+        self.assertIn(b"<VTKFile", target.read_bytes())
 
     def test_directories_outside_the_root_are_refused(self):
         for directory, reason in (("../escape", "contains '..'"),
