@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include <sys/stat.h>
 #include <unistd.h>
 #include <cstdlib>
 
@@ -97,12 +98,14 @@ std::string write_body_output(const std::filesystem::path& directory, const Body
   std::filesystem::create_directories(directory);
   // A fresh temporary file (mkstemp: O_EXCL, so never through an existing link), renamed into
   // place: a symbolic link at the target is replaced, not followed, and a reader never sees a
-  // half-written file.
+  // half-written file. mkstemp creates the file for its owner only; a result file is made
+  // readable by everyone (0644, as the Python server writes it).
   std::string temporary = (directory / ("." + file_name + ".XXXXXX")).string();
   const int descriptor = mkstemp(temporary.data());
   if (descriptor < 0) {
     throw std::runtime_error("cannot create a temporary file in '" + directory.string() + "'");
   }
+  fchmod(descriptor, S_IRUSR | S_IWUSR | S_IRGRP | S_IROTH);
   close(descriptor);
   try {
     write_vtu(temporary, output.mesh, output.point_fields, output.cell_fields);

@@ -245,6 +245,9 @@ TEST_P(BodyVtuModels, UniaxialCompressionFieldsReadByVtkMatchTheAnalyticSolution
   const TemporaryDirectory directory("result_files");
   const auto output = directory.path() / "not_yet_created";
   EXPECT_EQ(write_body_vtu(output, body, lambda), "block.vtu");
+  using std::filesystem::perms;
+  EXPECT_EQ(std::filesystem::status(output / "block.vtu").permissions(),
+            perms::owner_read | perms::owner_write | perms::group_read | perms::others_read);
   // The file is binary and compressed, and VTK's reader (ParaView's) reads it.
   EXPECT_EQ(read_vtk_xml(output / "block.vtu")["root"]["compressor"], "vtkZLibDataCompressor");
   const json grid = test::read_vtu_with_vtk(output / "block.vtu");
