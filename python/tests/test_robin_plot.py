@@ -240,7 +240,7 @@ class CommandLine(unittest.TestCase):
     def test_version_is_the_project_version(self):
         status, stdout, _ = run(BIN / "robin-plot", "--version")
         self.assertEqual(status, 0)
-        self.assertEqual(stdout.strip(), f"robin-plot (robin-contact) {project_version()}")
+        self.assertEqual(stdout.strip(), f"robin-plot {project_version()}")
 
     def test_usage_errors_exit_2(self):
         for arguments in ([], ["a", "b"], ["--no-such-option", "a"]):
