@@ -229,6 +229,27 @@ class HertzRun(unittest.TestCase):
                       stdout)
 
 
+@unittest.skipUnless((BIN / "robin-run").exists(), f"no robin-run in {BIN}: build it first")
+class UnconvergedRun(unittest.TestCase):
+    def test_iteration_limit_is_plotted_with_the_last_stopping_residual(self):
+        with tempfile.TemporaryDirectory() as scratch:
+            directory = pathlib.Path(scratch) / "limit"
+            status, _, log = run(BIN / "robin-run", REPOSITORY / "examples" / "asymmetric.toml",
+                                 "--output", directory, "--max-iterations", "3")
+            self.assertEqual(status, 3, log)  # the iteration limit
+            history = read_csv(directory / "history.csv")
+            self.assertEqual(len(history), 3)
+            last = float(history[-1]["stopping_residual"])
+            self.assertGreater(last, 1e-8)
+            self.assertIn(f"iteration limit reached after 3 iterations (either-sequence "
+                          f"stopping, tolerance 1e-08): the stopping test's last value "
+                          f"{last:.1e}", log)
+            status, stdout, stderr = run(BIN / "robin-plot", directory)
+            self.assertEqual(status, 0, stderr)
+            self.assertIn(f"history.png: iteration limit reached after 3 iterations: the "
+                          f"stopping residual ended at {last:.1e} > tolerance 1e-08", stdout)
+
+
 @unittest.skipUnless((BIN / "robin-plot").exists(), f"no robin-plot in {BIN}")
 class CommandLine(unittest.TestCase):
     def test_help(self):
