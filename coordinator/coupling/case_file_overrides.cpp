@@ -232,7 +232,7 @@ void add_override_option(CLI::App& app, std::vector<std::string>& overrides) {
                      (message.rfind(label, 0) == 0 ? message.substr(label.size()) : message);
             }
           },
-          "KEY=VALUE"));
+          ""));  // the type name says KEY=VALUE already
 }
 
 std::string mention_overrides(const std::string& message,
