@@ -296,6 +296,31 @@ class MonolithicRun(unittest.TestCase):
             self.assertFalse((directory / "history.png").exists())
             self.assertIn("contact.png: Hertz p0 =", stdout)
 
+    def test_cylinder_on_a_half_space_matches_the_verification_table(self):
+        # docs/verification.md, "Hertz: a real cylinder on non-matching meshes", row h = 0.1
+        # (benchmarks/hertz_mortar_study.sh, the same fit): P = 0.83217, a = 0.04332 against
+        # 0.04391 (-1.36 %), p0 = 12.2154 against 12.0641 (+1.25 %).
+        with tempfile.TemporaryDirectory() as scratch:
+            directory = pathlib.Path(scratch) / "cylinder"
+            status, _, log = run(BIN / "robin-monolithic",
+                                 REPOSITORY / "examples" / "hertz_cylinder.toml",
+                                 "--output", directory)
+            self.assertEqual(status, 0, log)
+            status, stdout, stderr = run(BIN / "robin-plot", directory)
+            self.assertEqual(status, 0, stderr)
+            numbers = re.search(r"Hertz p0 = (\S+), a = (\S+) \(P = (\S+) from .*computed "
+                                r"p0 = (\S+) \((\S+)%\), a = (\S+) \((\S+)%\)", stdout)
+            self.assertIsNotNone(numbers, stdout)
+            hertz_peak, hertz_half_width, load, peak, peak_error, half_width, half_width_error = (
+                float(value) for value in numbers.groups())
+            self.assertAlmostEqual(load, 0.83217, delta=1e-5)
+            self.assertAlmostEqual(hertz_half_width, 0.04391, delta=1e-5)
+            self.assertAlmostEqual(hertz_peak, 12.0641, delta=1e-4)
+            self.assertAlmostEqual(half_width, 0.04332, delta=1e-5)
+            self.assertAlmostEqual(peak, 12.2154, delta=1e-4)
+            self.assertAlmostEqual(half_width_error, -1.36, delta=0.01)
+            self.assertAlmostEqual(peak_error, 1.25, delta=0.01)
+
 
 if __name__ == "__main__":
     unittest.main()
