@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "coupling/case_file_body.hpp"
+#include "coupling/case_file_loading.hpp"
 #include "coupling/case_file_overrides.hpp"
 #include "coupling/case_file_table.hpp"
 #include "coupling/gap_function.hpp"
@@ -13,8 +14,8 @@ namespace robin {
 
 namespace {
 
-const std::vector<std::string> root_keys{"title",   "gap",  "solver",   "coupling",
-                                         "contact", "body", "reference"};
+const std::vector<std::string> root_keys{"title",   "gap",  "solver",  "coupling",
+                                         "contact", "body", "loading", "reference"};
 const std::vector<std::string> contact_keys{"method", "non_mortar"};
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
@@ -281,6 +282,7 @@ static CaseDefinition read_case_document(const std::filesystem::path& path,
   read_solver(root, definition.solver);
   read_coupling(root, definition.coupling);
   read_contact(root, definition.contact);
+  definition.loading = read_loading(root);  // [loading]: coupling/case_file_loading.hpp
   read_bodies(root, path.parent_path(), definition);
   definition.reference = read_reference(root);  // after the bodies: their materials give E*
   if (!definition.contact.non_mortar.empty() &&

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "coupling/acceleration.hpp"
+#include "coupling/case_file_loading.hpp"
 #include "coupling/case_file_reference.hpp"
 #include "coupling/contact_discretization.hpp"
 #include "numerics/body_definition.hpp"
@@ -86,6 +87,7 @@ struct CaseDefinition {
   /// The command-line overrides applied to the file, in order, as given ("KEY=VALUE", see
   /// case_file_overrides.hpp); empty when the file is read as it is.
   std::vector<std::string> overrides;
+  LoadingOptions loading;  // [loading]: quasi-static load steps (none: one solve at factor 1)
   std::optional<ReferenceSolution> reference;  // [reference]: an analytic solution, for plots
 };
 

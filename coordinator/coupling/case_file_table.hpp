@@ -59,6 +59,8 @@ class CheckedTable {
   /// "FILE:LINE: body 'NAME'" for `key` (see line(key)).
   std::string location(std::string_view key) const;
   bool contains(std::string_view key) const { return table_.contains(key); }
+  /// The TOML table itself, for readers of values no accessor below covers.
+  const toml::table& raw() const { return table_; }
 
   std::optional<double> optional_number(std::string_view key) const;
   double number(std::string_view key) const;

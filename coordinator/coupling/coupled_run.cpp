@@ -6,9 +6,12 @@
 #include <future>
 #include <iomanip>
 #include <limits>
+#include <sstream>
+#include <utility>
 
 #include "coupling/local_problem.hpp"
 #include "coupling/result_files.hpp"
+#include "coupling/step_outputs.hpp"
 
 namespace robin {
 namespace {
@@ -215,51 +218,68 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   return summary;
 }
 
-}  // namespace
+/// The start of load step `factor` from the fixed points of the steps before it: the linear
+/// extrapolation x_p + (t - t_p) / (t_p - t_q) (x_p - x_q) through the last two, (t_q, x_q) and
+/// (t_p, x_p), or x_p alone when there is one or the factors coincide. In a fixed active set the
+/// fixed point is an affine function of the load factor (e = t e_1, d fixed), so the
+/// extrapolation is exact there; when the contact zone changes it is a prediction.
+Eigen::VectorXd predicted_start(const std::vector<std::pair<double, Eigen::VectorXd>>& points,
+                                double factor) {
+  const auto& [last_factor, last] = points.back();
+  if (points.size() < 2) return last;
+  const auto& [before_factor, before] = points[points.size() - 2];
+  if (last_factor == before_factor || before.size() != last.size()) return last;
+  return last + ((factor - last_factor) / (last_factor - before_factor)) * (last - before);
+}
 
-CoupledRunResult run_coupled_case(const CaseDefinition& definition,
-                                  const std::array<SubdomainPort*, 2>& ports,
-                                  const CouplingOptions& options, const RunObserver& observer) {
-  const auto start = Clock::now();
-  CoupledRunResult result;
-  result.options = options;
-  report_stage(observer, "reading and meshing both bodies");
-  CaseDefinition loaded = definition;
-  load_meshes(loaded);
-  result.meshing_seconds = seconds_since(start);
-  report_stage(observer, "setting up both bodies (assembly, factorization)");
-  result.interfaces = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
-    return port.setup(loaded.bodies[alpha], definition.solver);
-  });
-  const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
-  const std::string& name1 = definition.bodies[0].definition.name;
-  const std::string& name2 = definition.bodies[1].definition.name;
-  const auto coupling_start = Clock::now();
-  result.pairing =
-      discretize_contact(result.interfaces[0], name1, result.interfaces[1], name2, gap.get(),
-                         definition.contact, definition.solver.pairing_tolerance);
-  result.coupling_seconds = seconds_since(coupling_start);
-  report_stage(observer, describe_contact(result.pairing, name1, name2));
-  for (const std::string& line : result.pairing.excluded) report_stage(observer, line);
-  if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
-    report_stage(observer, overlap);
-  for (int alpha = 0; alpha < 2; ++alpha)
-    ports[alpha]->assign_contact(result.pairing.assignment(alpha));
-  result.setup_seconds = seconds_since(start);
+/// Whether the first step's start, the scheme's iterate for the initial obstacle d, is the
+/// fixed point at load factor 0: with no load and no prescribed displacement u = 0, so for
+/// "robin", "robin-constant" and "dirichlet-neumann" H(x) = d when no gap is negative.
+bool start_is_the_unloaded_fixed_point(const CouplingOptions& options,
+                                       const ContactPairing& pairing) {
+  const bool obstacle_scheme = options.algorithm == "robin" ||
+                               options.algorithm == "robin-constant" ||
+                               options.algorithm == "dirichlet-neumann";
+  return obstacle_scheme && options.initial_obstacle == "gap" && pairing.size() > 0 &&
+         pairing.gaps().minCoeff() >= 0.0;
+}
 
-  const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
-  result.iteration =
-      run_robin_iteration(*ports[0], *ports[1], result.pairing, options, observer.iteration);
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    result.iteration_port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
+/// The load steps of a case with [loading] on ports whose contact is assigned (see
+/// run_coupled_case). Fills result.steps and, from the last step computed, result.iteration,
+/// outputs and iteration_port_timings; result.excluded_clearance is the worst over the steps.
+void run_load_steps(const LoadingOptions& loading, const std::array<SubdomainPort*, 2>& ports,
+                    const CouplingOptions& options, const RunObserver& observer,
+                    CoupledRunResult& result) {
+  const std::size_t count = loading.factors.size();
+  // The fixed points (restart iterates) of the steps so far, with their load factors.
+  std::vector<std::pair<double, Eigen::VectorXd>> points;
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto step_start = Clock::now();
+    LoadStepResult step;
+    step.step = static_cast<int>(k + 1);
+    step.factor = loading.factors[k];
+    step.warm_started = loading.warm_start && !points.empty();
+    std::ostringstream stage;
+    stage << "load step " << step.step << "/" << count << ": load factor " << step.factor
+          << (step.warm_started ? ", starting from the previous steps" : "");
+    report_stage(observer, stage.str());
+    if (definition.loading.stepped()) {
+    run_load_steps(definition.loading, ports, options, observer, result);
+  } else {
+    const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
+    result.iteration =
+        run_robin_iteration(*ports[0], *ports[1], result.pairing, options, observer.iteration);
+    for (int alpha = 0; alpha < 2; ++alpha) {
+      result.iteration_port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
+    }
+    report_stage(observer, "collecting the fields of both bodies");
+    const RobinResult& iteration = result.iteration;
+    result.outputs = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
+      return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
+    });
+    result.excluded_clearance = excluded_clearance(result);
   }
-  report_stage(observer, "collecting the fields of both bodies");
-  const RobinResult& iteration = result.iteration;
-  result.outputs = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
-    return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
-  });
   for (int alpha = 0; alpha < 2; ++alpha) result.port_timings[alpha] = ports[alpha]->timings();
-  result.excluded_clearance = excluded_clearance(result);
   result.total_seconds = seconds_since(start);
   return result;
 }
@@ -277,7 +297,12 @@ void write_coupled_outputs(const std::filesystem::path& directory, const CaseDef
     write_contact_csv(directory / "contact.csv", result.pairing, state);
   }
   write_history_csv(directory / "history.csv", iteration.history, result.options);
-  write_json(directory / "summary.json", make_summary(definition, result));
+  nlohmann::json summary = make_summary(definition, result);
+  if (!result.steps.empty()) {  // [loading]: the time series and per-step files (step_outputs)
+    write_coupled_step_outputs(directory, definition, result);
+    summary["load_steps"] = coupled_steps_json(result);
+  }
+  write_json(directory / "summary.json", summary);
 }
 
 int exit_code(IterationStatus status) {

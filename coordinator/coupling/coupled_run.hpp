@@ -14,6 +14,18 @@
 
 namespace robin {
 
+/// One quasi-static load step of a case with [loading] (case_file_loading.hpp).
+struct LoadStepResult {
+  int step = 0;               // 1, 2, ...
+  double factor = 1.0;        // the load factor of the step
+  bool warm_started = false;  // started from the previous steps' fixed points
+  RobinResult iteration;
+  std::array<BodyOutput, 2> outputs;
+  ExcludedPairClearance excluded_clearance;
+  std::array<PortTimings, 2> port_timings;  // the step alone: load factor, iteration, fields
+  double seconds = 0.0;                     // wall time of the step
+};
+
 struct CoupledRunResult {
   CouplingOptions options;  // the options the iteration ran with
   ContactPairing pairing;
@@ -30,6 +42,11 @@ struct CoupledRunResult {
   double meshing_seconds = 0.0;   // reading and meshing both bodies (coordinator side)
   double coupling_seconds = 0.0;  // building the contact rows (pairing or mortar)
   double total_seconds = 0.0;
+  /// The load steps of a case with [loading], in order, up to the first that did not converge
+  /// (the run stops there); empty for a case without [loading]. The fields above then describe
+  /// the last step computed (iteration, outputs, iteration_port_timings), except
+  /// excluded_clearance, the largest penetration over the steps.
+  std::vector<LoadStepResult> steps;
 };
 
 /// Observer of the run's stages ("setup", "pairing", iteration records) for progress lines.
@@ -40,6 +57,11 @@ struct RunObserver {
 
 /// Runs the case on the ports (ports[0] gets body 1). `options` replaces the case's
 /// [coupling] table (the caller merges command-line overrides). Throws PortError, InputError.
+/// A case with [loading] sets the bodies up and assigns the contact once, then per step sets
+/// the load factor on both ports (SetLoadFactor: the servers keep K's factor and F), runs the
+/// iteration (with loading.warm_start from the previous steps' fixed points: the last one, or
+/// the linear extrapolation through the last two to the step's factor), and collects the
+/// fields; it stops after the first step that does not converge.
 CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                   const std::array<SubdomainPort*, 2>& ports,
                                   const CouplingOptions& options, const RunObserver& observer = {});

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "numerics/errors.hpp"
+
 namespace robin {
 
 BodySolver& InProcessPort::body() {
@@ -59,6 +61,14 @@ void InProcessPort::start_neumann_solve(const Eigen::VectorXd& contact_force, in
 
 CorrectionSolveResult InProcessPort::finish_neumann_solve() {
   return neumann_result_;
+}
+
+void InProcessPort::set_load_factor(double factor) {
+  try {
+    body().set_load_factor(factor);
+  } catch (const InputError& error) {
+    throw PortError(describe() + ", step load factor: " + error.what());
+  }
 }
 
 BodyOutput InProcessPort::fields(const Eigen::VectorXd& contact_force) {

@@ -20,6 +20,7 @@ class InProcessPort final : public SubdomainPort {
   CorrectionSolveResult finish_correction() override;
   void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;
   CorrectionSolveResult finish_neumann_solve() override;
+  void set_load_factor(double factor) override;
   BodyOutput fields(const Eigen::VectorXd& contact_force) override;
   void end_run() noexcept override;
   const PortTimings& timings() const override { return timings_; }

@@ -55,8 +55,8 @@ InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::
 }
 
 MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& body2,
-                                  const ContactPairing& pairing,
-                                  const MprgpParameters& parameters) {
+                                  const ContactPairing& pairing, const MprgpParameters& parameters,
+                                  const Eigen::VectorXd& initial_force) {
   const auto start = std::chrono::steady_clock::now();
   const Eigen::Index size = static_cast<Eigen::Index>(pairing.size());
   if (body1.contact_size() != size || body2.contact_size() != size) {
@@ -70,8 +70,11 @@ MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& bod
   MonolithicResult result;
   MprgpParameters scaled = parameters;
   scaled.solution_scaled_tolerance = true;  // resolve lambda relative to itself, not to |e - d|
-  result.qp = solve_mprgp(compliance, right_hand_side, Eigen::VectorXd::Zero(size),
-                          Eigen::VectorXd::Zero(size), scaled);
+  const Eigen::VectorXd initial = initial_force.size() == size
+                                      ? Eigen::VectorXd(initial_force.cwiseMax(0.0))
+                                      : Eigen::VectorXd(Eigen::VectorXd::Zero(size));
+  result.qp =
+      solve_mprgp(compliance, right_hand_side, Eigen::VectorXd::Zero(size), initial, scaled);
   result.contact_force = result.qp.solution;
   // u_N = e - F lambda on each body
   Eigen::VectorXd product;
@@ -84,6 +87,28 @@ MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& bod
   result.solve_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+std::vector<MonolithicStep> solve_monolithic_steps(BodySolver& body1, BodySolver& body2,
+                                                   const ContactPairing& pairing,
+                                                   const LoadingOptions& loading,
+                                                   const MprgpParameters& parameters) {
+  std::vector<MonolithicStep> steps;
+  for (std::size_t k = 0; k < loading.factors.size(); ++k) {
+    MonolithicStep step;
+    step.step = static_cast<int>(k + 1);
+    step.factor = loading.factors[k];
+    body1.set_load_factor(step.factor);
+    body2.set_load_factor(step.factor);
+    const Eigen::VectorXd initial = loading.warm_start && !steps.empty()
+                                        ? steps.back().result.contact_force
+                                        : Eigen::VectorXd();
+    step.result = solve_monolithic(body1, body2, pairing, parameters, initial);
+    const bool converged = step.result.qp.status == QpStatus::converged;
+    steps.push_back(std::move(step));
+    if (!converged) break;
+  }
+  return steps;
 }
 
 }  // namespace robin

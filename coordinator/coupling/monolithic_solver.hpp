@@ -5,7 +5,9 @@
 // with the same factors and the same MPRGP as the subdomain solves.
 
 #include <Eigen/Core>
+#include <vector>
 
+#include "coupling/case_file_loading.hpp"
 #include "coupling/contact_pairing.hpp"
 #include "numerics/body_solver.hpp"
 
@@ -28,9 +30,28 @@ struct MonolithicResult {
   double solve_seconds = 0.0;
 };
 
-/// Both bodies must have been given pairing.assignment(0) and (1).
+/// Both bodies must have been given pairing.assignment(0) and (1). MPRGP starts from
+/// `initial_force` (lambda >= 0, pair order) when it is given, from 0 otherwise.
 MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& body2,
-                                  const ContactPairing& pairing, const MprgpParameters& parameters);
+                                  const ContactPairing& pairing, const MprgpParameters& parameters,
+                                  const Eigen::VectorXd& initial_force = {});
+
+/// One quasi-static load step of the monolithic reference.
+struct MonolithicStep {
+  int step = 0;         // 1, 2, ...
+  double factor = 1.0;  // the load factor of the step
+  MonolithicResult result;
+};
+
+/// The load steps of `loading` (case_file_loading.hpp): for each factor t_k, both bodies' loads
+/// and prescribed displacements are scaled by t_k (BodySolver::set_load_factor: the factors and
+/// F are kept) and the monolithic problem is solved, MPRGP starting from the previous step's
+/// contact force when loading.warm_start. Stops after the first step whose QP did not converge;
+/// leaves both bodies at the last computed step's factor.
+std::vector<MonolithicStep> solve_monolithic_steps(BodySolver& body1, BodySolver& body2,
+                                                   const ContactPairing& pairing,
+                                                   const LoadingOptions& loading,
+                                                   const MprgpParameters& parameters);
 
 /// Residuals of (u1_N, u2_N, lambda1, lambda2) against the gaps d. Displacement scale:
 /// max(max|d|, max|u1_N|, max|u2_N|, tiny); force scale: max(max lambda, tiny).

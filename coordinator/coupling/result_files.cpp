@@ -102,6 +102,43 @@ void write_solution_pvd(const std::filesystem::path& directory, const std::strin
   write_pvd(directory / "solution.pvd", {file1, file2});
 }
 
+void write_pvd_series(const std::filesystem::path& path, const std::vector<PvdDataSet>& datasets) {
+  ensure_directory(path.parent_path());
+  const auto escaped = [](const std::string& text) {
+    std::string result;
+    for (const char c : text) {
+      switch (c) {
+        case '&':
+          result += "&amp;";
+          break;
+        case '<':
+          result += "&lt;";
+          break;
+        case '>':
+          result += "&gt;";
+          break;
+        case '"':
+          result += "&quot;";
+          break;
+        default:
+          result += c;
+      }
+    }
+    return result;
+  };
+  std::ofstream out = open_for_writing(path);
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "  <Collection>\n";
+  for (const PvdDataSet& dataset : datasets) {
+    out << "    <DataSet timestep=\"" << exact_text(dataset.timestep) << "\" group=\"\" part=\""
+        << dataset.part << "\" file=\"" << escaped(dataset.file) << "\"/>\n";
+  }
+  out << "  </Collection>\n"
+      << "</VTKFile>\n";
+  finish_writing(out, path);
+}
+
 void write_json(const std::filesystem::path& path, const nlohmann::json& document) {
   ensure_directory(path.parent_path());
   // invalid UTF-8 (e.g. from a path) is replaced rather than thrown after the file is opened

@@ -11,6 +11,7 @@
 #include "coupling/case_file_body.hpp"
 #include "coupling/coupling_scheme.hpp"
 #include "coupling/monolithic_solver.hpp"
+#include "numerics/errors.hpp"
 
 namespace robin {
 namespace {
@@ -298,6 +299,7 @@ std::string to_string(IterationStatus status) {
 RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
                               const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                               const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
+                              const Eigen::VectorXd* initial_iterate,
                               const IterationObserver& observer);
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
@@ -311,7 +313,15 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const ContactPairing& pairing, const CouplingOptions& options,
                                 const IterationObserver& observer) {
   return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
-                           short_wavelength_forces(pairing), options, observer);
+                           short_wavelength_forces(pairing), options, nullptr, observer);
+}
+
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const ContactPairing& pairing, const CouplingOptions& options,
+                                const Eigen::VectorXd& initial_iterate,
+                                const IterationObserver& observer) {
+  return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
+                           short_wavelength_forces(pairing), options, &initial_iterate, observer);
 }
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
@@ -319,12 +329,13 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const CouplingOptions& options, const IterationObserver& observer) {
   Eigen::VectorXd probe = weights;  // without positions: alternate in pair order
   for (Eigen::Index i = 1; i < probe.size(); i += 2) probe[i] = -probe[i];
-  return run_coupling_loop(body1, body2, gaps, weights, probe, options, observer);
+  return run_coupling_loop(body1, body2, gaps, weights, probe, options, nullptr, observer);
 }
 
 RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
                               const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                               const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
+                              const Eigen::VectorXd* initial_iterate,
                               const IterationObserver& observer) {
   const auto run_start = Clock::now();
   double port_seconds = 0.0;
@@ -339,6 +350,15 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   result.algorithm = scheme->describe();
   Eigen::VectorXd iterate = scheme->initial_iterate(
       options.initial_obstacle == "zero" ? Eigen::VectorXd::Zero(gaps.size()) : gaps);
+  if (initial_iterate != nullptr) {
+    if (initial_iterate->size() != iterate.size()) {
+      throw InputError("the initial iterate of the " + result.algorithm + " iteration has " +
+                       std::to_string(initial_iterate->size()) + " values, expected " +
+                       std::to_string(iterate.size()));
+    }
+    iterate = *initial_iterate;
+  }
+  result.initial_iterate = iterate;
   ProgressMonitor monitor(options);
   std::array<ForceSequence, 2> force_sequences;  // each body's lambda over the iterations
   result.status = IterationStatus::max_iterations;
@@ -363,6 +383,7 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
     record.seconds = seconds_between(iteration_start, Clock::now());
     result.history.push_back(record);
     store_state(result, evaluation.state);
+    result.restart_iterate = evaluation.mapped;
     if (observer) observer(record);
     if (accept_converged_state(record, evaluation, options, result)) break;
     if (const auto stop = monitor.check(record, result.message)) {

@@ -91,6 +91,14 @@ struct RobinResult {
   /// The largest scaled residual of the state in the fields above: that of the accepted
   /// complete state, or of the last joint state.
   double final_largest_residual() const;
+  /// The iterate a nearby problem (the next load step) starts from: the fixed-point image
+  /// H(x) of the last iteration (for "robin" the obstacles (w2_N - u2_N + d, w1_N - u1_N + d)),
+  /// which at convergence is the fixed point itself. Its layout is the scheme's iterate, so it
+  /// is valid only for a run of the same algorithm on the same pairing.
+  Eigen::VectorXd restart_iterate;
+  /// The iterate of the first iteration (the scheme's start from the initial obstacle, or the
+  /// given initial iterate).
+  Eigen::VectorXd initial_iterate;
   double coordinator_seconds = 0.0;  // time in the coordinator's own computations
   /// Critical path of the bodies' compute: sum over iterations of max(contact1, contact2) +
   /// max(correction1, correction2), as reported by the bodies.
@@ -116,6 +124,13 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
 /// The same for a pairing (gaps, weights and the probe of short_wavelength_forces).
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const ContactPairing& pairing, const CouplingOptions& options,
+                                const IterationObserver& observer = {});
+/// The same, starting from `initial_iterate` (the restart_iterate of a previous run of the same
+/// algorithm on the same pairing, e.g. the previous load step) instead of the initial
+/// obstacle of `options`. Throws InputError when its size is not that of the scheme's iterate.
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const ContactPairing& pairing, const CouplingOptions& options,
+                                const Eigen::VectorXd& initial_iterate,
                                 const IterationObserver& observer = {});
 /// The same with unit weights (enough for every algorithm but "robin-constant").
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,

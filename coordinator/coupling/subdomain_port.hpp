@@ -57,6 +57,11 @@ class SubdomainPort {
   /// port without the capability cannot run the Dirichlet-Neumann iteration.
   virtual void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration);
   virtual CorrectionSolveResult finish_neumann_solve();
+  /// Quasi-static load steps (protocol 2.1, SetLoadFactor): scales every load and prescribed
+  /// displacement of the body by `factor` relative to its definition, keeping the factor of K
+  /// and F; later solves and fields answer for the new loads. Valid after setup(). Throws
+  /// PortError, also for a server of protocol 2.0 (naming the server and both versions).
+  virtual void set_load_factor(double factor) = 0;
   virtual BodyOutput fields(const Eigen::VectorXd& contact_force) = 0;
   /// Ends the run (the server stays up for the next one). Must not throw.
   virtual void end_run() noexcept = 0;

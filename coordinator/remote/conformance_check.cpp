@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -33,6 +34,13 @@ constexpr const char* neumann_solve_capability = "neumann_solve";  // optional, 
 constexpr unsigned run_id_minor = 2;  // Envelope.run_id and its rule: since protocol 1.2
 const std::vector<std::string> state_names = {"awaiting_setup", "awaiting_assignment", "ready"};
 
+/// SetLoadFactor (protocol 2.1) with `factor`.
+protocol::Envelope load_factor_request(double factor) {
+  protocol::Envelope envelope;
+  envelope.mutable_set_load_factor()->set_factor(factor);
+  return envelope;
+}
+
 // --- The checks -------------------------------------------------------------------------------
 
 class ServerChecks {
@@ -47,7 +55,12 @@ class ServerChecks {
     run_assignment_checks();
     run_solve_checks();
     run_neumann_solve_checks();
+    run_load_factor_checks();
     run_run_control_checks();
+    run_if_load_factor("load_factor_before_setup", [this] {
+      return refused(load_factor_request(2.0), "SetLoadFactor after EndRun",
+                     {protocol::WRONG_STATE}, "awaiting_setup");
+    });
     session_.run("oversized_message", [this] { return oversized_message(); });
     if (session_.options().include_shutdown) {
       session_.run("shutdown", [this] { return shutdown(); });
@@ -64,6 +77,10 @@ class ServerChecks {
   void run_solve_checks();
   void run_neumann_solve_checks();
   void run_run_control_checks();
+  /// SetLoadFactor (protocol 2.1), judged for servers that announce minor version 1 or later.
+  void run_load_factor_checks();
+  void run_if_load_factor(const std::string& name, const std::function<std::string()>& check);
+  std::string load_factor_scaling();
   /// Runs a check of the optional Neumann solve, only when the server announced it.
   void run_if_neumann(const std::string& name, const std::function<std::string()>& check);
 
@@ -194,12 +211,12 @@ void ServerChecks::run_envelope_checks() {
                    "awaiting_setup");
   });
   session_.run("unknown_request_type", [this] {
-    Envelope envelope;  // version and id, then field 30 (length-delimited, empty): a request
+    Envelope envelope;  // version and id, then field 1000 (length-delimited, empty): a request
     envelope.mutable_version()->set_major(protocol::protocol_major);  // type of a later minor
     envelope.mutable_version()->set_minor(protocol::protocol_minor);
     envelope.set_request_id(session_.next_request_id());
-    return raw_error({envelope.SerializeAsString() + std::string("\xf2\x01\x00", 3)},
-                     "a request of an unknown type (Envelope field 30)", envelope.request_id(),
+    return raw_error({envelope.SerializeAsString() + std::string("\xc2\x3e\x00", 3)},
+                     "a request of an unknown type (Envelope field 1000)", envelope.request_id(),
                      protocol::UNSUPPORTED);
   });
 }
@@ -782,6 +799,101 @@ std::string ServerChecks::fields_pair_order() {
     if (std::abs(abscissa - nodes_[k].x) > tolerance_) {
       return what + ": the top-edge node pushed down most is at x = " + number(abscissa) +
              ": the force was not applied in the pair order of AssignContact";
+    }
+  }
+  return "";
+}
+
+// Load steps (protocol 2.1): SetLoadFactor scales the loads and the prescribed displacements.
+
+void ServerChecks::run_if_load_factor(const std::string& name,
+                                      const std::function<std::string()>& check) {
+  if (capabilities_known_ && (server_major_ > 2 || (server_major_ == 2 && server_minor_ >= 1))) {
+    session_.run(name, check);
+  }
+}
+
+void ServerChecks::run_load_factor_checks() {
+  if (!capabilities_known_) {
+    session_.run("load_factor", []() -> std::string {
+      throw NotChecked("needs the server's protocol version from its HelloReply (see 'hello')");
+    });
+    return;
+  }
+  if (!(server_major_ > 2 || (server_major_ == 2 && server_minor_ >= 1))) {
+    session_.record_note("load_factor", "not applicable: the server speaks protocol " +
+                                            std::to_string(server_major_) + "." +
+                                            std::to_string(server_minor_) +
+                                            ", and SetLoadFactor is since 2.1; a 2.0 server must "
+                                            "refuse it as UNSUPPORTED");
+    if (server_major_ != 2) return;
+    session_.run("load_factor_unsupported", [this] {
+      require_assignment();
+      return refused(load_factor_request(2.0), "SetLoadFactor to a protocol 2.0 server",
+                     {protocol::UNSUPPORTED}, "ready");
+    });
+    return;
+  }
+  session_.record_note("load_factor", "protocol 2.1 or later: checked");
+  const auto bad = [this](double factor, const std::string& what) {
+    require_assignment();
+    return refused(load_factor_request(factor), "SetLoadFactor with " + what, {protocol::BAD_INPUT},
+                   "ready");
+  };
+  run_if_load_factor("load_factor_non_finite", [bad] {
+    const std::string problem = bad(std::numeric_limits<double>::quiet_NaN(), "a NaN factor");
+    return problem.empty() ? bad(-std::numeric_limits<double>::infinity(), "factor -infinity")
+                           : problem;
+  });
+  run_if_load_factor("load_factor_absurd", [bad] { return bad(1e9, "factor 1e9"); });
+  run_if_load_factor("load_factor_scaling", [this] { return load_factor_scaling(); });
+}
+
+/// The body's only load is the lift of its bottom edge: at load factor t the body translates
+/// by t lift, so u_N = t lift with far obstacles; F does not change (the correction for the same
+/// r); factor 1 restores the body of the other checks.
+std::string ServerChecks::load_factor_scaling() {
+  require_assignment();
+  const std::array<double, 3> factors{2.5, -0.5, 1.0};
+  for (const double factor : factors) {
+    const std::string what = "SetLoadFactor " + number(factor) + " in state ready";
+    const Exchange exchange = session_.request(load_factor_request(factor), what);
+    if (!exchange.reply) return what + ": " + exchange.problem;
+    const protocol::Envelope& reply = *exchange.reply;
+    if (!reply.has_load_factor_set()) {
+      return what + ": expected LoadFactorSet, got " + describe(reply);
+    }
+    if (reply.load_factor_set().factor() != factor || reply.load_factor_set().state() != "ready") {
+      return what + ": LoadFactorSet{factor " + number(reply.load_factor_set().factor()) +
+             ", state '" + reply.load_factor_set().state() + "'}, expected {" + number(factor) +
+             ", 'ready'}";
+    }
+    const std::string solve = "ContactSolveRequest with every obstacle far after " + what;
+    ContactSolution solution;
+    if (const std::string problem = read_contact_solution(
+            session_.request(contact_solve_request(obstacle_of(nodes_, false)), solve),
+            contact_count(), solution);
+        !problem.empty()) {
+      return solve + ": " + problem;
+    }
+    const double difference = (solution.normal_trace.array() - factor * lift).abs().maxCoeff();
+    if (difference > tolerance_ * lift) {
+      return solve + ": normal_trace differs from the load factor times the lift, " +
+             number(factor * lift) + ", by up to " + number(difference) +
+             " (every prescribed displacement must scale with the factor)";
+    }
+    if (first_force_.size() == contact_count()) {
+      Eigen::VectorXd response;
+      if (const std::string problem =
+              correction(first_force_, "CorrectionRequest after " + what, response);
+          !problem.empty()) {
+        return problem;
+      }
+      const double change = (response - first_response_).cwiseAbs().maxCoeff();
+      if (change > tolerance_ * first_response_.cwiseAbs().maxCoeff()) {
+        return "CorrectionRequest after " + what + ": w(r) changed by " + number(change) +
+               " (F = B K^-1 B' does not depend on the loads)";
+      }
     }
   }
   return "";

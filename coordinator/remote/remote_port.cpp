@@ -7,6 +7,7 @@
 #include <random>
 #include <sstream>
 
+#include "coupling/case_file_body.hpp"
 #include "protocol_version.hpp"
 #include "remote/reply_decoding.hpp"
 #include "remote/setup_encoding.hpp"
@@ -155,6 +156,8 @@ void RemotePort::handshake() {
     }
   }
   server_name_ = hello.server_name();
+  server_major_ = reply.version().major();
+  server_minor_ = reply.version().minor();
   capabilities_.assign(hello.capabilities().begin(), hello.capabilities().end());
   spdlog::debug("{}: {} (protocol {}, state {}, offers {})", describe(), server_name_,
                 version_text(reply.version().major(), reply.version().minor()), hello.state(),
@@ -263,6 +266,28 @@ CorrectionSolveResult RemotePort::finish_neumann_solve() {
     return result;
   } catch (const MalformedReply& malformed) {
     fail(step, std::string("malformed reply: ") + malformed.what());
+  }
+}
+
+void RemotePort::set_load_factor(double factor) {
+  const std::string step = "load factor " + format_number(factor);
+  if (!set_up_) fail(step, "no body set up yet: call setup() first");
+  if (server_minor_ < 1) {
+    fail(step, "the server ('" + server_name_ + "') speaks protocol " +
+                   version_text(server_major_, server_minor_) + ", this coordinator speaks " +
+                   version_text(protocol::protocol_major, protocol::protocol_minor) +
+                   "; a case with [loading] steps needs SetLoadFactor (protocol 2.1): use a "
+                   "server of protocol 2.1 or later, or a case without [loading]");
+  }
+  Envelope request;
+  request.mutable_set_load_factor()->set_factor(factor);
+  const Envelope reply =
+      exchange(request, step, options_.request_timeout_seconds, Envelope::kLoadFactorSet);
+  timings_.compute_seconds += reply.load_factor_set().compute_seconds();
+  if (reply.load_factor_set().factor() != factor) {
+    fail(step, "malformed reply: LoadFactorSet.factor is " +
+                   format_number(reply.load_factor_set().factor()) + ", expected " +
+                   format_number(factor));
   }
 }
 

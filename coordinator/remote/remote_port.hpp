@@ -70,6 +70,10 @@ class RemotePort final : public SubdomainPort {
   /// NeumannSolveRequest (protocol 1.1): u_N for the contact force lambda (pair order).
   void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;
   CorrectionSolveResult finish_neumann_solve() override;
+  /// SetLoadFactor (protocol 2.1). A server whose handshake announced minor version 0 is
+  /// refused before anything is sent: "the server ... speaks protocol 2.0; load steps need
+  /// 2.1 (SetLoadFactor), this coordinator speaks 2.1 ...".
+  void set_load_factor(double factor) override;
   BodyOutput fields(const Eigen::VectorXd& contact_force) override;
   void end_run() noexcept override;
   const PortTimings& timings() const override;
@@ -81,6 +85,9 @@ class RemotePort final : public SubdomainPort {
   const std::vector<std::string>& server_capabilities() const { return capabilities_; }
   /// Whether the handshake announced `capability`.
   bool offers(const std::string& capability) const;
+  /// The protocol version of the server's handshake reply ({0, 0} before setup()).
+  unsigned server_major() const { return server_major_; }
+  unsigned server_minor() const { return server_minor_; }
   /// The run_id this port's requests carry (empty before the first setup()).
   const std::string& run_id() const { return run_id_; }
 
@@ -101,6 +108,7 @@ class RemotePort final : public SubdomainPort {
   std::unique_ptr<Pending> pending_;
   std::string server_name_;
   std::vector<std::string> capabilities_;
+  unsigned server_major_ = 0, server_minor_ = 0;
   long contact_size_ = 0;
   bool set_up_ = false;
   std::string run_id_;  // Envelope.run_id of every request, drawn by setup()

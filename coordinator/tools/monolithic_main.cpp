@@ -17,6 +17,7 @@
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
 #include "coupling/result_files.hpp"
+#include "coupling/step_outputs.hpp"
 #include "numerics/errors.hpp"
 
 namespace {
@@ -112,8 +113,14 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
   for (const std::string& line : problem.pairing.excluded) log->warn("{}", line);
   if (const std::string overlap = robin::overlap_warning(problem.pairing); !overlap.empty())
     log->warn("{}", overlap);
-  const MonolithicResult result = robin::solve_monolithic(*problem.bodies[0], *problem.bodies[1],
-                                                          problem.pairing, definition.solver.qp);
+  // [loading]: every step at its load factor, the last one reported below (step_outputs.hpp).
+  const std::vector<robin::MonolithicStep> steps =
+      robin::solve_monolithic_steps(*problem.bodies[0], *problem.bodies[1], problem.pairing,
+                                    definition.loading, definition.solver.qp);
+  const MonolithicResult result =
+      steps.empty() ? robin::solve_monolithic(*problem.bodies[0], *problem.bodies[1],
+                                              problem.pairing, definition.solver.qp)
+                    : steps.back().result;
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The outcome, worded as robin-coordinator's: what the stopping test looked at, then the
@@ -129,7 +136,9 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
   nlohmann::json summary = make_summary(problem, result, total);
   const robin::ExcludedPairClearance clearance = excluded_pair_clearance(problem, result);
   summary["excluded_pair_penetration"] = clearance.relative_penetration;
+  if (!steps.empty()) summary["load_steps"] = robin::monolithic_steps_json(problem, steps);
   write_outputs(output, problem, result, summary);
+  if (!steps.empty()) robin::write_monolithic_step_outputs(output, problem, steps);
   log->info("results in {} (open solution.pvd in ParaView)", output.string());
   if (result.qp.status != robin::QpStatus::converged) {
     log->error("the contact QP did not converge: {}", result.qp.message);

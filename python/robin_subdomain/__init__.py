@@ -1,7 +1,7 @@
 """robin_subdomain: a reference external subdomain server of robin-contact, in Python.
 
 A second, independent implementation of one elastic body of the Robin domain decomposition
-(proto/robin.proto, protocol 2.0, docs/protocol.md): meshes received as data (MeshData) or read
+(proto/robin.proto, protocol 2.1, docs/protocol.md): meshes received as data (MeshData) or read
 from the operator's data directory by its own Gmsh reader, finite elements (P1, P2 triangles and
 Q1 quadrilaterals, plane strain or stress), sparse LU factorization (SuperLU via SciPy), a
 general sparse contact constraint operator B, dense interface compliance and bound-constrained

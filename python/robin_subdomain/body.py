@@ -127,6 +127,14 @@ class Body:
         self.free_solution = self.factor.solve(self.reduced_load)   # K^-1 f
         self.factorization_seconds = time.perf_counter() - start
         self.contact = None
+        self.load_factor = 1.0   # since protocol 2.1: loads and prescribed values times this
+
+    def set_load_factor(self, factor):
+        """Scales every load and prescribed displacement by `factor` relative to the definition
+        (f = t f_1, u_p = t u_p1, e = t e_1); keeps the factor of K, B, F and the warm start."""
+        self.load_factor = float(factor)
+        if self.contact is not None:
+            self.contact.set_load_factor(self.load_factor)
 
     def _factorize(self, reduced):
         try:
@@ -145,21 +153,23 @@ class Body:
         """Sets the constraint operator B (an assignment.ContactOperator whose nodes are contact
         nodes); builds e and F."""
         self.contact = contact.ContactInterface(self, operator)
+        self.contact.set_load_factor(self.load_factor)
 
     def displacement(self, contact_force):
-        """Full displacement (2 per node): u_f = K^-1 (f - B' lambda), prescribed values kept."""
-        free_values = self.free_solution.copy()
+        """Full displacement (2 per node): u_f = K^-1 (t f - B' lambda), prescribed values t u_p
+        (t the load factor)."""
+        free_values = self.load_factor * self.free_solution
         if len(contact_force) and np.max(np.abs(contact_force)) > 0.0:
             free_values -= self.factor.solve(self.contact.trace.T @ contact_force)
-        full = self.prescribed_full.copy()
+        full = self.load_factor * self.prescribed_full
         full[self.free_dofs] = free_values
         return full
 
     def reactions(self, displacement):
         """K u - f at the prescribed dofs, zero at the free ones."""
-        reaction = self.full_stiffness @ displacement - self.full_load
+        reaction = self.full_stiffness @ displacement - self.load_factor * self.full_load
         reaction[~self.is_prescribed] = 0.0
         return reaction
 
     def applied_force(self):
-        return self.full_load.reshape(-1, 2).sum(axis=0)
+        return self.load_factor * self.full_load.reshape(-1, 2).sum(axis=0)

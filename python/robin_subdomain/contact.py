@@ -218,11 +218,18 @@ class ContactInterface:
             shape=(count, body.free_dof_count()))
         self.full_operator = scipy.sparse.csr_matrix(
             (operator.values, (operator.entry_rows, dofs)), shape=(count, len(body.prescribed)))
-        self.free_trace = self.trace @ body.free_solution + self.prescribed_trace  # e
+        self.unit_free_trace = self.trace @ body.free_solution + self.prescribed_trace  # e
+        self.load_factor = 1.0
+        self.free_trace = self.unit_free_trace
         self.compliance = self._dense_compliance()
         self.norm = estimate_norm(self.compliance)
         self.warm_start = np.zeros(count)
         self.seconds = time.perf_counter() - start
+
+    def set_load_factor(self, factor):
+        """Since protocol 2.1: e = t e_1 for the load factor t (f and u_p scale with t)."""
+        self.load_factor = factor
+        self.free_trace = factor * self.unit_free_trace
 
     def nodal_forces(self, contact_force):
         """B' lambda on every dof (2n): minus the contact forces acting on the body."""
@@ -266,5 +273,5 @@ class ContactInterface:
         """The Neumann solve (since protocol 1.1): u_N = B u with K u = f - B' lambda, u = u_p
         on the prescribed dofs. One solve with the body's factor, not e - F lambda (so that it
         is an independent check of F and e)."""
-        load = self.reduced_load - self.trace.T @ contact_force
-        return self.trace @ self.factor.solve(load) + self.prescribed_trace
+        load = self.load_factor * self.reduced_load - self.trace.T @ contact_force
+        return self.trace @ self.factor.solve(load) + self.load_factor * self.prescribed_trace

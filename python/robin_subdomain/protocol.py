@@ -20,6 +20,10 @@ given at start (--output-root), refused without one. No reply carries a non-fini
 contact solve, correction, Neumann solve or fields reply that would is replaced by
 Error(SOLVER_FAILURE) naming the body and the request (the state is unchanged).
 
+Since 2.1: SetLoadFactor, in awaiting_assignment and ready (state unchanged), scales every load
+and prescribed displacement of the body (quasi-static load steps without a new SetupBody); a
+factor that is not finite or above 1e6 in magnitude is BAD_INPUT.
+
 Since 1.1: besides the core capabilities the server announces the optional "neumann_solve"
 (NeumannSolveRequest: u_N = B K^-1 (f - B' lambda) for a given contact force lambda).
 
@@ -31,7 +35,7 @@ WRONG_STATE ("... now belongs to another run ..."), the state unchanged: another
 the body up. An empty run_id (a 1.0 or 1.1 coordinator) is served as before. Replies echo the
 request's run_id.
 
-Every reply echoes the request_id and carries version (protocol_major, 0). Failures are Error
+Every reply echoes the request_id and carries version (protocol_major, 1). Failures are Error
 replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH (another
 major version, e.g. a 1.x request), WRONG_STATE (also for another run's run_id),
 INVALID_ARGUMENT (sizes, the constraint operator, non-finite values, a refused write_directory),
@@ -56,10 +60,11 @@ from .mesh_data import quoted
 from .paths import PathRefused, check_output_directory, write_under_root
 from .setup_decoding import decode_setup_body
 
-PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 0
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 1
+MAXIMUM_LOAD_FACTOR = 1e6         # SetLoadFactor: a larger magnitude is BAD_INPUT
 AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
 REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction",
-            "neumann_solve", "fields", "end_run", "shutdown")
+            "neumann_solve", "fields", "end_run", "shutdown", "set_load_factor")
 CAPABILITIES = ("contact_solve", "correction_solve", "fields", "neumann_solve")
 
 
@@ -204,7 +209,8 @@ class SubdomainProtocol:
                     "assign_contact": self._on_assign_contact,
                     "contact_solve": self._on_contact_solve, "correction": self._on_correction,
                     "neumann_solve": self._on_neumann_solve, "fields": self._on_fields,
-                    "end_run": self._on_end_run, "shutdown": self._on_shutdown}
+                    "end_run": self._on_end_run, "shutdown": self._on_shutdown,
+                    "set_load_factor": self._on_set_load_factor}
         if content in handlers:
             return handlers[content](request, reply, record)
         if content is not None:
@@ -368,6 +374,22 @@ class SubdomainProtocol:
         self._require_finite(reply.neumann_result, "NeumannSolveRequest", record)
         record.outcome = "ok, max |lambda| %.3e, max |u_N| %.3e" % (
             np.max(np.abs(force), initial=0.0), np.max(np.abs(trace), initial=0.0))
+
+    def _on_set_load_factor(self, request, reply, record):
+        """Since protocol 2.1: scales the body's loads and prescribed displacements; the factor
+        of K, B and F are kept and the state does not change."""
+        start = time.perf_counter()
+        factor = request.set_load_factor.factor
+        record.iteration = " factor %r" % factor
+        self._require_same_run(request, "SetLoadFactor")
+        self._require_state(AWAITING_ASSIGNMENT, "SetLoadFactor")
+        if not np.isfinite(factor) or abs(factor) > MAXIMUM_LOAD_FACTOR:
+            raise RequestError("BAD_INPUT", "SetLoadFactor.factor = %r for body '%s' is not a "
+                               "finite number of magnitude at most 1e6" % (factor, self.body.name))
+        self.body.set_load_factor(factor)
+        reply.load_factor_set.factor = self.body.load_factor
+        reply.load_factor_set.state = self.state
+        reply.load_factor_set.compute_seconds = time.perf_counter() - start
 
     def _on_fields(self, request, reply, record):
         message = request.fields

@@ -82,7 +82,7 @@ class ServerTestCase(unittest.TestCase):
     def ask(self, data):
         reply = protocol.Envelope()
         reply.ParseFromString(self.server.handle(data))
-        self.assertEqual((reply.version.major, reply.version.minor), (2, 0))
+        self.assertEqual((reply.version.major, reply.version.minor), (2, 1))
         return reply
 
     def expect_error(self, data, code, state):
@@ -118,7 +118,7 @@ class StateMachine(ServerTestCase):
         for major, minor in ((1, 2), (1, 0), (3, 1)):
             message = self.expect_error(request(major=major, minor=minor, hello=protocol.Hello()),
                                         "VERSION_MISMATCH", "awaiting_setup")
-            self.assertIn("the request speaks %d.%d, this server 2.0" % (major, minor), message)
+            self.assertIn("the request speaks %d.%d, this server 2.1" % (major, minor), message)
         self.expect_error(request(major=1, minor=2, setup_body=setup_body()), "VERSION_MISMATCH",
                           "awaiting_setup")
         self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
@@ -228,6 +228,62 @@ class StateMachine(ServerTestCase):
         scale = max(np.abs(free.normal_trace).max(), np.abs(response).max())
         np.testing.assert_allclose(trace, expected, rtol=0, atol=1e-10 * scale)
         self.assertEqual(self.server.state, "ready")
+
+    def test_set_load_factor_scales_loads_and_prescribed_displacements(self):
+        """Since 2.1: e(t) = t e(1) for body force and a prescribed lift together (both scale),
+        F is unchanged, bad factors are BAD_INPUT with the factor in force kept."""
+        scale = protocol.SetLoadFactor(factor=2.0)
+        self.expect_error(request(set_load_factor=scale), "WRONG_STATE", "awaiting_setup")
+        loaded = setup_body()
+        loaded.body_force.extend([0.0, -5.0])
+        loaded.dirichlet[0].y = 0.01             # the bottom lifted: a prescribed displacement
+        interface = self.ask(request(setup_body=loaded)).interface
+        count = len(interface.node_ids)
+        reply = self.ask(request(set_load_factor=protocol.SetLoadFactor(factor=1.0)))
+        self.assertEqual((reply.load_factor_set.factor, reply.load_factor_set.state),
+                         (1.0, "awaiting_assignment"))
+        self.ask(request(assign_contact=support.node_to_node_assignment(protocol, interface)))
+        far = protocol.ContactSolveRequest(obstacle=[1.0] * count)   # above every trace
+        unit = np.array(self.ask(request(contact_solve=far)).contact_result.normal_trace)
+        force = 1.0 + np.cos(np.arange(count))
+        correction = protocol.CorrectionRequest(interface_force=force)
+        response = np.array(self.ask(request(correction=correction)).correction_result.normal_trace)
+        unit_fields = self.ask(request(fields=protocol.FieldsRequest(
+            contact_force=[0.0] * count))).fields_reply
+        reply = self.ask(request(set_load_factor=protocol.SetLoadFactor(factor=2.5)))
+        self.assertEqual((reply.load_factor_set.factor, reply.load_factor_set.state), (2.5, "ready"))
+        for bad in (float("nan"), float("inf"), -float("inf"), 1.0e7, -2.0e6):
+            message = self.expect_error(request(set_load_factor=protocol.SetLoadFactor(factor=bad)),
+                                        "BAD_INPUT", "ready")
+            self.assertIn("SetLoadFactor.factor", message)
+            self.assertIn("body 'lower'", message)
+        scaled = np.array(self.ask(request(contact_solve=far)).contact_result.normal_trace)
+        np.testing.assert_allclose(scaled, 2.5 * unit, rtol=0, atol=1e-14)
+        self.assertGreater(np.abs(unit).max(), 1e-3)
+        again = np.array(self.ask(request(correction=correction)).correction_result.normal_trace)
+        np.testing.assert_allclose(again, response, rtol=0, atol=1e-14 * np.abs(response).max())
+        fields = self.ask(request(fields=protocol.FieldsRequest(
+            contact_force=[0.0] * count))).fields_reply
+        np.testing.assert_allclose(fields.applied_force, 2.5 * np.array(unit_fields.applied_force),
+                                   rtol=1e-14)
+        np.testing.assert_allclose(fields.reaction_resultant,      # the supports carry the load
+                                   -np.array(fields.applied_force), rtol=0,
+                                   atol=1e-10 * np.abs(fields.applied_force).max())
+        displacement = dict((f.name, np.array(f.values)) for f in fields.point_fields)
+        unit_displacement = dict((f.name, np.array(f.values)) for f in unit_fields.point_fields)
+        np.testing.assert_allclose(displacement["displacement"],
+                                   2.5 * unit_displacement["displacement"], rtol=0,
+                                   atol=1e-12 * np.abs(unit_displacement["displacement"]).max())
+        # the lift itself: u_y = 2.5 * 0.01 on the bottom edge y = -1
+        bottom = np.abs(np.array(fields.node_coordinates).reshape(-1, 2)[:, 1] + 1.0) < 1e-12
+        self.assertGreater(bottom.sum(), 1)
+        np.testing.assert_allclose(displacement["displacement"].reshape(-1, 2)[bottom, 1], 0.025,
+                                   rtol=1e-15)
+        # a new SetupBody is at factor 1 again
+        interface = self.ask(request(setup_body=loaded)).interface
+        self.ask(request(assign_contact=support.node_to_node_assignment(protocol, interface)))
+        fresh = np.array(self.ask(request(contact_solve=far)).contact_result.normal_trace)
+        np.testing.assert_allclose(fresh, unit, rtol=0, atol=1e-14)
 
     def test_requests_of_another_run_are_wrong_state_and_change_nothing(self):
         run, other = "0123456789abcdef0123456789abcdef", "another-coordinator"

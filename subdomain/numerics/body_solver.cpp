@@ -4,12 +4,20 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include "numerics/errors.hpp"
 #include "numerics/finite_element.hpp"
 
 namespace robin {
 namespace {
+
+/// The factor as text for messages ("nan", "inf", "2e+07").
+std::string format_load_factor(double factor) {
+  std::ostringstream text;
+  text << factor;
+  return text.str();
+}
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -215,7 +223,8 @@ void BodySolver::assign_contact(const ContactOperator& contact) {
   contact_ = contact;
   trace_.resize(row_count, dofs_->free_count());
   trace_.setFromTriplets(triplets.begin(), triplets.end());
-  free_trace_ = trace_ * free_solution_ + prescribed_trace_;  // e = B K^{-1} f + B u_p
+  unit_free_trace_ = trace_ * free_solution_ + prescribed_trace_;  // e = B K^{-1} f + B u_p
+  free_trace_ = load_factor_ * unit_free_trace_;
   build_interface_operator();
   reset_warm_start();
   timings_.interface_seconds = seconds_since(start);
@@ -241,6 +250,15 @@ void BodySolver::build_interface_operator() {
 }
 
 void BodySolver::reset_warm_start() { warm_start_ = Eigen::VectorXd::Zero(contact_size()); }
+
+void BodySolver::set_load_factor(double factor) {
+  if (!std::isfinite(factor) || std::abs(factor) > maximum_load_factor) {
+    throw InputError("body '" + name() + "': load factor " + format_load_factor(factor) +
+                     " is not a finite number of magnitude at most 1e6");
+  }
+  load_factor_ = factor;
+  if (unit_free_trace_.size() > 0) free_trace_ = load_factor_ * unit_free_trace_;
+}
 
 ContactSolveResult BodySolver::solve_contact(const Eigen::VectorXd& obstacle,
                                              const MprgpParameters& parameters) {
@@ -298,16 +316,18 @@ Eigen::VectorXd BodySolver::apply_transpose_trace(const Eigen::VectorXd& contact
 }
 
 Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force) const {
-  // u_f = K^{-1} (f - B' lambda)
-  Eigen::VectorXd free_values = free_solution_;
+  // u_f = K^{-1} (t f - B' lambda), u_p = t u_p1 (t the load factor)
+  Eigen::VectorXd free_values = load_factor_ * free_solution_;
   if (contact_force.size() > 0 && contact_force.lpNorm<Eigen::Infinity>() > 0) {
     free_values -= factor_->solve(apply_transpose_trace(contact_force));
   }
-  return dofs_->expand(free_values);
+  Eigen::VectorXd full = dofs_->expand(free_values);  // prescribed values at factor 1
+  if (load_factor_ != 1.0) full += (load_factor_ - 1.0) * dofs_->prescribed_values();
+  return full;
 }
 
 Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& displacement) const {
-  Eigen::VectorXd reaction = full_stiffness_ * displacement - full_load_;
+  Eigen::VectorXd reaction = full_stiffness_ * displacement - load_factor_ * full_load_;
   for (int dof = 0; dof < dofs_->total_count(); ++dof) {
     if (!dofs_->is_prescribed(dof)) reaction[dof] = 0.0;
   }
@@ -319,7 +339,7 @@ Eigen::Vector2d BodySolver::applied_force() const {
   for (Eigen::Index node = 0; node < full_load_.size() / 2; ++node) {
     total += full_load_.segment<2>(2 * node);
   }
-  return total;
+  return load_factor_ * total;
 }
 
 Eigen::VectorXd BodySolver::contact_force_field(const Eigen::VectorXd& contact_force) const {

@@ -13,6 +13,10 @@
 // Local contact problem (paper (10)): minimise 1/2 u'Ku - f'u subject to B u <= g, solved
 // in its dual form  minimise 1/2 lambda'F lambda - lambda'(e - g), lambda >= 0, by MPRGP.
 // Correction problem (paper (11)-(12)): K w = B' r, returns w_N = B w = F r.
+//
+// Load factor t (quasi-static load steps): every load of the body (body force, tractions,
+// pressures) and every prescribed displacement is multiplied by t, so f(t) = t f, u_p(t) = t u_p
+// and e(t) = t e, by linearity; K, its factor and F do not depend on t and are kept.
 
 #include <Eigen/Core>
 #include <memory>
@@ -126,6 +130,16 @@ class BodySolver {
   /// Forget the warm start (next solve starts from lambda = 0).
   void reset_warm_start();
 
+  /// Scales every load and every prescribed displacement of the body by `factor` (relative to
+  /// the definition's values, not to the current factor): f = factor f_1, u_p = factor u_p1,
+  /// e = factor e_1. Keeps the factor of K, B, F and the contact warm start (the previous
+  /// contact forces are the initial guess of the next contact solve). Throws InputError for a
+  /// factor that is not finite or whose magnitude exceeds maximum_load_factor.
+  void set_load_factor(double factor);
+  double load_factor() const { return load_factor_; }
+  /// The largest magnitude set_load_factor accepts.
+  static constexpr double maximum_load_factor = 1e6;
+
   /// Paper step 2: w_N = B K^{-1} B' r for an interface force vector r (force).
   Eigen::VectorXd solve_correction(const Eigen::VectorXd& interface_force) const;
   /// The Neumann solve of the Dirichlet-Neumann iteration: u_N = B K^{-1} (f - B' lambda)
@@ -160,15 +174,17 @@ class BodySolver {
   Eigen::VectorXd full_load_;
   Eigen::VectorXd reduced_load_;
   std::unique_ptr<CholeskyFactor> factor_;
-  Eigen::VectorXd free_solution_;  // K^{-1} f (free dofs)
+  Eigen::VectorXd free_solution_;  // K^{-1} f (free dofs) at load factor 1
 
   ContactOperator contact_;
   Eigen::VectorXd boundary_weights_;
   SparseMatrix trace_;  // B on free dofs (n_c x free)
-  Eigen::VectorXd prescribed_trace_;  // B u_p
+  Eigen::VectorXd prescribed_trace_;  // B u_p at load factor 1
   Eigen::VectorXd free_trace_;
   std::unique_ptr<LinearOperator> compliance_;
   Eigen::VectorXd warm_start_;
+  double load_factor_ = 1.0;
+  Eigen::VectorXd unit_free_trace_;  // e at load factor 1
 };
 
 }  // namespace robin

@@ -64,6 +64,7 @@ bool is_request(protocol::Envelope::ContentCase content) {
     case Envelope::kFields:
     case Envelope::kEndRun:
     case Envelope::kShutdown:
+    case Envelope::kSetLoadFactor:
       return true;
     default:
       return false;
@@ -282,6 +283,8 @@ void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Enve
       return on_neumann_solve(request, reply, record);
     case Envelope::kFields:
       return on_fields(request, reply);
+    case Envelope::kSetLoadFactor:
+      return on_set_load_factor(request, reply, record);
     case Envelope::kEndRun:
       require_same_run(request, "EndRun");
       body_.reset();
@@ -479,6 +482,33 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   protocol::FieldsReply& fields = *reply.mutable_fields_reply();
   encode_fields(output, fields);
   if (!directory.empty()) fields.set_written_file(write_fields_file(directory, output));
+}
+
+/// Since protocol 2.1: scales the body's loads and prescribed displacements (BodySolver::
+/// set_load_factor); the factor of K, B and F are kept, the state does not change.
+void SubdomainServer::on_set_load_factor(const protocol::Envelope& request,
+                                         protocol::Envelope& reply, RequestRecord& record) {
+  const auto start = Clock::now();
+  if (settings_.protocol_minor < 1) {  // playing a protocol 2.0 server (testing)
+    throw RequestError(protocol::UNSUPPORTED,
+                       "SetLoadFactor is a request of protocol 2.1; this server speaks " +
+                           version_text(settings_.protocol_major, settings_.protocol_minor));
+  }
+  require_same_run(request, "SetLoadFactor");
+  require_state(ServerState::awaiting_assignment, "SetLoadFactor");
+  const double factor = request.set_load_factor().factor();
+  record.iteration = fmt::format(" factor {}", factor);
+  if (!std::isfinite(factor) || std::abs(factor) > BodySolver::maximum_load_factor) {
+    throw RequestError(protocol::BAD_INPUT,
+                       fmt::format("SetLoadFactor.factor = {} for body '{}' is not a finite "
+                                   "number of magnitude at most {:g}",
+                                   factor, body_->name(), BodySolver::maximum_load_factor));
+  }
+  body_->set_load_factor(factor);
+  protocol::LoadFactorSet& result = *reply.mutable_load_factor_set();
+  result.set_factor(body_->load_factor());
+  result.set_state(to_string(state_));
+  result.set_compute_seconds(seconds_since(start));
 }
 
 bool SubdomainServer::offers(const std::string& name) const {

@@ -7,6 +7,10 @@
 //   awaiting_assignment  body assembled and factorized (SetupBody done); + AssignContact
 //   ready                contact nodes assigned; + AssignContact, ContactSolveRequest,
 //                        CorrectionRequest, NeumannSolveRequest, FieldsRequest
+// SetLoadFactor (since 2.1) is accepted in awaiting_assignment and ready and keeps the state:
+// it scales the body's loads and prescribed displacements (BAD_INPUT for a factor that is not
+// finite or above 1e6 in magnitude), keeps the factor of K, B and F, and makes the next
+// solves answer for the new loads.
 // Transitions: SetupBody -> awaiting_assignment (the previous body is discarded first, so a
 // failed SetupBody leaves awaiting_setup); AssignContact -> ready (a refused assignment keeps
 // the state and the previous assignment); EndRun -> awaiting_setup; Shutdown -> unchanged, and
@@ -133,6 +137,8 @@ class SubdomainServer {
   void on_neumann_solve(const protocol::Envelope& request, protocol::Envelope& reply,
                         RequestRecord& record);
   void on_fields(const protocol::Envelope& request, protocol::Envelope& reply);
+  void on_set_load_factor(const protocol::Envelope& request, protocol::Envelope& reply,
+                          RequestRecord& record);
   /// Whether the optional capability `name` is announced and served.
   bool offers(const std::string& name) const;
   void acknowledge(protocol::Envelope& reply) const;

@@ -26,6 +26,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -1330,6 +1331,97 @@ TEST(SubdomainServer, ShutdownIsAcknowledgedAndRaisesTheFlag) {
   ASSERT_TRUE(reply.has_acknowledge());
   EXPECT_EQ(reply.acknowledge().state(), "awaiting_setup");
   EXPECT_TRUE(server.shutdown_requested());
+}
+
+}  // namespace
+}  // namespace robin
+
+namespace robin {
+namespace {
+
+/// SetLoadFactor (protocol 2.1) with `factor`.
+protocol::Envelope load_factor_request(std::uint64_t id, double factor) {
+  protocol::Envelope envelope = request(id);
+  envelope.mutable_set_load_factor()->set_factor(factor);
+  return envelope;
+}
+
+TEST(SubdomainServer, SetLoadFactorScalesTheLoadsAndKeepsTheStateAndF) {
+  SubdomainServer server(quiet_settings());
+  expect_error(exchange(server, load_factor_request(1, 2.0)), protocol::WRONG_STATE,
+               "awaiting_setup");
+  protocol::SetupBody setup = lower_block_setup();
+  setup.mutable_dirichlet(0)->set_y(0.01);  // the bottom lifted: a prescribed displacement
+  setup.add_body_force(0.0);
+  setup.add_body_force(-5.0);
+  const protocol::Envelope described = exchange(server, setup_request(2, setup));
+  ASSERT_TRUE(described.has_interface()) << described.DebugString();
+  protocol::Envelope reply = exchange(server, load_factor_request(3, 1.0));
+  ASSERT_TRUE(reply.has_load_factor_set()) << reply.DebugString();
+  EXPECT_EQ(reply.load_factor_set().state(), "awaiting_assignment");
+  EXPECT_EQ(reply.load_factor_set().factor(), 1.0);
+
+  // The reference: the same body built directly, at factor 1 (the definition's values).
+  BodyDefinition definition = lower_block_definition();
+  definition.dirichlet[0].y = 0.01;
+  definition.body_force = {0.0, -5.0};
+  BodySolver reference(definition);
+  const InterfaceDescription interface = reference.contact_boundary();
+  reference.assign_contact(assign_all(interface));
+  ASSERT_TRUE(exchange(server, assign_all_request(4, interface)).has_acknowledge());
+  const Eigen::VectorXd far = Eigen::VectorXd::Constant(reference.contact_size(), 1.0);
+  const Eigen::VectorXd unit_trace = reference.free_trace();
+  ASSERT_GT(unit_trace.lpNorm<Eigen::Infinity>(), 1e-3);
+
+  reply = exchange(server, load_factor_request(5, -1.5));  // a reversed load is a load too
+  ASSERT_TRUE(reply.has_load_factor_set()) << reply.DebugString();
+  EXPECT_EQ(reply.load_factor_set().state(), "ready");
+  EXPECT_EQ(reply.load_factor_set().factor(), -1.5);
+  reply = exchange(server, load_factor_request(6, 2.5));
+  ASSERT_TRUE(reply.has_load_factor_set());
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity(),
+                           -std::numeric_limits<double>::infinity(), 1e7, -2e6}) {
+    reply = exchange(server, load_factor_request(7, bad));
+    expect_error(reply, protocol::BAD_INPUT, "ready");
+    EXPECT_NE(reply.error().message().find("SetLoadFactor.factor"), std::string::npos)
+        << reply.error().message();
+    EXPECT_NE(reply.error().message().find("body 'lower'"), std::string::npos);
+  }
+  // Far obstacles: no contact, u_N = e = 2.5 e(1) (the refused factors changed nothing).
+  reply = exchange(server, contact_solve_request(8, far));
+  ASSERT_TRUE(reply.has_contact_result()) << reply.DebugString();
+  const Eigen::VectorXd trace = to_vector(reply.contact_result().normal_trace());
+  EXPECT_LE((trace - 2.5 * unit_trace).lpNorm<Eigen::Infinity>(), 1e-14);
+  // F does not depend on the loads: the correction is that of the reference at factor 1.
+  const Eigen::VectorXd force = Eigen::VectorXd::LinSpaced(reference.contact_size(), 1.0, 2.0);
+  protocol::Envelope correction = request(9);
+  correction.mutable_correction()->mutable_interface_force()->Assign(force.begin(), force.end());
+  reply = exchange(server, correction);
+  ASSERT_TRUE(reply.has_correction_result());
+  expect_equal_vectors(to_vector(reply.correction_result().normal_trace()),
+                       reference.solve_correction(force));
+  // Fields: the applied force and the lift scale with the factor.
+  protocol::Envelope fields = request(10);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(reference.contact_size());
+  fields.mutable_fields()->mutable_contact_force()->Assign(zero.begin(), zero.end());
+  reply = exchange(server, fields);
+  ASSERT_TRUE(reply.has_fields_reply());
+  ASSERT_EQ(reply.fields_reply().applied_force_size(), 2);
+  EXPECT_NEAR(reply.fields_reply().applied_force(1), 2.5 * reference.applied_force().y(),
+              1e-12 * std::abs(reference.applied_force().y()));
+  EXPECT_EQ(server.state(), ServerState::ready);
+}
+
+TEST(SubdomainServer, SetLoadFactorIsUnsupportedByAProtocol20Server) {
+  ServerSettings settings = quiet_settings();
+  settings.protocol_minor = 0;
+  SubdomainServer server(settings);
+  protocol::Envelope reply;
+  EXPECT_TRUE(reply.ParseFromString(server.handle(load_factor_request(1, 2.0).SerializeAsString())));
+  expect_error(reply, protocol::UNSUPPORTED, "awaiting_setup");
+  EXPECT_NE(reply.error().message().find("protocol 2.1"), std::string::npos)
+      << reply.error().message();
 }
 
 }  // namespace
