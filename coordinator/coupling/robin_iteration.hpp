@@ -41,11 +41,11 @@ struct SequenceResiduals {
 /// the displacement scale D = max(|d|, |u1_N|, |u2_N|) (and |w_N| for the correction), forces by
 /// F = max(|lambda1|, |lambda2|).
 ///
-/// Stopping: converged when every residual is below the tolerance; diverged when the raw
-/// obstacle step grows beyond divergence_factor times its smallest value (and beyond the first
-/// step), or when the residuals have not contracted at all (still >= 0.1) after a stagnation
-/// window; stagnated when the largest residual has not decreased by 1% in stagnation_window
-/// iterations.
+/// Stopping, on the value progress() below (history.csv: stopping_residual): converged when it
+/// is at most the tolerance; diverged when the raw obstacle step grows beyond divergence_factor
+/// times its smallest value (and beyond the first step), or when it has not contracted at all
+/// (still >= 0.1) after a stagnation window; stagnated when it has not decreased by 1% in
+/// stagnation_window iterations.
 struct IterationRecord {
   int iteration = 0;
   double obstacle_change = 0.0;  // |g_new - g_old| / max(|g_new|, D), both bodies, max norm
