@@ -263,7 +263,86 @@ void run_load_steps(const LoadingOptions& loading, const std::array<SubdomainPor
     stage << "load step " << step.step << "/" << count << ": load factor " << step.factor
           << (step.warm_started ? ", starting from the previous steps" : "");
     report_stage(observer, stage.str());
-    if (definition.loading.stepped()) {
+    const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
+    on_both_ports(ports, [&](SubdomainPort& port, int) {
+      port.set_load_factor(step.factor);
+      return 0;
+    });
+    const std::array<PortTimings, 2> before_iteration = {ports[0]->timings(), ports[1]->timings()};
+    step.iteration =
+        step.warm_started
+            ? run_robin_iteration(*ports[0], *ports[1], result.pairing, options,
+                                  predicted_start(points, step.factor), observer.iteration)
+            : run_robin_iteration(*ports[0], *ports[1], result.pairing, options,
+                                  observer.iteration);
+    for (int alpha = 0; alpha < 2; ++alpha) {
+      result.iteration_port_timings[alpha] =
+          difference(ports[alpha]->timings(), before_iteration[alpha]);
+    }
+    report_stage(observer, "collecting the fields of both bodies (load step " +
+                               std::to_string(step.step) + ")");
+    const RobinResult& iteration = step.iteration;
+    step.outputs = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
+      return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
+    });
+    result.iteration = step.iteration;
+    result.outputs = step.outputs;
+    step.excluded_clearance = excluded_clearance(result);
+    for (int alpha = 0; alpha < 2; ++alpha) {
+      step.port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
+    }
+    step.seconds = seconds_since(step_start);
+    if (result.steps.empty() || step.excluded_clearance.relative_penetration >
+                                    result.excluded_clearance.relative_penetration) {
+      result.excluded_clearance = step.excluded_clearance;
+    }
+    if (points.empty() && start_is_the_unloaded_fixed_point(options, result.pairing)) {
+      points.emplace_back(0.0, step.iteration.initial_iterate);
+    }
+    points.emplace_back(step.factor, step.iteration.restart_iterate);
+    const bool converged = step.iteration.status == IterationStatus::converged;
+    result.steps.push_back(std::move(step));
+    if (!converged) {
+      report_stage(observer, "load step " + std::to_string(k + 1) +
+                                 " did not converge: the later steps are not computed");
+      break;
+    }
+  }
+}
+
+}  // namespace
+
+CoupledRunResult run_coupled_case(const CaseDefinition& definition,
+                                  const std::array<SubdomainPort*, 2>& ports,
+                                  const CouplingOptions& options, const RunObserver& observer) {
+  const auto start = Clock::now();
+  CoupledRunResult result;
+  result.options = options;
+  report_stage(observer, "reading and meshing both bodies");
+  CaseDefinition loaded = definition;
+  load_meshes(loaded);
+  result.meshing_seconds = seconds_since(start);
+  report_stage(observer, "setting up both bodies (assembly, factorization)");
+  result.interfaces = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
+    return port.setup(loaded.bodies[alpha], definition.solver);
+  });
+  const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
+  const std::string& name1 = definition.bodies[0].definition.name;
+  const std::string& name2 = definition.bodies[1].definition.name;
+  const auto coupling_start = Clock::now();
+  result.pairing =
+      discretize_contact(result.interfaces[0], name1, result.interfaces[1], name2, gap.get(),
+                         definition.contact, definition.solver.pairing_tolerance);
+  result.coupling_seconds = seconds_since(coupling_start);
+  report_stage(observer, describe_contact(result.pairing, name1, name2));
+  for (const std::string& line : result.pairing.excluded) report_stage(observer, line);
+  if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
+    report_stage(observer, overlap);
+  for (int alpha = 0; alpha < 2; ++alpha)
+    ports[alpha]->assign_contact(result.pairing.assignment(alpha));
+  result.setup_seconds = seconds_since(start);
+
+  if (definition.loading.stepped()) {
     run_load_steps(definition.loading, ports, options, observer, result);
   } else {
     const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
