@@ -310,6 +310,40 @@ TEST_P(BodyVtuModels, UniaxialCompressionFieldsReadByVtkMatchTheAnalyticSolution
   }
 }
 
+TEST(BodyVtu, VoigtPlaneStrainMaterialHasNoOutOfPlaneStress) {
+  // The plane-strain stiffness of (E, nu) given as a Voigt matrix: the same displacements as the
+  // isotropic plane-strain block, but a Voigt material carries no out-of-plane relation
+  // (numerics/material.hpp: s_zz = 0), so ZZ = 0 and von Mises = sqrt((p^2 + p^2) / 2) = p.
+  using Block = CompressedBlock;
+  BodyDefinition definition = Block::definition(PlaneModel::plane_strain);
+  definition.material =
+      make_voigt_material(definition.material.stiffness, PlaneModel::plane_strain, "test");
+  BodySolver body(definition);
+  const InterfaceDescription top = body.contact_boundary();
+  body.assign_contact(node_to_node_operator(
+      top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1)), top.weights));
+  Eigen::VectorXd lambda(5);
+  for (int i = 0; i < 5; ++i)
+    lambda[i] = Block::pressure * Block::face_weight(top.coordinates[i].x());
+  const TemporaryDirectory directory("result_files");
+  write_body_vtu(directory.path(), body, lambda);
+  const json grid = test::read_vtu_with_vtk(directory.path() / "block.vtu");
+  const double p = Block::pressure, nu = Block::poisson, tolerance = 1e-12;
+  const json& points = grid["points"];
+  const json& displacement = grid["point_data"]["displacement"]["values"];
+  const json& stress = grid["point_data"]["stress"]["values"];
+  const json& von_mises = grid["point_data"]["von_mises"]["values"];
+  for (std::size_t k = 0; k < 15; ++k) {
+    const double x = points[3 * k].get<double>(), y = points[3 * k + 1].get<double>();
+    EXPECT_NEAR(displacement[3 * k].get<double>(), nu * (1 + nu) * p * x / Block::young, tolerance);
+    EXPECT_NEAR(displacement[3 * k + 1].get<double>(), -(1 - nu * nu) * p * y / Block::young,
+                tolerance);
+    EXPECT_NEAR(stress[6 * k + 1].get<double>(), -p, tolerance * p);
+    EXPECT_EQ(stress[6 * k + 2].get<double>(), 0.0);
+    EXPECT_NEAR(von_mises[k].get<double>(), p, tolerance * p);
+  }
+}
+
 TEST(BodyVtu, ContactForceOfTheWrongSizeIsRejectedNamingTheFile) {
   BodySolver body(CompressedBlock::definition());
   const InterfaceDescription top = body.contact_boundary();
