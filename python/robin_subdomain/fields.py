@@ -72,7 +72,7 @@ def stress_tensors(material, stress):
 def _compressed_record(raw):
     """`raw` in vtkZLibDataCompressor's layout: UInt64 words [blocks, block size, size of the
     last block (0 when full), compressed size of each block], then the zlib streams."""
-    blocks = [zlib.compress(raw[begin:begin + VTU_BLOCK_SIZE])
+    blocks = [zlib.compress(raw[begin:begin + VTU_BLOCK_SIZE], 1)  # fastest, as the C++ writer
               for begin in range(0, len(raw), VTU_BLOCK_SIZE)]
     header = struct.pack("<%dQ" % (3 + len(blocks)), len(blocks), VTU_BLOCK_SIZE,
                          len(raw) % VTU_BLOCK_SIZE, *(len(block) for block in blocks))

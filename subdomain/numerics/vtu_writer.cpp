@@ -19,6 +19,9 @@ namespace {
 
 /// Uncompressed bytes per zlib block (vtkZLibDataCompressor's default block size).
 constexpr std::size_t compression_block_size = 32768;
+/// zlib's fastest level: the mantissas of computed doubles are close to random, so higher levels
+/// mostly spend time; the runs of zeros and repeated values compress at any level.
+constexpr int compression_level = Z_BEST_SPEED;
 
 /// Text escaped for an XML attribute value.
 std::string escape_xml(const std::string& text) {
@@ -276,7 +279,7 @@ std::string compressed_record(const std::vector<unsigned char>& bytes,
     const std::size_t size = std::min(compression_block_size, bytes.size() - begin);
     uLongf compressed_size = static_cast<uLongf>(buffer.size());
     if (compress2(buffer.data(), &compressed_size, bytes.data() + begin, static_cast<uLong>(size),
-                  Z_DEFAULT_COMPRESSION) != Z_OK) {
+                  compression_level) != Z_OK) {
       throw std::runtime_error("cannot write '" + path.string() + "': zlib compression failed");
     }
     data.append(reinterpret_cast<const char*>(buffer.data()), compressed_size);
