@@ -30,6 +30,14 @@
 // is no deviation (the check 'neumann_solve_capability' passes with a note); the request must
 // then be refused as UNSUPPORTED.
 //
+// Load steps (protocol 2.1, SetLoadFactor) are judged for servers whose HelloReply carries
+// version 2.1 or later: a NaN, -infinity and 1e9 must be refused as BAD_INPUT with the state
+// 'ready'; the factors 2.5, -0.5 and 1 must each be acknowledged (LoadFactorSet with the factor
+// and 'ready'), the far-obstacle contact solve must then give u_N = factor * lift (the body's
+// only load is its lifted edge) and the correction must not change (F does not depend on the
+// loads); after the final EndRun the request is WRONG_STATE. A 2.0 server must refuse it as
+// UNSUPPORTED.
+//
 // Materials: robin-coordinator sends every material that is not isotropic plane strain as the
 // 3x3 SetupBody.voigt matrix. 'voigt_material' sets the body up again with the Voigt matrix
 // equivalent to its isotropic material; the partial-contact solve and the correction w(r1) must

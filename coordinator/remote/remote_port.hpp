@@ -71,8 +71,9 @@ class RemotePort final : public SubdomainPort {
   void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;
   CorrectionSolveResult finish_neumann_solve() override;
   /// SetLoadFactor (protocol 2.1). A server whose handshake announced minor version 0 is
-  /// refused before anything is sent: "the server ... speaks protocol 2.0; load steps need
-  /// 2.1 (SetLoadFactor), this coordinator speaks 2.1 ...".
+  /// refused before anything is sent: "..., step load factor 0.5: the server ('NAME') speaks
+  /// protocol 2.0, this coordinator speaks 2.1; a case with [loading] steps needs
+  /// SetLoadFactor (protocol 2.1): ...".
   void set_load_factor(double factor) override;
   BodyOutput fields(const Eigen::VectorXd& contact_force) override;
   void end_run() noexcept override;
