@@ -12,6 +12,8 @@ find_package(cppzmq REQUIRED)
 find_package(PkgConfig REQUIRED)
 # zlib: compression of the binary .vtu output (vtkZLibDataCompressor layout).
 find_package(ZLIB REQUIRED)
+# libsodium: SHA-256 of case files in summary.json (libzmq3-dev depends on it already).
+pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)
 
 # SuiteSparse 5.12 on Debian 12 ships no CMake configuration for CHOLMOD.
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config git
   clang libclang-rt-14-dev
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread
-  libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
+  libzmq3-dev libsodium-dev cppzmq-dev libprotobuf-dev protobuf-compiler
   libspdlog-dev libfmt-dev
   libgmsh-dev gmsh
   libcli11-dev libtomlplusplus-dev libmuparser-dev nlohmann-json3-dev

@@ -8,7 +8,8 @@ inline constexpr unsigned protocol_major = 2;
 /// 2.0: meshes as data (no scripts from the wire), the general constraint operator B in
 /// AssignContact, contact surfaces in InterfaceDescription. Within 1.x, 1.1 added
 /// NeumannSolveRequest and 1.2 Envelope.run_id. 2.1: SetLoadFactor (quasi-static load steps
-/// reuse the body's factor and F; a coordinator sends it only to servers of minor >= 1).
+/// reuse the body's factor and F; a coordinator sends it only to servers of minor >= 1) and
+/// StatusRequest (heartbeat and setup progress, capability "status").
 inline constexpr unsigned protocol_minor = 1;
 
 }  // namespace robin::protocol

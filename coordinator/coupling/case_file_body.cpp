@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "numerics/errors.hpp"
+#include "numerics/gmsh_reader.hpp"
 
 namespace robin {
 
@@ -67,6 +68,14 @@ void read_mesh(const CheckedTable& table, const std::filesystem::path& directory
   if (auto size = table.optional_number("mesh_size")) {
     if (*size <= 0.0) table.fail("mesh_size", "must be > 0, got " + format_number(*size));
     body.mesh_options.size = *size;
+    // mesh_size defines the .geo variable h: a script without h would silently ignore it
+    if (geo_variable_use(body.mesh_path, "h") == GeoVariableUse::unused) {
+      table.fail("mesh_size",
+                 "has no effect: '" + mesh +
+                     "' never uses the variable h, which mesh_size sets. Give its points the "
+                     "size h (e.g. 'DefineConstant[ h = 0.1 ];' and 'Point(1) = {0, 0, 0, h};') "
+                     "or remove mesh_size");
+    }
   }
   if (auto order = table.optional_integer("element_order")) {
     if (*order != 1 && *order != 2) {

@@ -66,10 +66,6 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                   const std::array<SubdomainPort*, 2>& ports,
                                   const CouplingOptions& options, const RunObserver& observer = {});
 
-/// Writes <body>.vtu x2, solution.pvd, contact.csv, history.csv and summary.json.
-void write_coupled_outputs(const std::filesystem::path& directory, const CaseDefinition& definition,
-                           const CoupledRunResult& result);
-
 /// Exit code of a run: 0 converged, 3 iteration limit, 4 diverged, 5 stagnated.
 int exit_code(IterationStatus status);
 

@@ -2,6 +2,7 @@
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <fmt/ranges.h>
 
 #include <unistd.h>
 
@@ -11,7 +12,8 @@
 #include <vector>
 
 #include "coupling/case_file_overrides.hpp"
-#include "coupling/coupled_run.hpp"
+#include "coupling/result_directory.hpp"
+#include "coupling/run_outputs.hpp"
 #include "numerics/errors.hpp"
 #include "remote/remote_port.hpp"
 #include "remote/run_interruption.hpp"
@@ -109,6 +111,34 @@ std::pair<double, std::string> stopping_value(const IterationRecord& record,
   return value;
 }
 
+/// Logs each server's progress during setup and fields from its StatusReplies: a line when a
+/// stage begins (with the body's DOFs) and, while a stage lasts, one every 10 s, so that a long
+/// setup never looks hung. One reporter per port (it keeps that port's last stage).
+std::function<void(const std::string&, const std::string&, const ServerStatus&)>
+progress_reporter(const std::shared_ptr<spdlog::logger>& log) {
+  struct Shown {
+    std::string stage;
+    double reported_at = 0.0;  // stage_seconds of the last line about this stage
+  };
+  auto shown = std::make_shared<Shown>();
+  return [log, shown](const std::string& body, const std::string& step,
+                      const ServerStatus& status) {
+    if (!status.busy || status.stage.empty()) return;
+    const std::string dofs =
+        status.dof_count > 0 ? fmt::format(" ({} DOFs)", status.dof_count) : std::string();
+    if (status.stage != shown->stage) {
+      shown->stage = status.stage;
+      shown->reported_at = status.stage_seconds;
+      log->info("body '{}' {}: {}{}, {:.1f} s into the request", body, step, status.stage, dofs,
+                status.request_seconds);
+    } else if (status.stage_seconds - shown->reported_at >= 10.0) {
+      shown->reported_at = status.stage_seconds;
+      log->info("body '{}' {}: still in {}{} after {:.0f} s", body, step, status.stage, dofs,
+                status.stage_seconds);
+    }
+  };
+}
+
 /// Logs how the run ended and where the results are; returns the exit code of its status.
 /// Converged: which state the stopping test accepted, its largest residual against the
 /// tolerance, and the residuals of that state (the one the result files hold).
@@ -178,6 +208,20 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
   app.add_option("--output,-o", settings.output_directory, "directory for the result files")
       ->required()
       ->check(writable_directory());
+  app.add_flag("--overwrite", settings.overwrite,
+               "replace the results of an earlier run in the output directory (a directory "
+               "holding files is refused otherwise)");
+  // Refused before any server starts: a typo must not cost a setup, an earlier run's files
+  // must not be mixed with this run's.
+  app.final_callback([&settings] {
+    try {
+      check_result_directory(settings.output_directory, settings.overwrite
+                                                            ? ExistingResults::overwrite
+                                                            : ExistingResults::refuse);
+    } catch (const ResultDirectoryError& error) {
+      throw CLI::ValidationError("--output", error.what());
+    }
+  });
   app.add_option("--relaxation", settings.relaxation,
                  "relaxation delta of the obstacle update, in (0, 2)")
       ->check(open_interval(0.0, 2.0));
@@ -217,6 +261,10 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
                  "deadline of the mesh-sized requests (body setup: meshing, assembly, "
                  "factorization; fields), in seconds; default from the case file, 3600")
       ->check(positive());
+  app.add_option("--heartbeat-timeout", settings.heartbeat_timeout_seconds,
+                 "during setup and fields, a server that does not answer StatusRequest for this "
+                 "long (seconds) is declared hung (servers of protocol 2.1; 0: off)")
+      ->check(CLI::NonNegativeNumber);
   CLI::Option* log_level =
       app.add_option("--log-level", settings.log_level, "trace, debug, info, warn, error, off")
           ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
@@ -304,6 +352,19 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
                     const std::array<ChannelOptions, 2>& channels) {
   auto log = coordinator_logger();
   const CouplingOptions options = merged_coupling_options(definition.coupling, settings);
+  std::unique_ptr<ResultDirectory> results;
+  try {
+    results = std::make_unique<ResultDirectory>(
+        settings.output_directory,
+        settings.overwrite ? ExistingResults::overwrite : ExistingResults::refuse,
+        "robin-coordinator", definition.file);
+  } catch (const std::exception& error) {
+    return failure_exit_code(error);
+  }
+  if (!results->leftover_files().empty()) {
+    log->warn("the output directory {} also holds files that are not results of a run: {}",
+              settings.output_directory.string(), fmt::join(results->leftover_files(), ", "));
+  }
   std::array<std::unique_ptr<RemotePort>, 2> ports;
   int code = 1;
   try {
@@ -312,18 +373,23 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
       port_options.request_timeout_seconds = options.request_timeout_seconds;
       port_options.setup_timeout_seconds = options.setup_timeout_seconds;
       port_options.channel = channels[alpha];
+      port_options.heartbeat_timeout_seconds = settings.heartbeat_timeout_seconds;
+      port_options.on_status = progress_reporter(log);
       const std::string& body = definition.bodies[alpha].definition.name;
       ports[alpha] = std::make_unique<RemotePort>(endpoints[alpha], body, port_options);
       log->info("body {} '{}' on server {}", alpha + 1, body, endpoints[alpha]);
     }
     const CoupledRunResult result = run_coupled_case(definition, {ports[0].get(), ports[1].get()},
                                                      options, make_observer(log, options));
-    write_coupled_outputs(settings.output_directory, definition, result);
+    write_coupled_outputs(*results, definition, result);
     code = report_outcome(result, settings, *log);
   } catch (const InputError& error) {  // e.g. unmatched contact nodes: name the case file
-    code = failure_exit_code(InputError(in_case_file(definition.file, error.what())));
+    const InputError named(in_case_file(definition.file, error.what()));
+    code = failure_exit_code(named);
+    results->fail(stop_signal() != 0 ? RunFailure::interrupted : RunFailure::failed, named.what());
   } catch (const std::exception& error) {
     code = failure_exit_code(error);
+    results->fail(stop_signal() != 0 ? RunFailure::interrupted : RunFailure::failed, error.what());
   }
   for (auto& port : ports) {
     if (port) port->end_run();

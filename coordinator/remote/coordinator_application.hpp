@@ -31,6 +31,7 @@ namespace robin {
 struct CoordinatorSettings {
   std::filesystem::path case_file;
   std::filesystem::path output_directory;
+  bool overwrite = false;  // --overwrite: replace an earlier run's results (result_directory.hpp)
   std::optional<double> relaxation;
   std::optional<double> relaxation1, relaxation2;
   std::optional<std::string> acceleration;  // "iqn-ils", "aitken" or "none"
@@ -43,6 +44,7 @@ struct CoordinatorSettings {
   std::optional<std::string> initial_obstacle;  // "gap" or "zero"
   std::optional<double> timeout_seconds;        // deadline of each interface-sized request
   std::optional<double> setup_timeout_seconds;  // deadline of the setup and fields requests
+  double heartbeat_timeout_seconds = 10.0;      // remote_port.hpp; 0: no heartbeat
   std::string log_level = "info";
   bool quiet = false;  // --quiet: the coordinator logs only warnings and errors
   /// --set KEY=VALUE: overrides of case-file keys, in order (coupling/case_file_overrides.hpp).

@@ -58,8 +58,13 @@ struct RemotePort::Pending {
 
 RemotePort::RemotePort(std::string endpoint, std::string body_label, RemotePortOptions options)
     : endpoint_(std::move(endpoint)), body_label_(std::move(body_label)), options_(options) {
+  ChannelOptions channel = options_.channel;
+  channel.on_wait = [this, caller = options_.channel.on_wait] {
+    if (caller) caller();
+    if (heartbeat_) heartbeat_->poll();
+  };
   try {
-    channel_ = std::make_unique<RequestChannel>(endpoint_, options_.channel);
+    channel_ = std::make_unique<RequestChannel>(endpoint_, channel);
   } catch (const ChannelFailure& failure) {
     fail("connect", failure.what());
   }
@@ -137,6 +142,21 @@ Envelope RemotePort::exchange(Envelope& request, const std::string& step, double
   return finish_request(expected_content);
 }
 
+Envelope RemotePort::watched_exchange(Envelope& request, const std::string& step,
+                                      double timeout_seconds, int expected_content) {
+  if (!heartbeat_) return exchange(request, step, timeout_seconds, expected_content);
+  watched_step_ = step;
+  heartbeat_->start();
+  try {
+    Envelope reply = exchange(request, step, timeout_seconds, expected_content);
+    heartbeat_->stop();
+    return reply;
+  } catch (...) {
+    heartbeat_->stop();
+    throw;
+  }
+}
+
 void RemotePort::handshake() {
   Envelope request;
   request.mutable_hello()->set_client_name(
@@ -159,6 +179,17 @@ void RemotePort::handshake() {
   server_major_ = reply.version().major();
   server_minor_ = reply.version().minor();
   capabilities_.assign(hello.capabilities().begin(), hello.capabilities().end());
+  if (offers("status") && options_.heartbeat_timeout_seconds > 0.0) {
+    try {
+      heartbeat_ = std::make_unique<ServerHeartbeat>(
+          endpoint_, options_.channel, options_.heartbeat_timeout_seconds,
+          options_.heartbeat_interval_seconds, [this](const ServerStatus& status) {
+            if (options_.on_status) options_.on_status(body_label_, watched_step_, status);
+          });
+    } catch (const ChannelFailure& failure) {
+      fail("handshake", std::string("cannot open the heartbeat connection: ") + failure.what());
+    }
+  }
   spdlog::debug("{}: {} (protocol {}, state {}, offers {})", describe(), server_name_,
                 version_text(reply.version().major(), reply.version().minor()), hello.state(),
                 join_names(hello.capabilities()));
@@ -174,7 +205,7 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   Envelope request;
   *request.mutable_setup_body() = encode_setup_body(body.definition, body.context, solver);
   const Envelope reply =
-      exchange(request, "setup", options_.setup_timeout_seconds, Envelope::kInterface);
+      watched_exchange(request, "setup", options_.setup_timeout_seconds, Envelope::kInterface);
   timings_.compute_seconds += reply.interface().setup_seconds();
   try {
     InterfaceDescription interface = decode_interface(reply.interface());
@@ -189,7 +220,8 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
 void RemotePort::assign_contact(const ContactOperator& contact) {
   Envelope request;
   *request.mutable_assign_contact() = encode_contact_operator(contact);
-  exchange(request, "contact assignment", options_.request_timeout_seconds, Envelope::kAcknowledge);
+  watched_exchange(request, "contact assignment", options_.request_timeout_seconds,
+                   Envelope::kAcknowledge);
   contact_size_ = contact.row_count();
 }
 
@@ -295,7 +327,7 @@ BodyOutput RemotePort::fields(const Eigen::VectorXd& contact_force) {
   Envelope request;
   append(contact_force, *request.mutable_fields()->mutable_contact_force());
   const Envelope reply =
-      exchange(request, "fields", options_.setup_timeout_seconds, Envelope::kFieldsReply);
+      watched_exchange(request, "fields", options_.setup_timeout_seconds, Envelope::kFieldsReply);
   try {
     return decode_fields(reply.fields_reply(), body_label_);
   } catch (const MalformedReply& malformed) {

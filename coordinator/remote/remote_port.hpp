@@ -26,6 +26,13 @@
 // run ..." instead of being answered from the other run's body; a best-effort EndRun refused
 // that way ends nothing on the server. A server of protocol 1.0 or 1.1 ignores run_id.
 //
+// Heartbeat (protocol 2.1): with a server that announced "status", setup, contact assignment
+// and fields are watched by a ServerHeartbeat (server_heartbeat.hpp) on a second connection:
+// each StatusReply goes to RemotePortOptions::on_status (progress lines), and a server whose
+// socket thread stops answering for heartbeat_timeout_seconds fails the step at once, e.g.
+//   server tcp://127.0.0.1:5555 (body 'upper'), step setup: no heartbeat for 10 s: ...
+// instead of at the setup deadline. A 2.0 server (no "status") is waited for as before.
+//
 // Timings: compute_seconds adds the server-reported times of setup (assembly and
 // factorization), contact solves, corrections and Neumann solves; round_trip_seconds adds, for
 // the same requests, the time from sending the request to the decoded reply; bytes count every
@@ -41,6 +48,7 @@
 
 #include "coupling/subdomain_port.hpp"
 #include "remote/request_channel.hpp"
+#include "remote/server_heartbeat.hpp"
 
 namespace robin {
 
@@ -51,6 +59,13 @@ struct RemotePortOptions {
   double end_run_timeout_seconds = 2.0;   // EndRun is best effort
   /// Transport settings and the hooks run while waiting (cancellation, child-process checks).
   ChannelOptions channel;
+  /// Heartbeat of a server announcing "status" (protocol 2.1) during setup, contact
+  /// assignment and fields (server_heartbeat.hpp): a StatusRequest every interval on a second
+  /// connection; no StatusReply for the timeout fails the step. 0 turns heartbeats off.
+  double heartbeat_timeout_seconds = 10.0;
+  double heartbeat_interval_seconds = 1.0;
+  /// Told each StatusReply of a long request: (body name, step, status). May be empty.
+  std::function<void(const std::string&, const std::string&, const ServerStatus&)> on_status;
 };
 
 class RemotePort final : public SubdomainPort {
@@ -99,6 +114,9 @@ class RemotePort final : public SubdomainPort {
   protocol::Envelope finish_request(int expected_content);
   protocol::Envelope exchange(protocol::Envelope& request, const std::string& step,
                               double timeout_seconds, int expected_content);
+  /// exchange() with the heartbeat watching the server meanwhile (when it offers "status").
+  protocol::Envelope watched_exchange(protocol::Envelope& request, const std::string& step,
+                                      double timeout_seconds, int expected_content);
   [[noreturn]] void fail(const std::string& step, const std::string& problem) const;
   void update_byte_counts();
 
@@ -106,6 +124,8 @@ class RemotePort final : public SubdomainPort {
   std::string body_label_;
   RemotePortOptions options_;
   std::unique_ptr<RequestChannel> channel_;
+  std::unique_ptr<ServerHeartbeat> heartbeat_;  // made by the handshake when "status" is offered
+  std::string watched_step_;
   std::unique_ptr<Pending> pending_;
   std::string server_name_;
   std::vector<std::string> capabilities_;

@@ -130,24 +130,38 @@ protocol::Envelope RequestChannel::receive(std::uint64_t request_id, const Deadl
                         "abandoned requests, or a server that does not echo request_id)";
     }
     wait_for(ZMQ_POLLIN, deadline, timeout_problem);
-    std::vector<zmq::message_t> frames;
-    do {
-      frames.emplace_back();
-      if (!sockets_->dealer.recv(frames.back(), zmq::recv_flags::dontwait)) {
-        throw ChannelFailure("a reply was announced but could not be read");
-      }
-    } while (frames.back().more());
-    for (const zmq::message_t& frame : frames) bytes_received_ += static_cast<long>(frame.size());
-    protocol::Envelope reply;
-    if (frames.size() != 2 || frames[0].size() != 0 ||
-        !reply.ParseFromArray(frames[1].data(), static_cast<int>(frames[1].size()))) {
-      throw ChannelFailure(
-          "the reply is not a protocol message (expected an empty delimiter "
-          "frame and one serialized Envelope); is this a robin-subdomain server?");
-    }
+    protocol::Envelope reply = read_reply();
     if (reply.request_id() == request_id) return reply;
     // A late reply to an abandoned request: discard it (counted) and keep waiting.
   }
+}
+
+std::optional<protocol::Envelope> RequestChannel::try_receive(std::uint64_t request_id) {
+  while (poll_dealer(ZMQ_POLLIN, std::chrono::milliseconds(0))) {
+    protocol::Envelope reply = read_reply();
+    if (reply.request_id() == request_id) return reply;
+  }
+  check_connection();
+  return std::nullopt;
+}
+
+protocol::Envelope RequestChannel::read_reply() {
+  std::vector<zmq::message_t> frames;
+  do {
+    frames.emplace_back();
+    if (!sockets_->dealer.recv(frames.back(), zmq::recv_flags::dontwait)) {
+      throw ChannelFailure("a reply was announced but could not be read");
+    }
+  } while (frames.back().more());
+  for (const zmq::message_t& frame : frames) bytes_received_ += static_cast<long>(frame.size());
+  protocol::Envelope reply;
+  if (frames.size() != 2 || frames[0].size() != 0 ||
+      !reply.ParseFromArray(frames[1].data(), static_cast<int>(frames[1].size()))) {
+    throw ChannelFailure(
+        "the reply is not a protocol message (expected an empty delimiter "
+        "frame and one serialized Envelope); is this a robin-subdomain server?");
+  }
+  return reply;
 }
 
 bool RequestChannel::connection_lost() {

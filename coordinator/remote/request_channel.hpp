@@ -100,6 +100,9 @@ class RequestChannel {
   /// The reply to `request_id`. Throws ChannelFailure on deadline, lost connection or a reply
   /// that is not a protocol message.
   protocol::Envelope receive(std::uint64_t request_id, const Deadline& deadline);
+  /// The reply to `request_id` if it has arrived, without waiting (other replies are
+  /// discarded); nullopt otherwise. Throws ChannelFailure like receive().
+  std::optional<protocol::Envelope> try_receive(std::uint64_t request_id);
 
   /// Turns the on_wait and server_failure hooks off or on (off for best-effort requests that
   /// must still be sent after a cancellation, such as EndRun).
@@ -115,6 +118,8 @@ class RequestChannel {
   /// True when the dealer is ready for `events` within `timeout` (false on EINTR).
   bool poll_dealer(short events, std::chrono::milliseconds timeout);
   void check_connection();
+  /// Reads the waiting message and parses its Envelope (ChannelFailure when it is none).
+  protocol::Envelope read_reply();
   std::string server_failure_reason() const;
   void read_monitor_events();
   /// The message for a failed handshake (monitor event `event` with value `value`).

@@ -135,6 +135,10 @@ BodySolver::BodySolver(BodyDefinition definition, BodySolverOptions options)
 
 BodySolver::~BodySolver() = default;
 
+void BodySolver::report(SetupStage stage) const {
+  if (options_.observer) options_.observer(stage);
+}
+
 void BodySolver::assemble() {
   auto start = std::chrono::steady_clock::now();
   const Mesh& mesh = definition_.mesh;
@@ -149,6 +153,7 @@ void BodySolver::assemble() {
                              std::to_string(options_.maximum_dofs) +
                              " (robin-subdomain --max-dofs raises it)");
   }
+  report(SetupStage::assembly);
   dofs_ = std::make_unique<DofMap>(prescribed_dofs(definition_));
   if (!removes_rigid_motions(mesh, *dofs_)) {
     throw SingularBodyError(
@@ -164,8 +169,9 @@ void BodySolver::assemble() {
 
   start = std::chrono::steady_clock::now();
   boundary_weights_ = robin::boundary_weights(mesh, mesh.boundary(definition_.contact_boundary));
+  report(SetupStage::ordering);
   factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name(), trailing_unknowns(),
-                                             options_.maximum_factor_bytes);
+                                             options_.maximum_factor_bytes, options_.observer);
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
   timings_.factorization_seconds = seconds_since(start);
 }
@@ -204,6 +210,7 @@ InterfaceDescription BodySolver::contact_boundary() const {
 
 void BodySolver::assign_contact(const ContactOperator& contact) {
   const auto start = std::chrono::steady_clock::now();
+  report(SetupStage::interface_operator);
   const std::vector<int> boundary_nodes =
       definition_.mesh.boundary(definition_.contact_boundary).nodes();
   check_contact_operator(contact, boundary_nodes, "body '" + name() + "'");

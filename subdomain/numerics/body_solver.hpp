@@ -30,6 +30,7 @@
 #include "numerics/elasticity.hpp"
 #include "numerics/linear_operator.hpp"
 #include "numerics/mprgp.hpp"
+#include "numerics/setup_progress.hpp"
 
 namespace robin {
 
@@ -68,6 +69,9 @@ struct BodySolverOptions {
   /// analysis, before the numerical factorization). ResourceLimitError otherwise.
   long maximum_dofs = 0;
   double maximum_factor_bytes = 0.0;
+  /// Told when each setup stage begins (assembly, ordering, factorization, interface
+  /// operator); may be empty.
+  SetupObserver observer;
 };
 
 struct ContactSolveResult {
@@ -161,6 +165,7 @@ class BodySolver {
 
  private:
   void assemble();
+  void report(SetupStage stage) const;
   void build_interface_operator();
   /// Free dofs of the contact boundary nodes, to be eliminated last (empty when disabled).
   std::vector<int> trailing_unknowns() const;

@@ -180,14 +180,16 @@ struct CholeskyFactor::Implementation {
 
   double memory_limit_bytes = 0.0;
 
-  void factorize(const SparseMatrix& matrix, const std::vector<int>& trailing);
+  void factorize(const SparseMatrix& matrix, const std::vector<int>& trailing,
+                 const SetupObserver& observer);
   void check_memory_estimate();
   void check_pivots() const;
   void locate_trailing(const std::vector<int>& trailing);
 };
 
 void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
-                                               const std::vector<int>& trailing) {
+                                               const std::vector<int>& trailing,
+                                               const SetupObserver& observer) {
   cholmod_common& common = cholesky.cholmod();
   common.print = 0;                // CHOLMOD prints nothing, not even warnings
   common.error_handler = nullptr;  // failures are read from common.status instead
@@ -204,6 +206,7 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
                              std::to_string(common.status) + ", e.g. out of memory)");
   }
   check_memory_estimate();
+  if (observer) observer(SetupStage::factorization);
   cholesky.factorize(matrix);
   const cholmod_factor& factor = *cholesky.factor();
   if (common.status < CHOLMOD_OK) {
@@ -270,7 +273,8 @@ void CholeskyFactor::Implementation::check_pivots() const {
 }
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
-                               const std::vector<int>& trailing_unknowns, double memory_limit_bytes)
+                               const std::vector<int>& trailing_unknowns, double memory_limit_bytes,
+                               const SetupObserver& observer)
     : implementation_(std::make_unique<Implementation>()) {
   implementation_->body_name = body_name;
   implementation_->memory_limit_bytes = memory_limit_bytes;
@@ -284,7 +288,7 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& bo
                      "': the stiffness matrix is empty (every degree of freedom is prescribed)");
   }
   implementation_->size = static_cast<int>(matrix.rows());
-  implementation_->factorize(matrix, trailing_unknowns);
+  implementation_->factorize(matrix, trailing_unknowns, observer);
 }
 
 CholeskyFactor::~CholeskyFactor() = default;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "numerics/elasticity.hpp"
+#include "numerics/setup_progress.hpp"
 
 namespace robin {
 
@@ -29,9 +30,11 @@ class CholeskyFactor {
   /// in the given order. Empty: CHOLMOD's order of the whole matrix.
   /// `memory_limit_bytes` > 0 bounds the factor: when the symbolic analysis finds that L needs
   /// more (8 bytes per stored entry), ResourceLimitError is thrown before the numerical
-  /// factorization allocates it.
+  /// factorization allocates it. `observer` (may be empty) is told when the numerical
+  /// factorization begins, after the ordering and symbolic analysis.
   CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
-                 const std::vector<int>& trailing_unknowns = {}, double memory_limit_bytes = 0.0);
+                 const std::vector<int>& trailing_unknowns = {}, double memory_limit_bytes = 0.0,
+                 const SetupObserver& observer = {});
   ~CholeskyFactor();
   CholeskyFactor(const CholeskyFactor&) = delete;
   CholeskyFactor& operator=(const CholeskyFactor&) = delete;

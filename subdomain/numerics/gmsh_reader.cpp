@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -526,6 +527,65 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests)
     meshes[k].source = requests[k].path.string();
   }
   return meshes;
+}
+
+namespace {
+
+/// The script's text without comments (// to the end of the line, /* ... */) and without the
+/// contents of double-quoted strings; a string's own text is returned in `strings`.
+std::string code_of_geo_script(const std::string& text, std::vector<std::string>& strings) {
+  std::string code;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    if (text.compare(k, 2, "//") == 0) {
+      k = text.find('\n', k);
+      if (k == std::string::npos) break;
+      code += '\n';
+    } else if (text.compare(k, 2, "/*") == 0) {
+      k = text.find("*/", k + 2);
+      if (k == std::string::npos) break;
+      ++k;
+      code += ' ';
+    } else if (text[k] == '"') {
+      std::string value;
+      for (++k; k < text.size() && text[k] != '"'; ++k) {
+        if (text[k] == '\\' && k + 1 < text.size()) ++k;
+        value += text[k];
+      }
+      strings.push_back(value);
+      code += "\"\"";
+    } else {
+      code += text[k];
+    }
+  }
+  return code;
+}
+
+bool is_identifier_character(char character) {
+  return std::isalnum(static_cast<unsigned char>(character)) != 0 || character == '_';
+}
+
+bool mentions_identifier(const std::string& code, const std::string& name) {
+  for (std::size_t at = code.find(name); at != std::string::npos; at = code.find(name, at + 1)) {
+    const bool starts = at == 0 || !is_identifier_character(code[at - 1]);
+    const std::size_t end = at + name.size();
+    const bool ends = end >= code.size() || !is_identifier_character(code[end]);
+    if (starts && ends) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+GeoVariableUse geo_variable_use(const std::filesystem::path& path, const std::string& name) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError("mesh file '" + path.string() + "' cannot be read");
+  std::ostringstream text;
+  text << file.rdbuf();
+  std::vector<std::string> strings;
+  const std::string code = code_of_geo_script(text.str(), strings);
+  if (mentions_identifier(code, name)) return GeoVariableUse::used;
+  return mentions_identifier(code, "Include") ? GeoVariableUse::indeterminate
+                                               : GeoVariableUse::unused;
 }
 
 }  // namespace robin

@@ -39,4 +39,16 @@ struct MeshFileRequest {
 /// Throws InputError naming the file for the first request that fails.
 std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests);
 
+/// How a .geo script refers to a variable, read from its text (comments and strings skipped).
+enum class GeoVariableUse {
+  used,           // the identifier occurs in the script
+  unused,         // it does not, and the script includes no other file
+  indeterminate,  // it does not, but the script includes other files (Include "...")
+};
+
+/// Whether the .geo script `path` mentions the variable `name` (e.g. "h", which MeshReadOptions
+/// sets: a script that never mentions it ignores the size). Throws InputError naming the file
+/// when it cannot be read.
+GeoVariableUse geo_variable_use(const std::filesystem::path& path, const std::string& name);
+
 }  // namespace robin

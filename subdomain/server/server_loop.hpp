@@ -1,5 +1,13 @@
 #pragma once
-// The subdomain server's transport: a ZeroMQ REP socket that feeds SubdomainServer::handle.
+// The subdomain server's transport: a ZeroMQ ROUTER socket that feeds SubdomainServer.
+//
+// Requests are handled one at a time, in arrival order, by a worker thread; the socket's thread
+// stays free meanwhile and answers StatusRequest at once (SubdomainServer::answer_status), so a
+// coordinator sees a long setup's progress and tells a slow server from a hung one. Requests of
+// other clients arriving while one is handled wait in a queue (at most
+// maximum_queued_requests; beyond, they get a MALFORMED_MESSAGE reply saying the server is
+// busy). Clients speak REQ framing (an empty delimiter frame, then one serialized Envelope; a
+// DEALER may leave the delimiter out); the reply goes back with the request's routing frames.
 //
 // The socket is bound to `endpoint` (tcp://host:port, tcp://*:port, tcp://127.0.0.1:* for an
 // ephemeral port, ipc://path). Socket options:
@@ -7,10 +15,9 @@
 //  - ZMQ_MAXMSGSIZE = max_message_size: libzmq refuses a larger message by dropping it and
 //    disconnecting its sender, so the sender gets NO reply (its request times out); the server
 //    itself stays up and serves other (and reconnecting) clients;
-//  - ZMQ_SNDTIMEO = send_timeout: a reply that cannot be queued within it (the client vanished
-//    and its pipe is full) is dropped, the socket is re-created on the same endpoint and the
-//    loop goes on.
-// Each message must be one frame (one serialized Envelope); a multi-frame message gets a
+//  - ZMQ_SNDTIMEO = send_timeout (a backstop: a ROUTER drops a reply to a client that vanished
+//    instead of blocking).
+// Each request must be one frame (one serialized Envelope); a multi-frame message gets a
 // MALFORMED_MESSAGE reply.
 //
 // With `curve` set, the socket is a CurveZMQ server (ZMQ_CURVE_SERVER with the server's secret
@@ -45,6 +52,8 @@ struct ServerLoopOptions {
   std::chrono::milliseconds send_timeout{10000};
   /// How often the stop flag is checked while no request arrives.
   std::chrono::milliseconds poll_interval{200};
+  /// Requests waiting behind the one being handled; more are refused at once.
+  std::size_t maximum_queued_requests = 16;
   /// Unset: no transport security.
   std::optional<CurveServerOptions> curve;
 };

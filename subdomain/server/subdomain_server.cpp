@@ -37,6 +37,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* neumann_solve_capability = "neumann_solve";  // protocol 1.1
+constexpr const char* status_capability = "status";                // protocol 2.1
+/// A StatusRequest Envelope is a few dozen bytes; larger messages are not parsed twice.
+constexpr std::size_t largest_status_request = 256;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -65,6 +68,7 @@ bool is_request(protocol::Envelope::ContentCase content) {
     case Envelope::kEndRun:
     case Envelope::kShutdown:
     case Envelope::kSetLoadFactor:
+    case Envelope::kStatusRequest:
       return true;
     default:
       return false;
@@ -205,6 +209,7 @@ std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
     record.type = content_type_name(request);
     if (body_) record.body = body_->name();
     check_version(request);
+    begin_request(record.type);
     dispatch(request, reply, record);
   } catch (const RequestError& error) {
     set_error(reply, error.code(), error.what(), state_);
@@ -217,15 +222,91 @@ std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
   } catch (...) {
     set_error(reply, protocol::INTERNAL, "internal error: unknown exception", state_);
   }
+  end_request();
   record.seconds = seconds_since(start);
   return finish(reply, record);
+}
+
+std::optional<std::string> SubdomainServer::answer_status(std::string_view request_bytes) noexcept {
+  if (!offers(status_capability) || request_bytes.size() > largest_status_request) {
+    return std::nullopt;
+  }
+  try {
+    protocol::Envelope request;
+    if (!request.ParseFromArray(request_bytes.data(), static_cast<int>(request_bytes.size())) ||
+        request.content_case() != protocol::Envelope::kStatusRequest ||
+        request.version().major() != settings_.protocol_major) {
+      return std::nullopt;
+    }
+    protocol::Envelope reply;
+    reply.set_request_id(request.request_id());
+    fill_status(reply);
+    reply.mutable_version()->set_major(settings_.protocol_major);
+    reply.mutable_version()->set_minor(settings_.protocol_minor);
+    return reply.SerializeAsString();
+  } catch (...) {
+    return std::nullopt;
+  }
+}
+
+void SubdomainServer::set_queued_requests(unsigned count) noexcept {
+  const std::lock_guard lock(progress_mutex_);
+  progress_.queued_requests = count;
+}
+
+void SubdomainServer::begin_request(const std::string& request_type) {
+  const std::lock_guard lock(progress_mutex_);
+  progress_.busy = true;
+  progress_.request_type = request_type;
+  progress_.stage.clear();
+  progress_.request_start = progress_.stage_start = Clock::now();
+}
+
+void SubdomainServer::begin_stage(SetupStage stage, long dof_count) {
+  const std::lock_guard lock(progress_mutex_);
+  progress_.stage = to_string(stage);
+  progress_.stage_start = Clock::now();
+  if (dof_count > 0) progress_.dof_count = dof_count;
+}
+
+void SubdomainServer::end_request() noexcept {
+  const std::lock_guard lock(progress_mutex_);
+  progress_.busy = false;
+  progress_.request_type.clear();
+  progress_.stage.clear();
+  progress_.state = state_;
+  progress_.body_name = body_ ? body_->name() : std::string();
+  progress_.dof_count = body_ ? 2L * static_cast<long>(body_->mesh().node_count()) : 0;
+}
+
+void SubdomainServer::fill_status(protocol::Envelope& reply) const {
+  protocol::StatusReply& status = *reply.mutable_status_reply();
+  const std::lock_guard lock(progress_mutex_);
+  const auto now = Clock::now();
+  status.set_state(to_string(progress_.state));
+  status.set_busy(progress_.busy);
+  status.set_request_type(progress_.request_type);
+  status.set_stage(progress_.stage);
+  status.set_request_seconds(
+      progress_.busy ? std::chrono::duration<double>(now - progress_.request_start).count() : 0.0);
+  status.set_stage_seconds(
+      progress_.busy ? std::chrono::duration<double>(now - progress_.stage_start).count() : 0.0);
+  status.set_dof_count(static_cast<std::uint64_t>(progress_.dof_count));
+  status.set_body_name(progress_.body_name);
+  status.set_queued_requests(progress_.queued_requests);
 }
 
 std::string SubdomainServer::reject(std::string_view reason) noexcept {
   RequestRecord record;
   protocol::Envelope reply;
   try {
-    set_error(reply, protocol::MALFORMED_MESSAGE, std::string(reason), state_);
+    ServerState state = ServerState::awaiting_setup;
+    {
+      // the state as of the last finished request: reject() may run while handle() works
+      const std::lock_guard lock(progress_mutex_);
+      state = progress_.state;
+    }
+    set_error(reply, protocol::MALFORMED_MESSAGE, std::string(reason), state);
   } catch (...) {
     return {};
   }
@@ -285,6 +366,9 @@ void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Enve
       return on_fields(request, reply);
     case Envelope::kSetLoadFactor:
       return on_set_load_factor(request, reply, record);
+    case Envelope::kStatusRequest:
+      if (!offers(status_capability)) break;
+      return fill_status(reply);
     case Envelope::kEndRun:
       require_same_run(request, "EndRun");
       body_.reset();
@@ -345,6 +429,7 @@ void SubdomainServer::on_hello(protocol::Envelope& reply) {
     hello.add_capabilities(capability);
   }
   if (offers(neumann_solve_capability)) hello.add_capabilities(neumann_solve_capability);
+  if (offers(status_capability)) hello.add_capabilities(status_capability);
   hello.set_state(to_string(state_));
 }
 
@@ -355,9 +440,17 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   interface_nodes_.clear();
   state_ = ServerState::awaiting_setup;
   record.body = request.setup_body().body_name();
+  {
+    const std::lock_guard lock(progress_mutex_);
+    progress_.body_name = printable_for_log(record.body);
+    progress_.dof_count = 0;
+  }
+  begin_stage(SetupStage::mesh, 0);
   DecodedSetup setup = decode_setup_body(request.setup_body(), settings_.data_directory);
   setup.body.maximum_dofs = settings_.maximum_dofs;
   setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;
+  const long dof_count = 2L * static_cast<long>(setup.definition.mesh.node_count());
+  setup.body.observer = [this, dof_count](SetupStage stage) { begin_stage(stage, dof_count); };
   auto body = std::make_unique<BodySolver>(std::move(setup.definition), setup.body);
   const InterfaceDescription interface = body->contact_boundary();
   protocol::InterfaceDescription& description = *reply.mutable_interface();
@@ -456,6 +549,7 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   const protocol::FieldsRequest& message = request.fields();
   require_same_run(request, "FieldsRequest");
   require_state(ServerState::ready, "FieldsRequest");
+  begin_stage(SetupStage::fields, 0);
   const Eigen::VectorXd contact_force = checked_vector(
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
   const BodyOutput output = make_body_output(*body_, contact_force);
@@ -512,6 +606,8 @@ void SubdomainServer::on_set_load_factor(const protocol::Envelope& request,
 }
 
 bool SubdomainServer::offers(const std::string& name) const {
+  // a server playing protocol 2.0 (testing) has no StatusRequest, as a 2.0 server would not
+  if (name == status_capability && settings_.protocol_minor < 1) return false;
   const auto& withheld = settings_.withheld_capabilities;
   return std::find(withheld.begin(), withheld.end(), name) == withheld.end();
 }

@@ -45,17 +45,24 @@
 // The state after the request is in Acknowledge.state, HelloReply.state and Error.state.
 //
 // Capabilities (HelloReply.capabilities): the core "contact_solve", "correction_solve",
-// "fields", and since protocol 1.1 the optional "neumann_solve" (NeumannSolveRequest:
-// u_N = B K^{-1} (f - B' lambda) = e - F lambda for a given contact force lambda).
+// "fields", since protocol 1.1 the optional "neumann_solve" (NeumannSolveRequest:
+// u_N = B K^{-1} (f - B' lambda) = e - F lambda for a given contact force lambda), and since 2.1
+// "status": StatusRequest is answered from a progress record (request, stage, DOFs, times) that
+// handle() keeps up to date, also through answer_status() from another thread while handle()
+// works (server_loop.hpp runs handle() on a worker thread).
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "numerics/body_solver.hpp"
 #include "numerics/mprgp.hpp"
+#include "numerics/setup_progress.hpp"
 #include "protocol_version.hpp"
 
 namespace spdlog {
@@ -107,8 +114,15 @@ class SubdomainServer {
   /// Handles one request and returns the serialized reply Envelope. Never throws; logs the
   /// request (type, body, iteration, duration, outcome).
   std::string handle(std::string_view request_bytes) noexcept;
+  /// The StatusReply to `request_bytes` when it is a StatusRequest of this server's major
+  /// version (capability "status"), otherwise nullopt (the request goes to handle()).
+  /// Thread-safe: answers from the progress record while handle() runs on another thread.
+  std::optional<std::string> answer_status(std::string_view request_bytes) noexcept;
+  /// The number of requests waiting behind the current one (reported in StatusReply).
+  void set_queued_requests(unsigned count) noexcept;
   /// The MALFORMED_MESSAGE reply (request_id 0) to a message the transport could not pass to
-  /// handle(), e.g. one of several frames; `reason` says why. Never throws; logs.
+  /// handle(), e.g. one of several frames; `reason` says why. Never throws; logs. Thread-safe
+  /// like answer_status().
   std::string reject(std::string_view reason) noexcept;
 
   ServerState state() const { return state_; }
@@ -146,7 +160,24 @@ class SubdomainServer {
   std::string finish(protocol::Envelope& reply, RequestRecord& record) noexcept;
   void log(const RequestRecord& record) const;
 
+  /// What the server is doing, for StatusReply: written by the thread in handle(), read by
+  /// answer_status() on the socket's thread.
+  struct Progress {
+    ServerState state = ServerState::awaiting_setup;
+    std::string request_type, stage, body_name;
+    std::chrono::steady_clock::time_point request_start, stage_start;
+    bool busy = false;
+    long dof_count = 0;
+    unsigned queued_requests = 0;
+  };
+  void begin_request(const std::string& request_type);
+  void begin_stage(SetupStage stage, long dof_count);
+  void end_request() noexcept;
+  void fill_status(protocol::Envelope& reply) const;
+
   ServerSettings settings_;
+  mutable std::mutex progress_mutex_;
+  Progress progress_;
   ServerState state_ = ServerState::awaiting_setup;
   bool shutdown_requested_ = false;
   std::unique_ptr<BodySolver> body_;

@@ -319,16 +319,16 @@ void expect_contact_csv_of_in_process_run(const std::filesystem::path& contact_c
 
 TEST(CurveTransport, RobinRunWithCurveWritesTheInProcessContactState) {
   const TemporaryDirectory output("robin-run-curve");
-  const testing::ProcessOutcome outcome =
-      run_tool("robin-run",
-               {example("two_blocks.toml").string(), "--output", output.path().string(), "--curve"},
-               output.path(), 120.0);
+  const testing::ProcessOutcome outcome = run_tool("robin-run",
+                                                   {example("two_blocks.toml").string(), "--output",
+                                                    (output.path() / "out").string(), "--curve"},
+                                                   output.path(), 120.0);
   EXPECT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
   EXPECT_NE(outcome.errors.find("CurveZMQ with keys made for this run"), std::string::npos)
       << outcome.errors;
   for (const char* body : {"lower", "upper"}) {
     const std::string log =
-        file_text(output.path() / "logs" / ("server-" + std::string(body) + ".log"));
+        file_text(output.path() / "out" / "logs" / ("server-" + std::string(body) + ".log"));
     EXPECT_NE(log.find("CurveZMQ with public key"), std::string::npos) << log;
     EXPECT_NE(log.find("admitted a client from 127.0.0.1"), std::string::npos) << log;
     // The keys made for the run are gone: "admitting the 1 client key(s) of DIR/NAME.public)".
@@ -341,7 +341,7 @@ TEST(CurveTransport, RobinRunWithCurveWritesTheInProcessContactState) {
     EXPECT_FALSE(std::filesystem::exists(allow_list.parent_path())) << allow_list;
   }
 
-  expect_contact_csv_of_in_process_run(output.path() / "contact.csv");
+  expect_contact_csv_of_in_process_run(output.path() / "out" / "contact.csv");
 }
 
 TEST(CurveTransport, ConformanceCheckerSpeaksCurve) {

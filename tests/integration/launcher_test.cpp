@@ -121,12 +121,14 @@ double in_process_resultant_y() {
 TEST(RobinRun, SolvesTwoBlocksAndLeavesNoServerBehind) {
   ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
   const TemporaryDirectory output("robin-run");
-  const ProcessOutcome outcome = run_tool(
-      "robin-run", {example("two_blocks.toml").string(), "--output", output.path().string()},
-      output.path(), 120.0);
+  // the results in a subdirectory: robin-run refuses a non-empty one (robin-run.stderr)
+  const ProcessOutcome outcome =
+      run_tool("robin-run",
+               {example("two_blocks.toml").string(), "--output", (output.path() / "out").string()},
+               output.path(), 120.0);
   EXPECT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
 
-  std::ifstream summary_file(output.path() / "summary.json");
+  std::ifstream summary_file(output.path() / "out" / "summary.json");
   ASSERT_TRUE(summary_file.good()) << "no summary.json; " << outcome.errors;
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
   EXPECT_EQ(summary.at("converged"), true);
@@ -144,8 +146,8 @@ TEST(RobinRun, SolvesTwoBlocksAndLeavesNoServerBehind) {
   EXPECT_EQ(servers.size(), 2u) << outcome.errors;
   EXPECT_TRUE(child_processes(getpid(), "robin-subdomain").empty())
       << "orphaned servers were reparented here";
-  EXPECT_TRUE(std::filesystem::exists(output.path() / "logs" / "server-lower.log"));
-  EXPECT_TRUE(std::filesystem::exists(output.path() / "logs" / "server-upper.log"));
+  EXPECT_TRUE(std::filesystem::exists(output.path() / "out" / "logs" / "server-lower.log"));
+  EXPECT_TRUE(std::filesystem::exists(output.path() / "out" / "logs" / "server-upper.log"));
 }
 
 TEST(RobinCoordinator, RequiresExactlyTwoSubdomains) {
@@ -155,7 +157,7 @@ TEST(RobinCoordinator, RequiresExactlyTwoSubdomains) {
        {std::vector<std::string>{"tcp://127.0.0.1:5555"},
         std::vector<std::string>{"tcp://127.0.0.1:5555", "tcp://127.0.0.1:5556",
                                  "tcp://127.0.0.1:5557"}}) {
-    std::vector<std::string> arguments{case_file, "--output", output.path().string()};
+    std::vector<std::string> arguments{case_file, "--output", (output.path() / "out").string()};
     for (const std::string& endpoint : endpoints) {
       arguments.insert(arguments.end(), {"--subdomain", endpoint});
     }

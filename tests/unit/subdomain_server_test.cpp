@@ -351,7 +351,7 @@ TEST(SubdomainServer, FullRunMatchesADirectlyBuiltBodySolver) {
   EXPECT_EQ(
       std::vector<std::string>(reply.hello_reply().capabilities().begin(),
                                reply.hello_reply().capabilities().end()),
-      (std::vector<std::string>{"contact_solve", "correction_solve", "fields", "neumann_solve"}));
+      (std::vector<std::string>{"contact_solve", "correction_solve", "fields", "neumann_solve", "status"}));
 
   reply = exchange(server, setup_request(2, lower_block_setup()));
   ASSERT_TRUE(reply.has_interface()) << reply.DebugString();

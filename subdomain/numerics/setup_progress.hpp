@@ -1,0 +1,41 @@
+#pragma once
+// The stages of setting a body up, reported as they begin (progress displays, heartbeats and
+// the stage-by-stage profile).
+
+#include <functional>
+#include <string>
+
+namespace robin {
+
+enum class SetupStage {
+  mesh,                // decoding and checking the mesh
+  assembly,            // stiffness matrix and load vector
+  ordering,            // the fill-reducing ordering and symbolic analysis of the factor
+  factorization,       // the numerical Cholesky factorization and K^{-1} f
+  interface_operator,  // B, e = B K^{-1} f and (when dense) F = B K^{-1} B'
+  fields,              // displacement, stress and reactions of the final state
+};
+
+/// "mesh", "assembly", "ordering", "factorization", "interface operator", "fields".
+inline std::string to_string(SetupStage stage) {
+  switch (stage) {
+    case SetupStage::mesh:
+      return "mesh";
+    case SetupStage::assembly:
+      return "assembly";
+    case SetupStage::ordering:
+      return "ordering";
+    case SetupStage::factorization:
+      return "factorization";
+    case SetupStage::interface_operator:
+      return "interface operator";
+    case SetupStage::fields:
+      return "fields";
+  }
+  return "unknown";
+}
+
+/// Called when a stage begins. Must not throw; may be called from a worker thread.
+using SetupObserver = std::function<void(SetupStage stage)>;
+
+}  // namespace robin
