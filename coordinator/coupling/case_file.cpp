@@ -321,12 +321,17 @@ void check_boundary_names(const BodyCase& body, const BodyDefinition& definition
   }
 }
 
+/// "case.toml:27: body 'upper': body[2].mesh" (or "case.toml: body 'upper': mesh").
+std::string mesh_context(const BodyCase& body) {
+  return body.mesh_context.empty() ? body.context + ": mesh" : body.mesh_context;
+}
+
 /// The InputError of a mesh reader, with the context of the body whose file it names.
 InputError mesh_error(const std::vector<BodyCase*>& bodies, const InputError& error) {
   const std::string message = error.what();
   for (const BodyCase* body : bodies) {
     if (message.find(body->mesh_path.string()) != std::string::npos) {
-      return InputError(body->context + ": mesh: " + message);
+      return InputError(mesh_context(*body) + ": " + message);
     }
   }
   return error;
@@ -339,7 +344,7 @@ BodyDefinition load_body(const BodyCase& body) {
   try {
     definition.mesh = read_gmsh_mesh(body.mesh_path, body.mesh_options);
   } catch (const InputError& error) {
-    throw InputError(body.context + ": mesh: " + error.what());
+    throw InputError(mesh_context(body) + ": " + error.what());
   }
   check_boundary_names(body, definition);
   return definition;

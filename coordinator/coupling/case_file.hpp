@@ -33,6 +33,9 @@ struct BodyCase {
   std::filesystem::path mesh_path;  // absolute (resolved against the case file's directory)
   MeshReadOptions mesh_options;
   std::string context;  // "case.toml: body 'upper'" for messages
+  /// "case.toml:27: body 'upper': body[2].mesh", where the mesh is named (for mesh errors:
+  /// Gmsh syntax errors, meshes without physical groups); empty for a BodyCase built by hand.
+  std::string mesh_context;
   /// contact_boundary, then every dirichlet and traction boundary, in file order. When empty
   /// (a BodyCase built by hand), load_body checks the names in `definition` instead.
   std::vector<BoundaryReference> boundary_references;

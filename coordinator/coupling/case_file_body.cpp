@@ -49,6 +49,7 @@ std::string lowercase(std::string text) {
 void read_mesh(const CheckedTable& table, const std::filesystem::path& directory, BodyCase& body) {
   const std::string mesh = table.string("mesh");
   if (mesh.empty()) table.fail("mesh", "the mesh file name is empty");
+  body.mesh_context = table.context().prefix(table.line("mesh")) + ": " + table.field("mesh");
   std::filesystem::path path(mesh);
   if (path.is_relative()) path = directory / path;
   body.mesh_path = std::filesystem::absolute(path).lexically_normal();

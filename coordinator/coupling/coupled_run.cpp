@@ -24,6 +24,33 @@ PortTimings difference(const PortTimings& later, const PortTimings& earlier) {
           later.bytes_sent - earlier.bytes_sent, later.bytes_received - earlier.bytes_received};
 }
 
+/// A server's refusal of a body's setup, with the place in the case file it is about: a body
+/// left with a rigid motion (SINGULAR_BODY) names the body's Dirichlet conditions, anything else
+/// (a resource limit, an unusable material) the body's [[body]] table.
+std::string in_body_case(const BodyCase& body, const std::string& message) {
+  std::string where = body.context;
+  if (message.find("SINGULAR_BODY") != std::string::npos) {
+    std::string dirichlet;
+    for (const BoundaryReference& reference : body.boundary_references) {
+      if (reference.field.find(".dirichlet[") == std::string::npos) continue;
+      dirichlet += (dirichlet.empty() ? "" : ", ") + reference.location + " " + reference.field;
+    }
+    if (!dirichlet.empty()) where += " (its Dirichlet conditions: " + dirichlet + ")";
+  } else if (!body.mesh_context.empty()) {
+    where = body.mesh_context.substr(0, body.mesh_context.rfind(": "));  // "case.toml:27: body 'x'"
+  }
+  return where + ": " + message;
+}
+
+/// A warning goes to observer.warning, or to observer.stage when there is none.
+void report_warning(const RunObserver& observer, const std::string& text) {
+  if (observer.warning) {
+    observer.warning(text);
+  } else if (observer.stage) {
+    observer.stage(text);
+  }
+}
+
 void report_stage(const RunObserver& observer, const std::string& text) {
   if (observer.stage) observer.stage(text);
 }
@@ -206,7 +233,11 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   result.meshing_seconds = seconds_since(start);
   report_stage(observer, "setting up both bodies (assembly, factorization)");
   result.interfaces = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
-    return port.setup(loaded.bodies[alpha], definition.solver);
+    try {
+      return port.setup(loaded.bodies[alpha], definition.solver);
+    } catch (const PortError& error) {
+      throw PortError(in_body_case(loaded.bodies[alpha], error.what()));
+    }
   });
   const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
   const std::string& name1 = definition.bodies[0].definition.name;
@@ -217,9 +248,9 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                          definition.contact, definition.solver.pairing_tolerance);
   result.coupling_seconds = seconds_since(coupling_start);
   report_stage(observer, describe_contact(result.pairing, name1, name2));
-  for (const std::string& line : result.pairing.excluded) report_stage(observer, line);
+  for (const std::string& line : result.pairing.excluded) report_warning(observer, line);
   if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
-    report_stage(observer, overlap);
+    report_warning(observer, overlap);
   for (int alpha = 0; alpha < 2; ++alpha)
     ports[alpha]->assign_contact(result.pairing.assignment(alpha));
   result.setup_seconds = seconds_since(start);

@@ -52,6 +52,8 @@ struct CoupledRunResult {
 /// Observer of the run's stages ("setup", "pairing", iteration records) for progress lines.
 struct RunObserver {
   std::function<void(const std::string&)> stage;
+  /// Excluded contact pairs and an initial overlap (stage when empty).
+  std::function<void(const std::string&)> warning;
   IterationObserver iteration;
 };
 

@@ -90,6 +90,7 @@ RunObserver make_observer(const std::shared_ptr<spdlog::logger>& log,
                           const CouplingOptions& options) {
   RunObserver observer;
   observer.stage = [log](const std::string& text) { log->info("{}", text); };
+  observer.warning = [log](const std::string& text) { log->warn("{}", text); };
   observer.iteration = [log, options](const IterationRecord& record) {
     log->info("{}", progress_line(record, options));
     throw_if_stop_requested();

@@ -80,7 +80,7 @@ class BadInput : public ::testing::Test {
                               const std::vector<std::string>& fragments) {
     const std::string binary = std::string(ROBIN_BINARY_DIR) + "/bin/robin-run";
     const CommandResult result = run_command(binary + " " + case_path.string() + " --output " +
-                                             (directory_ / "coupled").string());
+                                             (directory_ / "coupled").string() + " --overwrite");
     EXPECT_EQ(result.exit_code, 1) << result.output;
     expect_fragments(result.output, fragments);
   }
@@ -139,6 +139,44 @@ TEST_F(BadInput, NonPositiveDefiniteVoigtMatrix) {
 
 TEST_F(BadInput, BodyWithoutEnoughDirichletConditions) {
   expect_failure(write_case("x = 0.0\ny = 0.0", "y = 0.0"), {"case.toml", "lower", "rigid motion"});
+}
+
+// Through the service (robin-run), errors about a body's setup name the case file too: a body
+// left with a rigid motion (the server's SINGULAR_BODY) names the line and key of its Dirichlet
+// condition, a boundary name unknown to the mesh and a .geo with a syntax error name the line
+// and key of the case file.
+TEST_F(BadInput, ServiceErrorsAboutABodyNameTheCaseFileLineAndKey) {
+  const fs::path singular = write_case("x = 0.0\ny = 0.0", "y = 0.0");
+  const int dirichlet_line = 21;  // "boundary = \"bottom\"" of two_blocks.toml
+  ASSERT_NE(read_text(singular).find("boundary = \"bottom\""), std::string::npos);
+  std::istringstream lines(read_text(singular));
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    if (line == "boundary = \"bottom\"") {
+      EXPECT_EQ(number, dirichlet_line);
+    }
+  }
+  expect_coupled_failure(
+      singular, {"case.toml:" + std::to_string(dirichlet_line) + " body[1].dirichlet[1].boundary",
+                 "body 'lower'", "SINGULAR_BODY", "rigid motion"});
+
+  expect_coupled_failure(write_case("boundary = \"bottom\"", "boundary = \"floor\""),
+                         {"case.toml:" + std::to_string(dirichlet_line) +
+                          ": body 'lower': " + "body[1].dirichlet[1].boundary: boundary 'floor'"});
+
+  const fs::path broken = directory_ / "broken.geo";
+  std::ofstream(broken)
+      << "DefineConstant[ h = 0.1 ];\nPoint(1) = {0, 0, 0, h};\nLine(1) = {1, 2;\n";
+  const std::string lower = fs::path(ROBIN_EXAMPLES).string() + "/meshes/block_lower.geo";
+  const fs::path syntax = write_case(lower, broken.string());
+  int mesh_line = 0;
+  std::istringstream case_lines(read_text(syntax));
+  for (int number = 1; std::getline(case_lines, line); ++number) {
+    if (line.find("broken.geo") != std::string::npos) mesh_line = number;
+  }
+  expect_coupled_failure(
+      syntax, {"case.toml:" + std::to_string(mesh_line) + ": body 'lower': body[1].mesh: ",
+               "broken.geo", "line 3", "syntax error"});
 }
 
 TEST_F(BadInput, GapExpressionThatDoesNotParse) {
