@@ -58,13 +58,13 @@ def main():
     for case in CASES:
         case_file = REPOSITORY / "examples" / f"{case}.toml"
         monolithic = scratch / f"{case}-monolithic"
-        subprocess.run([tools / "robin-monolithic", case_file, "--output", monolithic],
+        subprocess.run([tools / "robin-monolithic", case_file, "--output", monolithic, "--overwrite"],
                        check=True, capture_output=True)
         reference = read_contact(monolithic / "contact.csv")
         cells, difference, pairs = [], "", ""
         for index, (name, arguments) in enumerate(METHODS):
             directory = scratch / f"{case}-{index}"
-            subprocess.run([tools / "robin-run", case_file, "--output", directory] + arguments +
+            subprocess.run([tools / "robin-run", case_file, "--output", directory, "--overwrite"] + arguments +
                            extra, check=False, capture_output=True)
             summary = json.loads((directory / "summary.json").read_text())
             pairs = summary.get("contact_pairs", pairs)

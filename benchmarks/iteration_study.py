@@ -152,7 +152,7 @@ def study_case(build, output, case, levels, reuse):
         code = 0
         if not (reuse and os.path.exists(os.path.join(monolithic_dir, "summary.json"))):
             code, _ = run([os.path.join(build, "bin", "robin-monolithic"),
-                           reference_case(case_path), "--output", monolithic_dir],
+                           reference_case(case_path), "--output", monolithic_dir, "--overwrite"],
                           os.path.join(directory, "monolithic.log"))
         if code != 0:
             sys.exit("robin-monolithic failed on %s level %d (see %s)" % (name, level, directory))
@@ -163,7 +163,7 @@ def study_case(build, output, case, levels, reuse):
             arguments = [repr(size / young_max) if a == "ALPHA" else a for a in arguments]
             slug = re.sub(r"[^a-z0-9]+", "-", method.lower()).strip("-")
             run_dir = os.path.join(directory, slug)
-            command = [os.path.join(build, "bin", "robin-run"), case_path, "--output", run_dir,
+            command = [os.path.join(build, "bin", "robin-run"), case_path, "--output", run_dir, "--overwrite",
                        "--tolerance", repr(TOLERANCE), "--max-iterations", str(MAX_ITERATIONS),
                        "--log-level", "warn"] + arguments
             code, seconds = 0, None
@@ -200,7 +200,7 @@ def fixed_delta_scan(build, output, case, deltas, reuse, stopping):
     for delta in deltas:
         run_dir = os.path.join(directory, "delta-%g" % delta)
         if not (reuse and os.path.exists(os.path.join(run_dir, "summary.json"))):
-            run([os.path.join(build, "bin", "robin-run"), case_path, "--output", run_dir,
+            run([os.path.join(build, "bin", "robin-run"), case_path, "--output", run_dir, "--overwrite",
                  "--tolerance", repr(TOLERANCE), "--max-iterations", "5000", "--acceleration",
                  "none", "--relaxation", repr(delta), "--stopping", stopping,
                  "--log-level", "warn"],

@@ -1,8 +1,8 @@
 #include "remote/coordinator_application.hpp"
 
+#include <fmt/ranges.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-#include <fmt/ranges.h>
 
 #include <unistd.h>
 
@@ -115,29 +115,29 @@ std::pair<double, std::string> stopping_value(const IterationRecord& record,
 /// Logs each server's progress during setup and fields from its StatusReplies: a line when a
 /// stage begins (with the body's DOFs) and, while a stage lasts, one every 10 s, so that a long
 /// setup never looks hung. One reporter per port (it keeps that port's last stage).
-std::function<void(const std::string&, const std::string&, const ServerStatus&)>
-progress_reporter(const std::shared_ptr<spdlog::logger>& log) {
+std::function<void(const std::string&, const std::string&, const ServerStatus&)> progress_reporter(
+    const std::shared_ptr<spdlog::logger>& log) {
   struct Shown {
     std::string stage;
     double reported_at = 0.0;  // stage_seconds of the last line about this stage
   };
   auto shown = std::make_shared<Shown>();
-  return [log, shown](const std::string& body, const std::string& step,
-                      const ServerStatus& status) {
-    if (!status.busy || status.stage.empty()) return;
-    const std::string dofs =
-        status.dof_count > 0 ? fmt::format(" ({} DOFs)", status.dof_count) : std::string();
-    if (status.stage != shown->stage) {
-      shown->stage = status.stage;
-      shown->reported_at = status.stage_seconds;
-      log->info("body '{}' {}: {}{}, {:.1f} s into the request", body, step, status.stage, dofs,
-                status.request_seconds);
-    } else if (status.stage_seconds - shown->reported_at >= 10.0) {
-      shown->reported_at = status.stage_seconds;
-      log->info("body '{}' {}: still in {}{} after {:.0f} s", body, step, status.stage, dofs,
-                status.stage_seconds);
-    }
-  };
+  return
+      [log, shown](const std::string& body, const std::string& step, const ServerStatus& status) {
+        if (!status.busy || status.stage.empty()) return;
+        const std::string dofs =
+            status.dof_count > 0 ? fmt::format(" ({} DOFs)", status.dof_count) : std::string();
+        if (status.stage != shown->stage) {
+          shown->stage = status.stage;
+          shown->reported_at = status.stage_seconds;
+          log->info("body '{}' {}: {}{}, {:.1f} s into the request", body, step, status.stage, dofs,
+                    status.request_seconds);
+        } else if (status.stage_seconds - shown->reported_at >= 10.0) {
+          shown->reported_at = status.stage_seconds;
+          log->info("body '{}' {}: still in {}{} after {:.0f} s", body, step, status.stage, dofs,
+                    status.stage_seconds);
+        }
+      };
 }
 
 /// Logs how the run ended and where the results are; returns the exit code of its status.
@@ -216,9 +216,11 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
   // must not be mixed with this run's.
   app.final_callback([&settings] {
     try {
-      check_result_directory(settings.output_directory, settings.overwrite
-                                                            ? ExistingResults::overwrite
-                                                            : ExistingResults::refuse);
+      // logs/: the servers' logs of this run when a launcher (deploy/remote-servers.sh) wrote
+      // them there before starting the coordinator
+      check_result_directory(
+          settings.output_directory,
+          settings.overwrite ? ExistingResults::overwrite : ExistingResults::refuse, {"logs"});
     } catch (const ResultDirectoryError& error) {
       throw CLI::ValidationError("--output", error.what());
     }

@@ -4,6 +4,7 @@
 // condition drives an excluded contact pair into penetration; the results are written); 2 bad
 // command line; 3 the contact QP did not converge (the results are written).
 
+#include <fmt/ranges.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -16,6 +17,7 @@
 #include "coupling/case_file_overrides.hpp"
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
+#include "coupling/result_directory.hpp"
 #include "coupling/result_files.hpp"
 #include "coupling/step_outputs.hpp"
 #include "numerics/errors.hpp"
@@ -33,6 +35,9 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   summary["case"] = problem.definition.file.string();
   summary["overrides"] = problem.definition.overrides;  // --set KEY=VALUE, in order
   summary["converged"] = result.qp.status == robin::QpStatus::converged;
+  // how the run ended, in robin-coordinator's words (a QP that did not converge hit its limit)
+  summary["status"] =
+      result.qp.status == robin::QpStatus::converged ? "converged" : "max_iterations";
   summary["qp_status"] = robin::to_string(result.qp.status);
   summary["iterations"] = result.qp.iterations;
   summary["operator_applications"] = result.qp.operator_applications;
@@ -81,9 +86,10 @@ robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem
   return robin::excluded_pair_clearance(problem.pairing, displacement_of, scale);
 }
 
+/// Writes the result files into the directory's staging area (result_directory.hpp); the
+/// caller commits them with summary.json.
 void write_outputs(const std::filesystem::path& directory, const LocalProblem& problem,
-                   const MonolithicResult& result, const nlohmann::json& summary) {
-  std::filesystem::create_directories(directory);
+                   const MonolithicResult& result) {
   const std::string file1 =
       robin::write_body_vtu(directory, *problem.bodies[0], result.contact_force);
   const std::string file2 =
@@ -92,14 +98,36 @@ void write_outputs(const std::filesystem::path& directory, const LocalProblem& p
   robin::InterfaceState state{result.normal_trace1, result.normal_trace2, result.contact_force,
                               result.contact_force};
   robin::write_contact_csv(directory / "contact.csv", problem.pairing, state);
-  robin::write_json(directory / "summary.json", summary);
 }
 
+int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
+                    std::chrono::steady_clock::time_point start);
+
+/// Reads the case, prepares the result directory and solves; a failure after the directory was
+/// prepared is recorded in its summary.json.
 int run(const std::filesystem::path& case_path, const std::vector<std::string>& overrides,
-        const std::filesystem::path& output) {
+        const std::filesystem::path& output, robin::ExistingResults existing) {
   auto log = spdlog::get("monolithic");
   const auto start = std::chrono::steady_clock::now();
   const robin::CaseDefinition definition = robin::read_case_file(case_path, overrides);
+  robin::ResultDirectory results(output, existing, "robin-monolithic", case_path);
+  if (!results.leftover_files().empty()) {
+    log->warn("the output directory {} also holds files that are not results of a run: {}",
+              output.string(), fmt::join(results.leftover_files(), ", "));
+  }
+  try {
+    return solve_and_write(definition, results, start);
+  } catch (const std::exception& error) {
+    results.fail(robin::RunFailure::failed, robin::in_case_file(case_path, error.what()));
+    throw;
+  }
+}
+
+/// Solves the case (all its load steps) and commits the result files with summary.json.
+int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
+                    std::chrono::steady_clock::time_point start) {
+  auto log = spdlog::get("monolithic");
+  const std::filesystem::path& case_path = definition.file;
   log->info("case {}: bodies '{}' and '{}'", case_path.string(),
             definition.bodies[0].definition.name, definition.bodies[1].definition.name);
   const LocalProblem problem = robin::prepare_local_problem(definition);
@@ -137,9 +165,10 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
   const robin::ExcludedPairClearance clearance = excluded_pair_clearance(problem, result);
   summary["excluded_pair_penetration"] = clearance.relative_penetration;
   if (!steps.empty()) summary["load_steps"] = robin::monolithic_steps_json(problem, steps);
-  write_outputs(output, problem, result, summary);
-  if (!steps.empty()) robin::write_monolithic_step_outputs(output, problem, steps);
-  log->info("results in {} (open solution.pvd in ParaView)", output.string());
+  write_outputs(results.staging(), problem, result);
+  if (!steps.empty()) robin::write_monolithic_step_outputs(results.staging(), problem, steps);
+  results.commit(summary);
+  log->info("results in {} (open solution.pvd in ParaView)", results.directory().string());
   if (result.qp.status != robin::QpStatus::converged) {
     log->error("the contact QP did not converge: {}", result.qp.message);
     return 3;
@@ -160,7 +189,19 @@ int main(int argc, char** argv) {
   bool quiet = false;
   std::vector<std::string> overrides;
   app.add_option("case", case_path, "case file (TOML, see docs/case-format.md)")->required();
+  bool overwrite = false;
   app.add_option("--output,-o", output, "directory for the result files")->required();
+  app.add_flag("--overwrite", overwrite,
+               "replace the results of an earlier run in the output directory (a directory "
+               "holding files is refused otherwise)");
+  app.final_callback([&] {
+    try {
+      robin::check_result_directory(
+          output, overwrite ? robin::ExistingResults::overwrite : robin::ExistingResults::refuse);
+    } catch (const robin::ResultDirectoryError& error) {
+      throw CLI::ValidationError("--output", error.what());
+    }
+  });
   CLI::Option* log_level =
       app.add_option("--log-level", level, "trace, debug, info, warn, error, off")
           ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
@@ -176,7 +217,8 @@ int main(int argc, char** argv) {
   log->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%^%l%$] %v");
   log->set_level(spdlog::level::from_str(quiet ? "warn" : level));
   try {
-    return run(case_path, overrides, output);
+    return run(case_path, overrides, output,
+               overwrite ? robin::ExistingResults::overwrite : robin::ExistingResults::refuse);
   } catch (const robin::InputError& error) {
     log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const robin::SingularBodyError& error) {

@@ -69,7 +69,7 @@ class BadInput : public ::testing::Test {
   void expect_failure(const fs::path& case_path, const std::vector<std::string>& fragments) {
     const std::string binary = std::string(ROBIN_BINARY_DIR) + "/bin/robin-monolithic";
     const CommandResult result = run_command(binary + " " + case_path.string() + " --output " +
-                                             (directory_ / "out").string());
+                                             (directory_ / "out").string() + " --overwrite");
     EXPECT_EQ(result.exit_code, 1) << result.output;
     expect_fragments(result.output, fragments);
   }

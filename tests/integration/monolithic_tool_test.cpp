@@ -97,16 +97,18 @@ void expect_timings(const json& timings) {
 }
 
 TEST(RobinMonolithic, WritesConsistentResultFiles) {
-  const TemporaryDirectory output("robin-monolithic");
+  const TemporaryDirectory work("robin-monolithic");
+  // robin-monolithic.stderr stays outside the result directory
+  const std::filesystem::path results = work.path() / "out";
   const ProcessOutcome outcome =
       run_tool("robin-monolithic",
-               {example("two_blocks_partial.toml").string(), "--output", output.path().string()},
-               output.path(), 120.0);
+               {example("two_blocks_partial.toml").string(), "--output", results.string()},
+               work.path(), 120.0);
   ASSERT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
   for (const char* file : {"solution.pvd", "contact.csv", "summary.json"}) {
-    EXPECT_TRUE(std::filesystem::exists(output.path() / file)) << file;
+    EXPECT_TRUE(std::filesystem::exists(results / file)) << file;
   }
-  std::ifstream summary_file(output.path() / "summary.json");
+  std::ifstream summary_file(results / "summary.json");
   const json summary = json::parse(summary_file);
   EXPECT_EQ(summary.at("method"), "monolithic");
   EXPECT_EQ(summary.at("converged"), true);
@@ -116,14 +118,14 @@ TEST(RobinMonolithic, WritesConsistentResultFiles) {
   // contact_force_resultant against contact.csv.
   int rows = 0;
   const Eigen::Vector2d resultant = vector_of(summary.at("contact_force_resultant"));
-  const Eigen::Vector2d from_csv = csv_resultant(output.path() / "contact.csv", rows);
+  const Eigen::Vector2d from_csv = csv_resultant(results / "contact.csv", rows);
   EXPECT_EQ(rows, summary.at("contact_pairs").get<int>());
   ASSERT_GT(resultant.norm(), 0.0);
   const double csv_error = (from_csv - resultant).norm() / resultant.norm();
   EXPECT_LE(csv_error, 1e-10);
 
   // One .vtu per body, named in solution.pvd; each body balances the resultant.
-  const json collection = test::read_vtk_xml(output.path() / "solution.pvd");
+  const json collection = test::read_vtk_xml(results / "solution.pvd");
   const json& bodies = summary.at("bodies");
   ASSERT_EQ(bodies.size(), 2u);
   ASSERT_EQ(collection.at("datasets").size(), 2u);
@@ -131,10 +133,9 @@ TEST(RobinMonolithic, WritesConsistentResultFiles) {
   for (std::size_t alpha = 0; alpha < 2; ++alpha) {
     const std::string file = bodies[alpha].at("name").get<std::string>() + ".vtu";
     EXPECT_EQ(collection["datasets"][alpha].at("file"), file);
-    ASSERT_TRUE(std::filesystem::exists(output.path() / file)) << file;
+    ASSERT_TRUE(std::filesystem::exists(results / file)) << file;
     std::size_t points = 0;
-    const Eigen::Vector2d reaction =
-        vtu_total_reaction(test::read_vtk_xml(output.path() / file), points);
+    const Eigen::Vector2d reaction = vtu_total_reaction(test::read_vtk_xml(results / file), points);
     EXPECT_EQ(bodies[alpha].at("nodes").get<std::size_t>(), points) << file;
     const int dofs = bodies[alpha].at("dofs").get<int>();
     EXPECT_GT(dofs, 0) << file;
