@@ -10,7 +10,8 @@ std::unique_ptr<GapFunction> make_gap_function(const CaseDefinition& definition)
                                        definition.file.string() + ": gap.expression");
 }
 
-LocalProblem prepare_local_problem(const CaseDefinition& definition) {
+LocalProblem prepare_local_problem(const CaseDefinition& definition,
+                                   const LocalSetupObserver& observer) {
   LocalProblem problem;
   problem.definition = definition;
   problem.gap = make_gap_function(definition);
@@ -20,8 +21,16 @@ LocalProblem prepare_local_problem(const CaseDefinition& definition) {
   problem.mesh_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (int alpha = 0; alpha < 2; ++alpha) {
-    problem.bodies[alpha] = std::make_unique<BodySolver>(std::move(loaded.bodies[alpha].definition),
-                                                         definition.solver.body);
+    BodySolverOptions options = definition.solver.body;
+    if (observer) {
+      const BodyDefinition& body = loaded.bodies[alpha].definition;
+      const long dof_count = 2L * static_cast<long>(body.mesh.node_count());
+      options.observer = [observer, name = body.name, dof_count](SetupStage stage) {
+        observer(name, stage, dof_count);
+      };
+    }
+    problem.bodies[alpha] =
+        std::make_unique<BodySolver>(std::move(loaded.bodies[alpha].definition), options);
   }
   const BodySolver& body1 = *problem.bodies[0];
   const BodySolver& body2 = *problem.bodies[1];

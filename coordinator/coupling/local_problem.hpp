@@ -5,6 +5,7 @@
 
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <memory>
 
 #include "coupling/case_file.hpp"
@@ -26,6 +27,11 @@ struct LocalProblem {
 std::unique_ptr<GapFunction> make_gap_function(const CaseDefinition& definition);
 
 /// Reads, assembles, factorizes and pairs. Throws InputError / SingularBodyError.
-LocalProblem prepare_local_problem(const CaseDefinition& definition);
+/// Told when a body's setup stage begins: (body name, stage, the body's DOFs).
+using LocalSetupObserver =
+    std::function<void(const std::string& body, SetupStage stage, long dof_count)>;
+
+LocalProblem prepare_local_problem(const CaseDefinition& definition,
+                                   const LocalSetupObserver& observer = {});
 
 }  // namespace robin

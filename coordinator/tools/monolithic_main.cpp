@@ -19,6 +19,7 @@
 #include "coupling/monolithic_solver.hpp"
 #include "coupling/result_directory.hpp"
 #include "coupling/result_files.hpp"
+#include "coupling/robin_iteration.hpp"
 #include "coupling/step_outputs.hpp"
 #include "numerics/errors.hpp"
 
@@ -36,8 +37,9 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   summary["overrides"] = problem.definition.overrides;  // --set KEY=VALUE, in order
   summary["converged"] = result.qp.status == robin::QpStatus::converged;
   // how the run ended, in robin-coordinator's words (a QP that did not converge hit its limit)
-  summary["status"] =
-      result.qp.status == robin::QpStatus::converged ? "converged" : "max_iterations";
+  summary["status"] = robin::to_string(result.qp.status == robin::QpStatus::converged
+                                           ? robin::IterationStatus::converged
+                                           : robin::IterationStatus::max_iterations);
   summary["qp_status"] = robin::to_string(result.qp.status);
   summary["iterations"] = result.qp.iterations;
   summary["operator_applications"] = result.qp.operator_applications;
@@ -130,7 +132,12 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
   const std::filesystem::path& case_path = definition.file;
   log->info("case {}: bodies '{}' and '{}'", case_path.string(),
             definition.bodies[0].definition.name, definition.bodies[1].definition.name);
-  const LocalProblem problem = robin::prepare_local_problem(definition);
+  log->info("reading and meshing both bodies");
+  // a line per setup stage of each body: a long setup never looks hung
+  const LocalProblem problem = robin::prepare_local_problem(
+      definition, [&log](const std::string& body, robin::SetupStage stage, long dof_count) {
+        log->info("body '{}': {} ({} DOFs)", body, robin::to_string(stage), dof_count);
+      });
   for (const auto& body : problem.bodies) {
     log->info("body '{}': {} dofs, assembly {:.3f} s, factorization {:.3f} s ({} nonzeros in L)",
               body->name(), body->free_dof_count(), body->timings().assembly_seconds,

@@ -232,7 +232,11 @@ std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& op
         } else if (queue.size() >= options.maximum_queued_requests) {
           send_reply(socket, *request,
                      server.reject("the server is busy: " + std::to_string(queue.size()) +
-                                   " requests of other clients are waiting; try again later"));
+                                       " requests of other clients are waiting; try again later",
+                                   request->payload.size() == 1
+                                       ? SubdomainServer::request_id_of(
+                                             request->payload.front().to_string_view())
+                                       : 0));
         } else {
           queue.push_back(std::move(*request));
         }

@@ -296,10 +296,24 @@ void SubdomainServer::fill_status(protocol::Envelope& reply) const {
   status.set_queued_requests(progress_.queued_requests);
 }
 
-std::string SubdomainServer::reject(std::string_view reason) noexcept {
+std::uint64_t SubdomainServer::request_id_of(std::string_view request_bytes) noexcept {
+  try {
+    protocol::Envelope request;
+    if (request_bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()) ||
+        !request.ParseFromArray(request_bytes.data(), static_cast<int>(request_bytes.size()))) {
+      return 0;
+    }
+    return request.request_id();
+  } catch (...) {
+    return 0;
+  }
+}
+
+std::string SubdomainServer::reject(std::string_view reason, std::uint64_t request_id) noexcept {
   RequestRecord record;
   protocol::Envelope reply;
   try {
+    reply.set_request_id(request_id);
     ServerState state = ServerState::awaiting_setup;
     {
       // the state as of the last finished request: reject() may run while handle() works

@@ -52,6 +52,7 @@
 // works (server_loop.hpp runs handle() on a worker thread).
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -123,7 +124,10 @@ class SubdomainServer {
   /// The MALFORMED_MESSAGE reply (request_id 0) to a message the transport could not pass to
   /// handle(), e.g. one of several frames; `reason` says why. Never throws; logs. Thread-safe
   /// like answer_status().
-  std::string reject(std::string_view reason) noexcept;
+  /// `request_id`: echoed when the message's id is known (0 otherwise).
+  std::string reject(std::string_view reason, std::uint64_t request_id = 0) noexcept;
+  /// The request_id of a serialized Envelope, 0 when it does not parse. Thread-safe.
+  static std::uint64_t request_id_of(std::string_view request_bytes) noexcept;
 
   ServerState state() const { return state_; }
   /// True once a Shutdown request has been answered.
