@@ -14,6 +14,9 @@
 #include <set>
 #include <sstream>
 
+#include "protocol_version.hpp"
+#include "robin_version.hpp"
+
 namespace robin {
 namespace {
 
@@ -205,9 +208,13 @@ ResultDirectory::~ResultDirectory() {
 }
 
 nlohmann::json ResultDirectory::record(const std::string& status) const {
-  return {{"status", status},   {"run_id", run_id_},           {"tool", tool_},
-          {"case", case_file_}, {"case_sha256", case_sha256_}, {"started", started_},
-          {"ended", nullptr}};
+  const std::string protocol =
+      std::to_string(protocol::protocol_major) + "." + std::to_string(protocol::protocol_minor);
+  return {
+      {"status", status},    {"versions", {{"product", product_version}, {"protocol", protocol}}},
+      {"run_id", run_id_},   {"tool", tool_},
+      {"case", case_file_},  {"case_sha256", case_sha256_},
+      {"started", started_}, {"ended", nullptr}};
 }
 
 void ResultDirectory::commit(nlohmann::json summary) {

@@ -8,7 +8,7 @@
 //   2. ResultDirectory's constructor removes the previous run's files (the names in its
 //      summary.json "files" list and the names every run writes; anything else is left alone
 //      and listed by leftover_files()), then writes summary.json with status "running", the run
-//      id, the start time and the case file's SHA-256.
+//      id, the start time, the product and protocol versions and the case file's SHA-256.
 //   3. The run writes its files into staging() (a hidden subdirectory).
 //   4. commit() moves each staged file into place (rename: each file appears whole) and writes
 //      summary.json last, atomically (temporary name, then rename), with the files list, the

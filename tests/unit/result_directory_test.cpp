@@ -79,6 +79,8 @@ TEST(ResultDirectory, SaysRunningWhileTheRunGoesOnThenCommitsItsFilesAndSummaryL
   EXPECT_EQ(running["run_id"], results.run_id());
   EXPECT_EQ(results.run_id().size(), 32u);
   EXPECT_EQ(running["tool"], "test-tool");
+  EXPECT_FALSE(running["versions"]["product"].get<std::string>().empty());
+  EXPECT_EQ(running["versions"]["protocol"].get<std::string>().rfind("2.", 0), 0u);  // 2.x
   EXPECT_EQ(running["case_sha256"],
             "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   EXPECT_TRUE(running["ended"].is_null());
