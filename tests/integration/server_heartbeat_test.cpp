@@ -183,24 +183,30 @@ BodyCase small_square_body() {
   return body;
 }
 
+/// The PortError message of a setup on `server` (a failure when the setup succeeds).
+std::string setup_failure(const SilentServer& server, const RemotePortOptions& options) {
+  RemotePort port(server.endpoint(), "square", options);
+  try {
+    port.setup(small_square_body(), SolverOptions{});
+  } catch (const PortError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "the setup on a silent server succeeded";
+  return "";
+}
+
 TEST(ServerHeartbeat, AHungServerFailsTheSetupWithNoHeartbeatLongBeforeItsDeadline) {
   SilentServer server(true, protocol::protocol_minor);
   RemotePortOptions options;
   options.setup_timeout_seconds = 600.0;
   options.heartbeat_timeout_seconds = 1.0;
   options.heartbeat_interval_seconds = 0.1;
-  RemotePort port(server.endpoint(), "square", options);
-  try {
-    port.setup(small_square_body(), SolverOptions{});
-    FAIL() << "the setup on a silent server succeeded";
-  } catch (const PortError& error) {
-    const std::string message = error.what();
-    EXPECT_NE(message.find("server " + server.endpoint() + " (body 'square'), step setup: "),
-              std::string::npos)
-        << message;
-    EXPECT_NE(message.find("no heartbeat for 1 s"), std::string::npos) << message;
-    EXPECT_NE(message.find("it never answered a StatusRequest"), std::string::npos) << message;
-  }
+  const std::string message = setup_failure(server, options);
+  EXPECT_NE(message.find("server " + server.endpoint() + " (body 'square'), step setup: "),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("no heartbeat for 1 s"), std::string::npos) << message;
+  EXPECT_NE(message.find("it never answered a StatusRequest"), std::string::npos) << message;
   EXPECT_GE(server.status_requests(), 1);
 }
 
@@ -209,14 +215,8 @@ TEST(ServerHeartbeat, AProtocol20ServerGetsNoStatusRequestAndIsWaitedForAsBefore
   RemotePortOptions options;
   options.setup_timeout_seconds = 1.5;
   options.heartbeat_timeout_seconds = 0.2;
-  RemotePort port(server.endpoint(), "square", options);
-  try {
-    port.setup(small_square_body(), SolverOptions{});
-    FAIL() << "the setup on a silent server succeeded";
-  } catch (const PortError& error) {
-    const std::string message = error.what();
-    EXPECT_NE(message.find("step setup: no reply within 1.5 s"), std::string::npos) << message;
-  }
+  const std::string message = setup_failure(server, options);
+  EXPECT_NE(message.find("step setup: no reply within 1.5 s"), std::string::npos) << message;
   EXPECT_EQ(server.status_requests(), 0);
 }
 
