@@ -15,6 +15,12 @@ packages=(
   python3 python3-numpy python3-scipy python3-matplotlib python3-zmq python3-protobuf
   iproute2 procps shellcheck python3-yaml
   zlib1g-dev python3-vtk9
+  # tests/network/slurm_namespaces_test.sh runs deploy/slurm/robin-contact.sbatch on a SLURM
+  # cluster it starts itself (its own munged, slurmctld and slurmds, configuration and key in
+  # its work directory). On a host run by systemd, Debian enables munge.service (its own key
+  # and socket under /etc/munge, /run/munge), and slurmctld/slurmd.service, which do not start
+  # without /etc/slurm/slurm.conf; the test uses none of them.
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()
