@@ -113,16 +113,23 @@ def first_non_finite(message, prefix):
     return None
 
 
+# The body size limit's default, robin-subdomain's (--max-dofs).
+DEFAULT_MAXIMUM_DOFS = 20000000
+
+
 class SubdomainProtocol:
     def __init__(self, protocol, name="", protocol_major=PROTOCOL_MAJOR, logger=None,
-                 data_directory=None, output_root=None):
+                 data_directory=None, output_root=None, maximum_dofs=DEFAULT_MAXIMUM_DOFS):
         """`data_directory`: where SetupBody.mesh_path is resolved (None: refused);
-        `output_root`: where FieldsRequest.write_directory is created (None: refused)."""
+        `output_root`: where FieldsRequest.write_directory is created (None: refused);
+        `maximum_dofs`: the largest body (2 degrees of freedom per node) set up, checked after
+        the mesh is decoded and before assembly (0: no limit)."""
         self.protocol = protocol          # the robin_pb2 module
         self.name = name
         self.protocol_major = protocol_major
         self.data_directory = data_directory
         self.output_root = output_root
+        self.maximum_dofs = maximum_dofs
         self.logger = logger or logging.getLogger("robin-subdomain-py")
         self.state = AWAITING_SETUP
         self.shutdown_requested = False
@@ -255,6 +262,14 @@ class SubdomainProtocol:
         self.state = AWAITING_SETUP
         self._acknowledge(reply)
 
+    def _check_size(self, definition):
+        """InputError when the body is above --max-dofs (before any assembly)."""
+        dof_count = 2 * definition.mesh.node_count()
+        if self.maximum_dofs and dof_count > self.maximum_dofs:
+            raise InputError("body '%s': %d degrees of freedom, above this server's limit of %d "
+                             "(robin-subdomain-py --max-dofs raises it)" %
+                             (definition.name, dof_count, self.maximum_dofs))
+
     def _on_shutdown(self, request, reply, record):
         self.shutdown_requested = True
         self._acknowledge(reply)
@@ -266,6 +281,7 @@ class SubdomainProtocol:
         record.body = quoted(request.setup_body.body_name, 64)[1:-1]
         definition, settings = decode_setup_body(request.setup_body, self.protocol,
                                                  self.data_directory)
+        self._check_size(definition)
         body = Body(definition)
         self._describe_interface(body, reply.interface)
         self.settings = settings

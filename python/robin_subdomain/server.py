@@ -25,7 +25,7 @@ import sys
 import time
 
 from .proto_module import load_protocol
-from .protocol import PROTOCOL_MAJOR, PROTOCOL_MINOR, SubdomainProtocol
+from .protocol import DEFAULT_MAXIMUM_DOFS, PROTOCOL_MAJOR, PROTOCOL_MINOR, SubdomainProtocol
 
 LOG_LEVELS = {"trace": 5, "debug": logging.DEBUG, "info": logging.INFO, "warn": logging.WARNING,
               "error": logging.ERROR, "critical": logging.CRITICAL, "off": logging.CRITICAL + 10}
@@ -92,6 +92,11 @@ def parse_arguments(arguments):
                         help="directory under which FieldsRequest.write_directory is created "
                              "(relative paths, no symbolic links); without it every "
                              "write_directory is refused")
+    parser.add_argument("--max-dofs", type=int, default=DEFAULT_MAXIMUM_DOFS, metavar="N",
+                        help="largest body set up, in degrees of freedom (2 per node), checked "
+                             "before assembly (default %d; 0: no limit). The factor's memory is "
+                             "bounded through it only: SciPy's SuperLU has no symbolic "
+                             "analysis to estimate it beforehand" % DEFAULT_MAXIMUM_DOFS)
     parser.add_argument("--version", action="version",
                         version="robin-subdomain-py %s (protocol %d.%d)" %
                         (product_version(), PROTOCOL_MAJOR, PROTOCOL_MINOR),
@@ -106,6 +111,8 @@ def parse_arguments(arguments):
     options = parser.parse_args(arguments)
     if options.max_message_size <= 0:
         parser.error("--max-message-size must be a positive number")
+    if options.max_dofs < 0:
+        parser.error("--max-dofs must be 0 (no limit) or a positive number")
     for option, value in (("--data-directory", options.data_directory),
                           ("--output-root", options.output_root)):
         if value is not None and not os.path.isdir(value):
@@ -226,7 +233,8 @@ def main(arguments=None):
         protocol_module = load_protocol()
         handler = SubdomainProtocol(protocol_module, options.name, options.protocol_major, logger,
                                     data_directory=options.data_directory,
-                                    output_root=options.output_root)
+                                    output_root=options.output_root,
+                                    maximum_dofs=options.max_dofs)
         reason = serve(handler, options, lambda: bool(stop_requested), logger)
         logger.info("stopped: %s", reason)
         return 0

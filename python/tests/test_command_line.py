@@ -63,6 +63,11 @@ class CurveOptions(unittest.TestCase):
         self.assertEqual(status, 2)
         self.assertIn("unrecognized arguments: --no-such-option", stderr)
 
+    def test_negative_max_dofs_is_refused(self):
+        status, _, stderr = run_server("--listen", "tcp://127.0.0.1:*", "--max-dofs", "-1")
+        self.assertEqual(status, 2)
+        self.assertIn("--max-dofs must be 0 (no limit) or a positive number", stderr)
+
 
 class Directories(unittest.TestCase):
     def setUp(self):

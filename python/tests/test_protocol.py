@@ -349,6 +349,18 @@ class StateMachine(ServerTestCase):
         self.expect_error(request(setup_body=setup_body(young_modulus=-1.0)), "BAD_INPUT",
                           "awaiting_setup")
 
+    def test_a_body_above_max_dofs_is_bad_input_before_assembly(self):
+        dof_count = len(LOWER_MESH.coordinates)   # 2 coordinates, 2 DOFs per node
+        self.server = self.make_server(maximum_dofs=dof_count - 1)
+        message = self.expect_error(request(setup_body=setup_body()), "BAD_INPUT",
+                                    "awaiting_setup")
+        self.assertIn("body 'lower': %d degrees of freedom, above this server's limit of %d "
+                      "(robin-subdomain-py --max-dofs raises it)" % (dof_count, dof_count - 1),
+                      message)
+        self.server = self.make_server(maximum_dofs=dof_count)
+        self.assertEqual(self.ask(request(setup_body=setup_body())).WhichOneof("content"),
+                         "interface")
+
     def test_a_discarded_body_is_freed_without_the_garbage_collector(self):
         # A body in a reference cycle (and its factor) waits for a full collection: a server
         # serving many runs then grows (benchmarks/soak_benchmark.py).

@@ -35,7 +35,9 @@ inline std::string to_string(SetupStage stage) {
   return "unknown";
 }
 
-/// Called when a stage begins. Must not throw; may be called from a worker thread.
+/// Called when a stage begins; may be called from a worker thread. It may throw to abandon the
+/// setup (the server does when the request's client has gone): the setup code is exception
+/// safe and the exception propagates to whoever started the setup.
 using SetupObserver = std::function<void(SetupStage stage)>;
 
 }  // namespace robin

@@ -3,11 +3,14 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <condition_variable>
+#include <cstring>
 #include <deque>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <thread>
 #include <vector>
 #include <zmq.hpp>
@@ -38,10 +41,13 @@ zmq::socket_t open_socket(zmq::context_t& context, const ServerLoopOptions& opti
   return socket;
 }
 
-/// One received request: its routing frames (kept for the reply) and its payload frames.
+/// One received request: its routing frames (kept for the reply), its payload frames and the
+/// file descriptor of the connection it came on (ZMQ_SRCFD; -1 when unknown), which names the
+/// connection in the socket monitor's disconnection events.
 struct Request {
   std::vector<zmq::message_t> routing;
   std::vector<zmq::message_t> payload;
+  int connection = -1;
 };
 
 /// Receives every frame of the waiting message and splits it after the empty delimiter (or
@@ -60,6 +66,7 @@ std::optional<Request> receive_request(zmq::socket_t& socket) {
   } while (frames.back().more());
   if (frames.size() < 2) return std::nullopt;  // a routing id alone: nothing to answer
   Request request;
+  request.connection = frames.back().get(ZMQ_SRCFD);
   const std::size_t payload_start = frames[1].size() == 0 ? 2 : 1;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     (k < payload_start ? request.routing : request.payload).push_back(std::move(frames[k]));
@@ -124,6 +131,8 @@ class RequestWorker {
 
   /// Hands `request` to the worker; only when not busy().
   void start(Request request) {
+    abandoned_.store(false);
+    current_connection_ = request.connection;
     {
       const std::lock_guard lock(mutex_);
       request_ = std::move(request);
@@ -131,6 +140,15 @@ class RequestWorker {
       busy_ = true;
     }
     wake_.notify_one();
+  }
+
+  /// The flag SubdomainServer::watch_abandonment() reads.
+  const std::atomic<bool>& abandoned() const { return abandoned_; }
+  /// Abandons the current request when it came on `connection`; returns whether it did.
+  bool abandon_if_from(int connection) {
+    if (!busy_ || connection < 0 || current_connection_ != connection) return false;
+    abandoned_.store(true);
+    return true;
   }
 
   /// The finished request and its reply, once ready_descriptor() was readable.
@@ -168,24 +186,104 @@ class RequestWorker {
   std::optional<Request> request_;
   std::string reply_;
   std::atomic<bool> busy_{false};
-  bool pending_ = false;  // a request was handed over and not yet picked up
+  std::atomic<bool> abandoned_{false};
+  int current_connection_ = -1;  // the current request's connection (socket thread only)
+  bool pending_ = false;         // a request was handed over and not yet picked up
   bool stopping_ = false;
   std::thread thread_;
 };
 
-/// Waits up to `timeout` for a request or a finished reply; returns {request waiting, reply
-/// ready} (both false on timeout or when a signal interrupted the wait).
-std::pair<bool, bool> wait_for_work(zmq::socket_t& socket, int ready_descriptor,
-                                    std::chrono::milliseconds timeout) {
+/// The socket monitor's disconnection events of the ROUTER socket: each names the file
+/// descriptor of a connection that closed (the client exited, closed its socket, or its peer
+/// heartbeat or TCP connection failed).
+class ConnectionMonitor {
+ public:
+  ConnectionMonitor(zmq::context_t& context, zmq::socket_t& socket)
+      : events_(context, zmq::socket_type::pair) {
+    std::ostringstream address;
+    address << "inproc://robin-server-connections-" << static_cast<const void*>(&socket);
+    if (zmq_socket_monitor(socket.handle(), address.str().c_str(), ZMQ_EVENT_DISCONNECTED) != 0) {
+      throw zmq::error_t();
+    }
+    events_.set(zmq::sockopt::linger, 0);
+    events_.connect(address.str());
+  }
+
+  zmq::socket_t& socket() { return events_; }
+
+  /// The connections reported closed since the last call (never blocks).
+  std::vector<int> take_disconnections() {
+    std::vector<int> connections;
+    while (true) {
+      zmq::message_t event;
+      zmq::message_t endpoint;
+      try {
+        if (!events_.recv(event, zmq::recv_flags::dontwait)) return connections;
+        if (event.more()) (void)events_.recv(endpoint, zmq::recv_flags::none);
+      } catch (const zmq::error_t& error) {
+        if (error.num() == EINTR) continue;
+        throw;
+      }
+      // Event frame: 16-bit event number, then the 32-bit value (here the descriptor).
+      if (event.size() < 6) continue;
+      std::uint16_t number = 0;
+      std::int32_t value = 0;
+      std::memcpy(&number, event.data(), sizeof number);
+      std::memcpy(&value, static_cast<const char*>(event.data()) + 2, sizeof value);
+      if (number == ZMQ_EVENT_DISCONNECTED) connections.push_back(value);
+    }
+  }
+
+ private:
+  zmq::socket_t events_;
+};
+
+/// Drops the queued requests that came on the closed `connections` and abandons the current
+/// one when it did (its reply could not be delivered). Descriptors are reused by later
+/// connections, so the events are taken just before each request is received: a request
+/// received afterwards came on a connection still open when its predecessor's event was seen.
+void forget_requests_of(const std::vector<int>& connections, RequestWorker& worker,
+                        std::deque<Request>& queue, spdlog::logger& logger) {
+  for (const int connection : connections) {
+    const auto before = queue.size();
+    queue.erase(std::remove_if(queue.begin(), queue.end(),
+                               [connection](const Request& request) {
+                                 return request.connection == connection;
+                               }),
+                queue.end());
+    if (queue.size() != before) {
+      logger.warn("a client disconnected: dropped its {} queued request(s)", before - queue.size());
+    }
+    if (worker.abandon_if_from(connection)) {
+      logger.warn(
+          "the client of the request being handled disconnected: abandoning the "
+          "request at its next stage");
+    }
+  }
+}
+
+/// What woke wait_for_work up.
+struct Work {
+  bool request_waiting = false;
+  bool reply_ready = false;
+  bool connection_event = false;
+};
+
+/// Waits up to `timeout` for a request, a finished reply or a connection event (nothing on
+/// timeout or when a signal interrupted the wait).
+Work wait_for_work(zmq::socket_t& socket, int ready_descriptor, zmq::socket_t& connection_events,
+                   std::chrono::milliseconds timeout) {
   zmq::pollitem_t items[] = {{socket.handle(), 0, ZMQ_POLLIN, 0},
-                             {nullptr, ready_descriptor, ZMQ_POLLIN, 0}};
+                             {nullptr, ready_descriptor, ZMQ_POLLIN, 0},
+                             {connection_events.handle(), 0, ZMQ_POLLIN, 0}};
   try {
-    zmq::poll(items, 2, timeout);
+    zmq::poll(items, 3, timeout);
   } catch (const zmq::error_t& error) {
-    if (error.num() == EINTR) return {false, false};
+    if (error.num() == EINTR) return {};
     throw;
   }
-  return {(items[0].revents & ZMQ_POLLIN) != 0, (items[1].revents & ZMQ_POLLIN) != 0};
+  return {(items[0].revents & ZMQ_POLLIN) != 0, (items[1].revents & ZMQ_POLLIN) != 0,
+          (items[2].revents & ZMQ_POLLIN) != 0};
 }
 
 }  // namespace
@@ -211,10 +309,15 @@ std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& op
                              : std::string("no transport security"));
   on_listening(endpoint);
   RequestWorker worker(server);
+  server.watch_abandonment(&worker.abandoned());
+  ConnectionMonitor monitor(context, socket);
   std::deque<Request> queue;  // requests of other clients behind the current one
   while (!stop.load()) {
-    const auto [request_waiting, reply_ready] =
-        wait_for_work(socket, worker.ready_descriptor(), options.poll_interval);
+    const auto [request_waiting, reply_ready, connection_event] =
+        wait_for_work(socket, worker.ready_descriptor(), monitor.socket(), options.poll_interval);
+    if (connection_event || request_waiting) {
+      forget_requests_of(monitor.take_disconnections(), worker, queue, *logger);
+    }
     if (reply_ready) {
       auto [request, reply] = worker.take_reply();
       send_reply(socket, request, reply);

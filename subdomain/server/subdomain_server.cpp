@@ -263,6 +263,10 @@ void SubdomainServer::begin_request(const std::string& request_type) {
 }
 
 void SubdomainServer::begin_stage(SetupStage stage, long dof_count) {
+  if (abandoned_ != nullptr && abandoned_->load()) {
+    throw RequestError(protocol::INTERNAL, "abandoned before the stage '" + to_string(stage) +
+                                               "': the client that sent the request disconnected");
+  }
   const std::lock_guard lock(progress_mutex_);
   progress_.stage = to_string(stage);
   progress_.stage_start = Clock::now();

@@ -51,6 +51,7 @@
 // handle() keeps up to date, also through answer_status() from another thread while handle()
 // works (server_loop.hpp runs handle() on a worker thread).
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -128,6 +129,12 @@ class SubdomainServer {
   std::string reject(std::string_view reason, std::uint64_t request_id = 0) noexcept;
   /// The request_id of a serialized Envelope, 0 when it does not parse. Thread-safe.
   static std::uint64_t request_id_of(std::string_view request_bytes) noexcept;
+  /// `abandoned` (may be null; must outlive the server's use of it) is read at each stage
+  /// boundary of a long request (the setup stages and the fields): once true, handle() stops
+  /// the request there and answers INTERNAL "abandoned ...", the state as after a failure of
+  /// that request (a SetupBody leaves awaiting_setup). The transport sets it when the
+  /// request's client has disconnected, so that nobody waits for a reply that cannot arrive.
+  void watch_abandonment(const std::atomic<bool>* abandoned) noexcept { abandoned_ = abandoned; }
 
   ServerState state() const { return state_; }
   /// True once a Shutdown request has been answered.
@@ -188,6 +195,7 @@ class SubdomainServer {
   std::string run_id_;  // run_id of the SetupBody that set up body_; "" without body or run_id
   std::vector<int> interface_nodes_;  // the contact boundary's node ids, ascending
   MprgpParameters qp_parameters_;
+  const std::atomic<bool>* abandoned_ = nullptr;  // see watch_abandonment()
 };
 
 }  // namespace robin

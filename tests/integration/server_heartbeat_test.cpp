@@ -7,11 +7,17 @@
 //  - a server that announced "status" and then stops answering (its socket thread hung, its
 //    connection alive) fails the setup with "no heartbeat", naming server, body and step, long
 //    before the setup deadline;
-//  - a protocol 2.0 server (no "status") gets no StatusRequest and is waited for as before.
+//  - a protocol 2.0 server (no "status") gets no StatusRequest and is waited for as before;
+//  - a client that disconnects while its SetupBody runs and its next request waits in the
+//    queue: robin-subdomain drops the queued request and abandons the setup at its next stage
+//    (the state stays awaiting_setup, which a completed setup would have left), logs both, and
+//    answers the next client.
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <fstream>
+#include <iterator>
 #include <thread>
 #include <zmq.hpp>
 
@@ -21,6 +27,7 @@
 #include "protocol_version.hpp"
 #include "remote/remote_port.hpp"
 #include "remote/server_launcher.hpp"
+#include "remote/setup_encoding.hpp"
 #include "remote_test_support.hpp"
 #include "robin.pb.h"
 
@@ -218,6 +225,108 @@ TEST(ServerHeartbeat, AProtocol20ServerGetsNoStatusRequestAndIsWaitedForAsBefore
   const std::string message = setup_failure(server, options);
   EXPECT_NE(message.find("step setup: no reply within 1.5 s"), std::string::npos) << message;
   EXPECT_EQ(server.status_requests(), 0);
+}
+
+/// A client of a real server speaking the protocol on a DEALER socket (several requests may
+/// be in flight); request ids are its own.
+class RawClient {
+ public:
+  explicit RawClient(const std::string& endpoint) : socket_(context_, zmq::socket_type::dealer) {
+    socket_.set(zmq::sockopt::linger, 0);
+    socket_.connect(endpoint);
+  }
+  void send(protocol::Envelope request) {
+    request.mutable_version()->set_major(protocol::protocol_major);
+    request.mutable_version()->set_minor(protocol::protocol_minor);
+    socket_.send(zmq::message_t(), zmq::send_flags::sndmore);
+    socket_.send(zmq::buffer(request.SerializeAsString()), zmq::send_flags::none);
+  }
+  /// The next reply, waiting at most `seconds` (a failure when none comes).
+  protocol::Envelope receive(double seconds) {
+    protocol::Envelope reply;
+    zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&item, 1, std::chrono::milliseconds(static_cast<long>(seconds * 1000)));
+    if ((item.revents & ZMQ_POLLIN) == 0) {
+      ADD_FAILURE() << "no reply within " << seconds << " s";
+      return reply;
+    }
+    zmq::message_t delimiter;
+    zmq::message_t payload;
+    (void)socket_.recv(delimiter, zmq::recv_flags::none);
+    (void)socket_.recv(payload, zmq::recv_flags::none);
+    EXPECT_TRUE(reply.ParseFromArray(payload.data(), static_cast<int>(payload.size())));
+    return reply;
+  }
+  protocol::StatusReply status() {
+    protocol::Envelope request;
+    request.set_request_id(++status_requests_);
+    request.mutable_status_request();
+    send(request);
+    return receive(30.0).status_reply();
+  }
+  void close() { socket_.close(); }
+
+ private:
+  zmq::context_t context_;
+  zmq::socket_t socket_;
+  std::uint64_t status_requests_ = 1000;
+};
+
+std::string file_text(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+TEST(ServerHeartbeat, TheRequestsOfAClientThatDisconnectsAreDroppedAndItsSetupAbandoned) {
+  const TemporaryDirectory logs("heartbeat-abandon");
+  SubdomainServer server("square", server_options(logs.path()));
+  server.await_listening();
+  BodyCase body = large_square_body();
+  body.definition.mesh = make_rectangle_mesh(0.0, 0.0, 1.0, 1.0, 400, 400, ElementType::triangle3);
+
+  RawClient departing(server.endpoint());
+  protocol::Envelope setup;
+  setup.set_request_id(1);
+  *setup.mutable_setup_body() = encode_setup_body(body.definition, body.context, SolverOptions{});
+  departing.send(setup);
+  protocol::Envelope hello;
+  hello.set_request_id(2);
+  hello.mutable_hello()->set_client_name("departing client");
+  departing.send(hello);  // waits behind the setup
+
+  // Leave while the setup is in an early stage with the Hello queued behind it.
+  RawClient observer(server.endpoint());
+  const auto start = std::chrono::steady_clock::now();
+  protocol::StatusReply status;
+  do {
+    status = observer.status();
+  } while (!(status.busy() && status.queued_requests() == 1 &&
+             (status.stage() == "mesh" || status.stage() == "assembly")) &&
+           testing::seconds_since(start) < 60.0);
+  ASSERT_TRUE(status.busy()) << "the setup never showed its first stages";
+  departing.close();
+
+  do {
+    status = observer.status();
+  } while (status.busy() && testing::seconds_since(start) < 120.0);
+  EXPECT_FALSE(status.busy());
+  EXPECT_EQ(status.queued_requests(), 0u);
+  EXPECT_EQ(status.state(), "awaiting_setup")
+      << "the setup ran to its end (stage " << status.stage() << ")";
+
+  protocol::Envelope second_hello;
+  second_hello.set_request_id(3);
+  second_hello.mutable_hello()->set_client_name("next client");
+  observer.send(second_hello);
+  const protocol::Envelope reply = observer.receive(30.0);
+  EXPECT_EQ(reply.request_id(), 3u);
+  EXPECT_TRUE(reply.has_hello_reply());
+  EXPECT_EQ(reply.hello_reply().state(), "awaiting_setup");
+
+  const std::string log = file_text(server.log_file());
+  EXPECT_NE(log.find("a client disconnected: dropped its 1 queued request(s)"), std::string::npos)
+      << log;
+  EXPECT_NE(log.find("abandoned before the stage"), std::string::npos) << log;
 }
 
 }  // namespace

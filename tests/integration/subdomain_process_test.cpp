@@ -8,7 +8,8 @@
 // and leave the server answering Hello: a 1.x .geo script with a shell command in the removed
 // SetupBody.mesh_content (hand-encoded wire bytes), mesh_path reads outside --data-directory,
 // write_directory writes outside --output-root (also through a symbolic link at the target),
-// a 100,000-character body name and an inverted cell.
+// a 100,000-character body name and an inverted cell; bodies above --max-dofs and
+// --max-factor-memory.
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -720,6 +721,41 @@ TEST(SubdomainProcess, HugeNameAndInvertedCellsAreBadInput) {
   expect_error(reply, protocol::BAD_INPUT, "element tag 13 ");
   expect_error(reply, protocol::BAD_INPUT, "inverted");
   expect_hello(server.socket, id++);
+  EXPECT_TRUE(exchange(server.socket, lower_block_data_setup(id++)).has_interface());
+}
+
+// Issue 11 (bounded resources): a body above --max-dofs is BAD_INPUT naming its size, the
+// limit and the option, before assembly; a factor above --max-factor-memory is BAD_INPUT from
+// the symbolic analysis (a factor holds at least its diagonal: 8 bytes per unknown, above a
+// limit of 1 KiB for this body); the server then answers Hello and sets the body up within
+// the limits.
+TEST(SubdomainProcess, BodiesAboveTheResourceLimitsAreBadInputNamingTheLimit) {
+  const long dof_count = 2L * static_cast<long>(lower_mesh().node_count());
+  // The factor's diagonal alone (8 bytes per unknown) exceeds 1 KiB when over half of the
+  // unknowns are free, which the fixed bottom edge leaves.
+  ASSERT_GT(dof_count, 2 * 1048 / 8);
+  std::uint64_t id = 1;
+  {
+    ConnectedServer server({"--max-dofs", std::to_string(dof_count - 1)});
+    ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+    const protocol::Envelope reply = exchange(server.socket, lower_block_data_setup(id++));
+    expect_error(reply, protocol::BAD_INPUT,
+                 "body 'lower': " + std::to_string(dof_count) +
+                     " degrees of freedom, above this server's limit of " +
+                     std::to_string(dof_count - 1) + " (robin-subdomain --max-dofs raises it)");
+    expect_hello(server.socket, id++);
+  }
+  {
+    ConnectedServer server({"--max-factor-memory", "0.001"});
+    ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+    const protocol::Envelope reply = exchange(server.socket, lower_block_data_setup(id++));
+    expect_error(reply, protocol::BAD_INPUT, "body 'lower': its Cholesky factor would need ");
+    expect_error(reply, protocol::BAD_INPUT,
+                 "above this server's limit of 9.77e-07 GiB (robin-subdomain "
+                 "--max-factor-memory MIB raises it)");  // 0.001 MiB = 1048.576 bytes
+    expect_hello(server.socket, id++);
+  }
+  ConnectedServer server({"--max-dofs", std::to_string(dof_count)});
   EXPECT_TRUE(exchange(server.socket, lower_block_data_setup(id++)).has_interface());
 }
 
