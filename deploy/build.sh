@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Configures and builds robin-contact.
 #   deploy/build.sh              Release build in build/ (binaries in build/bin)
-#   deploy/build.sh --sanitize   AddressSanitizer + UBSan build in build-sanitize/
+#   deploy/build.sh --sanitize   AddressSanitizer + UBSan build in build-sanitize/ (the tools,
+#                                unit and verification tests: what the sanitizer tier runs)
 #   deploy/build.sh --fuzz       clang build of the libFuzzer harnesses in build-fuzz/
 #                                (ASan + UBSan + libFuzzer; docs/fuzzing.md)
 # Warnings are errors in all three.
@@ -14,7 +15,10 @@ targets=()
 case "${1:-}" in
   --sanitize)
     build_directory=build-sanitize
-    options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DROBIN_WERROR=ON -DROBIN_SANITIZE=ON)
+    # Only what the sanitizer tier runs (unit and verification tests, and the tools they
+    # start): no integration tests, no benchmarks.
+    options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DROBIN_WERROR=ON -DROBIN_SANITIZE=ON
+             -DROBIN_BUILD_INTEGRATION_TESTS=OFF -DROBIN_BUILD_BENCHMARKS=OFF)
     ;;
   --fuzz)
     build_directory=build-fuzz
