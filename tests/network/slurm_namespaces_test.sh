@@ -1,21 +1,29 @@
 #!/usr/bin/env bash
 # deploy/slurm/robin-contact.sbatch on a SLURM cluster made of network namespaces: slurmctld in
 # the coordinator's namespace (host "ctl"), one slurmd in each server namespace (nodes "node1"
-# and "node2", each with its own host name), munged for authentication; every SLURM and munge
-# file lives in the work directory, and the host names are in an /etc/hosts bound over the real
-# one inside the daemons' mount namespaces only.
+# and "node2", each with its own host name), munged (in the coordinator's namespace, reached
+# through its socket file) for authentication. Every SLURM and munge file (slurm.conf, key,
+# socket, state, spool, logs) lives in the work directory, and the host names are in an
+# /etc/hosts bound over the real one inside the daemons' own mount namespaces only; no system
+# daemon, configuration or port is used (a munged, slurmctld or slurmd of the host's, Debian's
+# munge.service for one, neither serves nor disturbs this cluster).
 #
 #   tests/network/slurm_namespaces_test.sh BINARY_DIRECTORY [SOURCE_DIRECTORY]
 #
 # Checks, for examples/two_blocks.toml:
 #  1. sbatch: the job completes with exit code 0, its servers ran as job steps on node1 and
-#     node2 and were reached by node name, contact.csv equals the local robin-run's (lambda1,
-#     lambda2, un1, un2 to 1e-12 relative), and no server is left.
+#     node2 and were reached by node name, contact.csv equals that of robin-run on this machine
+#     computed by this test (lambda1, lambda2, un1, un2 to 1e-12 relative), and no server is
+#     left.
 #  2. scancel while the coordinator runs (a stub that sleeps): the job is cancelled,
 #     remote-servers.sh receives SIGTERM, and neither the servers nor the coordinator are left
 #     (SLURM also ends the server steps itself).
-# Exit code 77 (skipped) without root, network namespaces or SLURM (slurmctld, slurmd,
-# slurm-client, munge); everything it started is removed on any exit.
+# Exit code 77 (skipped) without root or where network namespaces cannot be created. Without
+# the SLURM programs (Debian packages slurmctld, slurmd, slurm-client, munge; deploy/setup.sh
+# installs them) it skips too, unless ROBIN_REQUIRE_SLURM=1 (set by deploy/test.sh, so CI
+# cannot skip it silently): then it fails. Everything it started (daemons, job processes,
+# namespaces, and with them the bind mounts) is removed on any exit; a run killed by SIGKILL
+# leaves its namespaces and the processes in them to the next run's remove_stale_namespaces.
 set -euo pipefail
 
 binary_directory=$(cd "${1:?usage: slurm_namespaces_test.sh BINARY_DIRECTORY [SOURCE_DIRECTORY]}" && pwd)
@@ -26,10 +34,20 @@ coordinator_override=""  # the coordinator of the next job, when not the built o
 
 # shellcheck source=tests/network/network_namespaces.sh
 source "$(dirname "$0")/network_namespaces.sh"
-for tool in slurmctld slurmd sbatch squeue scancel scontrol sinfo munged nsenter unshare; do
-  command -v "$tool" > /dev/null || skip "$tool is missing (Debian packages slurmctld, slurmd, slurm-client, munge)"
-done
 require_namespace_tools
+
+# Skips (77) without the SLURM and munge programs, or fails with ROBIN_REQUIRE_SLURM=1: where
+# deploy/setup.sh ran, a missing program is a setup bug, not a reason to skip.
+require_slurm() {
+  local tool message
+  for tool in slurmctld slurmd sbatch squeue scancel scontrol sinfo munged nsenter unshare; do
+    command -v "$tool" > /dev/null && continue
+    message="$tool is missing (Debian packages slurmctld slurmd slurm-client munge;"
+    message+=" deploy/setup.sh installs them)"
+    [ "${ROBIN_REQUIRE_SLURM:-0}" != 1 ] || fail "$message, and ROBIN_REQUIRE_SLURM=1"
+    skip "$message"
+  done
+}
 
 # host_prefix NAMESPACE HOST: sets `prefix` to the command words that run a command in
 # NAMESPACE's network with host name HOST and the test's /etc/hosts (in their own UTS and mount
@@ -78,6 +96,7 @@ SchedulerType=sched/backfill
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 ReturnToService=2
+SlurmdParameters=config_overrides
 KillWait=5
 NodeName=node1 NodeAddr=${server_addresses[0]} CPUs=2 State=UNKNOWN
 NodeName=node2 NodeAddr=${server_addresses[1]} CPUs=2 State=UNKNOWN
@@ -87,9 +106,11 @@ EOF
 }
 
 start_cluster() {
-  munged --force --foreground --key-file="$work/munge.key" --socket="$work/munge.socket" \
-    --pid-file="$work/munged.pid" --seed-file="$work/munge.seed" --log-file="$work/munged.log" \
-    2> "$work/munged.stderr" &
+  # munged in the coordinator's namespace, so that a run killed before its cleanup leaves it to
+  # the next run's remove_stale_namespaces; clients reach it through the socket file.
+  nsenter --net="/run/netns/$coordinator_namespace" munged --force --foreground \
+    --key-file="$work/munge.key" --socket="$work/munge.socket" --pid-file="$work/munged.pid" \
+    --seed-file="$work/munge.seed" --log-file="$work/munged.log" 2> "$work/munged.stderr" &
   started_pids+=($!)
   for _ in $(seq 50); do [ -S "$work/munge.socket" ] && break; sleep 0.1; done
   [ -S "$work/munge.socket" ] || fail "munged did not start: $(cat "$work/munged.stderr")"
@@ -147,7 +168,7 @@ servers_left() {
 }
 
 check_batch_job() {
-  local job comparison
+  local job comparison node
   job=$(submit "$work/slurm-run")
   await_job_end "$job" 120
   echo "job $job: $(job_field "$job" JobState), exit code $(job_field "$job" ExitCode)," \
@@ -155,10 +176,19 @@ check_batch_job() {
   if [ "$(job_field "$job" JobState)" != COMPLETED ] || [ "$(job_field "$job" ExitCode)" != 0:0 ]; then
     fail "job $job: $(cat "$work/job-$job.out")"
   fi
+  # The coordinator reached the servers by node name (node1 resolves to an address that exists
+  # only in node1's namespace), and each node's slurmd launched a step of the job.
   if ! grep -q "server 1 listening on tcp://node1:5555" "$work/job-$job.out" ||
     ! grep -q "server 2 listening on tcp://node2:5556" "$work/job-$job.out"; then
     fail "the servers did not run on node1 and node2: $(cat "$work/job-$job.out")"
   fi
+  for node in node1 node2; do
+    grep -q "launch task StepId=$job\\." "$work/slurm/slurmd-$node.log" ||
+      fail "no step of job $job was launched on $node: $(cat "$work/slurm/slurmd-$node.log")"
+  done
+  [ "$(job_field "$job" BatchHost)" = node1 ] || fail "job $job: batch host $(job_field "$job" BatchHost)"
+  grep -q "remote-servers: servers stopped" "$work/job-$job.out" ||
+    fail "remote-servers.sh did not stop the servers: $(cat "$work/job-$job.out")"
   comparison=$(compare_contact "$work/local" "$work/slurm-run") ||
     fail "contact.csv of the SLURM job differs from the local run: $comparison"
   echo "sbatch deploy/slurm/robin-contact.sbatch: $comparison"
@@ -179,13 +209,17 @@ check_cancel() {
   # SLURM cancels the server steps itself; the batch script is signalled too.
   grep -q "remote-servers: interrupted (SIGTERM)" "$work/job-$job.out" ||
     fail "remote-servers.sh was not signalled: $(cat "$work/job-$job.out")"
+  # The batch script execs remote-servers.sh: its cleanup ran to the end (before KillWait).
+  grep -q "remote-servers: servers stopped" "$work/job-$job.out" ||
+    fail "remote-servers.sh did not finish stopping the servers: $(cat "$work/job-$job.out")"
   [ "$(job_field "$job" JobState)" = CANCELLED ] || fail "job $job: $(job_field "$job" JobState)"
   echo "scancel of job $job while its coordinator ran: CANCELLED, remote-servers.sh got" \
-    "SIGTERM, no server or coordinator left"
+    "SIGTERM and stopped the servers, no server or coordinator left"
 }
 
 remove_stale_namespaces
 create_network
+require_slurm
 "$binary_directory/robin-run" "$source_directory/$case_file" --output "$work/local" \
   --log-level warn 2> "$work/robin-run.log" || fail "robin-run exited with status $?"
 write_configuration
