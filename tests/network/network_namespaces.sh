@@ -3,9 +3,12 @@
 # namespace) on the private subnet 10.231.77.0/24, which exists only inside the namespaces.
 #
 # The sourcing script sets binary_directory and source_directory, may define cleanup_hook (run
-# by the cleanup once the processes and namespaces are gone), then calls require_namespace_tools and create_network. Every exit
-# removes the namespaces (and so their links), kills what runs in them and the processes listed
-# in started_pids, prints the logs of the work directory when the test failed, and removes it.
+# by the cleanup once the processes and namespaces are gone), then calls
+# require_namespace_tools, remove_stale_namespaces and create_network. Every exit removes the
+# namespaces (and so their links), kills what runs in them and the processes listed in
+# started_pids, prints the logs of the work directory when the test failed, and removes it. A
+# run killed by SIGKILL cannot do that: the next run's remove_stale_namespaces removes its
+# namespaces, the processes in them and its work directory (named after its process id).
 # shellcheck shell=bash disable=SC2154  # binary_directory, source_directory: set by the caller
 
 python=/usr/bin/python3
@@ -35,7 +38,7 @@ require_namespace_tools() {
   [ -x "$python" ] || skip "$python is missing (the comparison of contact.csv needs it)"
   [ "$(id -u)" -eq 0 ] || skip "network namespaces need root (running as uid $(id -u))"
   command -v ip > /dev/null || skip "iproute2's ip is missing"
-  work=$(mktemp -d -t robin-namespaces.XXXXXX)
+  work=$(mktemp -d -t "robin-namespaces-$$.XXXXXX")  # $$: see remove_stale_namespaces
   trap cleanup EXIT
   trap 'exit 130' INT
   trap 'exit 143' TERM
@@ -81,9 +84,10 @@ cleanup() {
 }
 
 # Namespaces of earlier runs of this test that were killed (SIGKILL, e.g. at a CTest timeout)
-# before their cleanup: removed when the run that created them is gone.
+# before their cleanup, with the processes still in them, and their work directories: removed
+# when the run that created them is gone.
 remove_stale_namespaces() {
-  local namespace owner remaining
+  local namespace owner remaining directory
   for namespace in $(ip netns list 2> /dev/null | awk '/^robin-test-/ { print $1 }'); do
     owner=${namespace##*-}
     if [ "$owner" != $$ ] && ! kill -0 "$owner" 2> /dev/null; then
@@ -91,6 +95,15 @@ remove_stale_namespaces() {
       # shellcheck disable=SC2086  # one pid per word
       [ -z "$remaining" ] || kill -KILL $remaining 2> /dev/null || true
       if ip netns delete "$namespace" 2> /dev/null; then echo "removed stale namespace $namespace"; fi
+    fi
+  done
+  for directory in "${TMPDIR:-/tmp}"/robin-namespaces-*.*; do
+    [ -d "$directory" ] || continue
+    owner=${directory##*/robin-namespaces-}
+    owner=${owner%%.*}
+    [[ $owner =~ ^[0-9]+$ ]] || continue
+    if [ "$owner" != $$ ] && ! kill -0 "$owner" 2> /dev/null; then
+      if rm -rf "$directory"; then echo "removed stale work directory $directory"; fi
     fi
   done
 }
