@@ -18,7 +18,8 @@
 #  2. scancel while the coordinator runs (a stub that sleeps): the job is cancelled,
 #     remote-servers.sh receives SIGTERM, and neither the servers nor the coordinator are left
 #     (SLURM also ends the server steps itself).
-# Exit code 77 (skipped) without root or where network namespaces cannot be created. Without
+# It takes about 15 s; every wait is bounded (nodes idle 60 s, the job 60 s, the cancelled job
+# 30 s), well inside CTest's timeout. Exit code 77 (skipped) without root or where network namespaces cannot be created. Without
 # the SLURM programs (Debian packages slurmctld, slurmd, slurm-client, munge; deploy/setup.sh
 # installs them) it skips too, unless ROBIN_REQUIRE_SLURM=1 (set by deploy/test.sh, so CI
 # cannot skip it silently): then it fails. Everything it started (daemons, job processes,
@@ -170,7 +171,7 @@ servers_left() {
 check_batch_job() {
   local job comparison node
   job=$(submit "$work/slurm-run")
-  await_job_end "$job" 120
+  await_job_end "$job" 60
   echo "job $job: $(job_field "$job" JobState), exit code $(job_field "$job" ExitCode)," \
     "nodes $(job_field "$job" NodeList)"
   if [ "$(job_field "$job" JobState)" != COMPLETED ] || [ "$(job_field "$job" ExitCode)" != 0:0 ]; then
@@ -200,10 +201,10 @@ check_cancel() {
   printf '#!/bin/sh\necho "$@" > "%s/stub.arguments"\nexec sleep 300\n' "$work" > "$stub"
   chmod +x "$stub"
   job=$(coordinator_override=$stub submit "$work/slurm-cancelled")
-  for _ in $(seq 120); do [ -s "$work/stub.arguments" ] && break; sleep 0.5; done
+  for _ in $(seq 60); do [ -s "$work/stub.arguments" ] && break; sleep 0.5; done
   [ -s "$work/stub.arguments" ] || fail "the coordinator of job $job did not start: $(cat "$work/job-$job.out")"
   controller scancel "$job"
-  await_job_end "$job" 60
+  await_job_end "$job" 30
   for _ in $(seq 50); do [ -z "$(servers_left)" ] && break; sleep 0.2; done
   [ -z "$(servers_left)" ] || fail "processes left after scancel: $(servers_left)"
   # SLURM cancels the server steps itself; the batch script is signalled too.
@@ -220,7 +221,7 @@ check_cancel() {
 remove_stale_namespaces
 create_network
 require_slurm
-"$binary_directory/robin-run" "$source_directory/$case_file" --output "$work/local" \
+timeout 60 "$binary_directory/robin-run" "$source_directory/$case_file" --output "$work/local" \
   --log-level warn 2> "$work/robin-run.log" || fail "robin-run exited with status $?"
 write_configuration
 start_cluster
