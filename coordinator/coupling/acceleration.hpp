@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,12 @@ class Acceleration {
   virtual std::string state() const = 0;
   /// Forgets the history: the next step is a first step again.
   virtual void restart() = 0;
+  /// The history, exactly (checkpoint_encoding.hpp): an instance made with the same options and
+  /// sizes, given restore_state(save_state()), continues bit for bit as this one would.
+  virtual nlohmann::json save_state() const = 0;
+  /// Replaces the history by a saved one. Throws CheckpointFormatError (checkpoint_encoding.hpp)
+  /// naming the field when `state` is not one of this method and size.
+  virtual void restore_state(const nlohmann::json& state) = 0;
 };
 
 /// The method of `options` for blocks of sizes size1 (body 1) and size2 (body 2). Validates the

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "coupling/acceleration_relaxation.hpp"
+#include "coupling/checkpoint_encoding.hpp"
 
 namespace robin {
 
@@ -47,6 +48,29 @@ std::string AitkenAcceleration::state() const {
 void AitkenAcceleration::restart() {
   has_previous_ = false;
   omega_ = parameters_.initial;
+}
+
+nlohmann::json AitkenAcceleration::save_state() const {
+  return {{"method", "aitken"},
+          {"omega", encode_number(omega_)},
+          {"has_previous", has_previous_},
+          {"previous_residual", encode_vector(previous_residual_)}};
+}
+
+void AitkenAcceleration::restore_state(const nlohmann::json& state) {
+  if (decode_text(state, "method") != "aitken") {
+    throw CheckpointFormatError("the checkpoint's acceleration is not 'aitken'");
+  }
+  Eigen::VectorXd previous = decode_vector(state, "previous_residual");
+  const bool has_previous = decode_flag(state, "has_previous");
+  if (has_previous && previous.size() != size_) {
+    throw CheckpointFormatError("the checkpoint's aitken previous_residual has " +
+                                std::to_string(previous.size()) + " values, expected " +
+                                std::to_string(size_));
+  }
+  omega_ = decode_number(state, "omega");
+  has_previous_ = has_previous;
+  previous_residual_ = std::move(previous);
 }
 
 }  // namespace robin

@@ -30,6 +30,9 @@ class AitkenAcceleration : public Acceleration {
   /// "aitken omega = 0.31" (the omega of the last step).
   std::string state() const override;
   void restart() override;
+  /// {"omega", "has_previous", "previous_residual"}.
+  nlohmann::json save_state() const override;
+  void restore_state(const nlohmann::json& state) override;
   /// The relaxation factor of the last step (initial before any step).
   double omega() const { return omega_; }
 

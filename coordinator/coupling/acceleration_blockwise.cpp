@@ -3,6 +3,8 @@
 #include <cassert>
 #include <utility>
 
+#include "coupling/checkpoint_encoding.hpp"
+
 namespace robin {
 
 BlockwiseAcceleration::BlockwiseAcceleration(std::vector<int> sizes,
@@ -37,6 +39,24 @@ std::string BlockwiseAcceleration::state() const {
 
 void BlockwiseAcceleration::restart() {
   for (auto& part : parts_) part->restart();
+}
+
+nlohmann::json BlockwiseAcceleration::save_state() const {
+  nlohmann::json parts = nlohmann::json::array();
+  for (const auto& part : parts_) parts.push_back(part->save_state());
+  return {{"method", "blockwise"}, {"parts", parts}};
+}
+
+void BlockwiseAcceleration::restore_state(const nlohmann::json& state) {
+  const nlohmann::json& parts = member(state, "parts");
+  if (decode_text(state, "method") != "blockwise" || !parts.is_array() ||
+      parts.size() != parts_.size()) {
+    throw CheckpointFormatError("the checkpoint's acceleration does not have " +
+                                std::to_string(parts_.size()) + " blocks");
+  }
+  for (std::size_t index = 0; index < parts_.size(); ++index) {
+    parts_[index]->restore_state(parts[index]);
+  }
 }
 
 }  // namespace robin

@@ -19,6 +19,9 @@ class BlockwiseAcceleration : public Acceleration {
   /// "body 1: <state of part 1>; body 2: <state of part 2>".
   std::string state() const override;
   void restart() override;
+  /// {"method": "blockwise", "parts": [state of part 1, ...]}.
+  nlohmann::json save_state() const override;
+  void restore_state(const nlohmann::json& state) override;
   /// The acceleration of block `index` (0-based), for inspection.
   const Acceleration& part(int index) const { return *parts_.at(index); }
 

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "coupling/acceleration_filtered_qr.hpp"
+#include "coupling/checkpoint_encoding.hpp"
 
 namespace robin {
 namespace {
@@ -182,6 +183,50 @@ void IqnIlsAcceleration::restart() {
   filtered_ = 0;
   mixing_.clear();
   reason_ = "first step after a restart";
+}
+
+nlohmann::json IqnIlsAcceleration::save_state() const {
+  return {{"method", "iqn-ils"},
+          {"size", size_},
+          {"residual_differences", encode_vectors(residual_differences_)},
+          {"mapped_differences", encode_vectors(mapped_differences_)},
+          {"has_previous", has_previous_},
+          {"previous_was_quasi_newton", previous_was_quasi_newton_},
+          {"previous_residual", encode_vector(previous_residual_)},
+          {"previous_mapped", encode_vector(previous_mapped_)},
+          {"columns", columns_},
+          {"filtered", filtered_},
+          {"safeguard_restarts", safeguard_restarts_},
+          {"mixing", encode_numbers(mixing_)},
+          {"reason", reason_}};
+}
+
+void IqnIlsAcceleration::restore_state(const nlohmann::json& state) {
+  if (decode_text(state, "method") != "iqn-ils" || decode_integer(state, "size") != size_) {
+    throw CheckpointFormatError("the checkpoint's acceleration is not 'iqn-ils' of size " +
+                                std::to_string(size_));
+  }
+  std::deque<Eigen::VectorXd> residual_differences = decode_vectors(state, "residual_differences");
+  std::deque<Eigen::VectorXd> mapped_differences = decode_vectors(state, "mapped_differences");
+  const auto sized = [this](const std::deque<Eigen::VectorXd>& columns) {
+    return std::all_of(columns.begin(), columns.end(),
+                       [this](const Eigen::VectorXd& column) { return column.size() == size_; });
+  };
+  if (residual_differences.size() != mapped_differences.size() || !sized(residual_differences) ||
+      !sized(mapped_differences)) {
+    throw CheckpointFormatError("the checkpoint's iqn-ils columns do not match its size");
+  }
+  residual_differences_ = std::move(residual_differences);
+  mapped_differences_ = std::move(mapped_differences);
+  has_previous_ = decode_flag(state, "has_previous");
+  previous_was_quasi_newton_ = decode_flag(state, "previous_was_quasi_newton");
+  previous_residual_ = decode_vector(state, "previous_residual");
+  previous_mapped_ = decode_vector(state, "previous_mapped");
+  columns_ = decode_integer(state, "columns");
+  filtered_ = decode_integer(state, "filtered");
+  safeguard_restarts_ = decode_integer(state, "safeguard_restarts");
+  mixing_ = decode_numbers(state, "mixing");
+  reason_ = decode_text(state, "reason");
 }
 
 }  // namespace robin

@@ -61,6 +61,10 @@ class IqnIlsAcceleration : public Acceleration {
   /// "iqn-ils relaxation step (<reason>)".
   std::string state() const override;
   void restart() override;
+  /// The secant columns (V, W), the previous pair (r, x~), the counters, the mixing and the
+  /// reason of the last relaxation step.
+  nlohmann::json save_state() const override;
+  void restore_state(const nlohmann::json& state) override;
 
   /// Columns used by the last step (0 for a relaxation step).
   int columns() const { return columns_; }

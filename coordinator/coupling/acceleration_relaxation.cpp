@@ -4,6 +4,8 @@
 #include <sstream>
 #include <utility>
 
+#include "coupling/checkpoint_encoding.hpp"
+
 namespace robin {
 
 FixedRelaxation::FixedRelaxation(std::vector<RelaxationBlock> blocks)
@@ -33,6 +35,12 @@ std::string FixedRelaxation::state() const {
     line += format_for_state(blocks_[index].relaxation);
   }
   return line + ")";
+}
+
+void FixedRelaxation::restore_state(const nlohmann::json& state) {
+  if (decode_text(state, "method") != "none") {
+    throw CheckpointFormatError("the checkpoint's acceleration is not 'none'");
+  }
 }
 
 std::string format_for_state(double value) {

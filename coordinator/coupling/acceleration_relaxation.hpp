@@ -24,6 +24,9 @@ class FixedRelaxation : public Acceleration {
   /// "relaxation delta = (0.5, 0.5)".
   std::string state() const override;
   void restart() override {}
+  /// Stateless: {"method": "none"}.
+  nlohmann::json save_state() const override { return {{"method", "none"}}; }
+  void restore_state(const nlohmann::json& state) override;
 
  private:
   std::vector<RelaxationBlock> blocks_;

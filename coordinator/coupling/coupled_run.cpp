@@ -4,9 +4,11 @@
 #include <chrono>
 #include <future>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <utility>
 
+#include "coupling/iteration_checkpoint.hpp"
 #include "coupling/local_problem.hpp"
 
 namespace robin {
@@ -153,10 +155,54 @@ bool start_is_the_unloaded_fixed_point(const CouplingOptions& options,
          pairing.gaps().minCoeff() >= 0.0;
 }
 
+/// The timings of both bodies' ports (the replaced ones included).
+std::array<PortTimings, 2> port_timings(const RecoverablePorts& ports) {
+  return {ports.timings(0), ports.timings(1)};
+}
+
+/// The iteration on the recoverable ports: after a lost server, it continues from its last
+/// checkpoint (or `resume`, or starts again when there is none).
+RobinResult recoverable_iteration(RecoverablePorts& ports, const ContactPairing& pairing,
+                                  const CouplingOptions& options,
+                                  const Eigen::VectorXd* initial_iterate,
+                                  const IterationCheckpoint* resume,
+                                  const std::function<void(const IterationCheckpoint&)>& observe,
+                                  const RunObserver& observer) {
+  std::optional<IterationCheckpoint> latest;
+  if (resume != nullptr) latest = *resume;
+  IterationContinuation loop;
+  loop.checkpoint = [&](const IterationCheckpoint& checkpoint) {
+    latest = checkpoint;
+    if (observe) observe(checkpoint);
+  };
+  return ports.run([&] {
+    const IterationCheckpoint* start = nullptr;
+    std::optional<IterationCheckpoint> from;  // a copy: `latest` changes as the loop goes on
+    if (latest) {
+      from = *latest;
+      start = &*from;
+      report_stage(observer, "continuing the iteration after iteration " +
+                                 std::to_string(start->iteration) + " (checkpoint)");
+    }
+    loop.resume = start;
+    return run_robin_iteration(ports.port(0), ports.port(1), pairing, options, initial_iterate,
+                               loop, observer.iteration);
+  });
+}
+
+/// Both bodies' fields for the iteration's contact forces.
+std::array<BodyOutput, 2> collect_fields(RecoverablePorts& ports, const RobinResult& iteration) {
+  return ports.run([&] {
+    return on_both_ports(ports.ports(), [&](SubdomainPort& port, int alpha) {
+      return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
+    });
+  });
+}
+
 /// The load steps of a case with [loading] on ports whose contact is assigned (see
 /// run_coupled_case). Fills result.steps and, from the last step computed, result.iteration,
 /// outputs and iteration_port_timings; result.excluded_clearance is the worst over the steps.
-void run_load_steps(const LoadingOptions& loading, const std::array<SubdomainPort*, 2>& ports,
+void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
                     const CouplingOptions& options, const RunObserver& observer,
                     CoupledRunResult& result) {
   const std::size_t count = loading.factors.size();
@@ -172,33 +218,32 @@ void run_load_steps(const LoadingOptions& loading, const std::array<SubdomainPor
     stage << "load step " << step.step << "/" << count << ": load factor " << step.factor
           << (step.warm_started ? ", starting from the previous steps" : "");
     report_stage(observer, stage.str());
-    const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
-    on_both_ports(ports, [&](SubdomainPort& port, int) {
-      port.set_load_factor(step.factor);
-      return 0;
+    const std::array<PortTimings, 2> before = port_timings(ports);
+    ports.run([&] {
+      on_both_ports(ports.ports(), [&](SubdomainPort& port, int) {
+        port.set_load_factor(step.factor);
+        return 0;
+      });
     });
-    const std::array<PortTimings, 2> before_iteration = {ports[0]->timings(), ports[1]->timings()};
+    ports.load_factor_set(step.factor);
+    const std::array<PortTimings, 2> before_iteration = port_timings(ports);
+    const Eigen::VectorXd start =
+        step.warm_started ? predicted_start(points, step.factor) : Eigen::VectorXd();
     step.iteration =
-        step.warm_started
-            ? run_robin_iteration(*ports[0], *ports[1], result.pairing, options,
-                                  predicted_start(points, step.factor), observer.iteration)
-            : run_robin_iteration(*ports[0], *ports[1], result.pairing, options,
-                                  observer.iteration);
+        recoverable_iteration(ports, result.pairing, options, step.warm_started ? &start : nullptr,
+                              nullptr, {}, observer);
     for (int alpha = 0; alpha < 2; ++alpha) {
       result.iteration_port_timings[alpha] =
-          difference(ports[alpha]->timings(), before_iteration[alpha]);
+          difference(ports.timings(alpha), before_iteration[alpha]);
     }
     report_stage(observer, "collecting the fields of both bodies (load step " +
                                std::to_string(step.step) + ")");
-    const RobinResult& iteration = step.iteration;
-    step.outputs = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
-      return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
-    });
+    step.outputs = collect_fields(ports, step.iteration);
     result.iteration = step.iteration;
     result.outputs = step.outputs;
     step.excluded_clearance = excluded_clearance(result);
     for (int alpha = 0; alpha < 2; ++alpha) {
-      step.port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
+      step.port_timings[alpha] = difference(ports.timings(alpha), before[alpha]);
     }
     step.seconds = seconds_since(step_start);
     if (result.steps.empty() || step.excluded_clearance.relative_penetration >
@@ -219,11 +264,29 @@ void run_load_steps(const LoadingOptions& loading, const std::array<SubdomainPor
   }
 }
 
+/// Sets both bodies up (each once, also across recoveries) and returns their interfaces.
+std::array<InterfaceDescription, 2> set_up_bodies(RecoverablePorts& ports,
+                                                  const CaseDefinition& loaded) {
+  ports.run([&] {
+    on_both_ports(ports.ports(), [&](SubdomainPort& port, int alpha) {
+      if (ports.interface(alpha)) return 0;
+      try {
+        ports.interface(alpha) = port.setup(loaded.bodies[alpha], loaded.solver);
+      } catch (const PortError& error) {
+        throw PortError(in_body_case(loaded.bodies[alpha], error.what()));
+      }
+      return 0;
+    });
+  });
+  return {*ports.interface(0), *ports.interface(1)};
+}
+
 }  // namespace
 
 CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                   const std::array<SubdomainPort*, 2>& ports,
-                                  const CouplingOptions& options, const RunObserver& observer) {
+                                  const CouplingOptions& options, const RunObserver& observer,
+                                  const RunContinuation& continuation) {
   const auto start = Clock::now();
   CoupledRunResult result;
   result.options = options;
@@ -231,14 +294,13 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   CaseDefinition loaded = definition;
   load_meshes(loaded);
   result.meshing_seconds = seconds_since(start);
+  RecoverablePorts recoverable(ports, loaded, continuation.replacement,
+                               [&](const std::string& text) {
+                                 result.recoveries.push_back(text);
+                                 report_warning(observer, text);
+                               });
   report_stage(observer, "setting up both bodies (assembly, factorization)");
-  result.interfaces = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
-    try {
-      return port.setup(loaded.bodies[alpha], definition.solver);
-    } catch (const PortError& error) {
-      throw PortError(in_body_case(loaded.bodies[alpha], error.what()));
-    }
-  });
+  result.interfaces = set_up_bodies(recoverable, loaded);
   const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
   const std::string& name1 = definition.bodies[0].definition.name;
   const std::string& name2 = definition.bodies[1].definition.name;
@@ -251,27 +313,28 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   for (const std::string& line : result.pairing.excluded) report_warning(observer, line);
   if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
     report_warning(observer, overlap);
-  for (int alpha = 0; alpha < 2; ++alpha)
-    ports[alpha]->assign_contact(result.pairing.assignment(alpha));
+  recoverable.run([&] {
+    for (int alpha = 0; alpha < 2; ++alpha)
+      recoverable.port(alpha).assign_contact(result.pairing.assignment(alpha));
+  });
+  recoverable.contact_assigned(result.pairing);
   result.setup_seconds = seconds_since(start);
 
   if (definition.loading.stepped()) {
-    run_load_steps(definition.loading, ports, options, observer, result);
+    run_load_steps(definition.loading, recoverable, options, observer, result);
   } else {
-    const std::array<PortTimings, 2> before = {ports[0]->timings(), ports[1]->timings()};
+    const std::array<PortTimings, 2> before = port_timings(recoverable);
     result.iteration =
-        run_robin_iteration(*ports[0], *ports[1], result.pairing, options, observer.iteration);
+        recoverable_iteration(recoverable, result.pairing, options, nullptr, continuation.resume,
+                              continuation.checkpoint, observer);
     for (int alpha = 0; alpha < 2; ++alpha) {
-      result.iteration_port_timings[alpha] = difference(ports[alpha]->timings(), before[alpha]);
+      result.iteration_port_timings[alpha] = difference(recoverable.timings(alpha), before[alpha]);
     }
     report_stage(observer, "collecting the fields of both bodies");
-    const RobinResult& iteration = result.iteration;
-    result.outputs = on_both_ports(ports, [&](SubdomainPort& port, int alpha) {
-      return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
-    });
+    result.outputs = collect_fields(recoverable, result.iteration);
     result.excluded_clearance = excluded_clearance(result);
   }
-  for (int alpha = 0; alpha < 2; ++alpha) result.port_timings[alpha] = ports[alpha]->timings();
+  result.port_timings = port_timings(recoverable);
   result.total_seconds = seconds_since(start);
   return result;
 }

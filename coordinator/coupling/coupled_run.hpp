@@ -9,6 +9,7 @@
 
 #include "coupling/case_file.hpp"
 #include "coupling/contact_pairing.hpp"
+#include "coupling/port_recovery.hpp"
 #include "coupling/robin_iteration.hpp"
 #include "coupling/subdomain_port.hpp"
 
@@ -47,6 +48,20 @@ struct CoupledRunResult {
   /// the last step computed (iteration, outputs, iteration_port_timings), except
   /// excluded_clearance, the largest penetration over the steps.
   std::vector<LoadStepResult> steps;
+  /// What the run did about lost servers, in order, for people (empty: nothing was lost).
+  std::vector<std::string> recoveries;
+};
+
+/// Checkpoints, resume and server recovery of a coupled run (docs/outputs.md, "Checkpoint and
+/// resume").
+struct RunContinuation {
+  /// The iteration continues after this checkpoint instead of starting (the bodies are set up
+  /// and the contact assigned as usual first). Cases without [loading] only.
+  const IterationCheckpoint* resume = nullptr;
+  /// Told the iteration's state after every iteration (cases without [loading]).
+  std::function<void(const IterationCheckpoint&)> checkpoint;
+  /// Replaces lost servers (port_recovery.hpp); empty: a lost server fails the run.
+  ServerReplacement replacement;
 };
 
 /// Observer of the run's stages ("setup", "pairing", iteration records) for progress lines.
@@ -64,9 +79,13 @@ struct RunObserver {
 /// iteration (with loading.warm_start from the previous steps' fixed points: the last one, or
 /// the linear extrapolation through the last two to the step's factor), and collects the
 /// fields; it stops after the first step that does not converge.
+/// With `continuation`, the iteration is checkpointed and may resume, and a lost server is
+/// replaced: its body set up again and the stage it was lost in repeated, the iteration from
+/// its last checkpoint (port_recovery.hpp).
 CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                   const std::array<SubdomainPort*, 2>& ports,
-                                  const CouplingOptions& options, const RunObserver& observer = {});
+                                  const CouplingOptions& options, const RunObserver& observer = {},
+                                  const RunContinuation& continuation = {});
 
 /// Exit code of a run: 0 converged, 3 iteration limit, 4 diverged, 5 stagnated.
 int exit_code(IterationStatus status);

@@ -89,6 +89,11 @@ class RobinScheme final : public CouplingScheme {
     return iterate;
   }
 
+  void repeat_contact_solves(const Eigen::VectorXd& iterate, int iteration) override {
+    const Eigen::Index size = gaps_.size();
+    contact_solves(body1_, body2_, iterate.head(size), iterate.tail(size), iteration);
+  }
+
   CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) override {
     const Eigen::Index size = gaps_.size();
     CouplingEvaluation evaluation;
@@ -161,6 +166,11 @@ class DirichletNeumannScheme final : public CouplingScheme {
     return initial_obstacle;
   }
 
+  void repeat_contact_solves(const Eigen::VectorXd& iterate, int iteration) override {
+    contact_port_.start_contact_solve(iterate, iteration);
+    require_converged(contact_port_.finish_contact_solve(), contact_port_, iteration);
+  }
+
   CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) override {
     contact_port_.start_contact_solve(iterate, iteration);
     const ContactSolveResult contact = contact_port_.finish_contact_solve();
@@ -207,6 +217,10 @@ class NeumannNeumannScheme final : public CouplingScheme {
   /// the initial obstacle is the gap.
   Eigen::VectorXd initial_iterate(const Eigen::VectorXd& initial_obstacle) const override {
     return 0.5 * initial_obstacle;
+  }
+
+  void repeat_contact_solves(const Eigen::VectorXd& iterate, int iteration) override {
+    contact_solves(body1_, body2_, iterate, gaps_ - iterate, iteration);
   }
 
   CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) override {

@@ -81,6 +81,11 @@ class CouplingScheme {
   /// The subdomain requests of one iteration at x. Throws PortError when a port fails or a
   /// contact QP does not converge.
   virtual CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) = 0;
+  /// Only the contact solves of evaluate(iterate, iteration), results discarded: a server
+  /// warm-starts its contact QP from its previous contact force, so a resumed iteration
+  /// (iteration_checkpoint.hpp) first repeats the solves of the iterations it continues
+  /// after. Throws PortError as evaluate does.
+  virtual void repeat_contact_solves(const Eigen::VectorXd& iterate, int iteration) = 0;
 };
 
 /// Nodal forces r_i = +-m_i whose sign alternates from pair to pair along the contact zone

@@ -23,8 +23,11 @@ namespace {
 namespace fs = std::filesystem;
 
 /// The names every run may write (besides the .vtu files and those listed in summary.json).
-const std::set<std::string> run_file_names = {"summary.json", "history.csv", "contact.csv",
-                                              "solution.pvd", "contact.png", "history.png"};
+const std::set<std::string> run_file_names = {
+    "summary.json", "history.csv", "contact.csv",     "solution.pvd",
+    "contact.png",  "history.png", "checkpoint.json", "checkpoint-iterates.bin"};
+/// Kept by a resume (checkpoint.hpp), removed by commit().
+const std::set<std::string> checkpoint_names = {"checkpoint.json", "checkpoint-iterates.bin"};
 const std::string staging_prefix = ".staging-";
 const std::string log_directory_name = "logs";  // robin-run's server logs: written before us
 
@@ -81,7 +84,9 @@ std::set<std::string> previous_run_files(const fs::path& directory) {
 
 bool belongs_to_a_run(const std::string& name, const std::set<std::string>& listed) {
   const bool vtu = name.size() > 4 && name.compare(name.size() - 4, 4, ".vtu") == 0;
-  return listed.count(name) > 0 || run_file_names.count(name) > 0 || vtu ||
+  // a temporary file of write_file_atomically left by a killed run ('.summary.json.tmp-...')
+  const bool temporary = name.rfind('.', 0) == 0 && name.find(".tmp-") != std::string::npos;
+  return listed.count(name) > 0 || run_file_names.count(name) > 0 || vtu || temporary ||
          name.rfind(staging_prefix, 0) == 0;
 }
 
@@ -102,7 +107,7 @@ void check_result_directory(const fs::path& directory, ExistingResults policy,
     throw ResultDirectoryError("the output '" + directory.string() +
                                "' exists and is not a directory");
   }
-  if (policy == ExistingResults::overwrite) return;
+  if (policy != ExistingResults::refuse) return;
   std::vector<std::string> names = entry_names(directory);
   names.erase(std::remove_if(names.begin(), names.end(),
                              [&](const std::string& name) { return ignored.count(name) > 0; }),
@@ -184,6 +189,7 @@ ResultDirectory::ResultDirectory(fs::path directory, ExistingResults policy, std
   const std::set<std::string> listed = previous_run_files(directory_);
   for (const std::string& name : entry_names(directory_)) {
     if (name == log_directory_name) continue;
+    if (policy == ExistingResults::resume && checkpoint_names.count(name) > 0) continue;
     if (belongs_to_a_run(name, listed)) {
       fs::remove_all(directory_ / name, error);
       if (error) {
@@ -210,11 +216,21 @@ ResultDirectory::~ResultDirectory() {
 nlohmann::json ResultDirectory::record(const std::string& status) const {
   const std::string protocol =
       std::to_string(protocol::protocol_major) + "." + std::to_string(protocol::protocol_minor);
-  return {
+  nlohmann::json document = {
       {"status", status},    {"versions", {{"product", product_version}, {"protocol", protocol}}},
       {"run_id", run_id_},   {"tool", tool_},
       {"case", case_file_},  {"case_sha256", case_sha256_},
       {"started", started_}, {"ended", nullptr}};
+  for (const auto& [key, value] : additions_.items()) document[key] = value;
+  return document;
+}
+
+void ResultDirectory::add_to_record(const std::string& key, nlohmann::json value) {
+  additions_[key] = std::move(value);
+  if (finished_) return;
+  write_file_atomically(
+      directory_ / "summary.json",
+      record("running").dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 void ResultDirectory::commit(nlohmann::json summary) {
@@ -239,6 +255,9 @@ void ResultDirectory::commit(nlohmann::json summary) {
       document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   finished_ = true;
   remove_staging();
+  std::error_code error;
+  // the run is complete: nothing to resume
+  for (const std::string& name : checkpoint_names) fs::remove(directory_ / name, error);
 }
 
 void ResultDirectory::fail(RunFailure failure, const std::string& message) noexcept {

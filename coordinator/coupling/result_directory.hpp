@@ -14,6 +14,8 @@
 //      summary.json last, atomically (temporary name, then rename), with the files list, the
 //      end time and the status given by the caller. fail() writes summary.json with status
 //      "failed" or "interrupted" and the message instead, and removes the staged files.
+//   5. A coupled run keeps checkpoint.json (checkpoint.hpp) in the directory while it runs;
+//      commit() removes it after summary.json, fail() keeps it: the run can be resumed.
 // A run killed before commit() leaves summary.json saying "running" with its start time.
 
 #include <filesystem>
@@ -25,8 +27,10 @@
 
 namespace robin {
 
-/// What to do with a result directory that already holds files.
-enum class ExistingResults { refuse, overwrite };
+/// What to do with a result directory that already holds files: refuse it, replace an earlier
+/// run's files, or continue the run whose checkpoint.json it holds (checkpoint.hpp: the
+/// checkpoint and logs/ are kept, the earlier attempt's staging areas removed).
+enum class ExistingResults { refuse, overwrite, resume };
 
 /// How a run that did not produce results ended.
 enum class RunFailure { failed, interrupted };
@@ -73,6 +77,10 @@ class ResultDirectory {
   /// "status". Throws std::runtime_error naming the file that could not be moved or written.
   void commit(nlohmann::json summary);
 
+  /// Adds `key` to the run's record (e.g. "resumed_from", "server_restarts"); summary.json is
+  /// rewritten at once while the run goes on. Throws std::runtime_error naming the file.
+  void add_to_record(const std::string& key, nlohmann::json value);
+
   /// Records a run that ended without results: summary.json with the run's record, the status
   /// "failed" or "interrupted" and `message`; the staged files are removed. Never throws.
   void fail(RunFailure failure, const std::string& message) noexcept;
@@ -89,6 +97,7 @@ class ResultDirectory {
   std::string run_id_;
   std::string started_;
   std::vector<std::string> leftovers_;
+  nlohmann::json additions_ = nlohmann::json::object();  // add_to_record
   bool finished_ = false;
 };
 

@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "coupling/case_file_body.hpp"
+#include "coupling/checkpoint_encoding.hpp"
 #include "coupling/coupling_scheme.hpp"
+#include "coupling/iteration_checkpoint.hpp"
 #include "coupling/monolithic_solver.hpp"
 #include "numerics/errors.hpp"
 
@@ -65,6 +67,13 @@ class ProgressMonitor {
     }
     message = text.str();
     return IterationStatus::diverged;
+  }
+
+  ProgressMonitorState state() const { return {first_step_, smallest_step_, best_history_}; }
+  void restore(const ProgressMonitorState& state) {
+    first_step_ = state.first_step;
+    smallest_step_ = state.smallest_step;
+    best_history_ = state.best_history;
   }
 
  private:
@@ -166,6 +175,12 @@ class ForceSequence {
     previous_ = force;
     step_ = obstacle_step;
   }
+  ForceSequenceState state() const { return {previous_, previous_change_, step_}; }
+  void restore(const ForceSequenceState& state) {
+    previous_ = state.previous;
+    previous_change_ = state.previous_change;
+    step_ = state.step;
+  }
 
  private:
   static constexpr double maximum_contraction = 0.99;
@@ -199,6 +214,33 @@ void store_state(RobinResult& result, const CouplingState& state) {
   result.contact_force2 = state.contact_force2;
   result.correction1 = state.correction1;
   result.correction2 = state.correction2;
+}
+
+std::array<Eigen::VectorXd, 8> stored_state(const RobinResult& result) {
+  return {result.obstacle1,      result.obstacle2,      result.normal_trace1, result.normal_trace2,
+          result.contact_force1, result.contact_force2, result.correction1,   result.correction2};
+}
+
+void restore_state(RobinResult& result, const std::array<Eigen::VectorXd, 8>& state) {
+  store_state(result,
+              {state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7]});
+}
+
+/// The result of a loop that had stopped when `checkpoint` was written.
+RobinResult stopped_result(const IterationCheckpoint& checkpoint) {
+  RobinResult result;
+  result.status = checkpoint.status;
+  result.message = checkpoint.message;
+  result.algorithm = checkpoint.algorithm;
+  result.history = checkpoint.history;
+  restore_state(result, checkpoint.state);
+  result.completed_by_sequence = checkpoint.completed_by_sequence;
+  result.restart_iterate = checkpoint.restart_iterate;
+  result.initial_iterate = checkpoint.initial_iterate;
+  result.critical_compute_seconds = checkpoint.critical_compute_seconds;
+  result.wall_seconds = checkpoint.wall_seconds;
+  result.coordinator_seconds = checkpoint.wall_seconds - checkpoint.port_seconds;
+  return result;
 }
 
 /// The record of one iteration: the joint state's residuals, the obstacle change, the
@@ -300,6 +342,7 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
                               const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                               const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
                               const Eigen::VectorXd* initial_iterate,
+                              const IterationContinuation& continuation,
                               const IterationObserver& observer);
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
@@ -313,7 +356,7 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const ContactPairing& pairing, const CouplingOptions& options,
                                 const IterationObserver& observer) {
   return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
-                           short_wavelength_forces(pairing), options, nullptr, observer);
+                           short_wavelength_forces(pairing), options, nullptr, {}, observer);
 }
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
@@ -321,7 +364,18 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd& initial_iterate,
                                 const IterationObserver& observer) {
   return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
-                           short_wavelength_forces(pairing), options, &initial_iterate, observer);
+                           short_wavelength_forces(pairing), options, &initial_iterate, {},
+                           observer);
+}
+
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const ContactPairing& pairing, const CouplingOptions& options,
+                                const Eigen::VectorXd* initial_iterate,
+                                const IterationContinuation& continuation,
+                                const IterationObserver& observer) {
+  return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
+                           short_wavelength_forces(pairing), options, initial_iterate, continuation,
+                           observer);
 }
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
@@ -329,16 +383,90 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const CouplingOptions& options, const IterationObserver& observer) {
   Eigen::VectorXd probe = weights;  // without positions: alternate in pair order
   for (Eigen::Index i = 1; i < probe.size(); i += 2) probe[i] = -probe[i];
-  return run_coupling_loop(body1, body2, gaps, weights, probe, options, nullptr, observer);
+  return run_coupling_loop(body1, body2, gaps, weights, probe, options, nullptr, {}, observer);
 }
+
+namespace {
+
+/// What the loop carries from one iteration to the next, besides the ports.
+struct LoopMemory {
+  Acceleration& acceleration;
+  ProgressMonitor& monitor;
+  std::array<ForceSequence, 2>& force_sequences;
+};
+
+/// Restores the loop's memory from `checkpoint` and repeats its contact solves (the servers'
+/// warm start); returns the iterate of the next iteration. Throws CheckpointFormatError when
+/// the checkpoint's iterate does not fit the scheme.
+Eigen::VectorXd resume_loop(const IterationCheckpoint& checkpoint, CouplingScheme& scheme,
+                            const LoopMemory& memory, Eigen::Index iterate_size,
+                            RobinResult& result) {
+  const bool iterates_fit =
+      static_cast<int>(checkpoint.iterates.size()) == checkpoint.iteration &&
+      std::all_of(checkpoint.iterates.begin(), checkpoint.iterates.end(),
+                  [&](const Eigen::VectorXd& iterate) { return iterate.size() == iterate_size; });
+  if (checkpoint.next_iterate.size() != iterate_size || !iterates_fit ||
+      checkpoint.algorithm != result.algorithm) {
+    std::ostringstream text;
+    text << "the checkpoint's iterate (" << checkpoint.next_iterate.size() << " values, "
+         << checkpoint.algorithm << ") does not fit this run's iteration (" << iterate_size
+         << " values, " << result.algorithm << ")";
+    throw CheckpointFormatError(text.str());
+  }
+  memory.acceleration.restore_state(checkpoint.acceleration);
+  memory.monitor.restore(checkpoint.monitor);
+  for (int body = 0; body < 2; ++body) {
+    memory.force_sequences[body].restore(checkpoint.force_sequences[body]);
+  }
+  result.history = checkpoint.history;
+  result.initial_iterate = checkpoint.initial_iterate;
+  result.restart_iterate = checkpoint.restart_iterate;
+  result.critical_compute_seconds = checkpoint.critical_compute_seconds;
+  restore_state(result, checkpoint.state);
+  for (std::size_t index = 0; index < checkpoint.iterates.size(); ++index) {
+    scheme.repeat_contact_solves(checkpoint.iterates[index], static_cast<int>(index) + 1);
+  }
+  return checkpoint.next_iterate;
+}
+
+IterationCheckpoint make_checkpoint(const RobinResult& result, const LoopMemory& memory,
+                                    const std::vector<Eigen::VectorXd>& iterates,
+                                    const Eigen::VectorXd& next, bool stopped) {
+  IterationCheckpoint checkpoint;
+  checkpoint.iteration = static_cast<int>(result.history.size());
+  checkpoint.stopped = stopped;
+  checkpoint.status = result.status;
+  checkpoint.message = result.message;
+  checkpoint.algorithm = result.algorithm;
+  checkpoint.completed_by_sequence = result.completed_by_sequence;
+  checkpoint.iterates = iterates;
+  checkpoint.next_iterate = next;
+  checkpoint.initial_iterate = result.initial_iterate;
+  checkpoint.restart_iterate = result.restart_iterate;
+  checkpoint.state = stored_state(result);
+  checkpoint.acceleration = memory.acceleration.save_state();
+  checkpoint.monitor = memory.monitor.state();
+  checkpoint.force_sequences = {memory.force_sequences[0].state(),
+                                memory.force_sequences[1].state()};
+  checkpoint.history = result.history;
+  checkpoint.critical_compute_seconds = result.critical_compute_seconds;
+  return checkpoint;
+}
+
+}  // namespace
 
 RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
                               const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                               const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
                               const Eigen::VectorXd* initial_iterate,
+                              const IterationContinuation& continuation,
                               const IterationObserver& observer) {
+  const IterationCheckpoint* resume = continuation.resume;
+  if (resume != nullptr && resume->stopped) return stopped_result(*resume);
   const auto run_start = Clock::now();
-  double port_seconds = 0.0;
+  // the wall and port time of the iterations before a resume
+  const double earlier_wall = resume != nullptr ? resume->wall_seconds : 0.0;
+  double port_seconds = resume != nullptr ? resume->port_seconds : 0.0;
   const auto setup_start = Clock::now();
   const std::unique_ptr<CouplingScheme> scheme =
       make_coupling_scheme(options, body1, body2, gaps, weights, probe_forces);
@@ -350,7 +478,7 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   result.algorithm = scheme->describe();
   Eigen::VectorXd iterate = scheme->initial_iterate(
       options.initial_obstacle == "zero" ? Eigen::VectorXd::Zero(gaps.size()) : gaps);
-  if (initial_iterate != nullptr) {
+  if (initial_iterate != nullptr && resume == nullptr) {
     if (initial_iterate->size() != iterate.size()) {
       throw InputError("the initial iterate of the " + result.algorithm + " iteration has " +
                        std::to_string(initial_iterate->size()) + " values, expected " +
@@ -361,11 +489,21 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   result.initial_iterate = iterate;
   ProgressMonitor monitor(options);
   std::array<ForceSequence, 2> force_sequences;  // each body's lambda over the iterations
+  const LoopMemory memory{*acceleration, monitor, force_sequences};
+  int first_iteration = 1;
+  std::vector<Eigen::VectorXd> iterates;  // x_1 ... x_k, for checkpoints
+  if (resume != nullptr) {
+    const auto resume_start = Clock::now();
+    iterate = resume_loop(*resume, *scheme, memory, iterate.size(), result);
+    port_seconds += seconds_between(resume_start, Clock::now());
+    first_iteration = resume->iteration + 1;
+    if (continuation.checkpoint) iterates = resume->iterates;
+  }
   result.status = IterationStatus::max_iterations;
   result.message = "the iteration limit of " + std::to_string(options.max_iterations) +
                    " iterations was reached before the tolerance " +
                    format_number(options.tolerance);
-  for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
+  for (int iteration = first_iteration; iteration <= options.max_iterations; ++iteration) {
     const auto iteration_start = Clock::now();
     const CouplingEvaluation evaluation = scheme->evaluate(iterate, iteration);
     const auto update_start = Clock::now();
@@ -384,15 +522,26 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
     result.history.push_back(record);
     store_state(result, evaluation.state);
     result.restart_iterate = evaluation.mapped;
-    if (observer) observer(record);
-    if (accept_converged_state(record, evaluation, options, result)) break;
-    if (const auto stop = monitor.check(record, result.message)) {
-      result.status = *stop;
-      break;
+    bool stopped = accept_converged_state(record, evaluation, options, result);
+    if (!stopped) {
+      if (const auto stop = monitor.check(record, result.message)) {
+        result.status = *stop;
+        stopped = true;
+      }
     }
+    if (!stopped && iteration == options.max_iterations) stopped = true;
+    if (continuation.checkpoint) {
+      iterates.push_back(iterate);
+      IterationCheckpoint checkpoint = make_checkpoint(result, memory, iterates, next, stopped);
+      checkpoint.port_seconds = port_seconds;
+      checkpoint.wall_seconds = earlier_wall + seconds_between(run_start, Clock::now());
+      continuation.checkpoint(checkpoint);
+    }
+    if (observer) observer(record);
+    if (stopped) break;
     iterate = next;
   }
-  result.wall_seconds = seconds_between(run_start, Clock::now());
+  result.wall_seconds = earlier_wall + seconds_between(run_start, Clock::now());
   result.coordinator_seconds = result.wall_seconds - port_seconds;
   return result;
 }

@@ -113,6 +113,20 @@ struct RobinResult {
 
 using IterationObserver = std::function<void(const IterationRecord&)>;
 
+struct IterationCheckpoint;  // iteration_checkpoint.hpp
+
+/// Checkpointing and resuming the loop (iteration_checkpoint.hpp).
+struct IterationContinuation {
+  /// When set, the loop continues after this checkpoint's iteration k instead of starting: it
+  /// restores the acceleration, the monitors and the history, repeats the contact solves of
+  /// iteration k (the servers' warm start) and runs iteration k + 1 at its next_iterate; a
+  /// checkpoint of a stopped loop is returned as the result without any request. Must come
+  /// from a run of the same algorithm and options on the same pairing.
+  const IterationCheckpoint* resume = nullptr;
+  /// Told the loop's state after every iteration (after the stopping test), e.g. to write it.
+  std::function<void(const IterationCheckpoint&)> checkpoint;
+};
+
 /// Runs the coupling algorithm of options.algorithm (coupling_scheme.hpp) on two ports whose
 /// contact has been assigned, with the pairs' initial gaps and boundary weights (pair order).
 /// Throws PortError when a port fails or a contact QP does not converge (the message names
@@ -131,6 +145,13 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const ContactPairing& pairing, const CouplingOptions& options,
                                 const Eigen::VectorXd& initial_iterate,
+                                const IterationObserver& observer = {});
+/// The same, starting from `initial_iterate` when it is not null, checkpointed and possibly
+/// resumed as `continuation` says (its resume takes precedence over `initial_iterate`).
+RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
+                                const ContactPairing& pairing, const CouplingOptions& options,
+                                const Eigen::VectorXd* initial_iterate,
+                                const IterationContinuation& continuation,
                                 const IterationObserver& observer = {});
 /// The same with unit weights (enough for every algorithm but "robin-constant").
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,

@@ -65,6 +65,9 @@ class SubdomainPort {
   virtual BodyOutput fields(const Eigen::VectorXd& contact_force) = 0;
   /// Ends the run (the server stays up for the next one). Must not throw.
   virtual void end_run() noexcept = 0;
+  /// Forgets a request started but not finished (its reply, if any, is discarded), so that the
+  /// port can be used again after the other body's server failed mid-step. Must not throw.
+  virtual void abandon_request() noexcept {}
   virtual const PortTimings& timings() const = 0;
 };
 

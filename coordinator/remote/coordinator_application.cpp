@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <vector>
 
 #include "coupling/case_file_overrides.hpp"
@@ -17,6 +18,7 @@
 #include "numerics/errors.hpp"
 #include "remote/remote_port.hpp"
 #include "remote/run_interruption.hpp"
+#include "remote/run_resume.hpp"
 
 namespace robin {
 
@@ -203,18 +205,44 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
 }  // namespace
 
 void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
-  app.add_option("case", settings.case_file, "case file (TOML, see docs/case-format.md)")
-      ->required()
+  app.add_option("case", settings.case_file,
+                 "case file (TOML, see docs/case-format.md); with --resume, the checkpointed "
+                 "one by default")
       ->check(CLI::ExistingFile);
-  app.add_option("--output,-o", settings.output_directory, "directory for the result files")
-      ->required()
-      ->check(writable_directory());
-  app.add_flag("--overwrite", settings.overwrite,
-               "replace the results of an earlier run in the output directory (a directory "
-               "holding files is refused otherwise)");
+  CLI::Option* output =
+      app.add_option("--output,-o", settings.output_directory, "directory for the result files")
+          ->check(writable_directory());
+  CLI::Option* overwrite =
+      app.add_flag("--overwrite", settings.overwrite,
+                   "replace the results of an earlier run in the output directory (a directory "
+                   "holding files is refused otherwise)");
+  app.add_option("--resume", settings.resume_directory,
+                 "continue the run whose checkpoint is in DIR (after the coordinator died or "
+                 "was stopped) instead of starting one; DIR is the output directory; a changed "
+                 "case file or option is refused")
+      ->type_name("DIR")
+      ->excludes(output)
+      ->excludes(overwrite);
+  app.add_option("--max-server-restarts", settings.max_server_restarts,
+                 "how often a server lost mid-run is replaced per body (robin-run restarts it, "
+                 "robin-coordinator waits for it) before the run fails; 0: never")
+      ->check(CLI::NonNegativeNumber);
   // Refused before any server starts: a typo must not cost a setup, an earlier run's files
   // must not be mixed with this run's.
   app.final_callback([&settings] {
+    if (!settings.resume_directory.empty()) {
+      settings.output_directory = settings.resume_directory;
+      if (!std::filesystem::exists(settings.resume_directory / checkpoint_file_name)) {
+        throw CLI::ValidationError(
+            "--resume", "'" + settings.resume_directory.string() +
+                            "' holds no checkpoint.json: nothing to resume there (a run "
+                            "writes it after its first iteration and removes it once its "
+                            "results are written)");
+      }
+      return;
+    }
+    if (settings.case_file.empty()) throw CLI::RequiredError("case");
+    if (settings.output_directory.empty()) throw CLI::RequiredError("--output");
     try {
       // logs/: the servers' logs of this run when a launcher (deploy/remote-servers.sh) wrote
       // them there before starting the coordinator
@@ -331,9 +359,14 @@ std::string progress_line(const IterationRecord& record, const CouplingOptions& 
       record.acceleration_state);
 }
 
-std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings) {
+std::optional<CaseDefinition> load_case(CoordinatorSettings& settings) {
   try {
-    return read_case_file(settings.case_file, settings.overrides);
+    if (!settings.resume_directory.empty()) {
+      settings.resume = std::make_shared<const RunCheckpoint>(prepare_resume(settings));
+    }
+    CaseDefinition definition = read_case_file(settings.case_file, settings.overrides);
+    if (settings.resume) check_resumable(definition);
+    return definition;
   } catch (const std::exception& error) {
     coordinator_logger()->error("{}", error.what());
     return std::nullopt;
@@ -350,17 +383,53 @@ int failure_exit_code(const std::exception& error) {
   return 1;
 }
 
+namespace {
+
+/// The directory's record of a resumed run, and a log line about it.
+void record_resume(ResultDirectory& results, const RunCheckpoint& checkpoint, spdlog::logger& log) {
+  results.add_to_record("resumed_from", {{"run_id", checkpoint.run_id},
+                                         {"first_run_id", checkpoint.first_run_id},
+                                         {"first_started", checkpoint.started},
+                                         {"iteration", checkpoint.iteration.iteration}});
+  log.info("resuming run {} after iteration {} (checkpoint in {})", checkpoint.run_id,
+           checkpoint.iteration.iteration, results.directory().string());
+}
+
+/// The identity of this run in its checkpoints (checkpoint.hpp); the loop state is added per
+/// iteration.
+RunCheckpoint checkpoint_identity(const CaseDefinition& definition,
+                                  const CoordinatorSettings& settings,
+                                  const ResultDirectory& results) {
+  RunCheckpoint identity;
+  identity.run_id = results.run_id();
+  identity.first_run_id = settings.resume ? settings.resume->first_run_id : results.run_id();
+  identity.started = settings.resume ? settings.resume->started : utc_timestamp();
+  identity.case_file = std::filesystem::absolute(definition.file).string();
+  identity.case_sha256 = file_sha256(definition.file);
+  std::ifstream file(definition.file, std::ios::binary);
+  identity.case_text.assign(std::istreambuf_iterator<char>(file), {});
+  identity.overrides = definition.overrides;
+  identity.options = computation_options(settings);
+  return identity;
+}
+
+}  // namespace
+
 int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
                     const std::array<std::string, 2>& endpoints,
-                    const std::array<ChannelOptions, 2>& channels) {
+                    const std::array<ChannelOptions, 2>& channels, const ServerRestart& restart) {
   auto log = coordinator_logger();
   const CouplingOptions options = merged_coupling_options(definition.coupling, settings);
   std::unique_ptr<ResultDirectory> results;
+  const ExistingResults policy = settings.resume      ? ExistingResults::resume
+                                 : settings.overwrite ? ExistingResults::overwrite
+                                                      : ExistingResults::refuse;
+  RunCheckpoint checkpoint;
   try {
-    results = std::make_unique<ResultDirectory>(
-        settings.output_directory,
-        settings.overwrite ? ExistingResults::overwrite : ExistingResults::refuse,
-        "robin-coordinator", definition.file);
+    results = std::make_unique<ResultDirectory>(settings.output_directory, policy,
+                                                "robin-coordinator", definition.file);
+    if (settings.resume) record_resume(*results, *settings.resume, *log);
+    checkpoint = checkpoint_identity(definition, settings, *results);
   } catch (const std::exception& error) {
     return failure_exit_code(error);
   }
@@ -369,21 +438,68 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
               settings.output_directory.string(), fmt::join(results->leftover_files(), ", "));
   }
   std::array<std::unique_ptr<RemotePort>, 2> ports;
+  std::vector<std::unique_ptr<RemotePort>> replaced_ports;  // kept until the run ends
+  const auto make_port = [&](int alpha, const std::string& endpoint) {
+    RemotePortOptions port_options;
+    port_options.request_timeout_seconds = options.request_timeout_seconds;
+    port_options.setup_timeout_seconds = options.setup_timeout_seconds;
+    port_options.channel = channels[alpha];
+    port_options.heartbeat_timeout_seconds = settings.heartbeat_timeout_seconds;
+    port_options.on_status = progress_reporter(log);
+    const std::string& body = definition.bodies[alpha].definition.name;
+    ports[alpha] = std::make_unique<RemotePort>(endpoint, body, port_options);
+    log->info("body {} '{}' on server {}", alpha + 1, body, endpoint);
+  };
+  RunContinuation continuation;
+  if (settings.resume) continuation.resume = &settings.resume->iteration;
+  CheckpointWriter writer(settings.output_directory);
+  continuation.checkpoint = [&](const IterationCheckpoint& iteration) {
+    checkpoint.iteration = iteration;
+    writer.write(checkpoint);
+  };
+  std::array<int, 2> restarts{0, 0};
+  nlohmann::json restart_records = nlohmann::json::array();
+  if (restart.lost && restart.restart && settings.max_server_restarts > 0) {
+    continuation.replacement.lost = [&](int body) {
+      return restart.lost(body, ports[body]->connection_lost());
+    };
+    continuation.replacement.replace = [&](int body, const std::string& failure) {
+      const std::string& name = definition.bodies[body].definition.name;
+      if (restarts[body] >= settings.max_server_restarts) {
+        throw PortError(
+            fmt::format("{}\n  the server of body '{}' was lost again after {} restarts "
+                        "(--max-server-restarts {}): the run stops",
+                        failure, name, restarts[body], settings.max_server_restarts));
+      }
+      ++restarts[body];
+      log->warn("lost the server of body '{}': {}; replacing it (restart {} of {})", name, failure,
+                restarts[body], settings.max_server_restarts);
+      std::string endpoint;
+      try {
+        endpoint = restart.restart(body);
+      } catch (const std::exception& error) {
+        throw PortError(
+            fmt::format("{}\n  the server of body '{}' cannot be replaced (restart "
+                        "{} of {}): {}",
+                        failure, name, restarts[body], settings.max_server_restarts, error.what()));
+      }
+      restart_records.push_back({{"body", name},
+                                 {"restart", restarts[body]},
+                                 {"of", settings.max_server_restarts},
+                                 {"endpoint", endpoint},
+                                 {"failure", failure}});
+      results->add_to_record("server_restarts", restart_records);
+      replaced_ports.push_back(std::move(ports[body]));
+      make_port(body, endpoint);
+      return static_cast<SubdomainPort*>(ports[body].get());
+    };
+  }
   int code = 1;
   try {
-    for (int alpha = 0; alpha < 2; ++alpha) {
-      RemotePortOptions port_options;
-      port_options.request_timeout_seconds = options.request_timeout_seconds;
-      port_options.setup_timeout_seconds = options.setup_timeout_seconds;
-      port_options.channel = channels[alpha];
-      port_options.heartbeat_timeout_seconds = settings.heartbeat_timeout_seconds;
-      port_options.on_status = progress_reporter(log);
-      const std::string& body = definition.bodies[alpha].definition.name;
-      ports[alpha] = std::make_unique<RemotePort>(endpoints[alpha], body, port_options);
-      log->info("body {} '{}' on server {}", alpha + 1, body, endpoints[alpha]);
-    }
-    const CoupledRunResult result = run_coupled_case(definition, {ports[0].get(), ports[1].get()},
-                                                     options, make_observer(log, options));
+    for (int alpha = 0; alpha < 2; ++alpha) make_port(alpha, endpoints[alpha]);
+    const CoupledRunResult result =
+        run_coupled_case(definition, {ports[0].get(), ports[1].get()}, options,
+                         make_observer(log, options), continuation);
     write_coupled_outputs(*results, definition, result);
     code = report_outcome(result, settings, *log);
   } catch (const InputError& error) {  // e.g. unmatched contact nodes: name the case file

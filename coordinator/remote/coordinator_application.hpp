@@ -18,6 +18,7 @@
 
 #include "command_line.hpp"  // parse_command_line, add_version_option
 #include "coupling/case_file.hpp"
+#include "coupling/checkpoint.hpp"
 #include "coupling/robin_iteration.hpp"
 #include "remote/request_channel.hpp"
 
@@ -49,6 +50,28 @@ struct CoordinatorSettings {
   bool quiet = false;  // --quiet: the coordinator logs only warnings and errors
   /// --set KEY=VALUE: overrides of case-file keys, in order (coupling/case_file_overrides.hpp).
   std::vector<std::string> overrides;
+  /// --resume DIR: continue the run checkpointed in DIR (run_resume.hpp); DIR is then also the
+  /// output directory.
+  std::filesystem::path resume_directory;
+  /// Filled by load_case on --resume: the checkpoint to continue from.
+  std::shared_ptr<const RunCheckpoint> resume;
+  /// --max-server-restarts: how often a lost server of each body is replaced (robin-run
+  /// restarts it, robin-coordinator waits for it) before the run fails.
+  int max_server_restarts = 2;
+  /// --server-grace-period (robin-coordinator): how long to wait for a lost server to answer
+  /// at its endpoint again.
+  double server_grace_period_seconds = 30.0;
+};
+
+/// How run_coordinator replaces the server of a body that was lost mid-run (robin-run:
+/// restarts its process; robin-coordinator: waits for it at its endpoint). Empty hooks: a lost
+/// server fails the run.
+struct ServerRestart {
+  /// Whether the server of `body` is gone, given whether its connection dropped.
+  std::function<bool(int body, bool connection_lost)> lost;
+  /// Brings a server for `body` back and returns its endpoint; throws std::runtime_error
+  /// saying why it cannot.
+  std::function<std::string(int body)> restart;
 };
 
 /// Adds CASE, --output, --relaxation, --tolerance, --max-iterations, --initial-obstacle,
@@ -72,16 +95,21 @@ std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level
 std::string progress_line(const IterationRecord& record, const CouplingOptions& options);
 
 /// Reads the case file; logs the error (an InputError naming file, line and field) and returns
-/// nullopt when it is unusable.
-std::optional<CaseDefinition> load_case(const CoordinatorSettings& settings);
+/// nullopt when it is unusable. With --resume, first reads the checkpoint and completes
+/// `settings` from it (run_resume.hpp), logging why a resume is refused.
+std::optional<CaseDefinition> load_case(CoordinatorSettings& settings);
 
 /// Runs the case against the servers at `endpoints` (the first gets body 1), writes the result
 /// files into the output directory and returns the exit code (see the file comment). The
 /// servers' runs are always ended. `channels[i]` sets the transport and the waiting hooks of
 /// port i; the iteration also stops between iterations on a stop signal.
+/// `restart` replaces lost servers (at most settings.max_server_restarts per body); the run
+/// checkpoints every iteration into the output directory and, with settings.resume,
+/// continues from that checkpoint.
 int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
                     const std::array<std::string, 2>& endpoints,
-                    const std::array<ChannelOptions, 2>& channels = {});
+                    const std::array<ChannelOptions, 2>& channels = {},
+                    const ServerRestart& restart = {});
 
 /// Logs a failure and returns its exit code: 128 + signal once a stop signal was received
 /// (whatever exception the interruption surfaced as), 1 otherwise.

@@ -2,7 +2,9 @@
 // Runs the Robin domain decomposition of a case on two running robin-subdomain servers; the
 // first --subdomain serves body 1, the second body 2. With --curve-secret-key and
 // --curve-server-key the connections use CurveZMQ (curve_options.hpp, docs/security.md).
-// Exit codes: coordinator_application.hpp.
+// A server whose connection drops mid-run is waited for at its endpoint (--server-grace-period,
+// --max-server-restarts); then its body is set up again and the run carries on from its last
+// checkpoint. Exit codes: coordinator_application.hpp.
 
 #include <spdlog/spdlog.h>
 
@@ -13,6 +15,7 @@
 #include "remote/conformance_check.hpp"
 #include "remote/coordinator_application.hpp"
 #include "remote/curve_options.hpp"
+#include "remote/remote_port.hpp"
 #include "remote/run_interruption.hpp"
 
 int main(int argc, char** argv) {
@@ -32,6 +35,11 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false);  // one endpoint per --subdomain; the count is checked below
   robin::CurveClientSettings curve;
   robin::add_curve_client_options(app, curve, "--subdomain");
+  app.add_option("--server-grace-period", settings.server_grace_period_seconds,
+                 "when a server is lost mid-run, wait this long (seconds) for it to answer at "
+                 "its endpoint again (e.g. restarted by systemd), then set its body up again and "
+                 "carry on from the last checkpoint (at most --max-server-restarts times)")
+      ->check(CLI::NonNegativeNumber);
   std::string check_server;  // handled above; listed here for --help
   app.add_option("--check-server", check_server,
                  "instead of a run: check that the server at ENDPOINT conforms to the protocol "
@@ -65,5 +73,15 @@ int main(int argc, char** argv) {
     channels[index].on_wait = robin::throw_if_stop_requested;
     channels[index].curve = curve_keys[index];
   }
-  return robin::run_coordinator(*definition, settings, {subdomains[0], subdomains[1]}, channels);
+  // A lost server (its connection dropped) is waited for at its endpoint.
+  robin::ServerRestart restart;
+  restart.lost = [](int, bool connection_lost) { return connection_lost; };
+  restart.restart = [&](int body) {
+    log->info("waiting up to {} s for a server at {} (--server-grace-period)",
+              settings.server_grace_period_seconds, subdomains[body]);
+    robin::await_server(subdomains[body], settings.server_grace_period_seconds, channels[body]);
+    return subdomains[body];
+  };
+  return robin::run_coordinator(*definition, settings, {subdomains[0], subdomains[1]}, channels,
+                                restart);
 }

@@ -352,6 +352,14 @@ void RemotePort::end_run() noexcept {
   channel_->set_hooks_enabled(true);
 }
 
+void RemotePort::abandon_request() noexcept {
+  pending_.reset();  // a reply still in flight is discarded by its request id
+}
+
+bool RemotePort::connection_lost() {
+  return channel_->connection_lost();
+}
+
 const PortTimings& RemotePort::timings() const {
   return timings_;
 }
@@ -366,6 +374,30 @@ std::string new_run_id() {
     for (int digit = 0; digit < 8; ++digit, bits >>= 4) text += digits[bits & 0xfu];
   }
   return text;
+}
+
+void await_server(const std::string& endpoint, double seconds, const ChannelOptions& channel) {
+  const Deadline limit = Deadline::after(seconds);
+  std::string last_problem = "no attempt";
+  do {
+    const double remaining = std::chrono::duration<double>(limit.at - Clock::now()).count();
+    try {
+      RequestChannel probe(endpoint, channel);
+      const Deadline attempt = Deadline::after(std::max(0.1, std::min(1.0, remaining)));
+      Envelope request;
+      request.mutable_hello()->set_client_name("robin-coordinator (waiting for the server)");
+      const std::uint64_t request_id = probe.send(request, attempt);
+      if (probe.receive(request_id, attempt).has_hello_reply()) return;
+      last_problem = "the reply was not a HelloReply";
+    } catch (const ChannelFailure& failure) {
+      last_problem = failure.what();
+      if (channel.on_wait) channel.on_wait();
+    }
+  } while (Clock::now() < limit.at);
+  std::ostringstream text;
+  text << "no server answered at " << endpoint << " within " << seconds << " s (" << last_problem
+       << ")";
+  throw std::runtime_error(text.str());
 }
 
 bool request_server_shutdown(const std::string& endpoint, double timeout_seconds,

@@ -92,7 +92,11 @@ class RemotePort final : public SubdomainPort {
   void set_load_factor(double factor) override;
   BodyOutput fields(const Eigen::VectorXd& contact_force) override;
   void end_run() noexcept override;
+  void abandon_request() noexcept override;
   const PortTimings& timings() const override;
+  /// True once the connection to the server dropped after it was made (the server stopped,
+  /// crashed or was killed).
+  bool connection_lost();
 
   const std::string& endpoint() const { return endpoint_; }
   /// What the server said about itself in the handshake ("robin-subdomain 0.1.0").
@@ -140,6 +144,12 @@ class RemotePort final : public SubdomainPort {
 /// lowercase hexadecimal digits. Distinct runs get distinct identifiers with overwhelming
 /// probability.
 std::string new_run_id();
+
+/// Waits until a server answers a handshake (Hello) at `endpoint`, trying every second for at
+/// most `seconds`, on fresh connections with `channel`'s transport and hooks. Throws
+/// std::runtime_error ("no server answered at ENDPOINT within 30 s") when none did; the hooks'
+/// exceptions propagate.
+void await_server(const std::string& endpoint, double seconds, const ChannelOptions& channel);
 
 /// Asks the server at `endpoint` to stop (Shutdown request) on a fresh connection (a CurveZMQ
 /// one with `curve`); true when it acknowledged within `timeout_seconds`. Never throws.

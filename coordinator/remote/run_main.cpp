@@ -9,6 +9,8 @@
 // --server-executable its path there; each is given once for both servers or once per body
 // (body order). The prefix must pass the server's standard output through (its "listening on
 // ENDPOINT" line gives the endpoint the coordinator connects to) and forward SIGTERM.
+// A server that dies mid-run is restarted (--max-server-restarts times per body, default 2):
+// its body is set up again and the run carries on from its last checkpoint.
 // Exit codes: coordinator_application.hpp.
 
 #include <spdlog/spdlog.h>
@@ -93,10 +95,24 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
       spdlog::info("{} listening on {} (log: {})", server.label(), server.endpoint(),
                    server.log_file().string());
       channels[index].on_wait = robin::throw_if_stop_requested;
-      channels[index].server_failure = [&server] { return server.failure(); };
+      // the server of the body now: a restart replaces it
+      channels[index].server_failure = [&servers, index] {
+        return servers.server(index).failure();
+      };
       channels[index].curve = launch.curve_client;
     }
-    code = robin::run_coordinator(definition, settings, servers.endpoints(), channels);
+    robin::ServerRestart restart;
+    restart.lost = [&servers](int body, bool connection_lost) {
+      return servers.server(body).exited_within(connection_lost ? 2.0 : 0.0);
+    };
+    restart.restart = [&servers](int body) {
+      servers.restart(body, robin::throw_if_stop_requested);
+      const robin::SubdomainServer& server = servers.server(body);
+      spdlog::info("{} listening on {} (log: {})", server.label(), server.endpoint(),
+                   server.log_file().string());
+      return server.endpoint();
+    };
+    code = robin::run_coordinator(definition, settings, servers.endpoints(), channels, restart);
     servers.stop();
     spdlog::info("servers stopped");
   } catch (const std::exception& error) {
@@ -143,7 +159,7 @@ int main(int argc, char** argv) {
   // --quiet quietens this terminal; the servers' log files keep --log-level.
   robin::make_coordinator_logger(settings.quiet ? "warn" : settings.log_level);
   robin::install_stop_signal_handlers();
-  const auto definition = robin::load_case(settings);
+  auto definition = robin::load_case(settings);
   if (!definition) return 1;
   return run_with_local_servers(*definition, settings, curve, placement);
 }

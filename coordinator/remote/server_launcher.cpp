@@ -127,7 +127,8 @@ LocalServers::LocalServers(const std::array<std::string, 2>& bodies,
     : LocalServers(bodies, std::array<ServerLaunchOptions, 2>{options, options}) {}
 
 LocalServers::LocalServers(const std::array<std::string, 2>& bodies,
-                           const std::array<ServerLaunchOptions, 2>& options) {
+                           const std::array<ServerLaunchOptions, 2>& options)
+    : bodies_(bodies), options_(options) {
   for (int index = 0; index < 2; ++index) {
     servers_[index] = std::make_unique<SubdomainServer>(bodies[index], options[index]);
   }
@@ -139,6 +140,12 @@ LocalServers::~LocalServers() {
 
 void LocalServers::await_listening(const std::function<void()>& on_wait) {
   for (auto& server : servers_) server->await_listening(on_wait);
+}
+
+void LocalServers::restart(int index, const std::function<void()>& on_wait) {
+  servers_[index].reset();  // reaps the exited server (or stops one that still runs)
+  servers_[index] = std::make_unique<SubdomainServer>(bodies_[index], options_[index]);
+  servers_[index]->await_listening(on_wait);
 }
 
 std::array<std::string, 2> LocalServers::endpoints() const {

@@ -61,6 +61,9 @@ class SubdomainServer {
   /// Empty while the server runs; otherwise what happened to it, naming it and its log.
   /// Thread-safe.
   std::string failure();
+  /// Whether the server has exited, waiting up to `seconds` for it (a lost connection is
+  /// usually seen just before the process's exit is).
+  bool exited_within(double seconds) { return process_->wait_for_exit(seconds); }
 
   /// Sends Shutdown (when listening) without waiting for the process.
   void request_shutdown() noexcept;
@@ -89,10 +92,16 @@ class LocalServers {
   void await_listening(const std::function<void()>& on_wait = {});
   std::array<std::string, 2> endpoints() const;
   SubdomainServer& server(int index) { return *servers_[index]; }
+  /// Replaces server `index` (which has exited) by a new one started with the same options and
+  /// waits until it listens (its log goes on in the same file). Throws as the constructor and
+  /// await_listening do.
+  void restart(int index, const std::function<void()>& on_wait = {});
   /// Stops both servers; idempotent.
   void stop() noexcept;
 
  private:
+  std::array<std::string, 2> bodies_;
+  std::array<ServerLaunchOptions, 2> options_;
   std::array<std::unique_ptr<SubdomainServer>, 2> servers_;
 };
 

@@ -357,7 +357,7 @@ std::string expect_failing_upper_server(const std::string& name, const std::stri
   const ProcessOutcome outcome = run_robin_run(
       {example("two_blocks.toml").string(), "--output", (directory.path() / "out").string(),
        "--server-executable", testing::tool("robin-subdomain").string(), "--server-executable",
-       failing.string()},
+       failing.string(), "--max-server-restarts", "0"},  // the failure itself, not restarts
       directory.path(), 60.0);
   EXPECT_EQ(outcome.exit, "exited with status 1") << outcome.errors;
   EXPECT_NE(outcome.errors.find(name + " for body 'upper' (pid "), std::string::npos)

@@ -1,0 +1,74 @@
+#pragma once
+// The checkpoint files of a coupled run (docs/outputs.md, "Checkpoint and resume"), written
+// after every iteration and read by `robin-run --resume DIR` / `robin-coordinator --resume
+// DIR`:
+//   DIR/checkpoint-iterates.bin  the iterates x_1, x_2, ... of the iteration, one record per
+//                                iteration appended (an unsigned 64-bit count n, then n
+//                                IEEE 754 doubles, both in the machine's byte order);
+//   DIR/checkpoint.json          written atomically (write_file_atomically: a temporary
+//                                name, flushed, renamed) after the record is appended: the
+//                                loop's state after iteration k (iteration_checkpoint.hpp),
+//                                which says how many records are valid (k; a record beyond,
+//                                from an append cut short, is ignored), and the run it belongs
+//                                to, so that a resume with a changed case or changed options is
+//                                refused: the case file's path, SHA-256 and text (the text
+//                                names the changed keys), the --set overrides and the
+//                                command-line options that change the computation.
+// Per iteration this writes O(interface x history depth) bytes plus the residual records.
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "coupling/iteration_checkpoint.hpp"
+
+namespace robin {
+
+/// The names of the checkpoint files inside a result directory.
+extern const char* const checkpoint_file_name;
+extern const char* const checkpoint_iterates_file_name;
+
+struct RunCheckpoint {
+  static constexpr int current_format = 1;
+  std::string run_id;        // the run that wrote it (ResultDirectory::run_id)
+  std::string first_run_id;  // the run that started from scratch (itself, or resumed ones')
+  std::string started;       // when that first run started (UTC, ISO 8601)
+  std::string case_file;     // absolute path of the case file
+  std::string case_sha256;
+  std::string case_text;
+  std::vector<std::string> overrides;  // --set KEY=VALUE, in order
+  /// The command-line options that change the computation, name -> value ("--tolerance":
+  /// 1e-6); an option not given is absent.
+  nlohmann::json options = nlohmann::json::object();
+  IterationCheckpoint iteration;
+};
+
+/// Writes the checkpoints of one run (one process) into a directory.
+class CheckpointWriter {
+ public:
+  explicit CheckpointWriter(std::filesystem::path directory);
+  /// Writes checkpoint-iterates.bin (whole, atomically, on the first call; then by appending
+  /// the iterates it lacks) and then checkpoint.json atomically. Throws std::runtime_error
+  /// naming the file that cannot be written.
+  void write(const RunCheckpoint& checkpoint);
+
+ private:
+  std::filesystem::path directory_;
+  std::size_t iterates_written_ = 0;
+  bool first_ = true;
+};
+
+/// Reads the checkpoint files of `directory`. Throws CheckpointFormatError
+/// (checkpoint_encoding.hpp) naming the file and what is wrong with it (missing, unreadable,
+/// another format, a malformed field, too few iterates).
+RunCheckpoint read_checkpoint(const std::filesystem::path& directory);
+
+/// The keys whose values differ between two TOML texts (flattened key paths as the case
+/// reader names them, "coupling.tolerance", "body[2].mesh_size"), each as
+/// "KEY: OLD -> NEW" (a missing side shown as "(absent)"), at most `limit` of them and then
+/// "...". Empty when both parse to the same values; a text that does not parse is named.
+std::vector<std::string> toml_differences(const std::string& before, const std::string& after,
+                                          std::size_t limit = 10);
+
+}  // namespace robin
