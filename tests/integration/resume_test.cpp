@@ -11,7 +11,9 @@
 //    contact.csv and history.csv equal the uninterrupted run's (1e-10 and 1e-12 relative);
 //  - robin-coordinator against servers started by the test: one is killed mid-iteration and
 //    started again at the same endpoint within --server-grace-period; the run carries on to
-//    the same contact.csv.
+//    the same contact.csv;
+//  - a server that is lost at every start is replaced --max-server-restarts times (2), then
+//    the run fails naming the body and the limit.
 // The case: examples/asymmetric.toml with `--stopping joint` (85 iterations of a few ms) and,
 // for the setup and fields kills, finer meshes so that those stages last long enough to be hit.
 
@@ -352,6 +354,32 @@ TEST(ServerRecovery, RobinCoordinatorWaitsForAServerToComeBack) {
   EXPECT_NE(text.find("(restart 1 of 2)"), std::string::npos) << text;
   expect_same_table(csv_values(output / "contact.csv"), csv_values(reference / "contact.csv"),
                     1e-10, "robin-coordinator contact.csv");
+}
+
+TEST(ServerRecovery, RestartsAreBounded) {
+  ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
+  const TemporaryDirectory directory("robin-recovery-bounded");
+  // A "server" that announces an endpoint nobody binds and exits: every start is lost at once.
+  const std::filesystem::path lying = directory.path() / "lying-server";
+  std::ofstream(lying) << "#!/bin/sh\necho 'listening on ipc://"
+                       << (directory.path() / "nobody").string() << "'\n";
+  std::filesystem::permissions(lying, std::filesystem::perms(0755));
+  const std::filesystem::path log = directory.path() / "bounded.stderr";
+  const std::string exit =
+      run_to_end("robin-run",
+                 {example("two_blocks.toml").string(), "--output",
+                  (directory.path() / "out").string(), "--server-executable",
+                  testing::tool("robin-subdomain").string(), "--server-executable", lying.string()},
+                 log);
+  const std::string text = read_text(log);
+  EXPECT_EQ(exit, "exited with status 1") << text;
+  EXPECT_NE(text.find("(restart 1 of 2)"), std::string::npos) << text;
+  EXPECT_NE(text.find("(restart 2 of 2)"), std::string::npos) << text;
+  EXPECT_NE(text.find("the server of body 'upper' was lost again after 2 restarts "
+                      "(--max-server-restarts 2)"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(read_summary(directory.path() / "out").value("status", ""), "failed");
 }
 
 }  // namespace
