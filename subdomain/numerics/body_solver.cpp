@@ -126,6 +126,47 @@ std::vector<int> oriented_segments(const Mesh& mesh, const BoundaryGroup& group,
   return segments;
 }
 
+/// Whether two meshes have the same nodes, elements and boundary groups (bit for bit).
+bool same_geometry(const Mesh& left, const Mesh& right) {
+  if (left.nodes != right.nodes || left.blocks.size() != right.blocks.size() ||
+      left.boundaries.size() != right.boundaries.size()) {
+    return false;
+  }
+  for (std::size_t b = 0; b < left.blocks.size(); ++b) {
+    if (left.blocks[b].type != right.blocks[b].type ||
+        left.blocks[b].connectivity != right.blocks[b].connectivity) {
+      return false;
+    }
+  }
+  return std::equal(left.boundaries.begin(), left.boundaries.end(), right.boundaries.begin(),
+                    [](const auto& one, const auto& other) {
+                      return one.first == other.first && one.second.type == other.second.type &&
+                             one.second.connectivity == other.second.connectivity;
+                    });
+}
+
+bool same_material(const Material& left, const Material& right) {
+  return left.stiffness == right.stiffness && left.model == right.model &&
+         left.out_of_plane_poisson == right.out_of_plane_poisson;
+}
+
+/// Whether the same degrees of freedom are prescribed (whatever their values).
+bool same_prescribed_set(const std::vector<std::optional<double>>& prescribed, const DofMap& dofs) {
+  if (static_cast<int>(prescribed.size()) != dofs.total_count()) return false;
+  for (std::size_t dof = 0; dof < prescribed.size(); ++dof) {
+    if (prescribed[dof].has_value() != dofs.is_prescribed(static_cast<int>(dof))) return false;
+  }
+  return true;
+}
+
+bool same_factor_options(const BodySolverOptions& left, const BodySolverOptions& right) {
+  return left.interface_operator == right.interface_operator &&
+         left.dense_limit == right.dense_limit &&
+         left.contact_unknowns_last == right.contact_unknowns_last &&
+         left.maximum_dofs == right.maximum_dofs &&
+         left.maximum_factor_bytes == right.maximum_factor_bytes;
+}
+
 }  // namespace
 
 BodySolver::BodySolver(BodyDefinition definition, BodySolverOptions options)
@@ -214,27 +255,73 @@ void BodySolver::assign_contact(const ContactOperator& contact) {
   const std::vector<int> boundary_nodes =
       definition_.mesh.boundary(definition_.contact_boundary).nodes();
   check_contact_operator(contact, boundary_nodes, "body '" + name() + "'");
-  const int row_count = contact.row_count();
-  std::vector<Eigen::Triplet<double>> triplets;
-  prescribed_trace_ = Eigen::VectorXd::Zero(row_count);
-  for (int row = 0; row < row_count; ++row) {
+  const bool keep_compliance = compliance_ != nullptr && contact == contact_;
+  if (!keep_compliance) {
+    const int row_count = contact.row_count();
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (int row = 0; row < row_count; ++row) {
+      for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
+        const int dof = 2 * contact.nodes[k] + contact.components[k];
+        if (!dofs_->is_prescribed(dof)) {
+          triplets.emplace_back(row, dofs_->free_index(dof), contact.values[k]);
+        }
+      }
+    }
+    contact_ = contact;
+    trace_.resize(row_count, dofs_->free_count());
+    trace_.setFromTriplets(triplets.begin(), triplets.end());
+  }
+  update_free_trace();
+  if (!keep_compliance) build_interface_operator();
+  reset_warm_start();
+  timings_.interface_seconds = seconds_since(start);
+}
+
+void BodySolver::update_free_trace() {
+  const ContactOperator& contact = contact_;
+  prescribed_trace_ = Eigen::VectorXd::Zero(contact.row_count());
+  for (int row = 0; row < contact.row_count(); ++row) {
     for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
       const int dof = 2 * contact.nodes[k] + contact.components[k];
       if (dofs_->is_prescribed(dof)) {
         prescribed_trace_[row] += contact.values[k] * dofs_->prescribed_values()[dof];
-      } else {
-        triplets.emplace_back(row, dofs_->free_index(dof), contact.values[k]);
       }
     }
   }
-  contact_ = contact;
-  trace_.resize(row_count, dofs_->free_count());
-  trace_.setFromTriplets(triplets.begin(), triplets.end());
   unit_free_trace_ = trace_ * free_solution_ + prescribed_trace_;  // e = B K^{-1} f + B u_p
   free_trace_ = load_factor_ * unit_free_trace_;
-  build_interface_operator();
+}
+
+bool BodySolver::has_same_stiffness(const BodyDefinition& definition,
+                                    const BodySolverOptions& options) const {
+  if (definition.contact_boundary != definition_.contact_boundary ||
+      !same_factor_options(options, options_) ||
+      !same_material(definition.material, definition_.material) ||
+      !same_geometry(definition.mesh, definition_.mesh)) {
+    return false;
+  }
+  try {
+    return same_prescribed_set(prescribed_dofs(definition), *dofs_);
+  } catch (const InputError&) {
+    return false;  // conflicting conditions: the full setup reports them
+  }
+}
+
+void BodySolver::replace_loads(BodyDefinition definition, const BodySolverOptions& options) {
+  auto start = std::chrono::steady_clock::now();
+  options_.observer = options.observer;
+  report(SetupStage::assembly);
+  definition_ = std::move(definition);
+  dofs_ = std::make_unique<DofMap>(prescribed_dofs(definition_));
+  full_load_ = assemble_external_load(definition_);
+  reduced_load_ = dofs_->reduce_load(full_stiffness_, full_load_);
+  timings_.assembly_seconds = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+  free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f with the kept factor
+  timings_.factorization_seconds = seconds_since(start);
+  load_factor_ = 1.0;
+  if (compliance_) update_free_trace();
   reset_warm_start();
-  timings_.interface_seconds = seconds_since(start);
 }
 
 void BodySolver::build_interface_operator() {
@@ -256,7 +343,9 @@ void BodySolver::build_interface_operator() {
   }
 }
 
-void BodySolver::reset_warm_start() { warm_start_ = Eigen::VectorXd::Zero(contact_size()); }
+void BodySolver::reset_warm_start() {
+  warm_start_ = Eigen::VectorXd::Zero(contact_size());
+}
 
 void BodySolver::set_load_factor(double factor) {
   if (!std::isfinite(factor) || std::abs(factor) > maximum_load_factor) {

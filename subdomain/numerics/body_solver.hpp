@@ -48,7 +48,7 @@ struct InterfaceDescription {
   /// outward normal is the direction from the first to the second endpoint turned clockwise.
   EdgeType segment_type = EdgeType::line2;
   std::vector<int> segments;
-  int dof_count = 0;                         // free degrees of freedom of the body
+  int dof_count = 0;  // free degrees of freedom of the body
 };
 
 enum class InterfaceOperatorKind {
@@ -115,7 +115,19 @@ class BodySolver {
   /// The nodes of the contact boundary with geometric normals and weights.
   InterfaceDescription contact_boundary() const;
 
-  /// Sets the contact constraint operator B and builds e and F. Resets the warm start.
+  /// Whether `definition` set up with `options` has this body's stiffness factor and contact
+  /// boundary: the same mesh (node coordinates, element blocks, boundary groups: bit for bit),
+  /// material, prescribed degrees of freedom (which ones, not their values), contact boundary
+  /// and factor options. Its name, loads, prescribed values and tags may differ.
+  bool has_same_stiffness(const BodyDefinition& definition, const BodySolverOptions& options) const;
+  /// Takes the name, loads, prescribed values and tags of `definition`, for which
+  /// has_same_stiffness() holds, and keeps the factor of K: f is assembled again and K^{-1} f
+  /// is one solve. Load factor 1, warm start reset. An assigned B stays (e is recomputed), and
+  /// assign_contact() with the same B keeps F. `options` replaces the observer.
+  void replace_loads(BodyDefinition definition, const BodySolverOptions& options);
+
+  /// Sets the contact constraint operator B and builds e and F (F is kept when B equals the
+  /// assigned one, e.g. a later run of the same body). Resets the warm start.
   /// Throws InputError (check_contact_operator) when B is malformed or uses a node that is not
   /// on the contact boundary.
   void assign_contact(const ContactOperator& contact);
@@ -167,6 +179,8 @@ class BodySolver {
   void assemble();
   void report(SetupStage stage) const;
   void build_interface_operator();
+  /// e = B K^{-1} f + B u_p at load factor 1 and at the current one, for the assigned B.
+  void update_free_trace();
   /// Free dofs of the contact boundary nodes, to be eliminated last (empty when disabled).
   std::vector<int> trailing_unknowns() const;
   Eigen::VectorXd apply_transpose_trace(const Eigen::VectorXd& contact_force) const;  // B' lambda
@@ -183,7 +197,7 @@ class BodySolver {
 
   ContactOperator contact_;
   Eigen::VectorXd boundary_weights_;
-  SparseMatrix trace_;  // B on free dofs (n_c x free)
+  SparseMatrix trace_;                // B on free dofs (n_c x free)
   Eigen::VectorXd prescribed_trace_;  // B u_p at load factor 1
   Eigen::VectorXd free_trace_;
   std::unique_ptr<LinearOperator> compliance_;

@@ -20,6 +20,12 @@ void ContactOperator::finish_row(double weight) {
   weights.push_back(weight);
 }
 
+bool operator==(const ContactOperator& left, const ContactOperator& right) {
+  return left.row_offsets == right.row_offsets && left.nodes == right.nodes &&
+         left.components == right.components && left.values == right.values &&
+         left.weights == right.weights;
+}
+
 ContactOperator node_to_node_operator(const std::vector<int>& nodes,
                                       const std::vector<Eigen::Vector2d>& normals,
                                       const std::vector<double>& weights) {

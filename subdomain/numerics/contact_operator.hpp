@@ -30,6 +30,12 @@ struct ContactOperator {
   void finish_row(double weight);
 };
 
+/// Entry by entry equality (the same rows, nodes, components, coefficients and weights).
+bool operator==(const ContactOperator& left, const ContactOperator& right);
+inline bool operator!=(const ContactOperator& left, const ContactOperator& right) {
+  return !(left == right);
+}
+
 /// One row per node: (B u)_i = u(nodes[i]) . normals[i], weight weights[i].
 ContactOperator node_to_node_operator(const std::vector<int>& nodes,
                                       const std::vector<Eigen::Vector2d>& normals,

@@ -389,7 +389,7 @@ void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Enve
       return fill_status(reply);
     case Envelope::kEndRun:
       require_same_run(request, "EndRun");
-      body_.reset();
+      retained_body_ = std::move(body_);  // its factor may serve a later run of the same body
       run_id_.clear();
       interface_nodes_.clear();
       state_ = ServerState::awaiting_setup;
@@ -453,7 +453,12 @@ void SubdomainServer::on_hello(protocol::Envelope& reply) {
 
 void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol::Envelope& reply,
                                     RequestRecord& record) {
-  body_.reset();  // a SetupBody starts a new run, whatever its outcome (and whose the body was)
+  // A SetupBody starts a new run, whatever its outcome (and whose the body was); the previous
+  // body's factor serves it when the stiffness is the same, and is freed before a new one is
+  // computed otherwise.
+  std::unique_ptr<BodySolver> previous = body_ ? std::move(body_) : std::move(retained_body_);
+  body_.reset();
+  retained_body_.reset();
   run_id_.clear();
   interface_nodes_.clear();
   state_ = ServerState::awaiting_setup;
@@ -469,7 +474,15 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;
   const long dof_count = 2L * static_cast<long>(setup.definition.mesh.node_count());
   setup.body.observer = [this, dof_count](SetupStage stage) { begin_stage(stage, dof_count); };
-  auto body = std::make_unique<BodySolver>(std::move(setup.definition), setup.body);
+  const bool reuse = previous && previous->has_same_stiffness(setup.definition, setup.body);
+  std::unique_ptr<BodySolver> body;
+  if (reuse) {
+    previous->replace_loads(std::move(setup.definition), setup.body);
+    body = std::move(previous);
+  } else {
+    previous.reset();
+    body = std::make_unique<BodySolver>(std::move(setup.definition), setup.body);
+  }
   const InterfaceDescription interface = body->contact_boundary();
   protocol::InterfaceDescription& description = *reply.mutable_interface();
   encode_interface(body->name(), body->definition().contact_boundary, interface, description);
@@ -484,6 +497,7 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   record.outcome = "ok, " + std::to_string(body_->mesh().node_count()) + " nodes, " +
                    std::to_string(body_->free_dof_count()) + " free dofs, " +
                    std::to_string(interface_nodes_.size()) + " contact boundary nodes";
+  if (reuse) record.outcome += ", factorization of the previous run reused";
   if (!run_id_.empty()) record.outcome += ", run " + run_id_;
 }
 

@@ -14,8 +14,12 @@
 // Transitions: SetupBody -> awaiting_assignment (the previous body is discarded first, so a
 // failed SetupBody leaves awaiting_setup); AssignContact -> ready (a refused assignment keeps
 // the state and the previous assignment); EndRun -> awaiting_setup; Shutdown -> unchanged, and
-// shutdown_requested() becomes true. The body is factorized once per SetupBody; contact solves
-// warm-start from the previous converged solution of the same assignment.
+// shutdown_requested() becomes true. The body is factorized once per SetupBody, except that a
+// SetupBody whose body has the stiffness of the previous one (same mesh, material, prescribed
+// degrees of freedom, contact boundary; loads and prescribed values may differ), also after
+// EndRun, keeps that factor (and, when AssignContact brings the same B, F): a sweep over loads
+// or a repeated run skips the factorization. Contact solves warm-start from the previous
+// converged solution of the same assignment.
 //
 // Runs (protocol 1.2 and later, Envelope.run_id): a successful SetupBody records its request's
 // run_id with the body (any previous body is discarded whichever run it belonged to: a new run may
@@ -192,6 +196,10 @@ class SubdomainServer {
   ServerState state_ = ServerState::awaiting_setup;
   bool shutdown_requested_ = false;
   std::unique_ptr<BodySolver> body_;
+  /// The body of the last run after EndRun (state awaiting_setup): a SetupBody of a body with
+  /// the same stiffness (BodySolver::has_same_stiffness) takes its factor instead of computing
+  /// one; any other SetupBody frees it first.
+  std::unique_ptr<BodySolver> retained_body_;
   std::string run_id_;  // run_id of the SetupBody that set up body_; "" without body or run_id
   std::vector<int> interface_nodes_;  // the contact boundary's node ids, ascending
   MprgpParameters qp_parameters_;

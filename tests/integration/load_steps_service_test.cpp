@@ -30,6 +30,7 @@ namespace {
 
 using testing::example;
 using testing::ProcessOutcome;
+using testing::read_csv;
 using testing::run_tool;
 using testing::TemporaryDirectory;
 
@@ -38,26 +39,6 @@ double exact_patch_pressure() {
   const double lower = 0.5 * (1.0 - 0.3 * 0.3) / 1000.0;
   const double upper = 0.4 * (1.0 - 0.25 * 0.25) / 400.0;
   return 0.01 / (lower + upper);
-}
-
-/// The columns of a CSV file by header name.
-std::map<std::string, std::vector<std::string>> read_csv(const std::filesystem::path& path) {
-  std::ifstream file(path);
-  std::map<std::string, std::vector<std::string>> columns;
-  std::vector<std::string> names;
-  std::string line;
-  for (bool header = true; std::getline(file, line); header = false) {
-    std::stringstream row(line);
-    std::string cell;
-    for (std::size_t k = 0; std::getline(row, cell, ','); ++k) {
-      if (header) {
-        names.push_back(cell);
-      } else if (k < names.size()) {
-        columns[names[k]].push_back(cell);
-      }
-    }
-  }
-  return columns;
 }
 
 std::vector<double> numbers(const std::vector<std::string>& cells) {

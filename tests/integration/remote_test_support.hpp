@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -87,6 +89,26 @@ inline ProcessOutcome run_tool(const std::string& executable,
   std::ifstream file(options.log_file);
   outcome.errors.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
   return outcome;
+}
+
+/// The columns of a CSV file (history.csv, contact.csv, steps.csv) by header name.
+inline std::map<std::string, std::vector<std::string>> read_csv(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  std::map<std::string, std::vector<std::string>> columns;
+  std::vector<std::string> names;
+  std::string line;
+  for (bool header = true; std::getline(file, line); header = false) {
+    std::stringstream row(line);
+    std::string cell;
+    for (std::size_t k = 0; std::getline(row, cell, ','); ++k) {
+      if (header) {
+        names.push_back(cell);
+      } else if (k < names.size()) {
+        columns[names[k]].push_back(cell);
+      }
+    }
+  }
+  return columns;
 }
 
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
