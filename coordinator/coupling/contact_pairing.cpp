@@ -64,6 +64,23 @@ std::string describe_node(const std::string& body, std::size_t tag, const Eigen:
          format_point(point);
 }
 
+/// Throws InputError when the outward normals of paired nodes do not oppose each other
+/// (n1 . n2 >= 0): the bodies would lie on the same side of the contact boundary, and the pair's
+/// normal n1 - n2 would be meaningless.
+void require_facing(const InterfaceDescription& body1, std::size_t i, const std::string& name1,
+                    const InterfaceDescription& body2, std::size_t j, const std::string& name2) {
+  if (body1.normals[i].dot(body2.normals[j]) < 0.0) return;
+  throw InputError("contact pairing: the contact boundaries of bodies '" + name1 + "' and '" +
+                   name2 + "' do not face each other: their outward normals point the same way (" +
+                   describe_node(name1, body1.node_tags[i], body1.coordinates[i]) +
+                   " has the outward normal " + format_point(body1.normals[i]) +
+                   " and its partner, " +
+                   describe_node(name2, body2.node_tags[j], body2.coordinates[j]) +
+                   ", the outward normal " + format_point(body2.normals[j]) +
+                   "); each contact boundary must be the side of its body that touches the other "
+                   "body: check which side of each body the contact boundary is on");
+}
+
 }  // namespace
 
 std::string overlap_warning(const ContactPairing& pairing) {
@@ -196,6 +213,7 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
           " (node-to-node pairing needs matching meshes: use [contact] method = \"mortar\" or "
           "\"auto\" for non-matching ones)");
     }
+    require_facing(body1, i, name1, body2, static_cast<std::size_t>(j), name2);
     partner_of_second[j] = static_cast<int>(i);
     ContactPair pair;
     pair.node1 = body1.node_ids[i];

@@ -2,12 +2,16 @@
 // moved away from the lower one (its contact edge faces nothing), and an upper block whose
 // "contact" edge is its top (its outward normal points the same way as the lower block's). Each
 // is a clear error naming the case file and both bodies, exit status 1, for robin-monolithic and
-// robin-run alike; never a run that converges to a wrong answer.
+// robin-run alike; never a run that converges to a wrong answer. The same for node-to-node
+// pairing of matching contact edges whose outward normals point the same way.
 
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 #include <regex>
+#include <string>
+#include <vector>
 
 #include "remote_test_support.hpp"
 
@@ -52,13 +56,20 @@ std::string rectangle_geo(double x0, double y0, int contact_edge) {
   return geo.str();
 }
 
-void expect_refused(const std::string& upper_geo, const std::string& reason) {
+/// robin-monolithic and robin-run on the case `write` makes in a fresh directory, with
+/// `arguments` added, exit with status 1 saying the two bodies do not face each other for
+/// `reason`, and name the case file.
+void expect_not_facing(
+    const std::function<std::filesystem::path(const std::filesystem::path&)>& write,
+    const std::vector<std::string>& arguments, const std::string& reason) {
   for (const std::string tool : {"robin-monolithic", "robin-run"}) {
     const TemporaryDirectory directory("mortar-bad-input");
-    const std::filesystem::path case_file = write_case(directory.path(), upper_geo);
-    const testing::ProcessOutcome outcome = testing::run_tool(
-        tool, {case_file.string(), "--output", (directory.path() / "out").string()},
-        directory.path(), 120.0);
+    const std::filesystem::path case_file = write(directory.path());
+    std::vector<std::string> command = {case_file.string(), "--output",
+                                        (directory.path() / "out").string()};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    const testing::ProcessOutcome outcome =
+        testing::run_tool(tool, command, directory.path(), 120.0);
     EXPECT_EQ(outcome.exit, "exited with status 1") << tool << ": " << outcome.errors;
     const std::string expected =
         "the contact boundaries of bodies 'lower' and 'upper' do not face each other: " + reason;
@@ -68,6 +79,14 @@ void expect_refused(const std::string& upper_geo, const std::string& reason) {
   }
 }
 
+void expect_refused(const std::string& upper_geo, const std::string& reason) {
+  expect_not_facing(
+      [&upper_geo](const std::filesystem::path& directory) {
+        return write_case(directory, upper_geo);
+      },
+      {}, reason);
+}
+
 TEST(MortarBadInput, ContactBoundariesFarApartAreAnErrorNamingBothBodies) {
   expect_refused(rectangle_geo(5.0, 0.0, 1), "no point of one projects onto the other");
 }
@@ -75,6 +94,23 @@ TEST(MortarBadInput, ContactBoundariesFarApartAreAnErrorNamingBothBodies) {
 TEST(MortarBadInput, ContactBoundariesWhoseNormalsPointTheSameWayAreAnError) {
   // The upper block's "contact" curve is its top edge at y = 0.4: outward +y, like the lower one's.
   expect_refused(rectangle_geo(0.0, 0.0, 3), "their outward normals point the same way");
+}
+
+TEST(MortarBadInput, NodeToNodePairsWhoseNormalsPointTheSameWayAreAnError) {
+  // examples/two_blocks.toml with the upper body meshed like the lower one: the same nodes on
+  // the contact edge y = 0 (so node-to-node pairs them all), but both outward normals are +y.
+  const auto copy_two_blocks = [](const std::filesystem::path& directory) {
+    std::ifstream original(example("two_blocks.toml"));
+    std::string text((std::istreambuf_iterator<char>(original)), std::istreambuf_iterator<char>());
+    text = std::regex_replace(text, std::regex("meshes/"), example("meshes").string() + "/");
+    std::ofstream(directory / "case.toml") << text;
+    return directory / "case.toml";
+  };
+  expect_not_facing(
+      copy_two_blocks,
+      {"--set", "body[2].mesh=\"" + example("meshes/block_lower.geo").string() + "\"", "--set",
+       "body[2].dirichlet[1].boundary=\"bottom\"", "--set", "contact.method=\"node-to-node\""},
+      "their outward normals point the same way (body 'lower' contact node (tag ");
 }
 
 }  // namespace

@@ -80,6 +80,27 @@ TEST(ContactPairing, NonMatchingMeshesNameTheFirstUnmatchedNode) {
   }
 }
 
+TEST(ContactPairing, MatchingNodesWhoseNormalsPointTheSameWayAreAnError) {
+  // Both outward normals +y: the second body lies below the shared edge like the first.
+  const InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  const InterfaceDescription overlapping = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
+  try {
+    pair_contact_nodes(lower, "lower", overlapping, "upper", nullptr, 1e-6);
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("the contact boundaries of bodies 'lower' and 'upper' do not face "
+                           "each other: their outward normals point the same way"),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("body 'lower' contact node (tag 100) at (0, 0) has the outward normal "
+                           "(0, 1) and its partner, body 'upper' contact node (tag 100) at (0, 0), "
+                           "the outward normal (0, 1)"),
+              std::string::npos)
+        << message;
+  }
+}
+
 TEST(ContactPairing, ExtraNodeOnTheSecondBodyIsNamed) {
   const InterfaceDescription lower = flat_interface({0.0, 1.0}, 0.0, 1.0);
   const InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
