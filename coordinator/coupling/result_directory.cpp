@@ -90,6 +90,15 @@ bool belongs_to_a_run(const std::string& name, const std::set<std::string>& list
          name.rfind(staging_prefix, 0) == 0;
 }
 
+/// The file's SHA-256, or "" when it cannot be read (recorded as null).
+std::string sha256_if_readable(const fs::path& path) {
+  try {
+    return file_sha256(path);
+  } catch (const std::runtime_error&) {
+    return "";
+  }
+}
+
 std::string describe_entries(const std::vector<std::string>& names) {
   std::ostringstream text;
   for (std::size_t k = 0; k < names.size() && k < 5; ++k) text << (k ? ", " : "") << names[k];
@@ -175,7 +184,7 @@ ResultDirectory::ResultDirectory(fs::path directory, ExistingResults policy, std
     : directory_(std::move(directory)),
       tool_(std::move(tool)),
       case_file_(case_file.string()),
-      case_sha256_(file_sha256(case_file)),
+      case_sha256_(sha256_if_readable(case_file)),
       run_id_(random_run_id()),
       started_(utc_timestamp()) {
   // robin-run's server logs are written before the run starts: they are this run's
@@ -217,10 +226,14 @@ nlohmann::json ResultDirectory::record(const std::string& status) const {
   const std::string protocol =
       std::to_string(protocol::protocol_major) + "." + std::to_string(protocol::protocol_minor);
   nlohmann::json document = {
-      {"status", status},    {"versions", {{"product", product_version}, {"protocol", protocol}}},
-      {"run_id", run_id_},   {"tool", tool_},
-      {"case", case_file_},  {"case_sha256", case_sha256_},
-      {"started", started_}, {"ended", nullptr}};
+      {"status", status},
+      {"versions", {{"product", product_version}, {"protocol", protocol}}},
+      {"run_id", run_id_},
+      {"tool", tool_},
+      {"case", case_file_},
+      {"case_sha256", case_sha256_.empty() ? nlohmann::json() : nlohmann::json(case_sha256_)},
+      {"started", started_},
+      {"ended", nullptr}};
   for (const auto& [key, value] : additions_.items()) document[key] = value;
   return document;
 }
@@ -274,6 +287,12 @@ void ResultDirectory::fail(RunFailure failure, const std::string& message) noexc
   } catch (...) {
     // the directory is gone or read-only: nothing more can be recorded
   }
+}
+
+void record_failed_start(const fs::path& directory, ExistingResults policy, const std::string& tool,
+                         const fs::path& case_file, const std::string& message) {
+  ResultDirectory results(directory, policy, tool, case_file);
+  results.fail(RunFailure::failed, message);
 }
 
 void ResultDirectory::remove_staging() noexcept {

@@ -4,7 +4,9 @@
 //
 // Life of a directory:
 //   1. check_result_directory (at command-line time): a directory holding files is refused
-//      unless the user asked to overwrite.
+//      unless the user asked to overwrite. Overwriting removes an earlier run's files, its
+//      staging areas and the temporary files of an atomic write a kill interrupted
+//      (".summary.json.tmp-PID-N").
 //   2. ResultDirectory's constructor removes the previous run's files (the names in its
 //      summary.json "files" list and the names every run writes; anything else is left alone
 //      and listed by leftover_files()), then writes summary.json with status "running", the run
@@ -16,7 +18,8 @@
 //      "failed" or "interrupted" and the message instead, and removes the staged files.
 //   5. A coupled run keeps checkpoint.json (checkpoint.hpp) in the directory while it runs;
 //      commit() removes it after summary.json, fail() keeps it: the run can be resumed.
-// A run killed before commit() leaves summary.json saying "running" with its start time.
+// A run killed before commit() leaves summary.json saying "running" with its start time. A run
+// whose case file cannot be read records that with record_failed_start.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -59,6 +62,7 @@ class ResultDirectory {
  public:
   /// Prepares `directory` for a run of `tool` on `case_file` (see the file comment). Throws
   /// ResultDirectoryError when it holds files and `policy` is refuse, or cannot be written.
+  /// A case file that cannot be read is recorded with case_sha256 null.
   ResultDirectory(std::filesystem::path directory, ExistingResults policy, std::string tool,
                   const std::filesystem::path& case_file);
   ~ResultDirectory();
@@ -100,6 +104,15 @@ class ResultDirectory {
   nlohmann::json additions_ = nlohmann::json::object();  // add_to_record
   bool finished_ = false;
 };
+
+/// Records a run that failed before it could start, at the case file (a TOML syntax error, an
+/// unknown key, a bad --set): prepares `directory` as ResultDirectory's constructor does under
+/// `policy` and writes summary.json with status "failed", `tool`, the case file's path, its
+/// SHA-256 (null when the file cannot be read) and `message`. Throws ResultDirectoryError when
+/// the directory cannot be used (then nothing is recorded).
+void record_failed_start(const std::filesystem::path& directory, ExistingResults policy,
+                         const std::string& tool, const std::filesystem::path& case_file,
+                         const std::string& message);
 
 /// Writes `text` to `path` atomically: a temporary file in the same directory, flushed, then
 /// renamed over `path`. Throws std::runtime_error naming `path`.

@@ -359,6 +359,22 @@ std::string progress_line(const IterationRecord& record, const CouplingOptions& 
       record.acceleration_state);
 }
 
+namespace {
+
+/// summary.json "failed" naming the case file's error; nothing when the directory is unusable.
+void record_unusable_case(const CoordinatorSettings& settings, const std::string& message) {
+  try {
+    record_failed_start(settings.output_directory,
+                        settings.overwrite ? ExistingResults::overwrite : ExistingResults::refuse,
+                        settings.tool, settings.case_file,
+                        in_case_file(settings.case_file, message));
+  } catch (const std::exception&) {
+    // the output directory cannot be used: the error was logged, there is nowhere to record it
+  }
+}
+
+}  // namespace
+
 std::optional<CaseDefinition> load_case(CoordinatorSettings& settings) {
   try {
     if (!settings.resume_directory.empty()) {
@@ -369,6 +385,7 @@ std::optional<CaseDefinition> load_case(CoordinatorSettings& settings) {
     return definition;
   } catch (const std::exception& error) {
     coordinator_logger()->error("{}", error.what());
+    if (settings.resume_directory.empty()) record_unusable_case(settings, error.what());
     return std::nullopt;
   }
 }
@@ -426,8 +443,8 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
                                                       : ExistingResults::refuse;
   RunCheckpoint checkpoint;
   try {
-    results = std::make_unique<ResultDirectory>(settings.output_directory, policy,
-                                                "robin-coordinator", definition.file);
+    results = std::make_unique<ResultDirectory>(settings.output_directory, policy, settings.tool,
+                                                definition.file);
     if (settings.resume) record_resume(*results, *settings.resume, *log);
     checkpoint = checkpoint_identity(definition, settings, *results);
   } catch (const std::exception& error) {

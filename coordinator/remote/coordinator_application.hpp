@@ -30,6 +30,8 @@ namespace robin {
 
 /// The command line shared by both executables. Unset options keep the case file's values.
 struct CoordinatorSettings {
+  /// The program, as summary.json records it ("robin-run" or "robin-coordinator").
+  std::string tool = "robin-coordinator";
   std::filesystem::path case_file;
   std::filesystem::path output_directory;
   bool overwrite = false;  // --overwrite: replace an earlier run's results (result_directory.hpp)
@@ -95,8 +97,11 @@ std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level
 std::string progress_line(const IterationRecord& record, const CouplingOptions& options);
 
 /// Reads the case file; logs the error (an InputError naming file, line and field) and returns
-/// nullopt when it is unusable. With --resume, first reads the checkpoint and completes
-/// `settings` from it (run_resume.hpp), logging why a resume is refused.
+/// nullopt when it is unusable, after recording the failure in the output directory's
+/// summary.json (result_directory.hpp, record_failed_start; not when the directory cannot be
+/// used). With --resume, first reads the checkpoint and completes `settings` from it
+/// (run_resume.hpp), logging why a resume is refused; a refused resume leaves the directory
+/// as the interrupted run left it.
 std::optional<CaseDefinition> load_case(CoordinatorSettings& settings);
 
 /// Runs the case against the servers at `endpoints` (the first gets body 1), writes the result

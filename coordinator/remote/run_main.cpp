@@ -128,6 +128,7 @@ int main(int argc, char** argv) {
       "robin-run: solve a two-body contact case by Robin domain decomposition, with two local "
       "robin-subdomain servers"};
   robin::CoordinatorSettings settings;
+  settings.tool = "robin-run";
   robin::add_coordinator_options(app, settings);
   robin::add_version_option(app, "robin-run");
   bool curve = false;

@@ -2,7 +2,8 @@
 // The single-process reference solver of the whole two-body contact problem (paper (5)).
 // Exit codes: 0 converged (or --help, --version); 1 bad input or failure (also: a Dirichlet
 // condition drives an excluded contact pair into penetration; the results are written); 2 bad
-// command line; 3 the contact QP did not converge (the results are written).
+// command line; 3 the contact QP did not converge (the results are written); 130 / 143 stopped
+// by SIGINT / SIGTERM (summary.json then says "interrupted").
 
 #include <fmt/ranges.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -10,6 +11,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,8 @@
 #include "coupling/robin_iteration.hpp"
 #include "coupling/step_outputs.hpp"
 #include "numerics/errors.hpp"
+#include "remote/run_interruption.hpp"
+#include "remote/stop_signal_watcher.hpp"
 
 namespace {
 
@@ -105,14 +109,64 @@ void write_outputs(const std::filesystem::path& directory, const LocalProblem& p
 int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
                     std::chrono::steady_clock::time_point start);
 
+/// The result directory in which a stop signal records "interrupted" (on_stop_signal): set
+/// while the run computes; null before, and once its files are committed or its failure
+/// recorded. The main thread holds the mutex while it commits.
+struct ActiveResults {
+  std::mutex mutex;
+  robin::ResultDirectory* results = nullptr;
+};
+
+ActiveResults& active_results() {
+  static ActiveResults active;
+  return active;
+}
+
+/// StopSignalWatcher's handler: records the interruption (unless the results are complete),
+/// logs it and ends the process with 128 + signal.
+void on_stop_signal(int signal_number) {
+  ActiveResults& active = active_results();
+  const std::lock_guard<std::mutex> lock(active.mutex);  // waits for a commit under way
+  const std::string message = robin::RunInterrupted(signal_number).what();
+  if (active.results != nullptr) active.results->fail(robin::RunFailure::interrupted, message);
+  if (auto log = spdlog::get("monolithic")) {
+    log->warn("{}", message);
+    log->flush();
+  }
+  robin::end_interrupted_process(signal_number);
+}
+
+/// Reads the case file; when it is unusable, records that in the output directory (unless the
+/// directory itself is unusable) and rethrows.
+robin::CaseDefinition read_case(const std::filesystem::path& case_path,
+                                const std::vector<std::string>& overrides,
+                                const std::filesystem::path& output,
+                                robin::ExistingResults existing) {
+  try {
+    return robin::read_case_file(case_path, overrides);
+  } catch (const std::exception& error) {
+    try {
+      robin::record_failed_start(output, existing, "robin-monolithic", case_path,
+                                 robin::in_case_file(case_path, error.what()));
+    } catch (const std::exception&) {
+      // the output directory cannot be used: the error is logged by main
+    }
+    throw;
+  }
+}
+
 /// Reads the case, prepares the result directory and solves; a failure after the directory was
 /// prepared is recorded in its summary.json.
 int run(const std::filesystem::path& case_path, const std::vector<std::string>& overrides,
         const std::filesystem::path& output, robin::ExistingResults existing) {
   auto log = spdlog::get("monolithic");
   const auto start = std::chrono::steady_clock::now();
-  const robin::CaseDefinition definition = robin::read_case_file(case_path, overrides);
+  const robin::CaseDefinition definition = read_case(case_path, overrides, output, existing);
   robin::ResultDirectory results(output, existing, "robin-monolithic", case_path);
+  {
+    const std::lock_guard<std::mutex> lock(active_results().mutex);
+    active_results().results = &results;
+  }
   if (!results.leftover_files().empty()) {
     log->warn("the output directory {} also holds files that are not results of a run: {}",
               output.string(), fmt::join(results.leftover_files(), ", "));
@@ -120,6 +174,8 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
   try {
     return solve_and_write(definition, results, start);
   } catch (const std::exception& error) {
+    const std::lock_guard<std::mutex> lock(active_results().mutex);
+    active_results().results = nullptr;
     results.fail(robin::RunFailure::failed, robin::in_case_file(case_path, error.what()));
     throw;
   }
@@ -172,9 +228,14 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
   const robin::ExcludedPairClearance clearance = excluded_pair_clearance(problem, result);
   summary["excluded_pair_penetration"] = clearance.relative_penetration;
   if (!steps.empty()) summary["load_steps"] = robin::monolithic_steps_json(problem, steps);
-  write_outputs(results.staging(), problem, result);
-  if (!steps.empty()) robin::write_monolithic_step_outputs(results.staging(), problem, steps);
-  results.commit(summary);
+  {
+    // a stop signal now waits for the complete results
+    const std::lock_guard<std::mutex> lock(active_results().mutex);
+    write_outputs(results.staging(), problem, result);
+    if (!steps.empty()) robin::write_monolithic_step_outputs(results.staging(), problem, steps);
+    results.commit(summary);
+    active_results().results = nullptr;
+  }
   log->info("results in {} (open solution.pvd in ParaView)", results.directory().string());
   if (result.qp.status != robin::QpStatus::converged) {
     log->error("the contact QP did not converge: {}", result.qp.message);
@@ -223,6 +284,8 @@ int main(int argc, char** argv) {
   auto log = spdlog::stderr_color_mt("monolithic");
   log->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%^%l%$] %v");
   log->set_level(spdlog::level::from_str(quiet ? "warn" : level));
+  robin::install_stop_signal_handlers();
+  const robin::StopSignalWatcher watcher(on_stop_signal);
   try {
     return run(case_path, overrides, output,
                overwrite ? robin::ExistingResults::overwrite : robin::ExistingResults::refuse);

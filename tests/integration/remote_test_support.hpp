@@ -5,14 +5,22 @@
 #include <unistd.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iostream>
 #include <iterator>
 #include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "../test_files.hpp"
@@ -113,6 +121,108 @@ inline std::map<std::string, std::vector<std::string>> read_csv(const std::files
 
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// ---- Tools run in the background, their result directories ----------------------------
+
+inline std::string read_text(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+inline bool wait_until(const std::function<bool()>& condition, double seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  while (!condition()) {
+    if (testing::seconds_since(start) > seconds) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return true;
+}
+
+/// examples/`name` copied into `directory` with absolute mesh paths and the mesh size
+/// `mesh_size` for both bodies.
+inline std::filesystem::path case_copy(const std::filesystem::path& directory, double mesh_size,
+                                       const std::string& name = "asymmetric.toml") {
+  std::string text = std::regex_replace(read_text(example(name)), std::regex("meshes/"),
+                                        example("meshes").string() + "/");
+  std::ostringstream size;
+  size << "mesh_size = " << mesh_size;
+  text = std::regex_replace(text, std::regex("mesh_size = 0\\.1"), size.str());
+  const std::filesystem::path path = directory / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+/// A table of numbers read from a CSV file with a header row; `skipped` columns left out.
+inline std::vector<std::vector<double>> csv_values(const std::filesystem::path& path,
+                                                   const std::string& skipped = "") {
+  std::ifstream file(path);
+  std::string line;
+  std::getline(file, line);
+  std::vector<bool> keep;
+  std::istringstream header(line);
+  for (std::string name; std::getline(header, name, ',');) keep.push_back(name != skipped);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(file, line)) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    std::size_t column = 0;
+    for (std::string cell; std::getline(cells, cell, ','); ++column) {
+      if (column < keep.size() && keep[column]) row.push_back(cell.empty() ? 0.0 : std::stod(cell));
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+/// Every value of `actual` within `relative` (of the largest magnitude of its column) of
+/// `expected`, with the same shape; prints the largest relative difference.
+inline void expect_same_table(const std::vector<std::vector<double>>& actual,
+                              const std::vector<std::vector<double>>& expected, double relative,
+                              const std::string& what) {
+  ASSERT_EQ(actual.size(), expected.size()) << what << ": rows";
+  ASSERT_FALSE(expected.empty()) << what;
+  std::vector<double> scale(expected[0].size(), 1e-300);
+  for (const auto& row : expected) {
+    for (std::size_t k = 0; k < row.size() && k < scale.size(); ++k) {
+      scale[k] = std::max(scale[k], std::abs(row[k]));
+    }
+  }
+  double worst = 0.0;
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    ASSERT_EQ(actual[i].size(), expected[i].size()) << what << ": row " << i;
+    for (std::size_t k = 0; k < expected[i].size(); ++k) {
+      worst = std::max(worst, std::abs(actual[i][k] - expected[i][k]) / scale[k]);
+    }
+  }
+  std::cout << what << ": largest relative difference " << worst << "\n";
+  EXPECT_LE(worst, relative) << what;
+}
+
+inline nlohmann::json read_summary(const std::filesystem::path& directory) {
+  std::ifstream file(directory / "summary.json");
+  return file.good() ? nlohmann::json::parse(file, nullptr, false) : nlohmann::json::object();
+}
+
+/// A tool started in the background, its standard error in `log`.
+inline std::unique_ptr<ChildProcess> start_tool(const std::string& tool,
+                                                const std::vector<std::string>& arguments,
+                                                const std::filesystem::path& log) {
+  ChildProcessOptions options;
+  options.executable = testing::tool(tool);
+  options.arguments = arguments;
+  options.log_file = log;
+  return std::make_unique<ChildProcess>(options);
+}
+
+/// Runs a tool to its end (at most 120 s); returns its exit description.
+inline std::string run_to_end(const std::string& tool, const std::vector<std::string>& arguments,
+                              const std::filesystem::path& log) {
+  const auto process = start_tool(tool, arguments, log);
+  while (process->read_line(ChildProcess::Clock::now() + std::chrono::seconds(120))) {
+  }
+  EXPECT_TRUE(process->wait_for_exit(120.0)) << tool << " did not finish";
+  return process->exit_description();
 }
 
 }  // namespace robin::testing

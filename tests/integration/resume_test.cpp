@@ -9,6 +9,10 @@
 //  - a robin-subdomain killed with SIGKILL during setup, during the iterations and during the
 //    fields: robin-run restarts it (logging server, body, step and "restart 1 of 2"), and
 //    contact.csv and history.csv equal the uninterrupted run's (1e-10 and 1e-12 relative);
+//  - robin-coordinator killed with SIGKILL mid-iteration against two long-running servers,
+//    then `robin-coordinator --resume DIR` against the same servers: history.csv (but the wall
+//    time) and contact.csv equal those of an uninterrupted robin-coordinator run against the
+//    same servers (1e-12 relative);
 //  - robin-coordinator against servers started by the test: one is killed mid-iteration and
 //    started again at the same endpoint within --server-grace-period; the run carries on to
 //    the same contact.csv;
@@ -37,108 +41,16 @@
 namespace robin {
 namespace {
 
+using testing::case_copy;
+using testing::csv_values;
 using testing::example;
+using testing::expect_same_table;
+using testing::read_summary;
+using testing::read_text;
+using testing::run_to_end;
+using testing::start_tool;
 using testing::TemporaryDirectory;
-
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream file(path);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-}
-
-bool wait_until(const std::function<bool()>& condition, double seconds) {
-  const auto start = std::chrono::steady_clock::now();
-  while (!condition()) {
-    if (testing::seconds_since(start) > seconds) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  return true;
-}
-
-/// examples/`name` copied into `directory` with absolute mesh paths and the mesh size
-/// `mesh_size` for both bodies.
-std::filesystem::path case_copy(const std::filesystem::path& directory, double mesh_size,
-                                const std::string& name = "asymmetric.toml") {
-  std::string text = std::regex_replace(read_text(example(name)), std::regex("meshes/"),
-                                        example("meshes").string() + "/");
-  std::ostringstream size;
-  size << "mesh_size = " << mesh_size;
-  text = std::regex_replace(text, std::regex("mesh_size = 0\\.1"), size.str());
-  const std::filesystem::path path = directory / name;
-  std::ofstream(path) << text;
-  return path;
-}
-
-/// A table of numbers read from a CSV file with a header row; `skipped` columns left out.
-std::vector<std::vector<double>> csv_values(const std::filesystem::path& path,
-                                            const std::string& skipped = "") {
-  std::ifstream file(path);
-  std::string line;
-  std::getline(file, line);
-  std::vector<bool> keep;
-  std::istringstream header(line);
-  for (std::string name; std::getline(header, name, ',');) keep.push_back(name != skipped);
-  std::vector<std::vector<double>> rows;
-  while (std::getline(file, line)) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    std::size_t column = 0;
-    for (std::string cell; std::getline(cells, cell, ','); ++column) {
-      if (column < keep.size() && keep[column]) row.push_back(cell.empty() ? 0.0 : std::stod(cell));
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-/// Every value of `actual` within `relative` (of the largest magnitude of its column) of
-/// `expected`, with the same shape; prints the largest relative difference.
-void expect_same_table(const std::vector<std::vector<double>>& actual,
-                       const std::vector<std::vector<double>>& expected, double relative,
-                       const std::string& what) {
-  ASSERT_EQ(actual.size(), expected.size()) << what << ": rows";
-  ASSERT_FALSE(expected.empty()) << what;
-  std::vector<double> scale(expected[0].size(), 1e-300);
-  for (const auto& row : expected) {
-    for (std::size_t k = 0; k < row.size() && k < scale.size(); ++k) {
-      scale[k] = std::max(scale[k], std::abs(row[k]));
-    }
-  }
-  double worst = 0.0;
-  for (std::size_t i = 0; i < expected.size(); ++i) {
-    ASSERT_EQ(actual[i].size(), expected[i].size()) << what << ": row " << i;
-    for (std::size_t k = 0; k < expected[i].size(); ++k) {
-      worst = std::max(worst, std::abs(actual[i][k] - expected[i][k]) / scale[k]);
-    }
-  }
-  std::cout << what << ": largest relative difference " << worst << "\n";
-  EXPECT_LE(worst, relative) << what;
-}
-
-nlohmann::json read_summary(const std::filesystem::path& directory) {
-  std::ifstream file(directory / "summary.json");
-  return file.good() ? nlohmann::json::parse(file, nullptr, false) : nlohmann::json::object();
-}
-
-/// A tool started in the background, its standard error in `log`.
-std::unique_ptr<ChildProcess> start_tool(const std::string& tool,
-                                         const std::vector<std::string>& arguments,
-                                         const std::filesystem::path& log) {
-  ChildProcessOptions options;
-  options.executable = testing::tool(tool);
-  options.arguments = arguments;
-  options.log_file = log;
-  return std::make_unique<ChildProcess>(options);
-}
-
-/// Runs a tool to its end (at most 120 s); returns its exit description.
-std::string run_to_end(const std::string& tool, const std::vector<std::string>& arguments,
-                       const std::filesystem::path& log) {
-  const auto process = start_tool(tool, arguments, log);
-  while (process->read_line(ChildProcess::Clock::now() + std::chrono::seconds(120))) {
-  }
-  EXPECT_TRUE(process->wait_for_exit(120.0)) << tool << " did not finish";
-  return process->exit_description();
-}
+using testing::wait_until;
 
 const std::vector<std::string> joint_stopping = {"--stopping", "joint"};
 
@@ -226,6 +138,69 @@ TEST(Resume, KilledCoordinatorResumesToTheSameHistoryAndAnswer) {
   EXPECT_EQ(summary["resumed_from"].value("run_id", ""), checkpoint.value("run_id", "x"));
   EXPECT_FALSE(std::filesystem::exists(output / "checkpoint.json"));
   EXPECT_FALSE(std::filesystem::exists(output / "checkpoint-iterates.bin"));
+}
+
+TEST(Resume, KilledRobinCoordinatorResumesAgainstTheSameServers) {
+  ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
+  const TemporaryDirectory directory("robin-coordinator-resume");
+  const std::filesystem::path case_file = case_copy(directory.path(), 0.05);
+  // Two long-running servers, used by every run of this test.
+  std::array<std::unique_ptr<SubdomainServer>, 2> servers;
+  std::vector<std::string> endpoints;
+  for (int index = 0; index < 2; ++index) {
+    servers[index] = std::make_unique<SubdomainServer>(
+        index == 0 ? "block" : "cantilever", testing::server_options(directory.path() / "logs"));
+    servers[index]->await_listening();
+    endpoints.insert(endpoints.end(), {"--subdomain", servers[index]->endpoint()});
+  }
+  const auto coordinator_arguments = [&](const std::filesystem::path& output) {
+    return with(with({case_file.string(), "--output", output.string()}, endpoints), joint_stopping);
+  };
+  // The oracle: the uninterrupted run against the same servers.
+  const std::filesystem::path reference = directory.path() / "reference";
+  EXPECT_EQ(run_to_end("robin-coordinator", coordinator_arguments(reference),
+                       directory.path() / "reference.stderr"),
+            "exited with status 0")
+      << read_text(directory.path() / "reference.stderr");
+
+  const std::filesystem::path output = directory.path() / "resumed";
+  const std::filesystem::path killed_log = directory.path() / "killed.stderr";
+  const auto run = start_tool("robin-coordinator", coordinator_arguments(output), killed_log);
+  ASSERT_TRUE(wait_until(
+      [&] { return read_text(killed_log).find("iteration 10:") != std::string::npos; }, 60.0))
+      << read_text(killed_log);
+  ASSERT_EQ(kill(run->pid(), SIGKILL), 0);
+  ASSERT_TRUE(run->wait_for_exit(10.0));
+  ASSERT_EQ(run->exit_description(), "was killed by signal 9 (Killed)");
+  EXPECT_EQ(read_summary(output).value("status", ""), "running");
+  std::ifstream checkpoint_file(output / "checkpoint.json");
+  const nlohmann::json checkpoint = nlohmann::json::parse(checkpoint_file, nullptr, false);
+  ASSERT_TRUE(checkpoint.is_object()) << "no checkpoint.json";
+  const int checkpointed = checkpoint["loop"]["iteration"].get<int>();
+  std::cout << "robin-coordinator killed after the checkpoint of iteration " << checkpointed
+            << "\n";
+  EXPECT_GE(checkpointed, 10);
+
+  const std::filesystem::path resume_log = directory.path() / "resume.stderr";
+  EXPECT_EQ(
+      run_to_end("robin-coordinator", with({"--resume", output.string()}, endpoints), resume_log),
+      "exited with status 0")
+      << read_text(resume_log);
+  EXPECT_NE(read_text(resume_log)
+                .find("continuing the iteration after iteration " + std::to_string(checkpointed)),
+            std::string::npos)
+      << read_text(resume_log);
+  expect_same_table(csv_values(output / "history.csv", "seconds"),
+                    csv_values(reference / "history.csv", "seconds"), 1e-12,
+                    "robin-coordinator history.csv");
+  expect_same_table(csv_values(output / "contact.csv"), csv_values(reference / "contact.csv"),
+                    1e-12, "robin-coordinator contact.csv");
+  const nlohmann::json summary = read_summary(output);
+  EXPECT_EQ(summary.value("status", ""), "converged");
+  EXPECT_EQ(summary.value("tool", ""), "robin-coordinator");
+  EXPECT_EQ(summary["resumed_from"].value("iteration", 0), checkpointed);
+  EXPECT_FALSE(std::filesystem::exists(output / "checkpoint.json"));
+  for (const auto& server : servers) EXPECT_FALSE(server->exited_within(0.0)) << "a server stopped";
 }
 
 // ---- Lost servers -------------------------------------------------------------------------

@@ -7,7 +7,12 @@
 //    .vtu files, staging areas) and leaves any other file, listed as a leftover, and logs/;
 //  - commit moves the staged files into place and lists them in summary.json, written last;
 //  - fail records "failed" or "interrupted" with the message and removes the staged files, so
-//    that an earlier run's "converged" never stays in view.
+//    that an earlier run's "converged" never stays in view;
+//  - overwriting removes the temporary files a killed atomic write left (.NAME.tmp-PID-N), not
+//    other hidden files;
+//  - record_failed_start writes a "failed" summary.json for a run whose case file is unusable,
+//    with the case file's hash when it can be read and null when not, honouring refuse and
+//    overwrite.
 
 #include "coupling/result_directory.hpp"
 
@@ -157,6 +162,59 @@ TEST(ResultDirectory, AFailedOrInterruptedRunSaysSoAndLeavesNoEarlierSuccessInVi
   EXPECT_EQ(read_summary(output)["status"], "interrupted");
   { const ResultDirectory abandoned(output, ExistingResults::overwrite, "test", case_file); }
   EXPECT_EQ(read_summary(output)["status"], "failed");
+}
+
+TEST(ResultDirectory, OverwritingRemovesTemporaryFilesOfAKilledAtomicWrite) {
+  const TemporaryDirectory work("result-temporary");
+  const fs::path output = work.path() / "out";
+  fs::create_directories(output);
+  // what write_file_atomically leaves when the process is killed between writing and renaming
+  write_text(output / ".summary.json.tmp-4242-0", "{\"status\": \"conv");
+  write_text(output / ".checkpoint.json.tmp-4242-3", "{");
+  write_text(output / ".hidden-notes", "the user's");
+  EXPECT_THROW(check_result_directory(output, ExistingResults::refuse), ResultDirectoryError);
+  const ResultDirectory results(output, ExistingResults::overwrite, "test",
+                                write_case(work.path()));
+  EXPECT_FALSE(fs::exists(output / ".summary.json.tmp-4242-0"));
+  EXPECT_FALSE(fs::exists(output / ".checkpoint.json.tmp-4242-3"));
+  EXPECT_TRUE(fs::exists(output / ".hidden-notes"));
+  EXPECT_EQ(results.leftover_files(), std::vector<std::string>{".hidden-notes"});
+}
+
+TEST(ResultDirectory, RecordsARunWhoseCaseFileCannotBeRead) {
+  const TemporaryDirectory work("result-failed-start");
+  const fs::path output = work.path() / "out";
+  const fs::path case_file = write_case(work.path());
+  // a readable case file with an error: its hash is recorded
+  record_failed_start(output, ExistingResults::refuse, "robin-run", case_file,
+                      "case.toml:3: unknown key 'x'");
+  nlohmann::json summary = read_summary(output);
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_EQ(summary["tool"], "robin-run");
+  EXPECT_EQ(summary["case"], case_file.string());
+  EXPECT_EQ(summary["case_sha256"],
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(summary["message"], "case.toml:3: unknown key 'x'");
+  EXPECT_FALSE(summary["ended"].is_null());
+  // a missing case file: no hash; an earlier run's files are replaced under overwrite only
+  EXPECT_THROW(record_failed_start(output, ExistingResults::refuse, "robin-run",
+                                   work.path() / "missing.toml", "cannot be read"),
+               ResultDirectoryError);
+  record_failed_start(output, ExistingResults::overwrite, "robin-monolithic",
+                      work.path() / "missing.toml", "missing.toml: cannot be read");
+  summary = read_summary(output);
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_TRUE(summary["case_sha256"].is_null());
+  EXPECT_EQ(summary["message"], "missing.toml: cannot be read");
+  int entries = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(output)) ++entries;
+  EXPECT_EQ(entries, 1);  // summary.json only
+  // a file where the directory should be: nothing recorded
+  write_text(work.path() / "a_file", "");
+  EXPECT_THROW(
+      record_failed_start(work.path() / "a_file", ExistingResults::overwrite, "t", case_file, "x"),
+      ResultDirectoryError);
+  EXPECT_EQ(file_text(work.path() / "a_file"), "");
 }
 
 TEST(ResultDirectory, WritesFilesAtomically) {
