@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include <system_error>
 #include <unordered_map>
 
+#include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <optional>
@@ -458,6 +460,24 @@ std::string finish_meshing_child(const MeshingChild& child, const MeshFileReques
   return message;
 }
 
+using Clock = std::chrono::steady_clock;
+
+/// Blocks until one of the children `pending` (indices into `children`) has written to or
+/// closed its error pipe (it is ending) and returns its index; the first on a poll error.
+std::size_t next_ended_child(const std::vector<std::optional<MeshingChild>>& children,
+                             const std::vector<std::size_t>& pending) {
+  std::vector<pollfd> pipes;
+  for (const std::size_t k : pending) pipes.push_back({children[k]->error_pipe, POLLIN, 0});
+  for (;;) {
+    const int ready = poll(pipes.data(), pipes.size(), -1);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready < 0) return pending.front();
+    for (std::size_t i = 0; i < pipes.size(); ++i) {
+      if (pipes[i].revents != 0) return pending[i];
+    }
+  }
+}
+
 /// A private directory for the meshes of the children, removed on destruction.
 class PrivateDirectory {
  public:
@@ -498,11 +518,12 @@ Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& op
   return mesh;
 }
 
-std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests) {
+std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
+                                   const MeshReadObserver& observer) {
   std::vector<Mesh> meshes(requests.size());
   std::vector<std::optional<MeshingChild>> children(requests.size());
+  std::vector<Clock::time_point> started(requests.size());
   const PrivateDirectory directory;
-  std::string first_error;
   for (std::size_t k = 0; k < requests.size(); ++k) {
     if (lower_extension(requests[k].path) != ".geo") continue;
     const ErrorSource source{"", "mesh file '" + requests[k].path.string() + "'"};
@@ -513,19 +534,45 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests)
     }
     children[k] =
         start_meshing_child(requests[k], directory.path() / ("body" + std::to_string(k) + ".msh"));
+    started[k] = Clock::now();
+    if (observer.started) observer.started(k);
   }
-  for (std::size_t k = 0; k < requests.size(); ++k) {
-    if (!children[k]) continue;
-    const std::string error = finish_meshing_child(*children[k], requests[k]);
-    if (!error.empty() && first_error.empty()) first_error = error;
-  }
-  if (!first_error.empty()) throw InputError(first_error);
-  for (std::size_t k = 0; k < requests.size(); ++k) {
+  std::string first_error;
+  const auto read = [&](std::size_t k) {
     const std::filesystem::path& path = children[k] ? children[k]->output : requests[k].path;
     const ErrorSource source{path.string(), "mesh file '" + requests[k].path.string() + "'"};
-    meshes[k] = read_mesh_file(path, source, children[k] ? MeshReadOptions{} : requests[k].options);
+    try {
+      meshes[k] =
+          read_mesh_file(path, source, children[k] ? MeshReadOptions{} : requests[k].options);
+    } catch (const InputError& error) {
+      if (first_error.empty()) first_error = error.what();
+      return;
+    }
     meshes[k].source = requests[k].path.string();
+    if (observer.finished) {
+      observer.finished(k, meshes[k],
+                        std::chrono::duration<double>(Clock::now() - started[k]).count());
+    }
+  };
+  // each child's mesh is read as soon as it ends, in the order they end
+  std::vector<std::size_t> pending;
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    if (children[k]) pending.push_back(k);
   }
+  while (!pending.empty()) {
+    const std::size_t k = next_ended_child(children, pending);
+    pending.erase(std::find(pending.begin(), pending.end(), k));
+    const std::string error = finish_meshing_child(*children[k], requests[k]);
+    if (!error.empty() && first_error.empty()) first_error = error;
+    if (error.empty() && first_error.empty()) read(k);
+  }
+  for (std::size_t k = 0; k < requests.size() && first_error.empty(); ++k) {
+    if (children[k]) continue;
+    started[k] = Clock::now();
+    if (observer.started) observer.started(k);
+    read(k);
+  }
+  if (!first_error.empty()) throw InputError(first_error);
   return meshes;
 }
 
@@ -585,7 +632,7 @@ GeoVariableUse geo_variable_use(const std::filesystem::path& path, const std::st
   const std::string code = code_of_geo_script(text.str(), strings);
   if (mentions_identifier(code, name)) return GeoVariableUse::used;
   return mentions_identifier(code, "Include") ? GeoVariableUse::indeterminate
-                                               : GeoVariableUse::unused;
+                                              : GeoVariableUse::unused;
 }
 
 }  // namespace robin

@@ -8,7 +8,9 @@
 // triangles, quadrilaterals); every 1D physical group becomes a named boundary.
 // Node coordinates must lie in the z = 0 plane.
 
+#include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,12 +34,22 @@ struct MeshFileRequest {
   MeshReadOptions options;
 };
 
+/// Told as read_gmsh_meshes goes, with the index of the request: when its meshing (a .geo) or
+/// reading (a .msh) begins, and when its mesh has been read, with the seconds since it began.
+/// Called on the calling thread; empty members are not called.
+struct MeshReadObserver {
+  std::function<void(std::size_t request)> started;
+  std::function<void(std::size_t request, const Mesh& mesh, double seconds)> finished;
+};
+
 /// Reads several mesh files at once, each as read_gmsh_mesh reads it. Gmsh holds one model per
 /// process, so each .geo is meshed in a child process of its own, all concurrently; a child
 /// writes its mesh as binary MSH 4.1 into a private temporary directory, which this process
-/// reads (a .msh is read directly). Only the user's own files belong here: a .geo is a program.
-/// Throws InputError naming the file for the first request that fails.
-std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests);
+/// reads (a .msh is read directly) as soon as that child has ended. Only the user's own files
+/// belong here: a .geo is a program. Throws InputError naming the file for the first request
+/// that fails (in the order the failures are seen), after every child has ended.
+std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
+                                   const MeshReadObserver& observer = {});
 
 /// How a .geo script refers to a variable, read from its text (comments and strings skipped).
 enum class GeoVariableUse {

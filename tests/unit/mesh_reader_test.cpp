@@ -401,6 +401,28 @@ TEST(MeshReader, ReadGmshMeshesMatchesReadGmshMeshAndErrorsNameTheFile) {
   EXPECT_EQ(message.find("robin-mesh-"), std::string::npos) << message;
 }
 
+// The observer hears each request begin once and end once, with the mesh that is returned.
+TEST(MeshReader, ReadGmshMeshesTellsWhenEachMeshBeginsAndIsRead) {
+  const std::filesystem::path msh = data_directory / "mesh_square_v22.msh";
+  const std::filesystem::path geo = data_directory / "mesh_square.geo";
+  std::vector<std::size_t> started;
+  std::vector<std::pair<std::size_t, std::size_t>> finished;  // request, node count
+  MeshReadObserver observer;
+  observer.started = [&](std::size_t request) { started.push_back(request); };
+  observer.finished = [&](std::size_t request, const Mesh& mesh, double seconds) {
+    EXPECT_EQ(std::count(started.begin(), started.end(), request), 1) << request;
+    EXPECT_GE(seconds, 0.0);
+    finished.emplace_back(request, mesh.node_count());
+  };
+  const std::vector<Mesh> meshes =
+      read_gmsh_meshes({{geo, {.size = 0.25}}, {msh, {}}, {geo, {.size = 0.5}}}, observer);
+  std::sort(started.begin(), started.end());
+  EXPECT_EQ(started, (std::vector<std::size_t>{0, 1, 2}));
+  ASSERT_EQ(finished.size(), 3u);
+  EXPECT_EQ(finished.back().first, 1u);  // the .msh is read once the children have ended
+  for (const auto& [request, nodes] : finished) EXPECT_EQ(nodes, meshes[request].node_count());
+}
+
 TEST(MeshReader, ReadGmshMeshesLeavesNoTemporaryFile) {
   // A private temporary directory (through TMPDIR) so that other processes do not interfere.
   const std::filesystem::path directory =
