@@ -9,7 +9,8 @@ inline constexpr unsigned protocol_major = 2;
 /// AssignContact, contact surfaces in InterfaceDescription. Within 1.x, 1.1 added
 /// NeumannSolveRequest and 1.2 Envelope.run_id. 2.1: SetLoadFactor (quasi-static load steps
 /// reuse the body's factor and F; a coordinator sends it only to servers of minor >= 1) and
-/// StatusRequest (heartbeat and setup progress, capability "status").
-inline constexpr unsigned protocol_minor = 1;
+/// StatusRequest (heartbeat and setup progress, capability "status"). 2.2: the stage times of
+/// SetupBody, AssignContact and FieldsRequest in their replies (StageTime), for the profile.
+inline constexpr unsigned protocol_minor = 2;
 
 }  // namespace robin::protocol

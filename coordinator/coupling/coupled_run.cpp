@@ -229,16 +229,20 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
     const std::array<PortTimings, 2> before_iteration = port_timings(ports);
     const Eigen::VectorXd start =
         step.warm_started ? predicted_start(points, step.factor) : Eigen::VectorXd();
+    const auto iteration_start = Clock::now();
     step.iteration =
         recoverable_iteration(ports, result.pairing, options, step.warm_started ? &start : nullptr,
                               nullptr, {}, observer);
+    result.profile.iterations_seconds += seconds_since(iteration_start);
     for (int alpha = 0; alpha < 2; ++alpha) {
       result.iteration_port_timings[alpha] =
           difference(ports.timings(alpha), before_iteration[alpha]);
     }
     report_stage(observer, "collecting the fields of both bodies (load step " +
                                std::to_string(step.step) + ")");
+    const auto fields_start = Clock::now();
     step.outputs = collect_fields(ports, step.iteration);
+    result.profile.fields_seconds += seconds_since(fields_start);
     result.iteration = step.iteration;
     result.outputs = step.outputs;
     step.excluded_clearance = excluded_clearance(result);
@@ -289,18 +293,22 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                   const RunContinuation& continuation) {
   const auto start = Clock::now();
   CoupledRunResult result;
+  result.profile.launch_seconds = seconds_launched();
   result.options = options;
   report_stage(observer, "reading and meshing both bodies");
   CaseDefinition loaded = definition;
   load_meshes(loaded);
   result.meshing_seconds = seconds_since(start);
+  result.profile.meshing_seconds = result.meshing_seconds;
   RecoverablePorts recoverable(ports, loaded, continuation.replacement,
                                [&](const std::string& text) {
                                  result.recoveries.push_back(text);
                                  report_warning(observer, text);
                                });
   report_stage(observer, "setting up both bodies (assembly, factorization)");
+  const auto setup_start = Clock::now();
   result.interfaces = set_up_bodies(recoverable, loaded);
+  result.profile.setup_seconds = seconds_since(setup_start);
   const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
   const std::string& name1 = definition.bodies[0].definition.name;
   const std::string& name2 = definition.bodies[1].definition.name;
@@ -309,32 +317,42 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
       discretize_contact(result.interfaces[0], name1, result.interfaces[1], name2, gap.get(),
                          definition.contact, definition.solver.pairing_tolerance);
   result.coupling_seconds = seconds_since(coupling_start);
+  result.profile.contact_coupling_seconds = result.coupling_seconds;
   report_stage(observer, describe_contact(result.pairing, name1, name2));
   for (const std::string& line : result.pairing.excluded) report_warning(observer, line);
   if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
     report_warning(observer, overlap);
+  const auto assignment_start = Clock::now();
   recoverable.run([&] {
     for (int alpha = 0; alpha < 2; ++alpha)
       recoverable.port(alpha).assign_contact(result.pairing.assignment(alpha));
   });
   recoverable.contact_assigned(result.pairing);
+  result.profile.contact_assignment_seconds = seconds_since(assignment_start);
   result.setup_seconds = seconds_since(start);
 
   if (definition.loading.stepped()) {
     run_load_steps(definition.loading, recoverable, options, observer, result);
   } else {
     const std::array<PortTimings, 2> before = port_timings(recoverable);
+    const auto iteration_start = Clock::now();
     result.iteration =
         recoverable_iteration(recoverable, result.pairing, options, nullptr, continuation.resume,
                               continuation.checkpoint, observer);
+    result.profile.iterations_seconds = seconds_since(iteration_start);
     for (int alpha = 0; alpha < 2; ++alpha) {
       result.iteration_port_timings[alpha] = difference(recoverable.timings(alpha), before[alpha]);
     }
     report_stage(observer, "collecting the fields of both bodies");
+    const auto fields_start = Clock::now();
     result.outputs = collect_fields(recoverable, result.iteration);
+    result.profile.fields_seconds = seconds_since(fields_start);
     result.excluded_clearance = excluded_clearance(result);
   }
   result.port_timings = port_timings(recoverable);
+  for (int alpha = 0; alpha < 2; ++alpha) {
+    result.profile.bodies[alpha] = recoverable.port(alpha).profile();
+  }
   result.total_seconds = seconds_since(start);
   return result;
 }

@@ -11,6 +11,7 @@
 #include "coupling/contact_pairing.hpp"
 #include "coupling/port_recovery.hpp"
 #include "coupling/robin_iteration.hpp"
+#include "coupling/run_profile.hpp"
 #include "coupling/subdomain_port.hpp"
 
 namespace robin {
@@ -50,6 +51,8 @@ struct CoupledRunResult {
   std::vector<LoadStepResult> steps;
   /// What the run did about lost servers, in order, for people (empty: nothing was lost).
   std::vector<std::string> recoveries;
+  /// The stages of the run (run_profile.hpp); output_seconds is set by write_coupled_outputs.
+  RunProfile profile;
 };
 
 /// Checkpoints, resume and server recovery of a coupled run (docs/outputs.md, "Checkpoint and

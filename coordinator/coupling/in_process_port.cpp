@@ -17,14 +17,23 @@ InterfaceDescription InProcessPort::setup(const BodyCase& body_case, const Solve
   if (body_case.definition.mesh.node_count() == 0) {
     throw PortError(describe() + ": body '" + name_ + "' has no mesh (load_meshes first)");
   }
+  const auto start = std::chrono::steady_clock::now();
   body_ = std::make_unique<BodySolver>(body_case.definition, solver.body);
-  timings_.compute_seconds +=
-      body_->timings().assembly_seconds + body_->timings().factorization_seconds;
+  const BodyTimings& timings = body_->timings();
+  timings_.compute_seconds += timings.setup_seconds();
+  profile_ = BodyProfile{};
+  profile_.stages = {{SetupStage::assembly, timings.assembly_seconds},
+                     {SetupStage::ordering, timings.ordering_seconds},
+                     {SetupStage::factorization, timings.factorization_seconds}};
+  profile_.setup_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  profile_.transfer_seconds = 0.0;
   return body_->contact_boundary();
 }
 
 void InProcessPort::assign_contact(const ContactOperator& contact) {
   body().assign_contact(contact);
+  profile_.stages[SetupStage::interface_operator] = body().timings().interface_seconds;
 }
 
 void InProcessPort::start_contact_solve(const Eigen::VectorXd& obstacle, int /*iteration*/) {
@@ -72,7 +81,11 @@ void InProcessPort::set_load_factor(double factor) {
 }
 
 BodyOutput InProcessPort::fields(const Eigen::VectorXd& contact_force) {
-  return make_body_output(body(), contact_force);
+  const auto start = std::chrono::steady_clock::now();
+  BodyOutput output = make_body_output(body(), contact_force);
+  profile_.stages[SetupStage::fields] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return output;
 }
 
 void InProcessPort::end_run() noexcept {

@@ -24,6 +24,7 @@ class InProcessPort final : public SubdomainPort {
   BodyOutput fields(const Eigen::VectorXd& contact_force) override;
   void end_run() noexcept override;
   const PortTimings& timings() const override { return timings_; }
+  const BodyProfile& profile() const override { return profile_; }
 
  private:
   BodySolver& body();
@@ -34,6 +35,7 @@ class InProcessPort final : public SubdomainPort {
   CorrectionSolveResult correction_result_;
   CorrectionSolveResult neumann_result_;
   PortTimings timings_;
+  BodyProfile profile_;
 };
 
 }  // namespace robin

@@ -20,7 +20,10 @@ struct LocalProblem {
   std::unique_ptr<GapFunction> gap;  // null when the case has no [gap]
   std::array<std::unique_ptr<BodySolver>, 2> bodies;
   ContactPairing pairing;
-  double mesh_seconds = 0.0;  // reading and meshing both bodies
+  double mesh_seconds = 0.0;        // reading and meshing both bodies
+  double setup_seconds = 0.0;       // both bodies' assembly and factorization, one after the other
+  double coupling_seconds = 0.0;    // pairing or mortar rows
+  double assignment_seconds = 0.0;  // both bodies' contact assignment (interface operators)
 };
 
 /// The case's gap function, or null when it has none.

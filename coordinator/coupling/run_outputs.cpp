@@ -1,5 +1,6 @@
 #include "coupling/run_outputs.hpp"
 
+#include <chrono>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -132,6 +133,7 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
 
 void write_coupled_outputs(ResultDirectory& results, const CaseDefinition& definition,
                            const CoupledRunResult& result) {
+  const auto start = std::chrono::steady_clock::now();
   const std::filesystem::path& directory = results.staging();
   const std::string file1 = write_body_output(directory, result.outputs[0]);
   const std::string file2 = write_body_output(directory, result.outputs[1]);
@@ -148,6 +150,11 @@ void write_coupled_outputs(ResultDirectory& results, const CaseDefinition& defin
     write_coupled_step_outputs(directory, definition, result);
     summary["load_steps"] = coupled_steps_json(result);
   }
+  RunProfile profile = result.profile;
+  profile.output_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary["profile"] = profile_json(
+      profile, {definition.bodies[0].definition.name, definition.bodies[1].definition.name});
   results.commit(summary);
 }
 

@@ -9,6 +9,8 @@
 // PortError (naming the server, the body and the step) on failure, including deadlines.
 
 #include <Eigen/Core>
+#include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -35,6 +37,20 @@ struct PortTimings {
   double round_trip_seconds = 0.0;  // request sent to reply decoded (remote); = compute in process
   long bytes_sent = 0;
   long bytes_received = 0;
+};
+
+/// Where one body's setup and fields went, stage by stage (summary.json "profile",
+/// docs/outputs.md), in seconds of wall time. Stages measured where the body lives; a stage
+/// that was not reported (a server of protocol 2.1 or older) is absent.
+struct BodyProfile {
+  /// mesh, assembly, ordering, factorization (SetupBody), interface operator (AssignContact),
+  /// fields (FieldsRequest) of the latest such request.
+  std::map<SetupStage, double> stages;
+  /// The whole SetupBody request where the body lives: at least the sum of its stages.
+  std::optional<double> setup_seconds;
+  /// Moving the SetupBody request and its reply: encoding the body, plus the round trip less
+  /// setup_seconds. Zero in process.
+  std::optional<double> transfer_seconds;
 };
 
 class SubdomainPort {
@@ -69,6 +85,8 @@ class SubdomainPort {
   /// port can be used again after the other body's server failed mid-step. Must not throw.
   virtual void abandon_request() noexcept {}
   virtual const PortTimings& timings() const = 0;
+  /// The stages of the latest setup, contact assignment and fields (empty before setup()).
+  virtual const BodyProfile& profile() const = 0;
 };
 
 }  // namespace robin

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <random>
 #include <sstream>
 
@@ -40,6 +41,18 @@ std::string join_names(const Names& items) {
   std::string text;
   for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;
   return text.empty() ? "nothing" : text;
+}
+
+/// Adds the reply's StageTime entries (protocol 2.2) to `stages`; unknown stage names and
+/// times that are not finite and non-negative are left out.
+template <typename StageTimes>
+void record_stage_times(const StageTimes& stage_times, std::map<SetupStage, double>& stages) {
+  for (const protocol::StageTime& entry : stage_times) {
+    const std::optional<SetupStage> stage = setup_stage_named(entry.stage());
+    if (stage && std::isfinite(entry.seconds()) && entry.seconds() >= 0.0) {
+      stages[*stage] = entry.seconds();
+    }
+  }
 }
 
 template <typename Values>
@@ -202,11 +215,16 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   }
   run_id_ = new_run_id();  // a new run: this port's requests carry it from now on
   if (server_name_.empty()) handshake();
+  const auto encoding_start = Clock::now();
   Envelope request;
   *request.mutable_setup_body() = encode_setup_body(body.definition, body.context, solver);
+  const double encoding_seconds = seconds_since(encoding_start);
+  const auto sent = Clock::now();
   const Envelope reply =
       watched_exchange(request, "setup", options_.setup_timeout_seconds, Envelope::kInterface);
+  const double round_trip_seconds = seconds_since(sent);
   timings_.compute_seconds += reply.interface().setup_seconds();
+  record_setup_profile(reply.interface(), encoding_seconds + round_trip_seconds);
   try {
     InterfaceDescription interface = decode_interface(reply.interface());
     contact_size_ = 0;
@@ -217,11 +235,23 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   }
 }
 
+/// The profile of a setup whose request took `seconds` from encoding to the decoded reply.
+void RemotePort::record_setup_profile(const protocol::InterfaceDescription& reply, double seconds) {
+  profile_ = BodyProfile{};
+  record_stage_times(reply.stage_times(), profile_.stages);
+  const double server_seconds = reply.request_seconds();
+  if (std::isfinite(server_seconds) && server_seconds > 0.0) {
+    profile_.setup_seconds = server_seconds;
+    profile_.transfer_seconds = std::max(0.0, seconds - server_seconds);
+  }
+}
+
 void RemotePort::assign_contact(const ContactOperator& contact) {
   Envelope request;
   *request.mutable_assign_contact() = encode_contact_operator(contact);
-  watched_exchange(request, "contact assignment", options_.request_timeout_seconds,
-                   Envelope::kAcknowledge);
+  const Envelope reply = watched_exchange(request, "contact assignment",
+                                          options_.request_timeout_seconds, Envelope::kAcknowledge);
+  record_stage_times(reply.acknowledge().stage_times(), profile_.stages);
   contact_size_ = contact.row_count();
 }
 
@@ -328,6 +358,7 @@ BodyOutput RemotePort::fields(const Eigen::VectorXd& contact_force) {
   append(contact_force, *request.mutable_fields()->mutable_contact_force());
   const Envelope reply =
       watched_exchange(request, "fields", options_.setup_timeout_seconds, Envelope::kFieldsReply);
+  record_stage_times(reply.fields_reply().stage_times(), profile_.stages);
   try {
     return decode_fields(reply.fields_reply(), body_label_);
   } catch (const MalformedReply& malformed) {

@@ -33,6 +33,11 @@
 //   server tcp://127.0.0.1:5555 (body 'upper'), step setup: no heartbeat for 10 s: ...
 // instead of at the setup deadline. A 2.0 server (no "status") is waited for as before.
 //
+// Profile (protocol 2.2): the stage times of the replies to SetupBody, AssignContact and
+// FieldsRequest (StageTime), the server's whole SetupBody time and the setup's transfer: the
+// encoding of SetupBody plus its round trip less the server's time. A server of protocol 2.1
+// or older reports none: the profile then holds no stages, no setup and no transfer time.
+//
 // Timings: compute_seconds adds the server-reported times of setup (assembly and
 // factorization), contact solves, corrections and Neumann solves; round_trip_seconds adds, for
 // the same requests, the time from sending the request to the decoded reply; bytes count every
@@ -49,6 +54,10 @@
 #include "coupling/subdomain_port.hpp"
 #include "remote/request_channel.hpp"
 #include "remote/server_heartbeat.hpp"
+
+namespace robin::protocol {
+class InterfaceDescription;
+}
 
 namespace robin {
 
@@ -94,6 +103,7 @@ class RemotePort final : public SubdomainPort {
   void end_run() noexcept override;
   void abandon_request() noexcept override;
   const PortTimings& timings() const override;
+  const BodyProfile& profile() const override { return profile_; }
   /// True once the connection to the server dropped after it was made (the server stopped,
   /// crashed or was killed).
   bool connection_lost();
@@ -123,6 +133,7 @@ class RemotePort final : public SubdomainPort {
                                       double timeout_seconds, int expected_content);
   [[noreturn]] void fail(const std::string& step, const std::string& problem) const;
   void update_byte_counts();
+  void record_setup_profile(const protocol::InterfaceDescription& reply, double seconds);
 
   std::string endpoint_;
   std::string body_label_;
@@ -138,6 +149,7 @@ class RemotePort final : public SubdomainPort {
   bool set_up_ = false;
   std::string run_id_;  // Envelope.run_id of every request, drawn by setup()
   PortTimings timings_;
+  BodyProfile profile_;
 };
 
 /// A fresh run identifier for Envelope.run_id: 128 bits from std::random_device, as 32

@@ -60,12 +60,20 @@ from .mesh_data import quoted
 from .paths import PathRefused, check_output_directory, write_under_root
 from .setup_decoding import decode_setup_body
 
-PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 1
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 2
 MAXIMUM_LOAD_FACTOR = 1e6         # SetLoadFactor: a larger magnitude is BAD_INPUT
 AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
 REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction",
             "neumann_solve", "fields", "end_run", "shutdown", "set_load_factor")
 CAPABILITIES = ("contact_solve", "correction_solve", "fields", "neumann_solve")
+
+
+def _add_stage_times(stage_times, stages):
+    """Appends a StageTime (protocol 2.2) per (stage name, seconds) to a reply's stage_times."""
+    for stage, seconds in stages:
+        entry = stage_times.add()
+        entry.stage = stage
+        entry.seconds = seconds
 
 
 class _Record:
@@ -77,6 +85,7 @@ class _Record:
         self.iteration = ""
         self.outcome = "ok"
         self.failed = False
+        self.start = time.perf_counter()   # the request's bytes received
 
 
 def _checked_vector(values, size, field, body_name):
@@ -142,8 +151,8 @@ class SubdomainProtocol:
 
     def handle(self, request_bytes):
         """The serialized reply to one request. Never raises."""
-        start = time.perf_counter()
         record = _Record()
+        start = record.start
         reply = self.protocol.Envelope()
         try:
             request = self.protocol.Envelope()
@@ -279,11 +288,19 @@ class SubdomainProtocol:
         self.run_id = ""                  # (and whichever run the body belonged to)
         self.state = AWAITING_SETUP
         record.body = quoted(request.setup_body.body_name, 64)[1:-1]
+        mesh_start = time.perf_counter()
         definition, settings = decode_setup_body(request.setup_body, self.protocol,
                                                  self.data_directory)
+        mesh_seconds = time.perf_counter() - mesh_start
         self._check_size(definition)
         body = Body(definition)
         self._describe_interface(body, reply.interface)
+        # Since 2.2: the stages (SuperLU orders and factorizes in one call: no "ordering" of
+        # its own, "factorization" holds both) and the whole request on this server.
+        _add_stage_times(reply.interface.stage_times, (
+            ("mesh", mesh_seconds), ("assembly", body.assembly_seconds),
+            ("factorization", body.factorization_seconds)))
+        reply.interface.request_seconds = time.perf_counter() - record.start
         self.settings = settings
         self.body = body
         self.run_id = request.run_id
@@ -319,9 +336,12 @@ class SubdomainProtocol:
         operator = decode_assign_contact(request.assign_contact, self.body.interface.node_ids,
                                          self.body.mesh.node_tags, self.body.name)
         self.state = AWAITING_ASSIGNMENT  # until the body accepted the assignment
+        start = time.perf_counter()
         self.body.assign_contact(operator)
+        interface_seconds = time.perf_counter() - start
         self.state = READY
         self._acknowledge(reply)
+        _add_stage_times(reply.acknowledge.stage_times, (("interface operator", interface_seconds),))
         record.outcome = "ok, %d constraints, %d entries" % (operator.row_count,
                                                              len(operator.values))
 
@@ -408,6 +428,7 @@ class SubdomainProtocol:
         reply.load_factor_set.compute_seconds = time.perf_counter() - start
 
     def _on_fields(self, request, reply, record):
+        start = time.perf_counter()
         message = request.fields
         self._require_same_run(request, "FieldsRequest")
         self._require_state(READY, "FieldsRequest")
@@ -427,6 +448,7 @@ class SubdomainProtocol:
                                          self.body.name + ".vtu", text),
                 message.write_directory)
             reply.fields_reply.written_file = path
+        _add_stage_times(reply.fields_reply.stage_times, (("fields", time.perf_counter() - start),))
 
     def _output_refusal(self, action, write_directory):
         """action(), its PathRefused or OSError an INVALID_ARGUMENT naming the body and the

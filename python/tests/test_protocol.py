@@ -82,7 +82,7 @@ class ServerTestCase(unittest.TestCase):
     def ask(self, data):
         reply = protocol.Envelope()
         reply.ParseFromString(self.server.handle(data))
-        self.assertEqual((reply.version.major, reply.version.minor), (2, 1))
+        self.assertEqual((reply.version.major, reply.version.minor), (2, 2))
         return reply
 
     def expect_error(self, data, code, state):
@@ -118,7 +118,7 @@ class StateMachine(ServerTestCase):
         for major, minor in ((1, 2), (1, 0), (3, 1)):
             message = self.expect_error(request(major=major, minor=minor, hello=protocol.Hello()),
                                         "VERSION_MISMATCH", "awaiting_setup")
-            self.assertIn("the request speaks %d.%d, this server 2.1" % (major, minor), message)
+            self.assertIn("the request speaks %d.%d, this server 2.2" % (major, minor), message)
         self.expect_error(request(major=1, minor=2, setup_body=setup_body()), "VERSION_MISMATCH",
                           "awaiting_setup")
         self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
@@ -228,6 +228,35 @@ class StateMachine(ServerTestCase):
         scale = max(np.abs(free.normal_trace).max(), np.abs(response).max())
         np.testing.assert_allclose(trace, expected, rtol=0, atol=1e-10 * scale)
         self.assertEqual(self.server.state, "ready")
+
+    def test_replies_carry_the_stage_times(self):
+        """Since 2.2: SetupBody's reply names mesh, assembly and factorization (SuperLU has no
+        separate ordering) and the whole request, which is at least their sum; AssignContact's
+        the interface operator, FieldsRequest's the fields; each once, finite, non-negative."""
+        def stages(stage_times):
+            names = [entry.stage for entry in stage_times]
+            self.assertEqual(len(names), len(set(names)), names)
+            for entry in stage_times:
+                self.assertTrue(np.isfinite(entry.seconds) and entry.seconds >= 0.0, entry)
+            return {entry.stage: entry.seconds for entry in stage_times}
+
+        interface = self.ask(request(setup_body=setup_body())).interface
+        setup = stages(interface.stage_times)
+        self.assertEqual(set(setup), {"mesh", "assembly", "factorization"})
+        self.assertGreater(setup["assembly"], 0.0)
+        self.assertGreater(setup["factorization"], 0.0)
+        self.assertGreaterEqual(interface.request_seconds, sum(setup.values()))
+        self.assertGreaterEqual(interface.request_seconds, interface.setup_seconds)
+        assign = support.node_to_node_assignment(protocol, interface)
+        acknowledge = self.ask(request(assign_contact=assign)).acknowledge
+        self.assertEqual(set(stages(acknowledge.stage_times)), {"interface operator"})
+        count = len(interface.node_ids)
+        fields = self.ask(request(fields=protocol.FieldsRequest(
+            contact_force=[0.0] * count))).fields_reply
+        self.assertEqual(set(stages(fields.stage_times)), {"fields"})
+        hello = self.ask(request(hello=protocol.Hello()))
+        self.assertEqual(len(self.ask(request(end_run=protocol.EndRun())).acknowledge.stage_times),
+                         0, hello)
 
     def test_set_load_factor_scales_loads_and_prescribed_displacements(self):
         """Since 2.1: e(t) = t e(1) for body force and a prescribed lift together (both scale),

@@ -88,10 +88,18 @@ struct ContactSolveResult {
   std::string message;
 };
 
+/// Wall time of the setup stages (numerics/setup_progress.hpp), in seconds. For a body set up
+/// anew; after replace_loads(): assembly is the load vector's, ordering 0 and factorization the
+/// solve K^{-1} f with the kept factor.
 struct BodyTimings {
-  double assembly_seconds = 0.0;
-  double factorization_seconds = 0.0;
-  double interface_seconds = 0.0;  // building e and (when dense) F
+  double assembly_seconds = 0.0;       // DOF map, stiffness, loads, contact boundary weights
+  double ordering_seconds = 0.0;       // fill-reducing ordering and symbolic analysis
+  double factorization_seconds = 0.0;  // numerical factorization and K^{-1} f
+  double interface_seconds = 0.0;      // building e and (when dense) F
+  /// assembly + ordering + factorization: the body's setup.
+  double setup_seconds() const {
+    return assembly_seconds + ordering_seconds + factorization_seconds;
+  }
 };
 
 class BodySolver {

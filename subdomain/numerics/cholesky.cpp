@@ -2,6 +2,7 @@
 
 #include <Eigen/CholmodSupport>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -154,6 +155,10 @@ Eigen::VectorXd supernodal_pivots(const cholmod_factor& factor) {
   return pivots;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 std::string format_number(double value) {
   std::ostringstream stream;
   stream.precision(3);
@@ -179,6 +184,8 @@ struct CholeskyFactor::Implementation {
   std::vector<int> position;  // position[j] = step at which unknown j is eliminated
 
   double memory_limit_bytes = 0.0;
+  double ordering_seconds = 0.0;
+  double factorization_seconds = 0.0;
 
   void factorize(const SparseMatrix& matrix, const std::vector<int>& trailing,
                  const SetupObserver& observer);
@@ -190,6 +197,7 @@ struct CholeskyFactor::Implementation {
 void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
                                                const std::vector<int>& trailing,
                                                const SetupObserver& observer) {
+  auto start = std::chrono::steady_clock::now();
   cholmod_common& common = cholesky.cholmod();
   common.print = 0;                // CHOLMOD prints nothing, not even warnings
   common.error_handler = nullptr;  // failures are read from common.status instead
@@ -206,7 +214,9 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
                              std::to_string(common.status) + ", e.g. out of memory)");
   }
   check_memory_estimate();
+  ordering_seconds = seconds_since(start);
   if (observer) observer(SetupStage::factorization);
+  start = std::chrono::steady_clock::now();
   cholesky.factorize(matrix);
   const cholmod_factor& factor = *cholesky.factor();
   if (common.status < CHOLMOD_OK) {
@@ -224,6 +234,7 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
   }
   check_pivots();
   locate_trailing(trailing);
+  factorization_seconds = seconds_since(start);
 }
 
 /// The symbolic factor knows how many entries L will store (supernodal: xsize; simplicial:
@@ -357,7 +368,17 @@ long CholeskyFactor::factor_nonzeros() const {
 
 namespace robin {
 
-bool CholeskyFactor::has_trailing_block() const { return implementation_->has_trailing_block; }
+double CholeskyFactor::ordering_seconds() const {
+  return implementation_->ordering_seconds;
+}
+
+double CholeskyFactor::factorization_seconds() const {
+  return implementation_->factorization_seconds;
+}
+
+bool CholeskyFactor::has_trailing_block() const {
+  return implementation_->has_trailing_block;
+}
 
 Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) const {
   const Implementation& factor = *implementation_;

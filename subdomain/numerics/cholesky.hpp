@@ -58,6 +58,10 @@ class CholeskyFactor {
   /// Number of right-hand sides solved so far: +1 per vector solve, +columns per matrix solve
   /// (each right-hand side costs one forward and one backward triangular solve).
   long solve_count() const { return solve_count_; }
+  /// Wall time of the fill-reducing ordering and symbolic analysis (seconds).
+  double ordering_seconds() const;
+  /// Wall time of the numerical factorization and its pivot checks (seconds).
+  double factorization_seconds() const;
 
  private:
   struct Implementation;

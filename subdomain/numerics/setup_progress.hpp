@@ -3,6 +3,7 @@
 // the stage-by-stage profile).
 
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace robin {
@@ -33,6 +34,16 @@ inline std::string to_string(SetupStage stage) {
       return "fields";
   }
   return "unknown";
+}
+
+/// The stage named `name` (as to_string gives it); empty for any other text.
+inline std::optional<SetupStage> setup_stage_named(const std::string& name) {
+  for (SetupStage stage :
+       {SetupStage::mesh, SetupStage::assembly, SetupStage::ordering, SetupStage::factorization,
+        SetupStage::interface_operator, SetupStage::fields}) {
+    if (to_string(stage) == name) return stage;
+  }
+  return std::nullopt;
 }
 
 /// Called when a stage begins; may be called from a worker thread. It may throw to abandon the

@@ -30,6 +30,7 @@ struct SubdomainServer::RequestRecord {
   std::string outcome = "ok";
   bool failed = false;
   double seconds = 0.0;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 };
 
 namespace {
@@ -43,6 +44,14 @@ constexpr std::size_t largest_status_request = 256;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Appends StageTime {stage, seconds} to a reply's stage_times (protocol 2.2).
+template <typename StageTimes>
+void add_stage_time(StageTimes& stage_times, SetupStage stage, double seconds) {
+  protocol::StageTime& entry = *stage_times.Add();
+  entry.set_stage(to_string(stage));
+  entry.set_seconds(seconds);
 }
 
 std::string version_text(unsigned major, unsigned minor) {
@@ -193,8 +202,8 @@ std::string SubdomainServer::server_name() const {
 }
 
 std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
-  const auto start = Clock::now();
   RequestRecord record;
+  const auto start = record.start;
   protocol::Envelope reply;
   try {
     protocol::Envelope request;
@@ -469,7 +478,9 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
     progress_.dof_count = 0;
   }
   begin_stage(SetupStage::mesh, 0);
+  const auto mesh_start = Clock::now();
   DecodedSetup setup = decode_setup_body(request.setup_body(), settings_.data_directory);
+  const double mesh_seconds = seconds_since(mesh_start);
   setup.body.maximum_dofs = settings_.maximum_dofs;
   setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;
   const long dof_count = 2L * static_cast<long>(setup.definition.mesh.node_count());
@@ -487,8 +498,16 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   protocol::InterfaceDescription& description = *reply.mutable_interface();
   encode_interface(body->name(), body->definition().contact_boundary, interface, description);
   description.set_dof_count(static_cast<std::uint64_t>(body->free_dof_count()));
-  description.set_setup_seconds(body->timings().assembly_seconds +
-                                body->timings().factorization_seconds);
+  const BodyTimings& timings = body->timings();
+  description.set_setup_seconds(timings.setup_seconds());
+  if (settings_.protocol_minor >= 2) {
+    auto& stage_times = *description.mutable_stage_times();
+    add_stage_time(stage_times, SetupStage::mesh, mesh_seconds);
+    add_stage_time(stage_times, SetupStage::assembly, timings.assembly_seconds);
+    add_stage_time(stage_times, SetupStage::ordering, timings.ordering_seconds);
+    add_stage_time(stage_times, SetupStage::factorization, timings.factorization_seconds);
+    description.set_request_seconds(seconds_since(record.start));
+  }
   interface_nodes_ = interface.node_ids;
   qp_parameters_ = setup.qp;
   body_ = std::move(body);
@@ -516,6 +535,10 @@ void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
   body_->assign_contact(contact);
   state_ = ServerState::ready;
   acknowledge(reply);
+  if (settings_.protocol_minor >= 2) {
+    add_stage_time(*reply.mutable_acknowledge()->mutable_stage_times(),
+                   SetupStage::interface_operator, body_->timings().interface_seconds);
+  }
 }
 
 void SubdomainServer::on_contact_solve(const protocol::Envelope& request, protocol::Envelope& reply,
@@ -582,6 +605,7 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   require_same_run(request, "FieldsRequest");
   require_state(ServerState::ready, "FieldsRequest");
   begin_stage(SetupStage::fields, 0);
+  const auto start = Clock::now();
   const Eigen::VectorXd contact_force = checked_vector(
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
   const BodyOutput output = make_body_output(*body_, contact_force);
@@ -608,6 +632,9 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   protocol::FieldsReply& fields = *reply.mutable_fields_reply();
   encode_fields(output, fields);
   if (!directory.empty()) fields.set_written_file(write_fields_file(directory, output));
+  if (settings_.protocol_minor >= 2) {
+    add_stage_time(*fields.mutable_stage_times(), SetupStage::fields, seconds_since(start));
+  }
 }
 
 /// Since protocol 2.1: scales the body's loads and prescribed displacements (BodySolver::

@@ -16,11 +16,14 @@
 // (node_to_node_operator, (B u)_i = u(node_i) . n_i), rows that combine two nodes and both
 // components (as mortar coupling sends them) are checked against the same independent solve,
 // also with a row that touches a prescribed dof (its value enters the trace as B u_p).
+// The setup's timings (the profile's stages): finite, non-negative, within the test's own
+// measurement of the setup, and the ordering reported apart from the numerical factorization.
 
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -199,6 +202,34 @@ std::unique_ptr<BodySolver> make_solver(const OperatorChoice& choice,
 
 double largest(const Eigen::VectorXd& vector) {
   return vector.cwiseAbs().maxCoeff();
+}
+
+TEST(BodySolver, SetupTimingsAreItsStagesWithinTheMeasuredSetup) {
+  using Clock = std::chrono::steady_clock;
+  const auto seconds_since = [](Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  BodyDefinition body = test_body();
+  const ContactOperator contact = top_assignment(body.mesh);
+  auto start = Clock::now();
+  BodySolver solver(std::move(body));
+  const double setup_measured = seconds_since(start);
+  start = Clock::now();
+  solver.assign_contact(contact);
+  const double assignment_measured = seconds_since(start);
+  const BodyTimings& timings = solver.timings();
+  for (const double seconds : {timings.assembly_seconds, timings.ordering_seconds,
+                               timings.factorization_seconds, timings.interface_seconds}) {
+    EXPECT_TRUE(std::isfinite(seconds) && seconds >= 0.0) << seconds;
+  }
+  // each stage did work, so a steady clock saw it take time
+  EXPECT_GT(timings.assembly_seconds, 0.0);
+  EXPECT_GT(timings.ordering_seconds, 0.0);
+  EXPECT_GT(timings.factorization_seconds, 0.0);
+  EXPECT_DOUBLE_EQ(timings.setup_seconds(), timings.assembly_seconds + timings.ordering_seconds +
+                                                timings.factorization_seconds);
+  EXPECT_LE(timings.setup_seconds(), setup_measured);
+  EXPECT_LE(timings.interface_seconds, assignment_measured);
 }
 
 TEST(BodySolver, CorrectionEqualsTheIndependentSolve) {

@@ -24,9 +24,12 @@
 #include <google/protobuf/unknown_field_set.h>
 
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -348,10 +351,10 @@ TEST(SubdomainServer, FullRunMatchesADirectlyBuiltBodySolver) {
   ASSERT_TRUE(reply.has_hello_reply()) << reply.DebugString();
   EXPECT_EQ(reply.hello_reply().state(), "awaiting_setup");
   EXPECT_NE(reply.hello_reply().server_name().find("unit test"), std::string::npos);
-  EXPECT_EQ(
-      std::vector<std::string>(reply.hello_reply().capabilities().begin(),
-                               reply.hello_reply().capabilities().end()),
-      (std::vector<std::string>{"contact_solve", "correction_solve", "fields", "neumann_solve", "status"}));
+  EXPECT_EQ(std::vector<std::string>(reply.hello_reply().capabilities().begin(),
+                                     reply.hello_reply().capabilities().end()),
+            (std::vector<std::string>{"contact_solve", "correction_solve", "fields",
+                                      "neumann_solve", "status"}));
 
   reply = exchange(server, setup_request(2, lower_block_setup()));
   ASSERT_TRUE(reply.has_interface()) << reply.DebugString();
@@ -1379,9 +1382,9 @@ TEST(SubdomainServer, SetLoadFactorScalesTheLoadsAndKeepsTheStateAndF) {
   EXPECT_EQ(reply.load_factor_set().factor(), -1.5);
   reply = exchange(server, load_factor_request(6, 2.5));
   ASSERT_TRUE(reply.has_load_factor_set());
-  for (const double bad : {std::numeric_limits<double>::quiet_NaN(),
-                           std::numeric_limits<double>::infinity(),
-                           -std::numeric_limits<double>::infinity(), 1e7, -2e6}) {
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+        -std::numeric_limits<double>::infinity(), 1e7, -2e6}) {
     reply = exchange(server, load_factor_request(7, bad));
     expect_error(reply, protocol::BAD_INPUT, "ready");
     EXPECT_NE(reply.error().message().find("SetLoadFactor.factor"), std::string::npos)
@@ -1418,10 +1421,80 @@ TEST(SubdomainServer, SetLoadFactorIsUnsupportedByAProtocol20Server) {
   settings.protocol_minor = 0;
   SubdomainServer server(settings);
   protocol::Envelope reply;
-  EXPECT_TRUE(reply.ParseFromString(server.handle(load_factor_request(1, 2.0).SerializeAsString())));
+  EXPECT_TRUE(
+      reply.ParseFromString(server.handle(load_factor_request(1, 2.0).SerializeAsString())));
   expect_error(reply, protocol::UNSUPPORTED, "awaiting_setup");
   EXPECT_NE(reply.error().message().find("protocol 2.1"), std::string::npos)
       << reply.error().message();
+}
+
+/// The StageTime entries of a reply by stage name; each stage at most once, every time finite
+/// and non-negative.
+template <typename StageTimes>
+std::map<std::string, double> stage_times(const StageTimes& entries) {
+  std::map<std::string, double> stages;
+  for (const protocol::StageTime& entry : entries) {
+    EXPECT_TRUE(stages.emplace(entry.stage(), entry.seconds()).second) << entry.stage();
+    EXPECT_TRUE(std::isfinite(entry.seconds()) && entry.seconds() >= 0.0) << entry.stage();
+  }
+  return stages;
+}
+
+/// The names of a stage map.
+std::set<std::string> names_of(const std::map<std::string, double>& stages) {
+  std::set<std::string> names;
+  for (const auto& [name, seconds] : stages) names.insert(name);
+  return names;
+}
+
+TEST(SubdomainServer, RepliesCarryTheStageTimesOfProtocol22) {
+  SubdomainServer server(quiet_settings());
+  const auto start = std::chrono::steady_clock::now();
+  const protocol::Envelope setup = exchange(server, setup_request(1, lower_block_setup()));
+  const double measured =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(setup.has_interface());
+  const protocol::InterfaceDescription& interface = setup.interface();
+  const std::map<std::string, double> stages = stage_times(interface.stage_times());
+  EXPECT_EQ(names_of(stages),
+            (std::set<std::string>{"mesh", "assembly", "ordering", "factorization"}));
+  double sum = 0.0;
+  for (const auto& [name, seconds] : stages) sum += seconds;
+  // the stages lie within the request, the request within the test's own measurement of it
+  EXPECT_LE(sum, interface.request_seconds());
+  EXPECT_LE(interface.request_seconds(), measured);
+  EXPECT_DOUBLE_EQ(interface.setup_seconds(),
+                   stages.at("assembly") + stages.at("ordering") + stages.at("factorization"));
+
+  const InterfaceDescription body_interface =
+      BodySolver(lower_block_definition()).contact_boundary();
+  const protocol::Envelope acknowledge = exchange(server, assign_all_request(2, body_interface));
+  ASSERT_TRUE(acknowledge.has_acknowledge());
+  EXPECT_EQ(names_of(stage_times(acknowledge.acknowledge().stage_times())),
+            std::set<std::string>{"interface operator"});
+  const protocol::Envelope fields = exchange(server, fields_request(3, ""));
+  ASSERT_TRUE(fields.has_fields_reply());
+  EXPECT_EQ(names_of(stage_times(fields.fields_reply().stage_times())),
+            std::set<std::string>{"fields"});
+}
+
+TEST(SubdomainServer, AProtocol21ServerSendsNoStageTimes) {
+  ServerSettings settings = quiet_settings();
+  settings.protocol_minor = 1;
+  SubdomainServer server(settings);
+  const auto handle = [&server](const protocol::Envelope& envelope) {
+    protocol::Envelope reply;
+    EXPECT_TRUE(reply.ParseFromString(server.handle(envelope.SerializeAsString())));
+    return reply;
+  };
+  const protocol::Envelope setup = handle(setup_request(1, lower_block_setup()));
+  ASSERT_TRUE(setup.has_interface());
+  EXPECT_EQ(setup.interface().stage_times_size(), 0);
+  EXPECT_EQ(setup.interface().request_seconds(), 0.0);
+  EXPECT_GT(setup.interface().setup_seconds(), 0.0);
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  EXPECT_EQ(handle(assign_all_request(2, interface)).acknowledge().stage_times_size(), 0);
+  EXPECT_EQ(handle(fields_request(3, "")).fields_reply().stage_times_size(), 0);
 }
 
 }  // namespace
