@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -22,8 +23,10 @@
 #include "coupling/result_directory.hpp"
 #include "coupling/result_files.hpp"
 #include "coupling/robin_iteration.hpp"
+#include "coupling/run_profile.hpp"
 #include "coupling/step_outputs.hpp"
 #include "numerics/errors.hpp"
+#include "remote/progress_display.hpp"
 #include "remote/run_interruption.hpp"
 #include "remote/stop_signal_watcher.hpp"
 
@@ -66,7 +69,8 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
          {"factor_nonzeros", body->factor_nonzeros()},
          {"applied_force", {body->applied_force().x(), body->applied_force().y()}}});
     assembly += body->timings().assembly_seconds;
-    factorization += body->timings().factorization_seconds + body->timings().interface_seconds;
+    factorization += body->timings().ordering_seconds + body->timings().factorization_seconds +
+                     body->timings().interface_seconds;
   }
   summary["timings"] = {{"mesh", problem.mesh_seconds},
                         {"assembly", assembly},
@@ -108,6 +112,13 @@ void write_outputs(const std::filesystem::path& directory, const LocalProblem& p
 
 int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
                     std::chrono::steady_clock::time_point start);
+
+/// How the bodies' meshing and setup are shown (set by main).
+std::shared_ptr<robin::ProgressDisplay>& progress_display() {
+  static std::shared_ptr<robin::ProgressDisplay> display =
+      std::make_shared<robin::ProgressDisplay>(robin::ProgressOutput::plain);
+  return display;
+}
 
 /// The result directory in which a stop signal records "interrupted" (on_stop_signal): set
 /// while the run computes; null before, and once its files are committed or its failure
@@ -181,23 +192,43 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
   }
 }
 
+/// prepare_local_problem, showing each body's meshing and setup stages as they begin (with the
+/// body's DOFs and the seconds since its setup began): a long setup never looks hung.
+LocalProblem prepare_with_progress(const robin::CaseDefinition& definition) {
+  auto log = spdlog::get("monolithic");
+  const std::shared_ptr<robin::ProgressDisplay> display = progress_display();
+  display->set_bodies({definition.bodies[0].definition.name, definition.bodies[1].definition.name});
+  robin::CaseDefinition observed = definition;
+  observed.meshing = robin::meshing_reporter(definition, display, log);
+  std::map<std::string, std::chrono::steady_clock::time_point> setup_started;
+  LocalProblem problem = robin::prepare_local_problem(
+      observed, [&](const std::string& body, robin::SetupStage stage, long dof_count) {
+        const auto now = std::chrono::steady_clock::now();
+        const auto started = setup_started.emplace(body, now).first->second;
+        const double seconds = std::chrono::duration<double>(now - started).count();
+        display->update(
+            body, {robin::to_string(stage), dof_count, seconds},
+            fmt::format("body '{}': {} ({} DOFs)", body, robin::to_string(stage), dof_count), *log);
+      });
+  display->finish();
+  return problem;
+}
+
 /// Solves the case (all its load steps) and commits the result files with summary.json.
 int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
                     std::chrono::steady_clock::time_point start) {
+  const double launched = robin::seconds_launched();  // the profile's "launch"
   auto log = spdlog::get("monolithic");
   const std::filesystem::path& case_path = definition.file;
   log->info("case {}: bodies '{}' and '{}'", case_path.string(),
             definition.bodies[0].definition.name, definition.bodies[1].definition.name);
   log->info("reading and meshing both bodies");
-  // a line per setup stage of each body: a long setup never looks hung
-  const LocalProblem problem = robin::prepare_local_problem(
-      definition, [&log](const std::string& body, robin::SetupStage stage, long dof_count) {
-        log->info("body '{}': {} ({} DOFs)", body, robin::to_string(stage), dof_count);
-      });
+  const LocalProblem problem = prepare_with_progress(definition);
   for (const auto& body : problem.bodies) {
     log->info("body '{}': {} dofs, assembly {:.3f} s, factorization {:.3f} s ({} nonzeros in L)",
               body->name(), body->free_dof_count(), body->timings().assembly_seconds,
-              body->timings().factorization_seconds, body->factor_nonzeros());
+              body->timings().ordering_seconds + body->timings().factorization_seconds,
+              body->factor_nonzeros());
   }
   log->info("{}", robin::describe_contact(problem.pairing, problem.bodies[0]->name(),
                                           problem.bodies[1]->name()));
@@ -231,8 +262,13 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
   {
     // a stop signal now waits for the complete results
     const std::lock_guard<std::mutex> lock(active_results().mutex);
+    const auto output_start = std::chrono::steady_clock::now();
     write_outputs(results.staging(), problem, result);
     if (!steps.empty()) robin::write_monolithic_step_outputs(results.staging(), problem, steps);
+    const double output_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - output_start).count();
+    summary["profile"] =
+        robin::monolithic_profile_json(problem, launched, steps, result, output_seconds);
     results.commit(summary);
     active_results().results = nullptr;
   }
@@ -281,19 +317,23 @@ int main(int argc, char** argv) {
       "did not converge (results are written).");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
 
-  auto log = spdlog::stderr_color_mt("monolithic");
-  log->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%^%l%$] %v");
-  log->set_level(spdlog::level::from_str(quiet ? "warn" : level));
+  progress_display() =
+      std::make_shared<robin::ProgressDisplay>(robin::progress_output_of_this_process(quiet));
+  auto log =
+      robin::make_progress_logger("monolithic", quiet ? "warn" : level, progress_display().get());
   robin::install_stop_signal_handlers();
   const robin::StopSignalWatcher watcher(on_stop_signal);
   try {
     return run(case_path, overrides, output,
                overwrite ? robin::ExistingResults::overwrite : robin::ExistingResults::refuse);
   } catch (const robin::InputError& error) {
+    progress_display()->finish();  // the error goes below the status lines
     log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const robin::SingularBodyError& error) {
+    progress_display()->finish();
     log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const std::exception& error) {
+    progress_display()->finish();
     log->error("failed: {}", error.what());
   }
   return 1;
