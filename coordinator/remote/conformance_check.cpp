@@ -31,6 +31,7 @@ using protocol::Envelope;
 
 const std::vector<std::string> core_capabilities = {"contact_solve", "correction_solve", "fields"};
 constexpr const char* neumann_solve_capability = "neumann_solve";  // optional, protocol 1.1
+constexpr const char* status_capability = "status";                // optional, protocol 2.1
 constexpr unsigned run_id_minor = 2;  // Envelope.run_id and its rule: since protocol 1.2
 const std::vector<std::string> state_names = {"awaiting_setup", "awaiting_assignment", "ready"};
 
@@ -56,6 +57,7 @@ class ServerChecks {
     run_solve_checks();
     run_neumann_solve_checks();
     run_load_factor_checks();
+    run_status_checks();
     run_run_control_checks();
     run_if_load_factor("load_factor_before_setup", [this] {
       return refused(load_factor_request(2.0), "SetLoadFactor after EndRun",
@@ -81,6 +83,10 @@ class ServerChecks {
   void run_load_factor_checks();
   void run_if_load_factor(const std::string& name, const std::function<std::string()>& check);
   std::string load_factor_scaling();
+  /// StatusRequest (protocol 2.1, optional "status"): answered from the server's progress
+  /// record when announced, refused otherwise. Runs in state ready, between requests.
+  void run_status_checks();
+  std::string idle_status();
   /// Runs a check of the optional Neumann solve, only when the server announced it.
   void run_if_neumann(const std::string& name, const std::function<std::string()>& check);
 
@@ -137,10 +143,11 @@ class ServerChecks {
   std::optional<Eigen::VectorXd> free_trace_;  // e: u_N of the far-obstacle contact solve
   bool capabilities_known_ = false;            // a HelloReply to 'hello' arrived
   bool neumann_offered_ = false;               // HelloReply.capabilities has "neumann_solve"
+  bool status_offered_ = false;                // HelloReply.capabilities has "status"
   unsigned server_major_ = 0;                  // the version of the HelloReply
   unsigned server_minor_ = 0;
-  Eigen::VectorXd first_force_;                // r1 of 'correction_linearity'
-  Eigen::VectorXd first_response_;             // its reply w(r1)
+  Eigen::VectorXd first_force_;     // r1 of 'correction_linearity'
+  Eigen::VectorXd first_response_;  // its reply w(r1)
 };
 
 const std::vector<ContactNode>& ServerChecks::require_interface() const {
@@ -243,6 +250,7 @@ std::string ServerChecks::hello() {
   server_minor_ = exchange.reply->version().minor();
   neumann_offered_ =
       std::find(offered.begin(), offered.end(), neumann_solve_capability) != offered.end();
+  status_offered_ = std::find(offered.begin(), offered.end(), status_capability) != offered.end();
   if (std::find(state_names.begin(), state_names.end(), reply.state()) == state_names.end()) {
     problems.push_back("HelloReply.state '" + reply.state() + "' is not a state name (" +
                        join(state_names, ", ") + ")");
@@ -802,6 +810,71 @@ std::string ServerChecks::fields_pair_order() {
     }
   }
   return "";
+}
+
+// Status (protocol 2.1, optional): what the server is doing, answered between requests too.
+
+Envelope status_request() {
+  Envelope envelope;
+  envelope.mutable_status_request();
+  return envelope;
+}
+
+void ServerChecks::run_status_checks() {
+  if (!capabilities_known_) {
+    session_.run("status", []() -> std::string {
+      throw NotChecked("needs HelloReply.capabilities (see 'hello')");
+    });
+    return;
+  }
+  if (!status_offered_) {
+    session_.record_note("status", "not announced: StatusRequest must be refused");
+    session_.run("status_unannounced_refused", [this] {
+      require_assignment();
+      return refused(status_request(), "StatusRequest to a server without \"status\"",
+                     {protocol::UNSUPPORTED, protocol::MALFORMED_MESSAGE}, "ready");
+    });
+    return;
+  }
+  session_.record_note("status", "announced: checked");
+  session_.run("status_idle", [this] { return idle_status(); });
+}
+
+/// Between requests, in state ready after the setup of the conformance body: not busy, no
+/// request or stage, no queue, the body's name and its 2 degrees of freedom per node (at least
+/// the free ones of InterfaceDescription.dof_count), state "ready".
+std::string ServerChecks::idle_status() {
+  require_assignment();
+  const std::string what = "StatusRequest in state ready, between requests";
+  const Exchange exchange = session_.request(status_request(), what);
+  if (!exchange.reply) return what + ": " + exchange.problem;
+  if (!exchange.reply->has_status_reply()) {
+    return what + ": expected StatusReply, got " + describe(*exchange.reply);
+  }
+  const protocol::StatusReply& status = exchange.reply->status_reply();
+  std::vector<std::string> problems;
+  if (status.state() != "ready") problems.push_back("state '" + status.state() + "'");
+  if (status.busy() || !status.request_type().empty() || !status.stage().empty()) {
+    problems.push_back("busy " + std::string(status.busy() ? "true" : "false") +
+                       " with request_type '" + status.request_type() + "' and stage '" +
+                       status.stage() + "' while no request is being handled");
+  }
+  if (status.queued_requests() != 0) {
+    problems.push_back(std::to_string(status.queued_requests()) + " queued requests");
+  }
+  if (status.body_name() != body_name) {
+    problems.push_back("body_name '" + status.body_name() + "', expected '" + body_name + "'");
+  }
+  if (status.dof_count() < static_cast<std::uint64_t>(2 * contact_count())) {
+    problems.push_back("dof_count " + std::to_string(status.dof_count()) +
+                       ", fewer than the 2 per contact node");
+  }
+  if (!(status.request_seconds() == 0.0 && status.stage_seconds() == 0.0)) {
+    problems.push_back("request_seconds " + number(status.request_seconds()) +
+                       " and stage_seconds " + number(status.stage_seconds()) +
+                       " while idle (0 expected)");
+  }
+  return problems.empty() ? "" : what + ": " + join(problems, "; ");
 }
 
 // Load steps (protocol 2.1): SetLoadFactor scales the loads and the prescribed displacements.

@@ -240,6 +240,12 @@ TEST(PythonServer, PassesTheConformanceCheckIncludingTheNeumannSolve) {
     ASSERT_NE(found, report.checks.end()) << name;
     EXPECT_TRUE(found->passed) << name << ": " << found->explanation;
   }
+  // It does not announce the optional "status" and must refuse StatusRequest.
+  const auto refused = std::find_if(
+      report.checks.begin(), report.checks.end(),
+      [](const ConformanceCheck& check) { return check.name == "status_unannounced_refused"; });
+  ASSERT_NE(refused, report.checks.end());
+  EXPECT_TRUE(refused->passed) << refused->explanation;
 }
 
 /// Sends `frames` on a REQ socket and parses the reply.
