@@ -359,7 +359,7 @@ void load_meshes(CaseDefinition& definition) {
   }
   std::vector<Mesh> meshes;
   try {
-    meshes = read_gmsh_meshes(requests);
+    meshes = read_gmsh_meshes(requests, definition.meshing);
   } catch (const InputError& error) {
     throw mesh_error(bodies, error);
   }

@@ -92,6 +92,9 @@ struct CaseDefinition {
   std::vector<std::string> overrides;
   LoadingOptions loading;  // [loading]: quasi-static load steps (none: one solve at factor 1)
   std::optional<ReferenceSolution> reference;  // [reference]: an analytic solution, for plots
+  /// Not from the file: told as load_meshes meshes or reads each body's mesh (the request index
+  /// is the body's index), for the tools' progress lines. Empty: nobody is told.
+  MeshReadObserver meshing;
 };
 
 /// The acceleration options with the per-body relaxations resolved (relaxation1/2, else
@@ -118,7 +121,8 @@ CaseDefinition read_case_file(const std::filesystem::path& path,
 BodyDefinition load_body(const BodyCase& body);
 
 /// Reads every body's mesh into its definition at once (read_gmsh_meshes: each .geo meshed in a
-/// process of its own, concurrently) and checks every boundary name, as load_body does.
+/// process of its own, concurrently; definition.meshing is told as it goes) and checks every
+/// boundary name, as load_body does.
 void load_meshes(CaseDefinition& definition);
 
 }  // namespace robin

@@ -88,12 +88,20 @@ std::shared_ptr<spdlog::logger> coordinator_logger() {
   return log ? log : make_coordinator_logger("info");
 }
 
+/// The run's display; a plain one when the settings have none.
+std::shared_ptr<ProgressDisplay> display_of(const CoordinatorSettings& settings) {
+  return settings.display ? settings.display
+                          : std::make_shared<ProgressDisplay>(ProgressOutput::plain);
+}
+
 RunObserver make_observer(const std::shared_ptr<spdlog::logger>& log,
-                          const CouplingOptions& options) {
+                          const CouplingOptions& options,
+                          const std::shared_ptr<ProgressDisplay>& display) {
   RunObserver observer;
   observer.stage = [log](const std::string& text) { log->info("{}", text); };
   observer.warning = [log](const std::string& text) { log->warn("{}", text); };
-  observer.iteration = [log, options](const IterationRecord& record) {
+  observer.iteration = [log, options, display](const IterationRecord& record) {
+    display->finish();  // the setup is over: its status lines stay as they are
     log->info("{}", progress_line(record, options));
     throw_if_stop_requested();
   };
@@ -114,32 +122,36 @@ std::pair<double, std::string> stopping_value(const IterationRecord& record,
   return value;
 }
 
-/// Logs each server's progress during setup and fields from its StatusReplies: a line when a
-/// stage begins (with the body's DOFs) and, while a stage lasts, one every 10 s, so that a long
-/// setup never looks hung. One reporter per port (it keeps that port's last stage).
+/// Shows each server's progress during setup and fields from its StatusReplies. Plain: a line
+/// when a stage begins (with the body's DOFs) and, while a stage lasts, one every 10 s, so that
+/// a long setup never looks hung; live: the body's status line, rewritten at every reply. One
+/// reporter per port (it keeps that port's last stage).
 std::function<void(const std::string&, const std::string&, const ServerStatus&)> progress_reporter(
-    const std::shared_ptr<spdlog::logger>& log) {
+    const std::shared_ptr<spdlog::logger>& log, const std::shared_ptr<ProgressDisplay>& display) {
   struct Shown {
     std::string stage;
     double reported_at = 0.0;  // stage_seconds of the last line about this stage
   };
   auto shown = std::make_shared<Shown>();
-  return
-      [log, shown](const std::string& body, const std::string& step, const ServerStatus& status) {
-        if (!status.busy || status.stage.empty()) return;
-        const std::string dofs =
-            status.dof_count > 0 ? fmt::format(" ({} DOFs)", status.dof_count) : std::string();
-        if (status.stage != shown->stage) {
-          shown->stage = status.stage;
-          shown->reported_at = status.stage_seconds;
-          log->info("body '{}' {}: {}{}, {:.1f} s into the request", body, step, status.stage, dofs,
-                    status.request_seconds);
-        } else if (status.stage_seconds - shown->reported_at >= 10.0) {
-          shown->reported_at = status.stage_seconds;
-          log->info("body '{}' {}: still in {}{} after {:.0f} s", body, step, status.stage, dofs,
-                    status.stage_seconds);
-        }
-      };
+  return [log, shown, display](const std::string& body, const std::string& step,
+                               const ServerStatus& status) {
+    if (!status.busy || status.stage.empty()) return;
+    const std::string dofs =
+        status.dof_count > 0 ? fmt::format(" ({} DOFs)", status.dof_count) : std::string();
+    std::string line;
+    if (status.stage != shown->stage) {
+      shown->stage = status.stage;
+      shown->reported_at = status.stage_seconds;
+      line = fmt::format("body '{}' {}: {}{}, {:.1f} s into the request", body, step, status.stage,
+                         dofs, status.request_seconds);
+    } else if (status.stage_seconds - shown->reported_at >= 10.0) {
+      shown->reported_at = status.stage_seconds;
+      line = fmt::format("body '{}' {}: still in {}{} after {:.0f} s", body, step, status.stage,
+                         dofs, status.stage_seconds);
+    }
+    display->update(body, {step + ": " + status.stage, status.dof_count, status.request_seconds},
+                    line, *log);
+  };
 }
 
 /// Logs how the run ended and where the results are; returns the exit code of its status.
@@ -329,15 +341,9 @@ CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
   return options;
 }
 
-std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level) {
-  spdlog::drop("coordinator");
-  auto log = spdlog::stderr_color_mt("coordinator");
-  log->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%n] [%^%l%$] %v");
-  const auto parsed = spdlog::level::from_str(level);
-  if (parsed == spdlog::level::off && level != "off") {
-    throw std::invalid_argument("unknown log level '" + level + "'");
-  }
-  log->set_level(parsed);
+std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level,
+                                                        const ProgressDisplay* display) {
+  auto log = make_progress_logger("coordinator", level, display);
   spdlog::set_default_logger(log);
   return log;
 }
@@ -437,6 +443,10 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
                     const std::array<ChannelOptions, 2>& channels, const ServerRestart& restart) {
   auto log = coordinator_logger();
   const CouplingOptions options = merged_coupling_options(definition.coupling, settings);
+  const std::shared_ptr<ProgressDisplay> display = display_of(settings);
+  display->set_bodies({definition.bodies[0].definition.name, definition.bodies[1].definition.name});
+  CaseDefinition observed = definition;  // tells the display as each body's mesh is made
+  observed.meshing = meshing_reporter(definition, display, log);
   std::unique_ptr<ResultDirectory> results;
   const ExistingResults policy = settings.resume      ? ExistingResults::resume
                                  : settings.overwrite ? ExistingResults::overwrite
@@ -462,7 +472,7 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     port_options.setup_timeout_seconds = options.setup_timeout_seconds;
     port_options.channel = channels[alpha];
     port_options.heartbeat_timeout_seconds = settings.heartbeat_timeout_seconds;
-    port_options.on_status = progress_reporter(log);
+    port_options.on_status = progress_reporter(log, display);
     const std::string& body = definition.bodies[alpha].definition.name;
     ports[alpha] = std::make_unique<RemotePort>(endpoint, body, port_options);
     log->info("body {} '{}' on server {}", alpha + 1, body, endpoint);
@@ -515,15 +525,18 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
   try {
     for (int alpha = 0; alpha < 2; ++alpha) make_port(alpha, endpoints[alpha]);
     const CoupledRunResult result =
-        run_coupled_case(definition, {ports[0].get(), ports[1].get()}, options,
-                         make_observer(log, options), continuation);
+        run_coupled_case(observed, {ports[0].get(), ports[1].get()}, options,
+                         make_observer(log, options, display), continuation);
+    display->finish();
     write_coupled_outputs(*results, definition, result);
     code = report_outcome(result, settings, *log);
   } catch (const InputError& error) {  // e.g. unmatched contact nodes: name the case file
+    display->finish();
     const InputError named(in_case_file(definition.file, error.what()));
     code = failure_exit_code(named);
     results->fail(stop_signal() != 0 ? RunFailure::interrupted : RunFailure::failed, named.what());
   } catch (const std::exception& error) {
+    display->finish();
     code = failure_exit_code(error);
     results->fail(stop_signal() != 0 ? RunFailure::interrupted : RunFailure::failed, error.what());
   }

@@ -20,6 +20,7 @@
 #include "coupling/case_file.hpp"
 #include "coupling/checkpoint.hpp"
 #include "coupling/robin_iteration.hpp"
+#include "remote/progress_display.hpp"
 #include "remote/request_channel.hpp"
 
 namespace spdlog {
@@ -63,6 +64,9 @@ struct CoordinatorSettings {
   /// --server-grace-period (robin-coordinator): how long to wait for a lost server to answer
   /// at its endpoint again.
   double server_grace_period_seconds = 30.0;
+  /// How the bodies' meshing and setup progress is shown (progress_display.hpp); null: plain
+  /// log lines.
+  std::shared_ptr<ProgressDisplay> display;
 };
 
 /// How run_coordinator replaces the server of a body that was lost mid-run (robin-run:
@@ -85,9 +89,11 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings);
 CouplingOptions merged_coupling_options(const CouplingOptions& from_case,
                                         const CoordinatorSettings& settings);
 
-/// Creates the logger "coordinator" (standard error, timestamps, `level`) and makes it the
-/// default logger. Throws std::invalid_argument for an unknown level.
-std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level);
+/// Creates the logger "coordinator" (standard error, timestamps, `level`; through `display`'s
+/// sink when it is live) and makes it the default logger. Throws std::invalid_argument for an
+/// unknown level.
+std::shared_ptr<spdlog::logger> make_coordinator_logger(const std::string& level,
+                                                        const ProgressDisplay* display = nullptr);
 
 /// One line per iteration: the value the stopping test compares with the tolerance (the
 /// smallest of the joint state's and the obstacle sequences' largest residuals with

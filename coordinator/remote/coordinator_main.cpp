@@ -57,7 +57,10 @@ int main(int argc, char** argv) {
     std::cerr << "robin-coordinator: " << problem << "\nRun with --help for more information.\n";
     return 2;
   }
-  const auto log = robin::make_coordinator_logger(settings.quiet ? "warn" : settings.log_level);
+  settings.display = std::make_shared<robin::ProgressDisplay>(
+      robin::progress_output_of_this_process(settings.quiet));
+  const auto log = robin::make_coordinator_logger(settings.quiet ? "warn" : settings.log_level,
+                                                  settings.display.get());
   robin::install_stop_signal_handlers();
   std::vector<std::optional<robin::CurveClientKeys>> curve_keys;
   try {

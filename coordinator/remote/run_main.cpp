@@ -158,7 +158,10 @@ int main(int argc, char** argv) {
     }
   }
   // --quiet quietens this terminal; the servers' log files keep --log-level.
-  robin::make_coordinator_logger(settings.quiet ? "warn" : settings.log_level);
+  settings.display = std::make_shared<robin::ProgressDisplay>(
+      robin::progress_output_of_this_process(settings.quiet));
+  robin::make_coordinator_logger(settings.quiet ? "warn" : settings.log_level,
+                                 settings.display.get());
   robin::install_stop_signal_handlers();
   auto definition = robin::load_case(settings);
   if (!definition) return 1;
