@@ -464,12 +464,18 @@ using Clock = std::chrono::steady_clock;
 
 /// Blocks until one of the children `pending` (indices into `children`) has written to or
 /// closed its error pipe (it is ending) and returns its index; the first on a poll error.
+/// Calls `waiting` (when set) about once a second meanwhile.
 std::size_t next_ended_child(const std::vector<std::optional<MeshingChild>>& children,
-                             const std::vector<std::size_t>& pending) {
+                             const std::vector<std::size_t>& pending,
+                             const std::function<void()>& waiting) {
   std::vector<pollfd> pipes;
   for (const std::size_t k : pending) pipes.push_back({children[k]->error_pipe, POLLIN, 0});
   for (;;) {
-    const int ready = poll(pipes.data(), pipes.size(), -1);
+    const int ready = poll(pipes.data(), pipes.size(), 1000);
+    if (ready == 0) {
+      if (waiting) waiting();
+      continue;
+    }
     if (ready < 0 && errno == EINTR) continue;
     if (ready < 0) return pending.front();
     for (std::size_t i = 0; i < pipes.size(); ++i) {
@@ -560,7 +566,7 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
     if (children[k]) pending.push_back(k);
   }
   while (!pending.empty()) {
-    const std::size_t k = next_ended_child(children, pending);
+    const std::size_t k = next_ended_child(children, pending, observer.waiting);
     pending.erase(std::find(pending.begin(), pending.end(), k));
     const std::string error = finish_meshing_child(*children[k], requests[k]);
     if (!error.empty() && first_error.empty()) first_error = error;

@@ -40,6 +40,8 @@ struct MeshFileRequest {
 struct MeshReadObserver {
   std::function<void(std::size_t request)> started;
   std::function<void(std::size_t request, const Mesh& mesh, double seconds)> finished;
+  /// Called about once a second while meshing children are still running.
+  std::function<void()> waiting;
 };
 
 /// Reads several mesh files at once, each as read_gmsh_mesh reads it. Gmsh holds one model per
