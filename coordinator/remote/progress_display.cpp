@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
@@ -164,29 +165,60 @@ void ProgressDisplay::finish() {
   if (sink_) sink_->finish();
 }
 
+namespace {
+
+/// What meshing_reporter keeps about one body's mesh.
+struct BodyMesh {
+  std::string name;
+  std::filesystem::path path;
+  double size = 0.0;
+  std::chrono::steady_clock::time_point started;
+  bool meshing = false;
+  double reported_at = 0.0;  // seconds of the last plain "still meshing" line
+};
+
+/// Every 10 s of a body's meshing: "body 'upper': still meshing after 20 s" (plain); live, the
+/// seconds of its status line.
+void report_still_meshing(std::vector<BodyMesh>& bodies, ProgressDisplay& display,
+                          spdlog::logger& log) {
+  const auto now = std::chrono::steady_clock::now();
+  for (BodyMesh& body : bodies) {
+    if (!body.meshing) continue;
+    const double seconds = std::chrono::duration<double>(now - body.started).count();
+    std::string line;
+    if (seconds - body.reported_at >= 10.0) {
+      body.reported_at = seconds;
+      std::ostringstream text;
+      text << "body '" << body.name << "': still meshing after " << static_cast<long>(seconds)
+           << " s";
+      line = text.str();
+    }
+    display.update(body.name, {"meshing", 0, seconds}, line, log);
+  }
+}
+
+}  // namespace
+
 MeshReadObserver meshing_reporter(const CaseDefinition& definition,
                                   const std::shared_ptr<ProgressDisplay>& display,
                                   const std::shared_ptr<spdlog::logger>& log) {
-  struct BodyMesh {
-    std::string name;
-    std::filesystem::path path;
-    double size = 0.0;
-  };
-  std::vector<BodyMesh> bodies;
+  auto bodies = std::make_shared<std::vector<BodyMesh>>();
   for (const BodyCase& body : definition.bodies) {
-    bodies.push_back({body.definition.name, body.mesh_path, body.mesh_options.size});
+    bodies->push_back({body.definition.name, body.mesh_path, body.mesh_options.size, {}});
   }
   MeshReadObserver observer;
   observer.started = [bodies, display, log](std::size_t index) {
-    if (index >= bodies.size()) return;
-    const BodyMesh& body = bodies[index];
-    const bool geo = is_geo(body.path);
-    display->update(body.name, {geo ? "meshing" : "reading the mesh", 0, 0.0},
+    if (index >= bodies->size()) return;
+    BodyMesh& body = (*bodies)[index];
+    body.started = std::chrono::steady_clock::now();
+    body.meshing = is_geo(body.path);
+    display->update(body.name, {body.meshing ? "meshing" : "reading the mesh", 0, 0.0},
                     meshing_started_line(body.name, body.path, body.size), *log);
   };
   observer.finished = [bodies, display, log](std::size_t index, const Mesh& mesh, double seconds) {
-    if (index >= bodies.size()) return;
-    const BodyMesh& body = bodies[index];
+    if (index >= bodies->size()) return;
+    BodyMesh& body = (*bodies)[index];
+    body.meshing = false;
     std::ostringstream stage;
     stage << (is_geo(body.path) ? "meshed, " : "read, ") << mesh.node_count() << " nodes, "
           << mesh.element_count() << " elements";
@@ -195,6 +227,7 @@ MeshReadObserver meshing_reporter(const CaseDefinition& definition,
                                           mesh.element_count(), seconds),
                     *log);
   };
+  observer.waiting = [bodies, display, log] { report_still_meshing(*bodies, *display, *log); };
   return observer;
 }
 

@@ -108,7 +108,8 @@ class ProgressDisplay {
 };
 
 /// Reports the meshing of `definition`'s bodies (set as its `meshing` observer): their
-/// meshing_started_line and meshing_finished_line, or live their status lines.
+/// meshing_started_line, "body 'upper': still meshing after 10 s" every 10 s, and
+/// meshing_finished_line; live, their status lines with the seconds so far.
 MeshReadObserver meshing_reporter(const CaseDefinition& definition,
                                   const std::shared_ptr<ProgressDisplay>& display,
                                   const std::shared_ptr<spdlog::logger>& log);
