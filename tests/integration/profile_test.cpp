@@ -6,7 +6,8 @@
 //    test measured around the robin-run process;
 //  - robin-coordinator against a server playing protocol 2.1 (no stage times) and the Python
 //    server (no separate ordering): what was not reported is null, what was is a number;
-//  - robin-monolithic writes the same keys, its bodies' server-only stages null.
+//  - robin-monolithic writes the same keys, its bodies' server-only stages null, its bodies'
+//    setups (one after the other) within its setup stage.
 // No time is compared with a fixed threshold.
 
 #include <gtest/gtest.h>
@@ -131,6 +132,37 @@ TEST(RunProfile, WhatAServerDidNotReportIsNull) {
   for (const char* key : {"transfer", "interface_operator", "fields"}) {
     seconds_of(python, key);
   }
+}
+
+TEST(RunProfile, RobinMonolithicWritesTheSameKeys) {
+  const TemporaryDirectory directory("profile-monolithic");
+  const std::filesystem::path output = directory.path() / "run";
+  std::filesystem::create_directories(directory.path() / "logs");
+  const auto start = std::chrono::steady_clock::now();
+  const auto outcome = run_tool(
+      "robin-monolithic",
+      {example("two_blocks_partial.toml").string(), "--output", output.string(), "--quiet"},
+      directory.path() / "logs", 300.0);
+  const double wall = testing::seconds_since(start);
+  ASSERT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
+  json profile = read_summary(output)["profile"];
+  ASSERT_TRUE(profile.is_object());
+  expect_not_reported(profile, "fields");  // computed while writing the output
+  profile["fields"] = 0.0;
+  EXPECT_LE(coordinator_sum(profile), wall) << profile.dump(1);
+  ASSERT_EQ(profile["bodies"].size(), 2u);
+  double setups = 0.0;
+  for (const json& body : profile["bodies"]) {
+    for (const char* key : {"mesh", "transfer", "fields"}) expect_not_reported(body, key);
+    double stages = 0.0;
+    for (const char* key : {"assembly", "ordering", "factorization"}) {
+      stages += seconds_of(body, key);
+    }
+    EXPECT_NEAR(stages, seconds_of(body, "server_setup"), 1e-12 * stages);
+    EXPECT_LE(seconds_of(body, "interface_operator"), seconds_of(profile, "contact_assignment"));
+    setups += stages;
+  }
+  EXPECT_LE(setups, seconds_of(profile, "setup"));  // the bodies one after the other
 }
 
 }  // namespace
