@@ -314,7 +314,7 @@ int main(int argc, char** argv) {
   robin::add_version_option(app, "robin-monolithic");
   app.footer(
       "Exit codes: 0 converged; 1 bad input or a failure; 2 bad command line; 3 the contact QP "
-      "did not converge (results are written).");
+      "did not converge (results are written); 130/143 stopped by SIGINT/SIGTERM.");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
 
   progress_display() =
