@@ -111,14 +111,8 @@ void write_outputs(const std::filesystem::path& directory, const LocalProblem& p
 }
 
 int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
-                    std::chrono::steady_clock::time_point start);
-
-/// How the bodies' meshing and setup are shown (set by main).
-std::shared_ptr<robin::ProgressDisplay>& progress_display() {
-  static std::shared_ptr<robin::ProgressDisplay> display =
-      std::make_shared<robin::ProgressDisplay>(robin::ProgressOutput::plain);
-  return display;
-}
+                    std::chrono::steady_clock::time_point start,
+                    const std::shared_ptr<robin::ProgressDisplay>& display);
 
 /// The result directory in which a stop signal records "interrupted" (on_stop_signal): set
 /// while the run computes; null before, and once its files are committed or its failure
@@ -169,7 +163,8 @@ robin::CaseDefinition read_case(const std::filesystem::path& case_path,
 /// Reads the case, prepares the result directory and solves; a failure after the directory was
 /// prepared is recorded in its summary.json.
 int run(const std::filesystem::path& case_path, const std::vector<std::string>& overrides,
-        const std::filesystem::path& output, robin::ExistingResults existing) {
+        const std::filesystem::path& output, robin::ExistingResults existing,
+        const std::shared_ptr<robin::ProgressDisplay>& display) {
   auto log = spdlog::get("monolithic");
   const auto start = std::chrono::steady_clock::now();
   const robin::CaseDefinition definition = read_case(case_path, overrides, output, existing);
@@ -183,7 +178,7 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
               output.string(), fmt::join(results.leftover_files(), ", "));
   }
   try {
-    return solve_and_write(definition, results, start);
+    return solve_and_write(definition, results, start, display);
   } catch (const std::exception& error) {
     const std::lock_guard<std::mutex> lock(active_results().mutex);
     active_results().results = nullptr;
@@ -194,9 +189,9 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
 
 /// prepare_local_problem, showing each body's meshing and setup stages as they begin (with the
 /// body's DOFs and the seconds since its setup began): a long setup never looks hung.
-LocalProblem prepare_with_progress(const robin::CaseDefinition& definition) {
+LocalProblem prepare_with_progress(const robin::CaseDefinition& definition,
+                                   const std::shared_ptr<robin::ProgressDisplay>& display) {
   auto log = spdlog::get("monolithic");
-  const std::shared_ptr<robin::ProgressDisplay> display = progress_display();
   display->set_bodies({definition.bodies[0].definition.name, definition.bodies[1].definition.name});
   robin::CaseDefinition observed = definition;
   observed.meshing = robin::meshing_reporter(definition, display, log);
@@ -216,14 +211,15 @@ LocalProblem prepare_with_progress(const robin::CaseDefinition& definition) {
 
 /// Solves the case (all its load steps) and commits the result files with summary.json.
 int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
-                    std::chrono::steady_clock::time_point start) {
+                    std::chrono::steady_clock::time_point start,
+                    const std::shared_ptr<robin::ProgressDisplay>& display) {
   const double launched = robin::seconds_launched();  // the profile's "launch"
   auto log = spdlog::get("monolithic");
   const std::filesystem::path& case_path = definition.file;
   log->info("case {}: bodies '{}' and '{}'", case_path.string(),
             definition.bodies[0].definition.name, definition.bodies[1].definition.name);
   log->info("reading and meshing both bodies");
-  const LocalProblem problem = prepare_with_progress(definition);
+  const LocalProblem problem = prepare_with_progress(definition, display);
   for (const auto& body : problem.bodies) {
     log->info("body '{}': {} dofs, assembly {:.3f} s, factorization {:.3f} s ({} nonzeros in L)",
               body->name(), body->free_dof_count(), body->timings().assembly_seconds,
@@ -317,23 +313,23 @@ int main(int argc, char** argv) {
       "did not converge (results are written); 130/143 stopped by SIGINT/SIGTERM.");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
 
-  progress_display() =
+  const auto display =
       std::make_shared<robin::ProgressDisplay>(robin::progress_output_of_this_process(quiet));
-  auto log =
-      robin::make_progress_logger("monolithic", quiet ? "warn" : level, progress_display().get());
+  auto log = robin::make_progress_logger("monolithic", quiet ? "warn" : level, display.get());
   robin::install_stop_signal_handlers();
   const robin::StopSignalWatcher watcher(on_stop_signal);
   try {
     return run(case_path, overrides, output,
-               overwrite ? robin::ExistingResults::overwrite : robin::ExistingResults::refuse);
+               overwrite ? robin::ExistingResults::overwrite : robin::ExistingResults::refuse,
+               display);
   } catch (const robin::InputError& error) {
-    progress_display()->finish();  // the error goes below the status lines
+    display->finish();  // the error goes below the status lines
     log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const robin::SingularBodyError& error) {
-    progress_display()->finish();
+    display->finish();
     log->error("{}", robin::in_case_file(case_path, error.what()));
   } catch (const std::exception& error) {
-    progress_display()->finish();
+    display->finish();
     log->error("failed: {}", error.what());
   }
   return 1;
