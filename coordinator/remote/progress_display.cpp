@@ -2,6 +2,7 @@
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -90,13 +91,13 @@ std::string draw_status_lines(const std::vector<std::string>& lines) {
   return text;
 }
 
-LiveStatusSink::LiveStatusSink(std::size_t body_count, std::FILE* terminal)
-    : lines_(body_count), terminal_(terminal) {}
+LiveStatusSink::LiveStatusSink(std::size_t body_count, std::FILE* terminal, std::size_t columns)
+    : lines_(body_count), terminal_(terminal), columns_(columns) {}
 
 void LiveStatusSink::set_line(std::size_t index, const std::string& text) {
   const std::lock_guard<std::mutex> lock(mutex_);
   if (finished_ || index >= lines_.size()) return;
-  lines_[index] = text;
+  lines_[index] = columns_ > 1 && text.size() >= columns_ ? text.substr(0, columns_ - 1) : text;
   redraw();
 }
 
@@ -141,7 +142,11 @@ void LiveStatusSink::flush_() {
 }
 
 ProgressDisplay::ProgressDisplay(ProgressOutput output, std::size_t body_count) : output_(output) {
-  if (output_ == ProgressOutput::live) sink_ = std::make_shared<LiveStatusSink>(body_count, stderr);
+  if (output_ != ProgressOutput::live) return;
+  winsize size{};
+  const std::size_t columns =
+      ::ioctl(STDERR_FILENO, TIOCGWINSZ, &size) == 0 ? static_cast<std::size_t>(size.ws_col) : 0;
+  sink_ = std::make_shared<LiveStatusSink>(body_count, stderr, columns);
 }
 
 void ProgressDisplay::set_bodies(std::vector<std::string> bodies) {

@@ -64,7 +64,9 @@ std::string draw_status_lines(const std::vector<std::string>& lines);
 /// The live display: a spdlog sink that keeps the status lines below every log line it writes.
 class LiveStatusSink : public spdlog::sinks::base_sink<std::mutex> {
  public:
-  LiveStatusSink(std::size_t body_count, std::FILE* terminal);
+  /// `columns`: the terminal's width (0: unknown); longer status lines are cut to fit, so that
+  /// each takes one row and the cursor movements stay right.
+  LiveStatusSink(std::size_t body_count, std::FILE* terminal, std::size_t columns = 0);
   /// Replaces line `index` and redraws (nothing once finished).
   void set_line(std::size_t index, const std::string& text);
   /// Leaves the status lines as last drawn; later log lines follow below them.
@@ -81,6 +83,7 @@ class LiveStatusSink : public spdlog::sinks::base_sink<std::mutex> {
   std::size_t drawn_ = 0;
   bool finished_ = false;
   std::FILE* terminal_;
+  std::size_t columns_;
 };
 
 /// The progress of the bodies of a run, shown as `output` says (see the file comment).

@@ -88,6 +88,13 @@ TEST(ProgressDisplay, LiveSinkKeepsTheStatusLinesBelowTheLog) {
       draw_status_lines({"upper  meshing  0.0 s", "lower  assembly  10 DOFs  0.1 s"}) + "after\n";
   EXPECT_EQ(file_contents(terminal), expected);
   std::fclose(terminal);
+  // a status line as wide as the terminal is cut to one row
+  std::FILE* narrow = std::tmpfile();
+  ASSERT_NE(narrow, nullptr);
+  LiveStatusSink cut(1, narrow, 10);
+  cut.set_line(0, "cylinder  factorization  69438 DOFs  3.0 s");
+  EXPECT_EQ(file_contents(narrow), draw_status_lines({"cylinder "}));
+  std::fclose(narrow);
 }
 
 TEST(ProgressDisplay, PlainLinesWhenPlainOrFinished) {
