@@ -213,7 +213,6 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
           " (node-to-node pairing needs matching meshes: use [contact] method = \"mortar\" or "
           "\"auto\" for non-matching ones)");
     }
-    require_facing(body1, i, name1, body2, static_cast<std::size_t>(j), name2);
     partner_of_second[j] = static_cast<int>(i);
     ContactPair pair;
     pair.node1 = body1.node_ids[i];
@@ -234,6 +233,9 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
       pairing.excluded_pairs.push_back(pair);
       continue;
     }
+    // After the exclusions: a contact boundary held entirely by Dirichlet conditions is
+    // reported as such (require_constraints_left), whichever way its normals point.
+    require_facing(body1, i, name1, body2, static_cast<std::size_t>(j), name2);
     pairing.pairs.push_back(pair);
   }
   require_constraints_left(pairing, "contact pairing", "node pairs", name1, name2);
