@@ -1,7 +1,5 @@
 #include "coupling/checkpoint.hpp"
 
-#include <unistd.h>
-
 #include <toml++/toml.h>
 #include <cstdint>
 #include <cstdio>
@@ -30,15 +28,9 @@ std::string iterate_record(const Eigen::VectorXd& iterate) {
 }
 
 void append_to_file(const std::filesystem::path& path, const std::string& bytes) {
-  std::FILE* file = std::fopen(path.c_str(), "ab");
-  bool written = file != nullptr;
-  if (file != nullptr) {
-    written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
-    written = std::fflush(file) == 0 && written;
-    written = ::fsync(::fileno(file)) == 0 && written;
-    written = std::fclose(file) == 0 && written;
+  if (!write_durably(path, bytes, "ab")) {
+    throw std::runtime_error("cannot write '" + path.string() + "'");
   }
-  if (!written) throw std::runtime_error("cannot write '" + path.string() + "'");
 }
 
 /// The first `count` records of checkpoint-iterates.bin.

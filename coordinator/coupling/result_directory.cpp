@@ -158,19 +158,21 @@ std::string utc_timestamp() {
   return text.data();
 }
 
+bool write_durably(const fs::path& path, const std::string& bytes, const char* mode) {
+  std::FILE* file = std::fopen(path.c_str(), mode);
+  if (file == nullptr) return false;
+  bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+  written = std::fflush(file) == 0 && written;
+  written = ::fsync(::fileno(file)) == 0 && written;
+  return std::fclose(file) == 0 && written;
+}
+
 void write_file_atomically(const fs::path& path, const std::string& text) {
   static std::atomic<unsigned> counter{0};
   std::ostringstream name;
   name << '.' << path.filename().string() << ".tmp-" << ::getpid() << '-' << counter++;
   const fs::path temporary = path.parent_path() / name.str();
-  std::FILE* file = std::fopen(temporary.c_str(), "wb");
-  bool written = file != nullptr;
-  if (file != nullptr) {
-    written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
-    written = std::fflush(file) == 0 && written;
-    written = ::fsync(::fileno(file)) == 0 && written;
-    written = std::fclose(file) == 0 && written;
-  }
+  const bool written = write_durably(temporary, text, "wb");
   std::error_code error;
   if (written) fs::rename(temporary, path, error);
   if (!written || error) {

@@ -114,6 +114,10 @@ void record_failed_start(const std::filesystem::path& directory, ExistingResults
                          const std::string& tool, const std::filesystem::path& case_file,
                          const std::string& message);
 
+/// Writes `bytes` to `path` opened with fopen mode `mode` ("wb" replaces, "ab" appends), then
+/// flushes it to the disk (fsync); false when any step failed.
+bool write_durably(const std::filesystem::path& path, const std::string& bytes, const char* mode);
+
 /// Writes `text` to `path` atomically: a temporary file in the same directory, flushed, then
 /// renamed over `path`. Throws std::runtime_error naming `path`.
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
