@@ -33,7 +33,11 @@ static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs 
 /// cleanly. During a request (meshing and factorizing a large body can take minutes): _exit at
 /// once, which is async-signal-safe; the coordinator sees the lost connection.
 void request_stop(int) {
-  if (handling_request.load()) _exit(0);
+  if (handling_request.load()) {
+    static const char message[] = "robin-subdomain: stopped by a signal during a request\n";
+    [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, message, sizeof message - 1);
+    _exit(0);
+  }
   stop_requested.store(true);
 }
 

@@ -320,8 +320,10 @@ std::string run_server_loop(SubdomainServer& server, const ServerLoopOptions& op
     }
     if (reply_ready) {
       auto [request, reply] = worker.take_reply();
-      send_reply(socket, request, reply);
+      // Cleared before the reply leaves: a client may signal the server as soon as it has the
+      // reply, and that signal must find the server idle (a clean stop, not the mid-request exit).
       busy.store(false);
+      send_reply(socket, request, reply);
       if (server.shutdown_requested()) return "Shutdown request";
     }
     if (request_waiting) {
