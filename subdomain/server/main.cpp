@@ -15,6 +15,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
+#include <stdexcept>
+#include <string>
 
 #include "command_line.hpp"
 #include "curve_keys.hpp"
@@ -57,6 +59,42 @@ double default_factor_memory_mebibytes() {
   return 0.75 * static_cast<double>(pages) * static_cast<double>(page_size) / 1048576.0;
 }
 
+/// A --testing-stage-delay value, "correction=SECONDS" or "correction@ITERATION=SECONDS".
+struct StageDelay {
+  unsigned iteration = 0;  // 0: every iteration
+  double seconds = 0.0;
+};
+
+/// Parses a --testing-stage-delay value; throws std::invalid_argument saying what is wrong.
+StageDelay parse_stage_delay(const std::string& text) {
+  const std::string usage = "expected correction=SECONDS or correction@ITERATION=SECONDS";
+  const auto equals = text.find('=');
+  if (equals == std::string::npos) throw std::invalid_argument(usage);
+  const std::string stage = text.substr(0, equals);
+  const std::string seconds = text.substr(equals + 1);
+  StageDelay delay;
+  std::size_t used = 0;
+  try {
+    delay.seconds = std::stod(seconds, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != seconds.size() || !(delay.seconds >= 0.0) || delay.seconds > 3600.0) {
+    throw std::invalid_argument("'" + seconds + "' is not a number of seconds from 0 to 3600");
+  }
+  const std::string name = "correction";
+  if (stage == name) return delay;
+  if (stage.rfind(name + "@", 0) == 0) {
+    const std::string iteration = stage.substr(name.size() + 1);
+    if (!iteration.empty() && iteration.size() <= 9 &&
+        iteration.find_first_not_of("0123456789") == std::string::npos) {
+      delay.iteration = static_cast<unsigned>(std::stoul(iteration));
+      if (delay.iteration != 0) return delay;
+    }
+  }
+  throw std::invalid_argument("unknown stage '" + stage + "': " + usage + " (ITERATION from 1)");
+}
+
 struct CommandLine {
   robin::ServerLoopOptions loop;
   long maximum_dofs = 20'000'000;
@@ -65,6 +103,7 @@ struct CommandLine {
   std::string log_level = "info";
   std::filesystem::path curve_secret_key;  // empty: no CURVE
   std::filesystem::path curve_allow;
+  std::string stage_delay;  // --testing-stage-delay; empty: none
 };
 
 void add_options(CLI::App& app, CommandLine& command_line) {
@@ -124,6 +163,22 @@ void add_options(CLI::App& app, CommandLine& command_line) {
       ->type_name("NAME")
       ->check(CLI::IsMember({"neumann_solve"}))
       ->group("Testing only");
+  app.add_option("--testing-stage-delay", command_line.stage_delay,
+                 "TESTING ONLY: sleep SECONDS at the start of each CorrectionRequest (of "
+                 "iteration ITERATION only, when given), after logging 'correction request "
+                 "(iteration K)', so that a test can kill the server inside a correction step")
+      ->type_name("correction[@ITERATION]=SECONDS")
+      ->check(CLI::Validator(
+          [](const std::string& value) {
+            try {
+              parse_stage_delay(value);
+            } catch (const std::invalid_argument& error) {
+              return std::string(error.what());
+            }
+            return std::string();
+          },
+          "", "stage delay"))
+      ->group("Testing only");
 }
 
 /// The CURVE settings of the command line; throws std::runtime_error or KeyFileError naming the
@@ -172,6 +227,11 @@ int main(int argc, char** argv) {
   } catch (const std::exception& error) {
     logger->error("{}", error.what());
     return 1;
+  }
+  if (!command_line.stage_delay.empty()) {
+    const StageDelay delay = parse_stage_delay(command_line.stage_delay);  // checked by CLI11
+    command_line.server.correction_delay_seconds = delay.seconds;
+    command_line.server.correction_delay_iteration = delay.iteration;
   }
   command_line.server.maximum_dofs = command_line.maximum_dofs;
   command_line.server.maximum_factor_bytes = command_line.maximum_factor_mebibytes * 1048576.0;

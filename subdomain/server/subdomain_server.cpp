@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <thread>
 
 #include "numerics/body_output.hpp"
 #include "numerics/errors.hpp"
@@ -565,6 +566,7 @@ void SubdomainServer::on_correction(const protocol::Envelope& request, protocol:
   record.iteration = " iteration " + std::to_string(message.iteration());
   require_same_run(request, "CorrectionRequest");
   require_state(ServerState::ready, "CorrectionRequest");
+  delay_for_testing(message.iteration());
   const Eigen::VectorXd interface_force =
       checked_vector(message.interface_force(), body_->contact_size(),
                      "CorrectionRequest.interface_force", body_->name());
@@ -573,6 +575,20 @@ void SubdomainServer::on_correction(const protocol::Envelope& request, protocol:
   protocol::CorrectionResult& result = *reply.mutable_correction_result();
   result.mutable_normal_trace()->Assign(trace.begin(), trace.end());
   result.set_compute_seconds(seconds_since(start));
+}
+
+void SubdomainServer::delay_for_testing(unsigned iteration) const {
+  const double seconds = settings_.correction_delay_seconds;
+  if (seconds <= 0.0) return;
+  if (settings_.correction_delay_iteration != 0 &&
+      settings_.correction_delay_iteration != iteration) {
+    return;
+  }
+  settings_.logger->info(
+      "correction request (iteration {}): waiting {} s before the solve (--testing-stage-delay, "
+      "testing only)",
+      iteration, seconds);
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
 }
 
 /// Since protocol 1.1: K u = f - B' lambda with the given lambda, u_N = B u = e - F lambda.

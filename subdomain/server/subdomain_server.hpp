@@ -106,6 +106,13 @@ struct ServerSettings {
   /// (--max-factor-memory).
   long maximum_dofs = 0;
   double maximum_factor_bytes = 0.0;
+  /// Testing only (robin-subdomain --testing-stage-delay correction[@ITERATION]=SECONDS): the
+  /// server sleeps this long at the start of each CorrectionRequest (of iteration
+  /// `correction_delay_iteration` only, when that is not 0), logging "correction request
+  /// (iteration K): ..." first, so that a test can kill it inside a correction step. Set by
+  /// the operator's command line only, never by a request.
+  double correction_delay_seconds = 0.0;
+  unsigned correction_delay_iteration = 0;
   /// Where requests are logged; null means subdomain_logger().
   std::shared_ptr<spdlog::logger> logger;
 };
@@ -165,6 +172,9 @@ class SubdomainServer {
                      RequestRecord& record);
   void on_neumann_solve(const protocol::Envelope& request, protocol::Envelope& reply,
                         RequestRecord& record);
+  /// Sleeps at the start of a CorrectionRequest of `iteration` as ServerSettings'
+  /// correction_delay_* say (testing only; nothing when they are 0).
+  void delay_for_testing(unsigned iteration) const;
   void on_fields(const protocol::Envelope& request, protocol::Envelope& reply);
   void on_set_load_factor(const protocol::Envelope& request, protocol::Envelope& reply,
                           RequestRecord& record);

@@ -6,9 +6,11 @@
 //    relative), summary.json says "resumed_from" the checkpoint's iteration, and the checkpoint
 //    files are gone; before that, a resume with a changed case file is refused naming the key
 //    and both hashes, and one with a changed --tolerance naming the option;
-//  - a robin-subdomain killed with SIGKILL during setup, during the iterations and during the
-//    fields: robin-run restarts it (logging server, body, step and "restart 1 of 2"), and
-//    contact.csv and history.csv equal the uninterrupted run's (1e-10 and 1e-12 relative);
+//  - a robin-subdomain killed with SIGKILL during setup, during the iterations, during a
+//    correction solve (made long enough to be hit by robin-subdomain's testing-only
+//    --testing-stage-delay) and during the fields: robin-run restarts it (logging server, body,
+//    step and "restart 1 of 2"), and contact.csv and history.csv equal the uninterrupted run's
+//    (1e-10 and 1e-12 relative);
 //  - robin-coordinator killed with SIGKILL mid-iteration against two long-running servers,
 //    then `robin-coordinator --resume DIR` against the same servers: history.csv (but the wall
 //    time) and contact.csv equal those of an uninterrupted robin-coordinator run against the
@@ -214,23 +216,30 @@ int server_pid(const std::string& log, const std::string& body) {
   return std::stoi(log.substr(at + marker.size()));
 }
 
-/// Runs robin-run on `case_file`, kills body `body`'s server with SIGKILL `delay` after the log
-/// shows `moment`, and checks that the run recovers to the reference's answer. Returns the log.
+/// Runs robin-run on `case_file` (with `arguments` more), kills body `body`'s server with
+/// SIGKILL `delay` after the log shows `moment`, and checks that the run recovers to the
+/// reference's answer. The log watched for `moment` is robin-run's, or `watched_log` (relative
+/// to the run's output directory) when given. Returns robin-run's log.
 std::string expect_recovery(const std::filesystem::path& directory,
                             const std::filesystem::path& case_file,
                             const std::filesystem::path& reference, const std::string& body,
                             const std::string& moment, const std::string& name,
-                            std::chrono::milliseconds delay = std::chrono::milliseconds(0)) {
+                            std::chrono::milliseconds delay = std::chrono::milliseconds(0),
+                            const std::filesystem::path& watched_log = {},
+                            const std::vector<std::string>& arguments = {}) {
   const std::filesystem::path output = directory / name;
   const std::filesystem::path log = directory / (name + ".stderr");
   const auto run = start_tool(
-      "robin-run", with({case_file.string(), "--output", output.string()}, joint_stopping), log);
+      "robin-run",
+      with(with({case_file.string(), "--output", output.string()}, joint_stopping), arguments),
+      log);
+  const std::filesystem::path watched = watched_log.empty() ? log : output / watched_log;
   int pid = 0;
   EXPECT_TRUE(wait_until(
       [&] {
-        const std::string text = read_text(log);
-        pid = server_pid(text, body);
-        return (pid != 0 && text.find(moment) != std::string::npos) || !run->running();
+        pid = server_pid(read_text(log), body);
+        return (pid != 0 && read_text(watched).find(moment) != std::string::npos) ||
+               !run->running();
       },
       60.0));
   EXPECT_NE(pid, 0) << read_text(log);
@@ -286,6 +295,47 @@ TEST(ServerRecovery, RobinRunRestartsAServerKilledDuringSetupAndFields) {
       expect_recovery(directory.path(), case_file, reference, "lower",
                       "collecting the fields of both bodies", "lower-fields");
   EXPECT_NE(fields.find("step fields"), std::string::npos) << fields;
+}
+
+TEST(ServerRecovery, RobinRunRestartsAServerKilledDuringACorrectionSolve) {
+  ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
+  const TemporaryDirectory directory("robin-recovery-correction");
+  const std::filesystem::path case_file = case_copy(directory.path(), 0.05);
+  const std::filesystem::path reference = reference_run(directory.path(), case_file);
+  // A correction solve lasts about a millisecond: the cantilever's first server waits 30 s at
+  // the start of the correction of iteration 20 (--testing-stage-delay), and is killed while
+  // it waits. The wrapper passes the option to that first start only, so the restarted server
+  // redoes iteration 20 at once. It is called robin-subdomain so that robin-run's log names it
+  // as it names the real one.
+  const std::filesystem::path wrapper = directory.path() / "delayed" / "robin-subdomain";
+  std::filesystem::create_directories(wrapper.parent_path());
+  const std::string server = testing::tool("robin-subdomain").string();
+  std::ofstream(wrapper) << "#!/bin/sh\nif mkdir '" << (directory.path() / "first-start").string()
+                         << "' 2>/dev/null; then\n  exec '" << server
+                         << "' \"$@\" --testing-stage-delay correction@20=30\nfi\nexec '" << server
+                         << "' \"$@\"\n";
+  std::filesystem::permissions(wrapper, std::filesystem::perms(0755));
+  const std::string log = expect_recovery(
+      directory.path(), case_file, reference, "cantilever", "correction request (iteration 20)",
+      "cantilever-correction", std::chrono::milliseconds(0), "logs/server-cantilever.log",
+      {"--server-executable", server, "--server-executable", wrapper.string()});
+  EXPECT_NE(log.find("step correction (iteration 20)"), std::string::npos) << log;
+  EXPECT_NE(log.find("continuing the iteration after iteration"), std::string::npos) << log;
+  // the restarted server did not wait
+  const std::string server_log =
+      read_text(directory.path() / "cantilever-correction" / "logs" / "server-cantilever.log");
+  const auto waited = server_log.find("correction request (iteration 20)");
+  EXPECT_NE(waited, std::string::npos) << server_log;
+  EXPECT_EQ(server_log.find("correction request (iteration", waited + 1), std::string::npos)
+      << server_log;
+  // The option takes only the correction stage and a number of seconds.
+  for (const char* value : {"setup=1", "correction=x", "correction@0=1", "correction"}) {
+    EXPECT_EQ(run_to_end("robin-subdomain",
+                         {"--listen", "tcp://127.0.0.1:*", "--testing-stage-delay", value},
+                         directory.path() / "bad-delay.stderr"),
+              "exited with status 2")
+        << value;
+  }
 }
 
 TEST(ServerRecovery, RobinCoordinatorWaitsForAServerToComeBack) {
