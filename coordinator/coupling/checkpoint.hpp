@@ -30,7 +30,8 @@ extern const char* const checkpoint_file_name;
 extern const char* const checkpoint_iterates_file_name;
 
 struct RunCheckpoint {
-  static constexpr int current_format = 1;
+  /// 2: the iteration state per body (contact graphs); 1 had fixed pairs of vectors.
+  static constexpr int current_format = 2;
   std::string run_id;        // the run that wrote it (ResultDirectory::run_id)
   std::string first_run_id;  // the run that started from scratch (itself, or resumed ones')
   std::string started;       // when that first run started (UTC, ISO 8601)

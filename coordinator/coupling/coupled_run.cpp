@@ -115,8 +115,10 @@ Eigen::Vector2d displacement_near(const BodyOutput& output, const Eigen::Vector2
 ExcludedPairClearance excluded_clearance(const CoupledRunResult& result) {
   const RobinResult& iteration = result.iteration;
   double scale = 0.0;
-  for (const Eigen::VectorXd* values : {&iteration.normal_trace1, &iteration.normal_trace2}) {
-    if (values->size() > 0) scale = std::max(scale, values->cwiseAbs().maxCoeff());
+  for (const BodyInterfaceState& body : iteration.state.bodies) {
+    if (body.normal_trace.size() > 0) {
+      scale = std::max(scale, body.normal_trace.cwiseAbs().maxCoeff());
+    }
   }
   if (result.pairing.size() > 0)
     scale = std::max(scale, result.pairing.gaps().cwiseAbs().maxCoeff());
@@ -194,7 +196,7 @@ RobinResult recoverable_iteration(RecoverablePorts& ports, const ContactPairing&
 std::array<BodyOutput, 2> collect_fields(RecoverablePorts& ports, const RobinResult& iteration) {
   return ports.run([&] {
     return on_both_ports(ports.ports(), [&](SubdomainPort& port, int alpha) {
-      return port.fields(alpha == 0 ? iteration.contact_force1 : iteration.contact_force2);
+      return port.fields(iteration.state.bodies[static_cast<std::size_t>(alpha)].contact_force);
     });
   });
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <numeric>
+#include <optional>
 
 #include <Eigen/Eigenvalues>
 
@@ -22,61 +23,106 @@ void require_converged(const ContactSolveResult& result, const SubdomainPort& po
                   "': " + result.message);
 }
 
-/// Step 1 on both bodies in parallel: u^a = argmin 1/2 u'K^a u - f^a'u s.t. B^a u <= g^a.
-std::array<ContactSolveResult, 2> contact_solves(SubdomainPort& body1, SubdomainPort& body2,
-                                                 const Eigen::VectorXd& obstacle1,
-                                                 const Eigen::VectorXd& obstacle2, int iteration) {
-  body1.start_contact_solve(obstacle1, iteration);
-  body2.start_contact_solve(obstacle2, iteration);
-  std::array<ContactSolveResult, 2> results{body1.finish_contact_solve(),
-                                            body2.finish_contact_solve()};
-  require_converged(results[0], body1, iteration);
-  require_converged(results[1], body2, iteration);
+/// Step 1 on every body in parallel: u^a = argmin 1/2 u'K^a u - f^a'u s.t. B^a u <= g^a.
+std::vector<ContactSolveResult> contact_solves(const std::vector<SubdomainPort*>& ports,
+                                               const std::vector<Eigen::VectorXd>& obstacles,
+                                               int iteration) {
+  for (std::size_t body = 0; body < ports.size(); ++body) {
+    ports[body]->start_contact_solve(obstacles[body], iteration);
+  }
+  std::vector<ContactSolveResult> results;
+  for (SubdomainPort* port : ports) results.push_back(port->finish_contact_solve());
+  for (std::size_t body = 0; body < ports.size(); ++body) {
+    require_converged(results[body], *ports[body], iteration);
+  }
   return results;
 }
 
-/// Correction solves on both bodies in parallel: w^a_N = F^a r^a.
-std::array<CorrectionSolveResult, 2> correction_solves(SubdomainPort& body1, SubdomainPort& body2,
-                                                       const Eigen::VectorXd& force1,
-                                                       const Eigen::VectorXd& force2,
-                                                       int iteration) {
-  body1.start_correction(force1, iteration);
-  body2.start_correction(force2, iteration);
-  return {body1.finish_correction(), body2.finish_correction()};
+/// Correction solves on every body in parallel: w^a_N = F^a r^a.
+std::vector<CorrectionSolveResult> correction_solves(const std::vector<SubdomainPort*>& ports,
+                                                     const std::vector<Eigen::VectorXd>& forces,
+                                                     int iteration) {
+  for (std::size_t body = 0; body < ports.size(); ++body) {
+    ports[body]->start_correction(forces[body], iteration);
+  }
+  std::vector<CorrectionSolveResult> results;
+  for (SubdomainPort* port : ports) results.push_back(port->finish_correction());
+  return results;
 }
 
-/// Step 1 on both bodies at the obstacles already in evaluation.state; fills the state's
+double slowest(const std::vector<double>& seconds) {
+  return seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end());
+}
+
+/// Step 1 on every body at the obstacles already in evaluation.state; fills the state's
 /// traces and forces and the evaluation's counters.
-void solve_both_contacts(SubdomainPort& body1, SubdomainPort& body2, int iteration,
-                         CouplingEvaluation& evaluation) {
-  CouplingState& state = evaluation.state;
-  const auto contact = contact_solves(body1, body2, state.obstacle1, state.obstacle2, iteration);
-  state.normal_trace1 = contact[0].normal_trace;
-  state.normal_trace2 = contact[1].normal_trace;
-  state.contact_force1 = contact[0].contact_force;
-  state.contact_force2 = contact[1].contact_force;
-  evaluation.active1 = count_active(contact[0]);
-  evaluation.active2 = count_active(contact[1]);
-  evaluation.qp_iterations1 = contact[0].iterations;
-  evaluation.qp_iterations2 = contact[1].iterations;
-  evaluation.critical_compute_seconds += std::max(contact[0].seconds, contact[1].seconds);
+void solve_all_contacts(const std::vector<SubdomainPort*>& ports, int iteration,
+                        CouplingEvaluation& evaluation) {
+  std::vector<Eigen::VectorXd> obstacles;
+  for (const BodyInterfaceState& body : evaluation.state.bodies) obstacles.push_back(body.obstacle);
+  const std::vector<ContactSolveResult> contact = contact_solves(ports, obstacles, iteration);
+  std::vector<double> seconds;
+  for (std::size_t body = 0; body < ports.size(); ++body) {
+    BodyInterfaceState& state = evaluation.state.bodies[body];
+    state.normal_trace = contact[body].normal_trace;
+    state.contact_force = contact[body].contact_force;
+    evaluation.active.push_back(count_active(contact[body]));
+    evaluation.qp_iterations.push_back(contact[body].iterations);
+    seconds.push_back(contact[body].seconds);
+  }
+  evaluation.critical_compute_seconds += slowest(seconds);
 }
 
-/// "robin" and "robin-constant" (alpha > 0): two obstacle sequences.
+/// Body `body`'s block of an iterate stacked in body order.
+Eigen::VectorXd body_block(const ContactGraph& graph, const Eigen::VectorXd& iterate, int body) {
+  Eigen::Index offset = 0;
+  for (int other = 0; other < body; ++other) offset += graph.body_rows(other);
+  return iterate.segment(offset, graph.body_rows(body));
+}
+
+/// The vectors of every body stacked in body order.
+Eigen::VectorXd stack(const std::vector<Eigen::VectorXd>& per_body) {
+  Eigen::Index size = 0;
+  for (const Eigen::VectorXd& part : per_body) size += part.size();
+  Eigen::VectorXd stacked(size);
+  Eigen::Index offset = 0;
+  for (const Eigen::VectorXd& part : per_body) {
+    stacked.segment(offset, part.size()) = part;
+    offset += part.size();
+  }
+  return stacked;
+}
+
+/// "robin" and "robin-constant" (alpha > 0): one obstacle sequence per colour class.
 class RobinScheme final : public CouplingScheme {
  public:
-  RobinScheme(SubdomainPort& body1, SubdomainPort& body2, Eigen::VectorXd gaps,
-              Eigen::VectorXd weights, double constant_alpha)
-      : body1_(body1),
-        body2_(body2),
-        gaps_(std::move(gaps)),
-        weights_(std::move(weights)),
-        constant_alpha_(constant_alpha) {}
+  RobinScheme(std::vector<SubdomainPort*> ports, CouplingProblem problem, double constant_alpha)
+      : ports_(std::move(ports)),
+        problem_(std::move(problem)),
+        constant_alpha_(constant_alpha),
+        colouring_(problem_.graph.two_colouring()) {}
 
   std::vector<int> block_sizes() const override {
-    const int size = static_cast<int>(gaps_.size());
-    if (constant_alpha_ > 0.0) return {2 * size};  // H^1 depends on g^2 through lambda^2
-    return {size, size};
+    const ContactGraph& graph = problem_.graph;
+    if (constant_alpha_ > 0.0) {  // H^a depends on g^b through lambda^b
+      return {static_cast<int>(stack(all_body_parts(problem_.gaps)).size())};
+    }
+    std::vector<int> sizes;
+    for (int body = 0; body < graph.body_count(); ++body) {
+      sizes.push_back(static_cast<int>(graph.body_rows(body)));
+    }
+    return sizes;
+  }
+  std::vector<ObstacleSequence> sequences() const override {
+    if (!colouring_) return {};
+    std::vector<ObstacleSequence> sequences(2);
+    for (int body = 0; body < problem_.graph.body_count(); ++body) {
+      ObstacleSequence& sequence = sequences[static_cast<std::size_t>((*colouring_)[body])];
+      sequence.bodies.push_back(body);
+      sequence.blocks.push_back(constant_alpha_ > 0.0 ? 0 : body);
+    }
+    if (sequences[1].bodies.empty()) sequences.pop_back();  // a single body
+    return sequences;
   }
   std::string describe() const override {
     return constant_alpha_ > 0.0
@@ -84,79 +130,119 @@ class RobinScheme final : public CouplingScheme {
                : std::string("robin");
   }
   Eigen::VectorXd initial_iterate(const Eigen::VectorXd& initial_obstacle) const override {
-    Eigen::VectorXd iterate(2 * gaps_.size());
-    iterate << initial_obstacle, initial_obstacle;
-    return iterate;
+    return stack(all_body_parts(initial_obstacle));
   }
 
   void repeat_contact_solves(const Eigen::VectorXd& iterate, int iteration) override {
-    const Eigen::Index size = gaps_.size();
-    contact_solves(body1_, body2_, iterate.head(size), iterate.tail(size), iteration);
+    contact_solves(ports_, split(iterate), iteration);
   }
 
   CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) override {
-    const Eigen::Index size = gaps_.size();
+    const ContactGraph& graph = problem_.graph;
     CouplingEvaluation evaluation;
     CouplingState& state = evaluation.state;
-    state.obstacle1 = iterate.head(size);
-    state.obstacle2 = iterate.tail(size);
-    solve_both_contacts(body1_, body2_, iteration, evaluation);
-    // Step 2: K^1 w^1 = B^1'(lambda^2 - lambda^1), K^2 w^2 = B^2'(lambda^1 - lambda^2), or the
-    // constant-alpha stand-in alpha (lambda^b - lambda^a) / m for w^a_N.
-    const Eigen::VectorXd imbalance = state.contact_force2 - state.contact_force1;
-    if (constant_alpha_ > 0.0) {
-      state.correction1 = constant_alpha_ * imbalance.cwiseQuotient(weights_);
-      state.correction2 = -state.correction1;
-    } else {
-      const auto correction = correction_solves(body1_, body2_, imbalance, -imbalance, iteration);
-      state.correction1 = correction[0].normal_trace;
-      state.correction2 = correction[1].normal_trace;
-      evaluation.critical_compute_seconds += std::max(correction[0].seconds, correction[1].seconds);
-      evaluation.completions = {completion(state, 1), completion(state, 2)};
+    state.bodies.resize(ports_.size());
+    const std::vector<Eigen::VectorXd> obstacles = split(iterate);
+    for (std::size_t body = 0; body < ports_.size(); ++body) {
+      state.bodies[body].obstacle = obstacles[body];
     }
-    // Step 3's map: H = (w2_N - u2_N + d, w1_N - u1_N + d).
-    evaluation.mapped.resize(2 * size);
-    evaluation.mapped << state.correction2 - state.normal_trace2 + gaps_,
-        state.correction1 - state.normal_trace1 + gaps_;
+    solve_all_contacts(ports_, iteration, evaluation);
+    // Step 2: K^a w^a = B^a'(lambda^across - lambda^a), or the constant-alpha stand-in
+    // alpha (lambda^across - lambda^a) / m for w^a_N.
+    const std::vector<Eigen::VectorXd> forces = state.contact_forces();
+    std::vector<Eigen::VectorXd> imbalances;
+    for (int body = 0; body < graph.body_count(); ++body) {
+      imbalances.push_back(graph.across(body, forces) - forces[static_cast<std::size_t>(body)]);
+    }
+    if (constant_alpha_ > 0.0) {
+      for (int body = 0; body < graph.body_count(); ++body) {
+        state.bodies[static_cast<std::size_t>(body)].correction =
+            constant_alpha_ * imbalances[static_cast<std::size_t>(body)].cwiseQuotient(
+                                  graph.body_part(body, problem_.weights));
+      }
+    } else {
+      const auto correction = correction_solves(ports_, imbalances, iteration);
+      std::vector<double> seconds;
+      for (std::size_t body = 0; body < ports_.size(); ++body) {
+        state.bodies[body].correction = correction[body].normal_trace;
+        seconds.push_back(correction[body].seconds);
+      }
+      evaluation.critical_compute_seconds += slowest(seconds);
+      for (const ObstacleSequence& sequence : sequences()) {
+        evaluation.completions.push_back(completion(state, sequence));
+      }
+    }
+    // Step 3's map: H^a = (w_N - u_N)^across + d on each of body a's rows.
+    std::vector<Eigen::VectorXd> sent;
+    for (const BodyInterfaceState& body : state.bodies) {
+      sent.push_back(body.correction - body.normal_trace);
+    }
+    std::vector<Eigen::VectorXd> mapped;
+    for (int body = 0; body < graph.body_count(); ++body) {
+      mapped.push_back(graph.across(body, sent) + graph.body_part(body, problem_.gaps));
+    }
+    evaluation.mapped = stack(mapped);
     return evaluation;
   }
 
  private:
-  /// The complete state of obstacle sequence `sequence`: its body's contact force on both
-  /// bodies, the other body's trace u_N - w_N = e - F lambda.
-  static CouplingState completion(const CouplingState& state, int sequence) {
-    CouplingState complete = state;
-    if (sequence == 1) {
-      complete.normal_trace2 = state.normal_trace2 - state.correction2;
-      complete.contact_force2 = state.contact_force1;
-    } else {
-      complete.normal_trace1 = state.normal_trace1 - state.correction1;
-      complete.contact_force1 = state.contact_force2;
+  std::vector<Eigen::VectorXd> all_body_parts(const Eigen::VectorXd& global) const {
+    std::vector<Eigen::VectorXd> parts;
+    for (int body = 0; body < problem_.graph.body_count(); ++body) {
+      parts.push_back(problem_.graph.body_part(body, global));
     }
-    complete.correction1.setZero();
-    complete.correction2.setZero();
+    return parts;
+  }
+  std::vector<Eigen::VectorXd> split(const Eigen::VectorXd& iterate) const {
+    std::vector<Eigen::VectorXd> parts;
+    for (int body = 0; body < problem_.graph.body_count(); ++body) {
+      parts.push_back(body_block(problem_.graph, iterate, body));
+    }
+    return parts;
+  }
+
+  /// The complete state of `sequence`: its bodies keep (u, lambda); every other body (all its
+  /// neighbours are in the sequence) takes lambda^across, its trace u_N - w_N = e - F lambda.
+  CouplingState completion(const CouplingState& state, const ObstacleSequence& sequence) const {
+    CouplingState complete = state;
+    const std::vector<Eigen::VectorXd> forces = state.contact_forces();
+    for (int body = 0; body < problem_.graph.body_count(); ++body) {
+      BodyInterfaceState& target = complete.bodies[static_cast<std::size_t>(body)];
+      const bool keeps =
+          std::find(sequence.bodies.begin(), sequence.bodies.end(), body) != sequence.bodies.end();
+      if (!keeps) {
+        target.normal_trace = target.normal_trace - target.correction;
+        target.contact_force = problem_.graph.across(body, forces);
+      }
+      target.correction.setZero();
+    }
     return complete;
   }
 
-  SubdomainPort& body1_;
-  SubdomainPort& body2_;
-  const Eigen::VectorXd gaps_;
-  const Eigen::VectorXd weights_;
+  const std::vector<SubdomainPort*> ports_;
+  const CouplingProblem problem_;
   const double constant_alpha_;  // 0: the Steklov-Poincare choice (correction solves)
+  const std::optional<std::vector<int>> colouring_;
 };
+
+/// The two obstacle sequences of a two-body scheme with one block.
+std::vector<ObstacleSequence> two_body_sequences() {
+  return {{{0}, {0}}, {{1}, {0}}};
+}
 
 /// "dirichlet-neumann": one obstacle sequence, for the contact body.
 class DirichletNeumannScheme final : public CouplingScheme {
  public:
   /// `contact_body` 0 or 1: the body that solves the contact problem.
-  DirichletNeumannScheme(SubdomainPort& body1, SubdomainPort& body2, Eigen::VectorXd gaps,
+  DirichletNeumannScheme(const std::vector<SubdomainPort*>& ports, Eigen::VectorXd gaps,
                          int contact_body)
-      : contact_port_(contact_body == 0 ? body1 : body2),
-        neumann_port_(contact_body == 0 ? body2 : body1),
+      : contact_port_(*ports[static_cast<std::size_t>(contact_body)]),
+        neumann_port_(*ports[static_cast<std::size_t>(1 - contact_body)]),
         gaps_(std::move(gaps)),
         contact_body_(contact_body) {}
 
   std::vector<int> block_sizes() const override { return {static_cast<int>(gaps_.size())}; }
+  std::vector<ObstacleSequence> sequences() const override { return two_body_sequences(); }
   bool shares_contact_force() const override { return true; }
   std::string describe() const override {
     return "dirichlet-neumann (contact body " + std::to_string(contact_body_ + 1) +
@@ -179,21 +265,23 @@ class DirichletNeumannScheme final : public CouplingScheme {
     const CorrectionSolveResult neumann = neumann_port_.finish_neumann_solve();
     CouplingEvaluation evaluation;
     evaluation.critical_compute_seconds = contact.seconds + neumann.seconds;
-    const int active = count_active(contact);
-    (contact_body_ == 0 ? evaluation.active1 : evaluation.active2) = active;
-    (contact_body_ == 0 ? evaluation.qp_iterations1 : evaluation.qp_iterations2) =
-        contact.iterations;
-    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(gaps_.size());
-    const Eigen::VectorXd other_obstacle = gaps_ - iterate;
-    CouplingState& state = evaluation.state;
-    state.obstacle1 = contact_body_ == 0 ? iterate : other_obstacle;
-    state.obstacle2 = contact_body_ == 0 ? other_obstacle : iterate;
-    state.normal_trace1 = contact_body_ == 0 ? contact.normal_trace : neumann.normal_trace;
-    state.normal_trace2 = contact_body_ == 0 ? neumann.normal_trace : contact.normal_trace;
-    state.contact_force1 = contact.contact_force;
-    state.contact_force2 = contact.contact_force;
-    state.correction1 = zero;
-    state.correction2 = zero;
+    evaluation.active = {0, 0};
+    evaluation.qp_iterations = {0, 0};
+    evaluation.active[static_cast<std::size_t>(contact_body_)] = count_active(contact);
+    evaluation.qp_iterations[static_cast<std::size_t>(contact_body_)] = contact.iterations;
+    evaluation.state.bodies.resize(2);
+    BodyInterfaceState& contact_state =
+        evaluation.state.bodies[static_cast<std::size_t>(contact_body_)];
+    BodyInterfaceState& neumann_state =
+        evaluation.state.bodies[static_cast<std::size_t>(1 - contact_body_)];
+    contact_state.obstacle = iterate;
+    contact_state.normal_trace = contact.normal_trace;
+    neumann_state.obstacle = gaps_ - iterate;
+    neumann_state.normal_trace = neumann.normal_trace;
+    for (BodyInterfaceState& body : evaluation.state.bodies) {
+      body.contact_force = contact.contact_force;
+      body.correction = Eigen::VectorXd::Zero(gaps_.size());
+    }
     evaluation.mapped = gaps_ - neumann.normal_trace;  // H = d - u^N_N
     return evaluation;
   }
@@ -208,10 +296,11 @@ class DirichletNeumannScheme final : public CouplingScheme {
 /// "neumann-neumann": one sequence, the share g1 of the gap given to body 1.
 class NeumannNeumannScheme final : public CouplingScheme {
  public:
-  NeumannNeumannScheme(SubdomainPort& body1, SubdomainPort& body2, Eigen::VectorXd gaps)
-      : body1_(body1), body2_(body2), gaps_(std::move(gaps)) {}
+  NeumannNeumannScheme(std::vector<SubdomainPort*> ports, Eigen::VectorXd gaps)
+      : ports_(std::move(ports)), gaps_(std::move(gaps)) {}
 
   std::vector<int> block_sizes() const override { return {static_cast<int>(gaps_.size())}; }
+  std::vector<ObstacleSequence> sequences() const override { return two_body_sequences(); }
   std::string describe() const override { return "neumann-neumann"; }
   /// Body 1 starts with half of the initial obstacle, so that g1 + g2 = d from the start when
   /// the initial obstacle is the gap.
@@ -220,41 +309,69 @@ class NeumannNeumannScheme final : public CouplingScheme {
   }
 
   void repeat_contact_solves(const Eigen::VectorXd& iterate, int iteration) override {
-    contact_solves(body1_, body2_, iterate, gaps_ - iterate, iteration);
+    contact_solves(ports_, {iterate, gaps_ - iterate}, iteration);
   }
 
   CouplingEvaluation evaluate(const Eigen::VectorXd& iterate, int iteration) override {
     CouplingEvaluation evaluation;
     CouplingState& state = evaluation.state;
-    state.obstacle1 = iterate;
-    state.obstacle2 = gaps_ - iterate;
-    solve_both_contacts(body1_, body2_, iteration, evaluation);
+    state.bodies.resize(2);
+    state.bodies[0].obstacle = iterate;
+    state.bodies[1].obstacle = gaps_ - iterate;
+    solve_all_contacts(ports_, iteration, evaluation);
     // Both bodies loaded by the force jump j = lambda1 - lambda2 along their outward normal.
-    const Eigen::VectorXd jump = state.contact_force1 - state.contact_force2;
-    const auto correction = correction_solves(body1_, body2_, jump, jump, iteration);
-    state.correction1 = correction[0].normal_trace;
-    state.correction2 = correction[1].normal_trace;
+    const Eigen::VectorXd jump = state.bodies[0].contact_force - state.bodies[1].contact_force;
+    const auto correction = correction_solves(ports_, {jump, jump}, iteration);
+    state.bodies[0].correction = correction[0].normal_trace;
+    state.bodies[1].correction = correction[1].normal_trace;
     evaluation.critical_compute_seconds += std::max(correction[0].seconds, correction[1].seconds);
-    evaluation.mapped = iterate + 0.25 * (state.correction1 + state.correction2);
+    evaluation.mapped = iterate + 0.25 * (state.bodies[0].correction + state.bodies[1].correction);
     return evaluation;
   }
 
  private:
-  SubdomainPort& body1_;
-  SubdomainPort& body2_;
+  const std::vector<SubdomainPort*> ports_;
   const Eigen::VectorXd gaps_;
 };
 
 /// "auto": the body that is more compliant at short wavelengths takes the obstacle.
-int more_compliant_body(SubdomainPort& body1, SubdomainPort& body2,
+int more_compliant_body(const std::vector<SubdomainPort*>& ports,
                         const Eigen::VectorXd& probe_forces) {
-  const auto response = correction_solves(body1, body2, probe_forces, probe_forces, 0);
+  const auto response = correction_solves(ports, {probe_forces, probe_forces}, 0);
   const double compliance1 = probe_forces.dot(response[0].normal_trace);
   const double compliance2 = probe_forces.dot(response[1].normal_trace);
   return compliance1 >= compliance2 ? 0 : 1;
 }
 
+/// Throws InputError unless the graph is two bodies with one interface.
+void require_two_bodies(const CouplingOptions& options, const ContactGraph& graph) {
+  if (graph.body_count() == 2 && graph.interfaces().size() == 1) return;
+  throw InputError("coupling.algorithm \"" + options.algorithm +
+                   "\" couples exactly two bodies with one contact interface; this run has " +
+                   std::to_string(graph.body_count()) + " bodies and " +
+                   std::to_string(graph.interfaces().size()) +
+                   " contact interfaces: use \"robin\" or \"robin-constant\"");
+}
+
 }  // namespace
+
+std::vector<Eigen::VectorXd> CouplingState::normal_traces() const {
+  std::vector<Eigen::VectorXd> values;
+  for (const BodyInterfaceState& body : bodies) values.push_back(body.normal_trace);
+  return values;
+}
+
+std::vector<Eigen::VectorXd> CouplingState::contact_forces() const {
+  std::vector<Eigen::VectorXd> values;
+  for (const BodyInterfaceState& body : bodies) values.push_back(body.contact_force);
+  return values;
+}
+
+std::vector<Eigen::VectorXd> CouplingState::corrections() const {
+  std::vector<Eigen::VectorXd> values;
+  for (const BodyInterfaceState& body : bodies) values.push_back(body.correction);
+  return values;
+}
 
 Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing) {
   const std::size_t size = pairing.size();
@@ -281,32 +398,37 @@ Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing) {
 }
 
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
-                                                     SubdomainPort& body1, SubdomainPort& body2,
-                                                     const Eigen::VectorXd& gaps,
-                                                     const Eigen::VectorXd& weights,
-                                                     const Eigen::VectorXd& probe_forces) {
+                                                     const std::vector<SubdomainPort*>& ports,
+                                                     const CouplingProblem& problem) {
+  const ContactGraph& graph = problem.graph;
+  if (static_cast<int>(ports.size()) != graph.body_count()) {
+    throw InputError("the coupling has " + std::to_string(ports.size()) + " ports for " +
+                     std::to_string(graph.body_count()) + " bodies");
+  }
   if (options.algorithm == "robin") {
-    return std::make_unique<RobinScheme>(body1, body2, gaps, weights, 0.0);
+    return std::make_unique<RobinScheme>(ports, problem, 0.0);
   }
   if (options.algorithm == "robin-constant") {
     if (!(options.alpha > 0.0)) {
       throw InputError("coupling.alpha must be > 0 for the algorithm \"robin-constant\"");
     }
-    if (weights.size() != gaps.size() || (weights.array() <= 0.0).any()) {
+    if (problem.weights.size() != problem.gaps.size() || (problem.weights.array() <= 0.0).any()) {
       throw InputError(
           "the algorithm \"robin-constant\" needs a positive boundary weight per pair");
     }
-    return std::make_unique<RobinScheme>(body1, body2, gaps, weights, options.alpha);
+    return std::make_unique<RobinScheme>(ports, problem, options.alpha);
   }
   if (options.algorithm == "dirichlet-neumann") {
+    require_two_bodies(options, graph);
     const int contact_body = options.contact_body == "1" ? 0
                              : options.contact_body == "2"
                                  ? 1
-                                 : more_compliant_body(body1, body2, probe_forces);
-    return std::make_unique<DirichletNeumannScheme>(body1, body2, gaps, contact_body);
+                                 : more_compliant_body(ports, problem.probe_forces);
+    return std::make_unique<DirichletNeumannScheme>(ports, problem.gaps, contact_body);
   }
   if (options.algorithm == "neumann-neumann") {
-    return std::make_unique<NeumannNeumannScheme>(body1, body2, gaps);
+    require_two_bodies(options, graph);
+    return std::make_unique<NeumannNeumannScheme>(ports, problem.gaps);
   }
   throw InputError(
       "coupling.algorithm must be \"robin\", \"robin-constant\", "

@@ -8,6 +8,10 @@
 //                        solves, both correction solves w1_N = F1 (lambda2 - lambda1),
 //                        w2_N = F2 (lambda1 - lambda2);
 //                        H = (w2_N - u2_N + d, w1_N - u1_N + d).
+//                        On a contact graph (contact_graph.hpp): x = (g^1, ..., g^N) in body
+//                        order; w^a_N = F^a (lambda^across - lambda^a) and
+//                        H^a = (w_N - u_N)^across + d on each of body a's rows, "across" being
+//                        the other side of the row.
 //   "robin-constant"     paper (6) with a constant alpha_S (Remark 1): the correction w^b_N is
 //                        replaced by alpha (lambda^a - lambda^b) / m (nodal forces turned into
 //                        pressures); no correction solves.
@@ -29,7 +33,11 @@
 // iteration also yields two complete candidate states, one per obstacle sequence:
 // (u1, lambda1; u2_N - w2_N, lambda1) and (u1_N - w1_N, lambda2; u2, lambda2). Either solves the
 // monolithic KKT system when its penetration and complementarity vanish (docs/method.md,
-// "Either sequence alone"); the loop may stop on the first that does.
+// "Either sequence alone"); the loop may stop on the first that does. On a contact graph whose
+// bodies can be 2-coloured (every row joins colours 0 and 1: a chain, a stack, an even ring),
+// sequence c is colour class c: its bodies keep (u, lambda), every other body takes its
+// neighbours' forces, lambda^across, with the trace u_N - w_N. A graph with an odd cycle has no
+// completions (the loop stops on the joint state).
 
 #include <Eigen/Core>
 #include <memory>
@@ -37,19 +45,28 @@
 #include <vector>
 
 #include "coupling/case_file.hpp"
+#include "coupling/contact_graph.hpp"
 #include "coupling/contact_pairing.hpp"
 #include "coupling/subdomain_port.hpp"
 
 namespace robin {
 
-/// The interface state of both bodies, pair order. Vectors a scheme does not produce are zero
-/// (corrections of "robin-constant") or, for a body without an obstacle (the Neumann body of
-/// "dirichlet-neumann"), the obstacle it implicitly sees, d - g.
+/// One body's interface state, in its body order (contact_graph.hpp). Vectors a scheme does
+/// not produce are zero (corrections of "robin-constant") or, for a body without an obstacle
+/// (the Neumann body of "dirichlet-neumann"), the obstacle it implicitly sees, d - g.
+struct BodyInterfaceState {
+  Eigen::VectorXd obstacle;       // g in the contact solve
+  Eigen::VectorXd normal_trace;   // u_N
+  Eigen::VectorXd contact_force;  // lambda
+  Eigen::VectorXd correction;     // w_N
+};
+
+/// The interface state of every body (for two bodies: body order = pair order).
 struct CouplingState {
-  Eigen::VectorXd obstacle1, obstacle2;          // g in the contact solves
-  Eigen::VectorXd normal_trace1, normal_trace2;  // u_N
-  Eigen::VectorXd contact_force1, contact_force2;
-  Eigen::VectorXd correction1, correction2;  // w_N
+  std::vector<BodyInterfaceState> bodies;
+  std::vector<Eigen::VectorXd> normal_traces() const;
+  std::vector<Eigen::VectorXd> contact_forces() const;
+  std::vector<Eigen::VectorXd> corrections() const;
 };
 
 /// What one outer iteration produced.
@@ -57,26 +74,36 @@ struct CouplingEvaluation {
   Eigen::VectorXd mapped;  // H(x)
   CouplingState state;
   /// Candidate complete states (see the header comment), empty for most schemes; element k
-  /// belongs to obstacle sequence k.
+  /// belongs to obstacle sequence k (CouplingScheme::sequences).
   std::vector<CouplingState> completions;
-  int active1 = 0, active2 = 0;  // closed pairs seen by each body's contact solve
-  int qp_iterations1 = 0, qp_iterations2 = 0;
+  std::vector<int> active;         // per body: closed rows seen by its contact solve (0: none)
+  std::vector<int> qp_iterations;  // per body: iterations of its contact QP (0: none)
   /// Critical path of the bodies' compute in this iteration (parallel requests count once).
   double critical_compute_seconds = 0.0;
+};
+
+/// An obstacle sequence: the bodies whose contact forces it follows and the blocks of the
+/// iterate that are its obstacles (for "robin", a colour class of the contact graph).
+struct ObstacleSequence {
+  std::vector<int> bodies;
+  std::vector<int> blocks;
 };
 
 class CouplingScheme {
  public:
   virtual ~CouplingScheme() = default;
-  /// Sizes of the independent blocks of x (accelerated per block). "robin-constant" has one
-  /// block of both obstacles: its map couples g1 and g2.
+  /// Sizes of the independent blocks of x (accelerated per block): for "robin" one block per
+  /// body. "robin-constant" has one block of all obstacles: its map couples them.
   virtual std::vector<int> block_sizes() const = 0;
+  /// The obstacle sequences whose forces the loop follows (ForceSequence) and whose complete
+  /// states evaluate() returns as completions (same order).
+  virtual std::vector<ObstacleSequence> sequences() const = 0;
   /// True when both bodies carry the same contact force by construction ("dirichlet-neumann"):
   /// the loop then reports the force change between iterations as the force balance.
   virtual bool shares_contact_force() const { return false; }
   /// For logs and summary.json, e.g. "dirichlet-neumann (contact body 2, Neumann body 1)".
   virtual std::string describe() const = 0;
-  /// x_0 from the user's initial obstacle g_0 (per pair).
+  /// x_0 from the user's initial obstacle g_0 (per row, global order).
   virtual Eigen::VectorXd initial_iterate(const Eigen::VectorXd& initial_obstacle) const = 0;
   /// The subdomain requests of one iteration at x. Throws PortError when a port fails or a
   /// contact QP does not converge.
@@ -93,17 +120,25 @@ class CouplingScheme {
 /// the mesh carries.
 Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing);
 
-/// The scheme of options.algorithm on two ports whose contact has been assigned, with the
-/// pairs' initial gaps d, boundary weights m (needed by "robin-constant") and a short-wavelength
-/// probe (for "dirichlet-neumann" with contact_body "auto": the body with the larger r'F^a r,
-/// one correction solve each, takes the obstacle; its sequence is the well-conditioned one,
-/// the error being multiplied by I - delta (I + F^N (F^D)^-1). Short wavelengths decide, as the
-/// few smooth modes, such as a cantilever's bending, are absorbed by the accelerator.)
-/// Throws InputError for an unknown algorithm or a missing alpha.
+/// What a scheme needs to know about the constraints, in global row order (contact_graph.hpp).
+struct CouplingProblem {
+  ContactGraph graph = ContactGraph::two_bodies(0);
+  Eigen::VectorXd gaps;     // d
+  Eigen::VectorXd weights;  // m (needed by "robin-constant")
+  /// A short-wavelength probe (for "dirichlet-neumann" with contact_body "auto").
+  Eigen::VectorXd probe_forces;
+};
+
+/// The scheme of options.algorithm on ports (one per body of problem.graph, in body order)
+/// whose contact has been assigned (body alpha: its rows in body order). "dirichlet-neumann"
+/// with contact_body "auto": the body with the larger r'F^a r, one correction solve each, takes
+/// the obstacle; its sequence is the well-conditioned one, the error being multiplied by
+/// I - delta (I + F^N (F^D)^-1). Short wavelengths decide, as the few smooth modes, such as a
+/// cantilever's bending, are absorbed by the accelerator.
+/// Throws InputError for an unknown algorithm, a missing alpha, or an algorithm that couples
+/// exactly two bodies ("dirichlet-neumann", "neumann-neumann") on another graph.
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
-                                                     SubdomainPort& body1, SubdomainPort& body2,
-                                                     const Eigen::VectorXd& gaps,
-                                                     const Eigen::VectorXd& weights,
-                                                     const Eigen::VectorXd& probe_forces);
+                                                     const std::vector<SubdomainPort*>& ports,
+                                                     const CouplingProblem& problem);
 
 }  // namespace robin

@@ -1,6 +1,6 @@
 #include "coupling/iteration_checkpoint.hpp"
 
-#include <tuple>
+#include <algorithm>
 #include <utility>
 
 #include "coupling/checkpoint_encoding.hpp"
@@ -8,9 +8,17 @@
 namespace robin {
 namespace {
 
-const std::array<const char*, 8> state_names = {"obstacle1",     "obstacle2",      "normal_trace1",
-                                                "normal_trace2", "contact_force1", "contact_force2",
-                                                "correction1",   "correction2"};
+nlohmann::json body_state_json(const BodyInterfaceState& body) {
+  return {{"obstacle", encode_vector(body.obstacle)},
+          {"normal_trace", encode_vector(body.normal_trace)},
+          {"contact_force", encode_vector(body.contact_force)},
+          {"correction", encode_vector(body.correction)}};
+}
+
+BodyInterfaceState body_state_from_json(const nlohmann::json& object) {
+  return {decode_vector(object, "obstacle"), decode_vector(object, "normal_trace"),
+          decode_vector(object, "contact_force"), decode_vector(object, "correction")};
+}
 
 nlohmann::json sequence_json(const SequenceResiduals& sequence) {
   return {{"obstacle_change", encode_number(sequence.obstacle_change)},
@@ -40,20 +48,24 @@ nlohmann::json record_json(const IterationRecord& record) {
           {"force_balance", encode_number(record.force_balance)},
           {"complementarity", encode_number(record.complementarity)},
           {"correction", encode_number(record.correction)},
-          {"active", {record.active1, record.active2}},
-          {"qp_iterations", {record.qp_iterations1, record.qp_iterations2}},
+          {"active", record.active},
+          {"qp_iterations", record.qp_iterations},
           {"seconds", encode_number(record.seconds)},
           {"acceleration_state", record.acceleration_state},
           {"sequences", sequences}};
 }
 
-std::pair<int, int> integer_pair(const nlohmann::json& object, const std::string& key) {
-  const nlohmann::json& pair = member(object, key);
-  if (!pair.is_array() || pair.size() != 2 || !pair[0].is_number_integer() ||
-      !pair[1].is_number_integer()) {
-    throw CheckpointFormatError("the checkpoint's '" + key + "' is not a pair of integers");
+/// One integer per body.
+std::vector<int> integers(const nlohmann::json& object, const std::string& key) {
+  const nlohmann::json& values = member(object, key);
+  if (!values.is_array() ||
+      !std::all_of(values.begin(), values.end(),
+                   [](const nlohmann::json& value) { return value.is_number_integer(); })) {
+    throw CheckpointFormatError("the checkpoint's '" + key + "' is not an array of integers");
   }
-  return {pair[0].get<int>(), pair[1].get<int>()};
+  std::vector<int> result;
+  for (const nlohmann::json& value : values) result.push_back(value.get<int>());
+  return result;
 }
 
 IterationRecord record_from_json(const nlohmann::json& object) {
@@ -65,8 +77,8 @@ IterationRecord record_from_json(const nlohmann::json& object) {
   record.force_balance = decode_number(object, "force_balance");
   record.complementarity = decode_number(object, "complementarity");
   record.correction = decode_number(object, "correction");
-  std::tie(record.active1, record.active2) = integer_pair(object, "active");
-  std::tie(record.qp_iterations1, record.qp_iterations2) = integer_pair(object, "qp_iterations");
+  record.active = integers(object, "active");
+  record.qp_iterations = integers(object, "qp_iterations");
   record.seconds = decode_number(object, "seconds");
   record.acceleration_state = decode_text(object, "acceleration_state");
   const nlohmann::json& sequences = member(object, "sequences");
@@ -115,15 +127,19 @@ nlohmann::json to_json(const IterationCheckpoint& checkpoint) {
        {{"first_step", encode_number(checkpoint.monitor.first_step)},
         {"smallest_step", encode_number(checkpoint.monitor.smallest_step)},
         {"best_history", encode_numbers(checkpoint.monitor.best_history)}}},
-      {"force_sequences",
-       {force_sequence_json(checkpoint.force_sequences[0]),
-        force_sequence_json(checkpoint.force_sequences[1])}},
       {"critical_compute_seconds", encode_number(checkpoint.critical_compute_seconds)},
       {"port_seconds", encode_number(checkpoint.port_seconds)},
       {"wall_seconds", encode_number(checkpoint.wall_seconds)}};
-  for (std::size_t index = 0; index < state_names.size(); ++index) {
-    document["state"][state_names[index]] = encode_vector(checkpoint.state[index]);
+  nlohmann::json sequences = nlohmann::json::array();
+  for (const ForceSequenceState& sequence : checkpoint.force_sequences) {
+    sequences.push_back(force_sequence_json(sequence));
   }
+  document["force_sequences"] = sequences;
+  nlohmann::json bodies = nlohmann::json::array();
+  for (const BodyInterfaceState& body : checkpoint.state.bodies) {
+    bodies.push_back(body_state_json(body));
+  }
+  document["state"] = bodies;
   nlohmann::json history = nlohmann::json::array();
   for (const IterationRecord& record : checkpoint.history) history.push_back(record_json(record));
   document["history"] = history;
@@ -147,17 +163,19 @@ IterationCheckpoint iteration_checkpoint_from_json(const nlohmann::json& documen
   checkpoint.monitor.smallest_step = decode_number(monitor, "smallest_step");
   checkpoint.monitor.best_history = decode_numbers(monitor, "best_history");
   const nlohmann::json& sequences = member(document, "force_sequences");
-  if (!sequences.is_array() || sequences.size() != 2) {
-    throw CheckpointFormatError("the checkpoint's 'force_sequences' is not a pair");
+  if (!sequences.is_array()) {
+    throw CheckpointFormatError("the checkpoint's 'force_sequences' is no array");
   }
-  checkpoint.force_sequences = {force_sequence_from_json(sequences[0]),
-                                force_sequence_from_json(sequences[1])};
+  for (const nlohmann::json& sequence : sequences) {
+    checkpoint.force_sequences.push_back(force_sequence_from_json(sequence));
+  }
   checkpoint.critical_compute_seconds = decode_number(document, "critical_compute_seconds");
   checkpoint.port_seconds = decode_number(document, "port_seconds");
   checkpoint.wall_seconds = decode_number(document, "wall_seconds");
   const nlohmann::json& state = member(document, "state");
-  for (std::size_t index = 0; index < state_names.size(); ++index) {
-    checkpoint.state[index] = decode_vector(state, state_names[index]);
+  if (!state.is_array()) throw CheckpointFormatError("the checkpoint's 'state' is no array");
+  for (const nlohmann::json& body : state) {
+    checkpoint.state.bodies.push_back(body_state_from_json(body));
   }
   const nlohmann::json& history = member(document, "history");
   if (!history.is_array()) throw CheckpointFormatError("the checkpoint's 'history' is no array");

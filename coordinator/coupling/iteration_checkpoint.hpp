@@ -34,7 +34,7 @@ struct ProgressMonitorState {
 };
 
 /// ForceSequence's memory (robin_iteration.cpp): lambda_{k}, |lambda_k - lambda_{k-1}| and the
-/// obstacle step of the body's block.
+/// obstacle step of the sequence's blocks.
 struct ForceSequenceState {
   Eigen::VectorXd previous;
   double previous_change = 0.0;
@@ -51,11 +51,10 @@ struct IterationCheckpoint {
   std::vector<Eigen::VectorXd> iterates;             // x_1 ... x_k (not in to_json)
   Eigen::VectorXd next_iterate;                      // x_{k+1} (meaningless once stopped)
   Eigen::VectorXd initial_iterate, restart_iterate;  // RobinResult's
-  /// The state of iteration k (RobinResult's obstacle1 ... correction2, in that order).
-  std::array<Eigen::VectorXd, 8> state;
+  CouplingState state;          // the state of iteration k (RobinResult's), per body
   nlohmann::json acceleration;  // Acceleration::save_state()
   ProgressMonitorState monitor;
-  std::array<ForceSequenceState, 2> force_sequences;
+  std::vector<ForceSequenceState> force_sequences;  // one per obstacle sequence
   std::vector<IterationRecord> history;
   double critical_compute_seconds = 0.0;  // RobinResult's, up to iteration k
   double port_seconds = 0.0;              // time in port requests, up to iteration k

@@ -9,21 +9,26 @@
 namespace robin {
 namespace {
 
-/// (F1 + F2) x: the compliance of the pair of bodies seen by a common contact force.
-class SumOperator final : public LinearOperator {
+/// sum_alpha C_alpha' F^alpha C_alpha x: the compliance of the graph's bodies seen by a common
+/// contact force on every row.
+class GraphComplianceOperator final : public LinearOperator {
  public:
-  SumOperator(const LinearOperator& first, const LinearOperator& second)
-      : first_(first), second_(second) {}
-  int size() const override { return first_.size(); }
+  GraphComplianceOperator(const std::vector<const BodySolver*>& bodies, const ContactGraph& graph)
+      : bodies_(bodies), graph_(graph) {}
+  int size() const override { return static_cast<int>(graph_.total_rows()); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
-    first_.apply(x, y);
-    second_.apply(x, scratch_);
-    y += scratch_;
+    y = Eigen::VectorXd::Zero(x.size());
+    for (std::size_t body = 0; body < bodies_.size(); ++body) {
+      const int index = static_cast<int>(body);
+      if (graph_.body_rows(index) == 0) continue;
+      bodies_[body]->compliance().apply(graph_.body_part(index, x), scratch_);
+      graph_.add_body_part(index, scratch_, y);
+    }
   }
 
  private:
-  const LinearOperator& first_;
-  const LinearOperator& second_;
+  const std::vector<const BodySolver*>& bodies_;
+  const ContactGraph& graph_;
   mutable Eigen::VectorXd scratch_;
 };
 
@@ -54,19 +59,32 @@ InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::
   return residuals;
 }
 
-MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& body2,
-                                  const ContactPairing& pairing, const MprgpParameters& parameters,
+MonolithicResult solve_monolithic(const std::vector<const BodySolver*>& bodies,
+                                  const ContactGraph& graph, const Eigen::VectorXd& gaps,
+                                  const MprgpParameters& parameters,
                                   const Eigen::VectorXd& initial_force) {
   const auto start = std::chrono::steady_clock::now();
-  const Eigen::Index size = static_cast<Eigen::Index>(pairing.size());
-  if (body1.contact_size() != size || body2.contact_size() != size) {
-    throw InputError("monolithic solve: both bodies must be assigned the " + std::to_string(size) +
-                     " contact pairs first");
+  const Eigen::Index size = graph.total_rows();
+  if (static_cast<int>(bodies.size()) != graph.body_count() || gaps.size() != size) {
+    throw InputError("monolithic solve: " + std::to_string(bodies.size()) + " bodies and " +
+                     std::to_string(gaps.size()) + " gaps for a contact graph of " +
+                     std::to_string(graph.body_count()) + " bodies and " + std::to_string(size) +
+                     " rows");
   }
-  const Eigen::VectorXd gap = pairing.gaps();
-  // minimise 1/2 l'(F1 + F2) l - l'(e1 + e2 - d), l >= 0
-  const SumOperator compliance(body1.compliance(), body2.compliance());
-  const Eigen::VectorXd right_hand_side = body1.free_trace() + body2.free_trace() - gap;
+  Eigen::VectorXd right_hand_side = Eigen::VectorXd::Zero(size);  // sum_alpha C_alpha' e^alpha
+  for (std::size_t body = 0; body < bodies.size(); ++body) {
+    const int index = static_cast<int>(body);
+    if (bodies[body]->contact_size() != graph.body_rows(index)) {
+      throw InputError("monolithic solve: body " + std::to_string(body + 1) +
+                       " must be assigned its " + std::to_string(graph.body_rows(index)) +
+                       " contact rows first");
+    }
+    if (graph.body_rows(index) > 0) {
+      graph.add_body_part(index, bodies[body]->free_trace(), right_hand_side);
+    }
+  }
+  right_hand_side -= gaps;
+  const GraphComplianceOperator compliance(bodies, graph);
   MonolithicResult result;
   MprgpParameters scaled = parameters;
   scaled.solution_scaled_tolerance = true;  // resolve lambda relative to itself, not to |e - d|
@@ -77,16 +95,35 @@ MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& bod
       solve_mprgp(compliance, right_hand_side, Eigen::VectorXd::Zero(size), initial, scaled);
   result.contact_force = result.qp.solution;
   // u_N = e - F lambda on each body
-  Eigen::VectorXd product;
-  body1.compliance().apply(result.contact_force, product);
-  result.normal_trace1 = body1.free_trace() - product;
-  body2.compliance().apply(result.contact_force, product);
-  result.normal_trace2 = body2.free_trace() - product;
-  result.residuals = interface_residuals(gap, result.normal_trace1, result.normal_trace2,
-                                         result.contact_force, result.contact_force);
+  std::vector<Eigen::VectorXd> forces;
+  for (std::size_t body = 0; body < bodies.size(); ++body) {
+    const int index = static_cast<int>(body);
+    Eigen::VectorXd product = Eigen::VectorXd::Zero(graph.body_rows(index));
+    const Eigen::VectorXd force = graph.body_part(index, result.contact_force);
+    if (force.size() > 0) bodies[body]->compliance().apply(force, product);
+    result.normal_traces.push_back(force.size() > 0
+                                       ? Eigen::VectorXd(bodies[body]->free_trace() - product)
+                                       : Eigen::VectorXd());
+    forces.push_back(force);
+  }
+  result.residuals = interface_residuals(gaps, graph.side(0, result.normal_traces),
+                                         graph.side(1, result.normal_traces), graph.side(0, forces),
+                                         graph.side(1, forces));
   result.solve_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& body2,
+                                  const ContactPairing& pairing, const MprgpParameters& parameters,
+                                  const Eigen::VectorXd& initial_force) {
+  const Eigen::Index size = static_cast<Eigen::Index>(pairing.size());
+  if (body1.contact_size() != size || body2.contact_size() != size) {
+    throw InputError("monolithic solve: both bodies must be assigned the " + std::to_string(size) +
+                     " contact pairs first");
+  }
+  return solve_monolithic({&body1, &body2}, ContactGraph::two_bodies(size), pairing.gaps(),
+                          parameters, initial_force);
 }
 
 std::vector<MonolithicStep> solve_monolithic_steps(BodySolver& body1, BodySolver& body2,

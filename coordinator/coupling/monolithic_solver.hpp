@@ -1,13 +1,19 @@
 #pragma once
-// The monolithic two-body reference (paper (5)): minimise sum_alpha 1/2 u'K u - f'u subject
+// The monolithic reference (paper (5)): minimise sum_alpha 1/2 u'K u - f'u subject
 // to B1 u1 + B2 u2 <= d, solved in its dual form
 //   minimise 1/2 lambda'(F1 + F2) lambda - lambda'(e1 + e2 - d),  lambda >= 0,
-// with the same factors and the same MPRGP as the subdomain solves.
+// with the same factors and the same MPRGP as the subdomain solves. On a contact graph
+// (contact_graph.hpp) lambda has one entry per row in global order, C_alpha lambda is body
+// alpha's part of it (body order), and the dual is
+//   minimise 1/2 lambda'(sum_alpha C_alpha' F^alpha C_alpha) lambda
+//            - lambda'(sum_alpha C_alpha' e^alpha - d),  lambda >= 0,
+// u^alpha_N = e^alpha - F^alpha C_alpha lambda.
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "coupling/case_file_loading.hpp"
+#include "coupling/contact_graph.hpp"
 #include "coupling/contact_pairing.hpp"
 #include "numerics/body_solver.hpp"
 
@@ -22,15 +28,24 @@ struct InterfaceResiduals {
 };
 
 struct MonolithicResult {
-  Eigen::VectorXd contact_force;  // lambda (same on both bodies)
-  Eigen::VectorXd normal_trace1;  // u1_N
-  Eigen::VectorXd normal_trace2;  // u2_N
+  Eigen::VectorXd contact_force;  // lambda (same on both sides of a row), global order
+  /// u_N per body, body order (two bodies: u1_N, u2_N in pair order)
+  std::vector<Eigen::VectorXd> normal_traces;
   MprgpResult qp;
   InterfaceResiduals residuals;
   double solve_seconds = 0.0;
 };
 
-/// Both bodies must have been given pairing.assignment(0) and (1). MPRGP starts from
+/// The monolithic problem of the contact graph: `bodies` in body order, each assigned its rows
+/// in body order; `gaps` d in global order. MPRGP starts from `initial_force` (lambda >= 0,
+/// global order) when it is given, from 0 otherwise. Throws InputError when a body's contact
+/// size is not its number of rows in the graph.
+MonolithicResult solve_monolithic(const std::vector<const BodySolver*>& bodies,
+                                  const ContactGraph& graph, const Eigen::VectorXd& gaps,
+                                  const MprgpParameters& parameters,
+                                  const Eigen::VectorXd& initial_force = {});
+
+/// Two bodies: both must have been given pairing.assignment(0) and (1). MPRGP starts from
 /// `initial_force` (lambda >= 0, pair order) when it is given, from 0 otherwise.
 MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& body2,
                                   const ContactPairing& pairing, const MprgpParameters& parameters,

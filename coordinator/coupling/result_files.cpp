@@ -56,6 +56,22 @@ void check_size(const Eigen::VectorXd& vector, std::size_t expected, const std::
 
 }  // namespace
 
+InterfaceState interface_state(const ContactGraph& graph, const CouplingState& state,
+                               std::size_t interface) {
+  const GraphInterface& edge = graph.interfaces().at(interface);
+  const BodyInterfaceState& side_a = state.bodies.at(static_cast<std::size_t>(edge.body_a));
+  const BodyInterfaceState& side_b = state.bodies.at(static_cast<std::size_t>(edge.body_b));
+  return {side_a.normal_trace.segment(edge.offset_a, edge.rows),
+          side_b.normal_trace.segment(edge.offset_b, edge.rows),
+          side_a.contact_force.segment(edge.offset_a, edge.rows),
+          side_b.contact_force.segment(edge.offset_b, edge.rows)};
+}
+
+InterfaceState two_body_interface_state(const CouplingState& state) {
+  return interface_state(ContactGraph::two_bodies(state.bodies.at(0).normal_trace.size()), state,
+                         0);
+}
+
 void write_contact_csv(const std::filesystem::path& path, const ContactPairing& pairing,
                        const InterfaceState& state) {
   const std::string context = "cannot write '" + path.string() + "'";

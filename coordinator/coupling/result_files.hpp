@@ -11,7 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "coupling/contact_graph.hpp"
 #include "coupling/contact_pairing.hpp"
+#include "coupling/coupling_scheme.hpp"
 #include "numerics/body_solver.hpp"
 
 namespace robin {
@@ -19,10 +21,17 @@ namespace robin {
 /// The interface state written to contact.csv, one row per pair:
 /// x, y, nx, ny (n1), gap0 (d), un1, un2, lambda1, lambda2, pressure, where
 /// pressure = (lambda1 + lambda2) / (2 m_i) (force per unit length).
+/// 1 and 2 are the interface's two sides, bodies a and b of its graph edge.
 struct InterfaceState {
   Eigen::VectorXd normal_trace1, normal_trace2;
   Eigen::VectorXd contact_force1, contact_force2;
 };
+
+/// The two sides of interface `interface` of `graph` in a coupled state.
+InterfaceState interface_state(const ContactGraph& graph, const CouplingState& state,
+                               std::size_t interface);
+/// The same for two bodies and one interface (body order = pair order).
+InterfaceState two_body_interface_state(const CouplingState& state);
 
 /// Header line "pair,x,y,nx,ny,gap0,un1,un2,lambda1,lambda2,pressure", then one row per pair
 /// (pair = zero-based index). Throws std::runtime_error when a state vector is not of the

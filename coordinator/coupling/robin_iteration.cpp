@@ -95,23 +95,33 @@ class ProgressMonitor {
   std::vector<double> best_history_;  // smallest largest-residual up to each iteration
 };
 
+/// The largest max norm of the vectors.
+double maximum_absolute(const std::vector<Eigen::VectorXd>& vectors) {
+  double largest = 0.0;
+  for (const Eigen::VectorXd& values : vectors)
+    largest = std::max(largest, maximum_absolute(values));
+  return largest;
+}
+
 /// Scaled residuals of a state (IterationRecord's definitions; obstacle_change is set apart).
-IterationRecord residual_record(int iteration, const Eigen::VectorXd& gaps,
+IterationRecord residual_record(int iteration, const CouplingProblem& problem,
                                 const CouplingState& state) {
   IterationRecord record;
   record.iteration = iteration;
-  const InterfaceResiduals residuals = interface_residuals(
-      gaps, state.normal_trace1, state.normal_trace2, state.contact_force1, state.contact_force2);
+  const std::vector<Eigen::VectorXd> traces = state.normal_traces();
+  const std::vector<Eigen::VectorXd> forces = state.contact_forces();
+  const ContactGraph& graph = problem.graph;
+  const InterfaceResiduals residuals =
+      interface_residuals(problem.gaps, graph.side(0, traces), graph.side(1, traces),
+                          graph.side(0, forces), graph.side(1, forces));
+  const double correction = maximum_absolute(state.corrections());
   const double displacement_scale =
-      std::max({maximum_absolute(gaps), maximum_absolute(state.normal_trace1),
-                maximum_absolute(state.normal_trace2), maximum_absolute(state.correction1),
-                maximum_absolute(state.correction2), std::numeric_limits<double>::min()});
+      std::max({maximum_absolute(problem.gaps), maximum_absolute(traces), correction,
+                std::numeric_limits<double>::min()});
   record.penetration = residuals.penetration;
   record.force_balance = residuals.force_balance;
   record.complementarity = residuals.complementarity;
-  record.correction =
-      std::max(maximum_absolute(state.correction1), maximum_absolute(state.correction2)) /
-      displacement_scale;
+  record.correction = correction / displacement_scale;
   return record;
 }
 
@@ -128,9 +138,9 @@ ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::Vect
                                const Eigen::VectorXd& next, const std::vector<int>& block_sizes,
                                const Eigen::VectorXd& gaps, const CouplingState& state) {
   ObstacleChange change;
-  change.scale = std::max(
-      {maximum_absolute(next), maximum_absolute(gaps), maximum_absolute(state.normal_trace1),
-       maximum_absolute(state.normal_trace2), std::numeric_limits<double>::min()});
+  change.scale =
+      std::max({maximum_absolute(next), maximum_absolute(gaps),
+                maximum_absolute(state.normal_traces()), std::numeric_limits<double>::min()});
   Eigen::Index offset = 0;
   for (const int size : block_sizes) {
     change.per_block.push_back(
@@ -191,12 +201,13 @@ class ForceSequence {
 };
 
 /// The residuals of the complete state of obstacle sequence k: its penetration and
-/// complementarity, the change of its own obstacle block, and the estimated relative error of
-/// its contact force (ForceSequence).
-SequenceResiduals completion_residuals(const CouplingState& completion, const Eigen::VectorXd& gaps,
-                                       double block_change, double obstacle_residual,
-                                       const Eigen::VectorXd& force, const ForceSequence& forces) {
-  const IterationRecord record = residual_record(0, gaps, completion);
+/// complementarity, the change of its own obstacle blocks, and the estimated relative error of
+/// its contact forces (ForceSequence).
+SequenceResiduals completion_residuals(const CouplingState& completion,
+                                       const CouplingProblem& problem, double block_change,
+                                       double obstacle_residual, const Eigen::VectorXd& force,
+                                       const ForceSequence& forces) {
+  const IterationRecord record = residual_record(0, problem, completion);
   SequenceResiduals residuals;
   residuals.obstacle_change = block_change;
   residuals.penetration = record.penetration;
@@ -205,25 +216,30 @@ SequenceResiduals completion_residuals(const CouplingState& completion, const Ei
   return residuals;
 }
 
-void store_state(RobinResult& result, const CouplingState& state) {
-  result.obstacle1 = state.obstacle1;
-  result.obstacle2 = state.obstacle2;
-  result.normal_trace1 = state.normal_trace1;
-  result.normal_trace2 = state.normal_trace2;
-  result.contact_force1 = state.contact_force1;
-  result.contact_force2 = state.contact_force2;
-  result.correction1 = state.correction1;
-  result.correction2 = state.correction2;
+/// The contact forces of a sequence's bodies, stacked in body order.
+Eigen::VectorXd sequence_forces(const CouplingState& state, const ObstacleSequence& sequence) {
+  Eigen::Index size = 0;
+  for (const int body : sequence.bodies) {
+    size += state.bodies[static_cast<std::size_t>(body)].contact_force.size();
+  }
+  Eigen::VectorXd forces(size);
+  Eigen::Index offset = 0;
+  for (const int body : sequence.bodies) {
+    const Eigen::VectorXd& part = state.bodies[static_cast<std::size_t>(body)].contact_force;
+    forces.segment(offset, part.size()) = part;
+    offset += part.size();
+  }
+  return forces;
 }
 
-std::array<Eigen::VectorXd, 8> stored_state(const RobinResult& result) {
-  return {result.obstacle1,      result.obstacle2,      result.normal_trace1, result.normal_trace2,
-          result.contact_force1, result.contact_force2, result.correction1,   result.correction2};
-}
-
-void restore_state(RobinResult& result, const std::array<Eigen::VectorXd, 8>& state) {
-  store_state(result,
-              {state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7]});
+/// The largest of `per_block` over the sequence's blocks.
+double sequence_block_value(const std::vector<double>& per_block,
+                            const ObstacleSequence& sequence) {
+  double largest = 0.0;
+  for (const int block : sequence.blocks) {
+    largest = std::max(largest, per_block[static_cast<std::size_t>(block)]);
+  }
+  return largest;
 }
 
 /// The result of a loop that had stopped when `checkpoint` was written.
@@ -233,7 +249,7 @@ RobinResult stopped_result(const IterationCheckpoint& checkpoint) {
   result.message = checkpoint.message;
   result.algorithm = checkpoint.algorithm;
   result.history = checkpoint.history;
-  restore_state(result, checkpoint.state);
+  result.state = checkpoint.state;
   result.completed_by_sequence = checkpoint.completed_by_sequence;
   result.restart_iterate = checkpoint.restart_iterate;
   result.initial_iterate = checkpoint.initial_iterate;
@@ -245,28 +261,27 @@ RobinResult stopped_result(const IterationCheckpoint& checkpoint) {
 
 /// The record of one iteration: the joint state's residuals, the obstacle change, the
 /// counters and, per obstacle sequence, the largest residual of its complete state.
-IterationRecord iteration_record(int iteration, const Eigen::VectorXd& gaps,
+IterationRecord iteration_record(int iteration, const CouplingProblem& problem,
                                  const CouplingScheme& scheme, const CouplingEvaluation& evaluation,
                                  const ObstacleChange& change,
-                                 const std::array<ForceSequence, 2>& force_sequences) {
-  IterationRecord record = residual_record(iteration, gaps, evaluation.state);
+                                 const std::vector<ForceSequence>& force_sequences) {
+  IterationRecord record = residual_record(iteration, problem, evaluation.state);
   if (scheme.shares_contact_force()) {
     record.force_balance = force_sequences[0].relative_error_estimate(
-        evaluation.state.contact_force1,
+        evaluation.state.bodies[0].contact_force,
         *std::max_element(change.residual_per_block.begin(), change.residual_per_block.end()));
   }
   record.obstacle_change = change.relative();
   record.obstacle_step = change.relative() * change.scale;
-  record.active1 = evaluation.active1;
-  record.active2 = evaluation.active2;
-  record.qp_iterations1 = evaluation.qp_iterations1;
-  record.qp_iterations2 = evaluation.qp_iterations2;
-  const std::array<const Eigen::VectorXd*, 2> forces{&evaluation.state.contact_force1,
-                                                     &evaluation.state.contact_force2};
+  record.active = evaluation.active;
+  record.qp_iterations = evaluation.qp_iterations;
+  const std::vector<ObstacleSequence> sequences = scheme.sequences();
   for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
     record.sequences.push_back(
-        completion_residuals(evaluation.completions[k], gaps, change.per_block[k] / change.scale,
-                             change.residual_per_block[k], *forces[k], force_sequences[k]));
+        completion_residuals(evaluation.completions[k], problem,
+                             sequence_block_value(change.per_block, sequences[k]) / change.scale,
+                             sequence_block_value(change.residual_per_block, sequences[k]),
+                             sequence_forces(evaluation.state, sequences[k]), force_sequences[k]));
   }
   return record;
 }
@@ -274,6 +289,7 @@ IterationRecord iteration_record(int iteration, const Eigen::VectorXd& gaps,
 /// When the joint state or (with "either-sequence") a complete state has every residual below
 /// the tolerance: stores the accepted state and the status in `result` and returns true.
 bool accept_converged_state(const IterationRecord& record, const CouplingEvaluation& evaluation,
+                            const std::vector<ObstacleSequence>& sequences,
                             const CouplingOptions& options, RobinResult& result) {
   const std::string iterations = std::to_string(record.iteration) + " iterations";
   if (record.largest() <= options.tolerance) {
@@ -284,12 +300,16 @@ bool accept_converged_state(const IterationRecord& record, const CouplingEvaluat
   if (options.stopping != "either-sequence") return false;
   for (std::size_t k = 0; k < record.sequences.size(); ++k) {
     if (record.sequences[k].largest() > options.tolerance) continue;
-    store_state(result, evaluation.completions[k]);
+    result.state = evaluation.completions[k];
     result.status = IterationStatus::converged;
     result.completed_by_sequence = static_cast<int>(k) + 1;
-    result.message = "converged in " + iterations + " (the obstacle sequence of body " +
-                     std::to_string(k + 1) +
-                     " reached its fixed point; the other body takes its contact force)";
+    const bool alone = sequences[k].bodies.size() == 1;
+    result.message = "converged in " + iterations + " (the obstacle sequence of " +
+                     describe_bodies(sequences[k].bodies) + " reached its fixed point; " +
+                     (evaluation.state.bodies.size() == 2
+                          ? std::string("the other body takes its contact force)")
+                          : std::string("the bodies touching ") + (alone ? "it" : "them") +
+                                " take " + (alone ? "its" : "their") + " contact forces)");
     return true;
   }
   return false;
@@ -337,13 +357,19 @@ std::string to_string(IterationStatus status) {
   return "unknown";
 }
 
-/// The loop behind every run_robin_iteration overload.
-RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
-                              const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
-                              const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
-                              const Eigen::VectorXd* initial_iterate,
-                              const IterationContinuation& continuation,
-                              const IterationObserver& observer);
+namespace {
+
+/// The problem of two bodies and one interface.
+CouplingProblem two_body_problem(const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
+                                 const Eigen::VectorXd& probe_forces) {
+  return {ContactGraph::two_bodies(gaps.size()), gaps, weights, probe_forces};
+}
+
+CouplingProblem two_body_problem(const ContactPairing& pairing) {
+  return two_body_problem(pairing.gaps(), pairing.weights(), short_wavelength_forces(pairing));
+}
+
+}  // namespace
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd& gaps, const CouplingOptions& options,
@@ -355,17 +381,16 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const ContactPairing& pairing, const CouplingOptions& options,
                                 const IterationObserver& observer) {
-  return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
-                           short_wavelength_forces(pairing), options, nullptr, {}, observer);
+  return run_robin_iteration({&body1, &body2}, two_body_problem(pairing), options, nullptr, {},
+                             observer);
 }
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const ContactPairing& pairing, const CouplingOptions& options,
                                 const Eigen::VectorXd& initial_iterate,
                                 const IterationObserver& observer) {
-  return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
-                           short_wavelength_forces(pairing), options, &initial_iterate, {},
-                           observer);
+  return run_robin_iteration({&body1, &body2}, two_body_problem(pairing), options, &initial_iterate,
+                             {}, observer);
 }
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
@@ -373,9 +398,8 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const Eigen::VectorXd* initial_iterate,
                                 const IterationContinuation& continuation,
                                 const IterationObserver& observer) {
-  return run_coupling_loop(body1, body2, pairing.gaps(), pairing.weights(),
-                           short_wavelength_forces(pairing), options, initial_iterate, continuation,
-                           observer);
+  return run_robin_iteration({&body1, &body2}, two_body_problem(pairing), options, initial_iterate,
+                             continuation, observer);
 }
 
 RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
@@ -383,7 +407,8 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
                                 const CouplingOptions& options, const IterationObserver& observer) {
   Eigen::VectorXd probe = weights;  // without positions: alternate in pair order
   for (Eigen::Index i = 1; i < probe.size(); i += 2) probe[i] = -probe[i];
-  return run_coupling_loop(body1, body2, gaps, weights, probe, options, nullptr, {}, observer);
+  return run_robin_iteration({&body1, &body2}, two_body_problem(gaps, weights, probe), options,
+                             nullptr, {}, observer);
 }
 
 namespace {
@@ -392,7 +417,7 @@ namespace {
 struct LoopMemory {
   Acceleration& acceleration;
   ProgressMonitor& monitor;
-  std::array<ForceSequence, 2>& force_sequences;
+  std::vector<ForceSequence>& force_sequences;
 };
 
 /// Restores the loop's memory from `checkpoint` and repeats its contact solves (the servers'
@@ -415,14 +440,20 @@ Eigen::VectorXd resume_loop(const IterationCheckpoint& checkpoint, CouplingSchem
   }
   memory.acceleration.restore_state(checkpoint.acceleration);
   memory.monitor.restore(checkpoint.monitor);
-  for (int body = 0; body < 2; ++body) {
-    memory.force_sequences[body].restore(checkpoint.force_sequences[body]);
+  if (checkpoint.force_sequences.size() != memory.force_sequences.size()) {
+    throw CheckpointFormatError("the checkpoint follows " +
+                                std::to_string(checkpoint.force_sequences.size()) +
+                                " obstacle sequences, this run's iteration " +
+                                std::to_string(memory.force_sequences.size()));
+  }
+  for (std::size_t sequence = 0; sequence < checkpoint.force_sequences.size(); ++sequence) {
+    memory.force_sequences[sequence].restore(checkpoint.force_sequences[sequence]);
   }
   result.history = checkpoint.history;
   result.initial_iterate = checkpoint.initial_iterate;
   result.restart_iterate = checkpoint.restart_iterate;
   result.critical_compute_seconds = checkpoint.critical_compute_seconds;
-  restore_state(result, checkpoint.state);
+  result.state = checkpoint.state;
   for (std::size_t index = 0; index < checkpoint.iterates.size(); ++index) {
     scheme.repeat_contact_solves(checkpoint.iterates[index], static_cast<int>(index) + 1);
   }
@@ -443,11 +474,12 @@ IterationCheckpoint make_checkpoint(const RobinResult& result, const LoopMemory&
   checkpoint.next_iterate = next;
   checkpoint.initial_iterate = result.initial_iterate;
   checkpoint.restart_iterate = result.restart_iterate;
-  checkpoint.state = stored_state(result);
+  checkpoint.state = result.state;
   checkpoint.acceleration = memory.acceleration.save_state();
   checkpoint.monitor = memory.monitor.state();
-  checkpoint.force_sequences = {memory.force_sequences[0].state(),
-                                memory.force_sequences[1].state()};
+  for (const ForceSequence& sequence : memory.force_sequences) {
+    checkpoint.force_sequences.push_back(sequence.state());
+  }
   checkpoint.history = result.history;
   checkpoint.critical_compute_seconds = result.critical_compute_seconds;
   return checkpoint;
@@ -455,12 +487,12 @@ IterationCheckpoint make_checkpoint(const RobinResult& result, const LoopMemory&
 
 }  // namespace
 
-RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
-                              const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
-                              const Eigen::VectorXd& probe_forces, const CouplingOptions& options,
-                              const Eigen::VectorXd* initial_iterate,
-                              const IterationContinuation& continuation,
-                              const IterationObserver& observer) {
+RobinResult run_robin_iteration(const std::vector<SubdomainPort*>& ports,
+                                const CouplingProblem& problem, const CouplingOptions& options,
+                                const Eigen::VectorXd* initial_iterate,
+                                const IterationContinuation& continuation,
+                                const IterationObserver& observer) {
+  const Eigen::VectorXd& gaps = problem.gaps;
   const IterationCheckpoint* resume = continuation.resume;
   if (resume != nullptr && resume->stopped) return stopped_result(*resume);
   const auto run_start = Clock::now();
@@ -468,8 +500,7 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   const double earlier_wall = resume != nullptr ? resume->wall_seconds : 0.0;
   double port_seconds = resume != nullptr ? resume->port_seconds : 0.0;
   const auto setup_start = Clock::now();
-  const std::unique_ptr<CouplingScheme> scheme =
-      make_coupling_scheme(options, body1, body2, gaps, weights, probe_forces);
+  const std::unique_ptr<CouplingScheme> scheme = make_coupling_scheme(options, ports, problem);
   port_seconds += seconds_between(setup_start, Clock::now());
   const std::vector<int> block_sizes = scheme->block_sizes();
   const std::unique_ptr<Acceleration> acceleration =
@@ -488,7 +519,9 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
   }
   result.initial_iterate = iterate;
   ProgressMonitor monitor(options);
-  std::array<ForceSequence, 2> force_sequences;  // each body's lambda over the iterations
+  const std::vector<ObstacleSequence> sequences = scheme->sequences();
+  // each sequence's lambda over the iterations
+  std::vector<ForceSequence> force_sequences(sequences.size());
   const LoopMemory memory{*acceleration, monitor, force_sequences};
   int first_iteration = 1;
   std::vector<Eigen::VectorXd> iterates;  // x_1 ... x_k, for checkpoints
@@ -514,15 +547,17 @@ RobinResult run_coupling_loop(SubdomainPort& body1, SubdomainPort& body2,
     const ObstacleChange change =
         obstacle_change(iterate, evaluation.mapped, next, block_sizes, gaps, evaluation.state);
     IterationRecord record =
-        iteration_record(iteration, gaps, *scheme, evaluation, change, force_sequences);
-    force_sequences[0].push(evaluation.state.contact_force1, change.per_block.front());
-    force_sequences[1].push(evaluation.state.contact_force2, change.per_block.back());
+        iteration_record(iteration, problem, *scheme, evaluation, change, force_sequences);
+    for (std::size_t k = 0; k < sequences.size(); ++k) {
+      force_sequences[k].push(sequence_forces(evaluation.state, sequences[k]),
+                              sequence_block_value(change.per_block, sequences[k]));
+    }
     record.acceleration_state = acceleration->state();
     record.seconds = seconds_between(iteration_start, Clock::now());
     result.history.push_back(record);
-    store_state(result, evaluation.state);
+    result.state = evaluation.state;
     result.restart_iterate = evaluation.mapped;
-    bool stopped = accept_converged_state(record, evaluation, options, result);
+    bool stopped = accept_converged_state(record, evaluation, sequences, options, result);
     if (!stopped) {
       if (const auto stop = monitor.check(record, result.message)) {
         result.status = *stop;

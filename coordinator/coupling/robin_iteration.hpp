@@ -20,6 +20,7 @@
 
 #include "coupling/case_file.hpp"
 #include "coupling/contact_pairing.hpp"
+#include "coupling/coupling_scheme.hpp"
 #include "coupling/subdomain_port.hpp"
 
 namespace robin {
@@ -39,7 +40,8 @@ struct SequenceResiduals {
 
 /// Residuals of one iteration, all dimensionless: displacement-like quantities are divided by
 /// the displacement scale D = max(|d|, |u1_N|, |u2_N|) (and |w_N| for the correction), forces by
-/// F = max(|lambda1|, |lambda2|).
+/// F = max(|lambda1|, |lambda2|). On a contact graph the same over every row, with 1 and 2 the
+/// row's two sides (bodies a and b of its interface) and every body's u_N, w_N and lambda.
 ///
 /// Stopping, on the value progress() below (history.csv: stopping_residual): converged when it
 /// is at most the tolerance; diverged when the raw obstacle step grows beyond divergence_factor
@@ -48,15 +50,15 @@ struct SequenceResiduals {
 /// stagnation_window iterations.
 struct IterationRecord {
   int iteration = 0;
-  double obstacle_change = 0.0;  // |g_new - g_old| / max(|g_new|, D), both bodies, max norm
-  double obstacle_step = 0.0;    // |g_new - g_old| (length), unscaled: watched for divergence
-  double penetration = 0.0;      // max(0, u1_N + u2_N - d) / D
-  double force_balance = 0.0;    // |lambda1 - lambda2| / F (for "dirichlet-neumann", whose
-                                 // bodies share lambda: |lambda_k - lambda_{k-1}| / F)
-  double complementarity = 0.0;  // |lambda (d - u1_N - u2_N)| / (F D), lambda = mean
-  double correction = 0.0;       // max(|w1_N|, |w2_N|) / D
-  int active1 = 0, active2 = 0;  // closed pairs seen by each body
-  int qp_iterations1 = 0, qp_iterations2 = 0;
+  double obstacle_change = 0.0;    // |g_new - g_old| / max(|g_new|, D), both bodies, max norm
+  double obstacle_step = 0.0;      // |g_new - g_old| (length), unscaled: watched for divergence
+  double penetration = 0.0;        // max(0, u1_N + u2_N - d) / D
+  double force_balance = 0.0;      // |lambda1 - lambda2| / F (for "dirichlet-neumann", whose
+                                   // bodies share lambda: |lambda_k - lambda_{k-1}| / F)
+  double complementarity = 0.0;    // |lambda (d - u1_N - u2_N)| / (F D), lambda = mean
+  double correction = 0.0;         // max(|w1_N|, |w2_N|) / D
+  std::vector<int> active;         // per body: closed rows seen by its contact solve
+  std::vector<int> qp_iterations;  // per body: iterations of its contact QP
   double seconds = 0.0;            // wall time of the iteration
   std::string acceleration_state;  // e.g. "iqn-ils 4 columns", for progress lines
   /// "robin": the residuals of the complete state of each obstacle sequence
@@ -76,14 +78,13 @@ struct RobinResult {
   std::string message;    // why it stopped, for people
   std::string algorithm;  // the scheme, e.g. "dirichlet-neumann (contact body 1)"
   std::vector<IterationRecord> history;
-  // The state of the last iteration (pair order).
-  Eigen::VectorXd obstacle1, obstacle2;          // g used in the last contact solves
-  Eigen::VectorXd normal_trace1, normal_trace2;  // u_N
-  Eigen::VectorXd contact_force1, contact_force2;
-  Eigen::VectorXd correction1, correction2;  // w_N
-  /// 0, or the obstacle sequence (1 or 2) whose complete state was accepted: then the fields
-  /// above hold that state (both contact forces equal, corrections zero) and its residuals are
-  /// history.back().sequences[completed_by_sequence - 1], not those of the joint state.
+  /// The state of the last iteration, per body in body order (contact_graph.hpp; two bodies:
+  /// pair order): the obstacles g of the last contact solves, u_N, lambda, w_N.
+  CouplingState state;
+  /// 0, or the obstacle sequence (1, 2) whose complete state was accepted: then `state` holds
+  /// that state (the contact forces of both sides of every row equal, corrections zero) and its
+  /// residuals are history.back().sequences[completed_by_sequence - 1], not those of the joint
+  /// state.
   int completed_by_sequence = 0;
   /// The residuals of the accepted complete state, or null when the joint state was accepted
   /// (or the run stopped otherwise).
@@ -100,8 +101,8 @@ struct RobinResult {
   /// given initial iterate).
   Eigen::VectorXd initial_iterate;
   double coordinator_seconds = 0.0;  // time in the coordinator's own computations
-  /// Critical path of the bodies' compute: sum over iterations of max(contact1, contact2) +
-  /// max(correction1, correction2), as reported by the bodies.
+  /// Critical path of the bodies' compute: sum over iterations of the slowest contact solve plus
+  /// the slowest correction solve, as reported by the bodies.
   double critical_compute_seconds = 0.0;
   double wall_seconds = 0.0;
   /// Transport time: wall - coordinator - critical compute (for in-process ports this is the
@@ -127,6 +128,19 @@ struct IterationContinuation {
   std::function<void(const IterationCheckpoint&)> checkpoint;
 };
 
+/// Runs the coupling algorithm of options.algorithm (coupling_scheme.hpp) on the contact graph
+/// of `problem`, with one port per body (body order) whose contact has been assigned (each body
+/// its rows in body order), starting from `initial_iterate` when it is not null, checkpointed
+/// and possibly resumed as `continuation` says (its resume takes precedence over
+/// `initial_iterate`). Throws PortError when a port fails or a contact QP does not converge (the
+/// message names server, body and step), InputError for inconsistent options.
+RobinResult run_robin_iteration(const std::vector<SubdomainPort*>& ports,
+                                const CouplingProblem& problem, const CouplingOptions& options,
+                                const Eigen::VectorXd* initial_iterate,
+                                const IterationContinuation& continuation,
+                                const IterationObserver& observer = {});
+
+/// The same for two bodies and one interface:
 /// Runs the coupling algorithm of options.algorithm (coupling_scheme.hpp) on two ports whose
 /// contact has been assigned, with the pairs' initial gaps and boundary weights (pair order).
 /// Throws PortError when a port fails or a contact QP does not converge (the message names

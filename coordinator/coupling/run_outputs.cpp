@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <limits>
 
+#include "coupling/history_rows.hpp"
 #include "coupling/result_files.hpp"
 #include "coupling/step_outputs.hpp"
 
@@ -22,20 +23,12 @@ void write_history_csv(const std::filesystem::path& path,
   std::ofstream file(path);
   if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
   file << std::setprecision(std::numeric_limits<double>::max_digits10);
-  file << "iteration,obstacle_change,penetration,force_balance,complementarity,correction,"
-          "active1,active2,qp_iterations1,qp_iterations2,seconds,sequence1,sequence2,"
-          "stopping_residual,tolerance\n";
+  write_history_header(file, history_body_count(history));
+  file << '\n';
   const bool either_sequence = options.stopping == "either-sequence";
   for (const IterationRecord& record : history) {
-    file << record.iteration << ',' << record.obstacle_change << ',' << record.penetration << ','
-         << record.force_balance << ',' << record.complementarity << ',' << record.correction << ','
-         << record.active1 << ',' << record.active2 << ',' << record.qp_iterations1 << ','
-         << record.qp_iterations2 << ',' << record.seconds;
-    for (std::size_t k = 0; k < 2; ++k) {
-      file << ',';
-      if (k < record.sequences.size()) file << record.sequences[k].largest();
-    }
-    file << ',' << record.progress(either_sequence) << ',' << options.tolerance << '\n';
+    write_history_row(file, record, either_sequence, options.tolerance);
+    file << '\n';
   }
   if (!file) throw std::runtime_error("cannot write '" + path.string() + "'");
 }
@@ -64,7 +57,8 @@ nlohmann::json final_residuals_json(const RobinResult& iteration) {
 
 nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunResult& result) {
   const RobinResult& iteration = result.iteration;
-  const Eigen::VectorXd mean_force = 0.5 * (iteration.contact_force1 + iteration.contact_force2);
+  const Eigen::VectorXd mean_force =
+      0.5 * (iteration.state.bodies[0].contact_force + iteration.state.bodies[1].contact_force);
   const Eigen::Vector2d resultant = contact_resultant(result.pairing, mean_force);
   nlohmann::json summary;
   summary["method"] = "robin";
@@ -139,8 +133,7 @@ void write_coupled_outputs(ResultDirectory& results, const CaseDefinition& defin
   const std::string file2 = write_body_output(directory, result.outputs[1]);
   write_solution_pvd(directory, file1, file2);
   const RobinResult& iteration = result.iteration;
-  const InterfaceState state{iteration.normal_trace1, iteration.normal_trace2,
-                             iteration.contact_force1, iteration.contact_force2};
+  const InterfaceState state = two_body_interface_state(iteration.state);
   if (state.normal_trace1.size() == static_cast<Eigen::Index>(result.pairing.size())) {
     write_contact_csv(directory / "contact.csv", result.pairing, state);
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "coupling/history_rows.hpp"
 #include "coupling/result_files.hpp"
 #include "numerics/body_output.hpp"
 
@@ -78,22 +79,17 @@ void write_series(const std::filesystem::path& directory, const LoadingOptions& 
 void write_coupled_history(const std::filesystem::path& path, const CoupledRunResult& result) {
   std::ofstream file = open_csv(path);
   file << std::setprecision(std::numeric_limits<double>::max_digits10);
-  file << "step,load_factor,iteration,obstacle_change,penetration,force_balance,complementarity,"
-          "correction,active1,active2,qp_iterations1,qp_iterations2,seconds,sequence1,"
-          "sequence2,stopping_residual,tolerance\n";
+  file << "step,load_factor,";
+  std::size_t bodies = 2;
+  if (!result.steps.empty()) bodies = history_body_count(result.steps.front().iteration.history);
+  write_history_header(file, bodies);
+  file << '\n';
   const bool either_sequence = result.options.stopping == "either-sequence";
   for (const LoadStepResult& step : result.steps) {
     for (const IterationRecord& record : step.iteration.history) {
-      file << step.step << ',' << exact_text(step.factor) << ',' << record.iteration << ','
-           << record.obstacle_change << ',' << record.penetration << ',' << record.force_balance
-           << ',' << record.complementarity << ',' << record.correction << ',' << record.active1
-           << ',' << record.active2 << ',' << record.qp_iterations1 << ',' << record.qp_iterations2
-           << ',' << record.seconds;
-      for (std::size_t k = 0; k < 2; ++k) {
-        file << ',';
-        if (k < record.sequences.size()) file << record.sequences[k].largest();
-      }
-      file << ',' << record.progress(either_sequence) << ',' << result.options.tolerance << '\n';
+      file << step.step << ',' << exact_text(step.factor) << ',';
+      write_history_row(file, record, either_sequence, result.options.tolerance);
+      file << '\n';
     }
   }
   close_csv(file, path);
@@ -102,7 +98,7 @@ void write_coupled_history(const std::filesystem::path& path, const CoupledRunRe
 int qp_iterations(const RobinResult& iteration) {
   int total = 0;
   for (const IterationRecord& record : iteration.history) {
-    total += record.qp_iterations1 + record.qp_iterations2;
+    for (const int count : record.qp_iterations) total += count;
   }
   return total;
 }
@@ -121,7 +117,8 @@ nlohmann::json coupled_steps_json(const CoupledRunResult& result) {
   for (const LoadStepResult& step : result.steps) {
     const RobinResult& iteration = step.iteration;
     const StepInterface interface =
-        step_interface(result.pairing, iteration.contact_force1, iteration.contact_force2);
+        step_interface(result.pairing, iteration.state.bodies[0].contact_force,
+                       iteration.state.bodies[1].contact_force);
     steps.push_back(
         {{"step", step.step},
          {"load_factor", step.factor},
@@ -155,13 +152,13 @@ void write_coupled_step_outputs(const std::filesystem::path& directory,
     files.push_back({write_body_output(step_path, step.outputs[0]),
                      write_body_output(step_path, step.outputs[1])});
     const RobinResult& iteration = step.iteration;
-    const InterfaceState state{iteration.normal_trace1, iteration.normal_trace2,
-                               iteration.contact_force1, iteration.contact_force2};
+    const InterfaceState state = two_body_interface_state(iteration.state);
     if (state.normal_trace1.size() == static_cast<Eigen::Index>(result.pairing.size())) {
       write_contact_csv(step_path / "contact.csv", result.pairing, state);
     }
     const StepInterface interface =
-        step_interface(result.pairing, iteration.contact_force1, iteration.contact_force2);
+        step_interface(result.pairing, iteration.state.bodies[0].contact_force,
+                       iteration.state.bodies[1].contact_force);
     table << step.step << ',' << exact_text(step.factor) << ',' << to_string(iteration.status)
           << ',' << iteration.history.size() << ',' << qp_iterations(iteration) << ','
           << (step.warm_started ? 1 : 0) << ',' << exact_text(iteration.final_largest_residual())
@@ -214,9 +211,9 @@ void write_monolithic_step_outputs(const std::filesystem::path& directory,
       names[alpha] = write_body_vtu(step_path, *problem.bodies[alpha], result.contact_force);
     }
     files.push_back(names);
-    write_contact_csv(
-        step_path / "contact.csv", problem.pairing,
-        {result.normal_trace1, result.normal_trace2, result.contact_force, result.contact_force});
+    write_contact_csv(step_path / "contact.csv", problem.pairing,
+                      {result.normal_traces[0], result.normal_traces[1], result.contact_force,
+                       result.contact_force});
     const StepInterface interface =
         step_interface(problem.pairing, result.contact_force, result.contact_force);
     table << step.step << ',' << exact_text(step.factor) << ',' << to_string(result.qp.status)

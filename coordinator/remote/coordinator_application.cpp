@@ -358,10 +358,10 @@ std::string progress_line(const IterationRecord& record, const CouplingOptions& 
   return fmt::format(
       "iteration {}: stopping test {:.2e} ({}; tolerance {:.0e}){}; joint state: obstacle change "
       "{:.2e}, penetration {:.2e}, force balance {:.2e}, complementarity {:.2e}, correction "
-      "{:.2e}; active {}/{}, QP iterations {}/{}, {:.3f} s; {}",
+      "{:.2e}; active {}, QP iterations {}, {:.3f} s; {}",
       record.iteration, value, state, options.tolerance, sequences, record.obstacle_change,
       record.penetration, record.force_balance, record.complementarity, record.correction,
-      record.active1, record.active2, record.qp_iterations1, record.qp_iterations2, record.seconds,
+      fmt::join(record.active, "/"), fmt::join(record.qp_iterations, "/"), record.seconds,
       record.acceleration_state);
 }
 

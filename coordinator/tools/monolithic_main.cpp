@@ -91,8 +91,8 @@ robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem
     return Eigen::Vector2d(displacements[body].segment<2>(2 * node));
   };
   const double scale = std::max({problem.pairing.gaps().cwiseAbs().maxCoeff(),
-                                 result.normal_trace1.cwiseAbs().maxCoeff(),
-                                 result.normal_trace2.cwiseAbs().maxCoeff()});
+                                 result.normal_traces[0].cwiseAbs().maxCoeff(),
+                                 result.normal_traces[1].cwiseAbs().maxCoeff()});
   return robin::excluded_pair_clearance(problem.pairing, displacement_of, scale);
 }
 
@@ -105,8 +105,8 @@ void write_outputs(const std::filesystem::path& directory, const LocalProblem& p
   const std::string file2 =
       robin::write_body_vtu(directory, *problem.bodies[1], result.contact_force);
   robin::write_solution_pvd(directory, file1, file2);
-  robin::InterfaceState state{result.normal_trace1, result.normal_trace2, result.contact_force,
-                              result.contact_force};
+  robin::InterfaceState state{result.normal_traces[0], result.normal_traces[1],
+                              result.contact_force, result.contact_force};
   robin::write_contact_csv(directory / "contact.csv", problem.pairing, state);
 }
 

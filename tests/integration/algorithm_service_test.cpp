@@ -85,13 +85,17 @@ void run_every_variant(const std::string& case_name) {
     std::printf("%s: %s: %s after %zu iterations\n", case_name.c_str(), variant.label.c_str(),
                 to_string(state.status).c_str(), state.history.size());
     ASSERT_EQ(state.status, IterationStatus::converged) << variant.label << ": " << state.message;
-    EXPECT_LE(relative_difference(state.contact_force1, monolithic.contact_force), 1e-7)
+    EXPECT_LE(relative_difference(state.state.bodies[0].contact_force, monolithic.contact_force),
+              1e-7)
         << variant.label;
-    EXPECT_LE(relative_difference(state.contact_force2, monolithic.contact_force), 1e-7)
+    EXPECT_LE(relative_difference(state.state.bodies[1].contact_force, monolithic.contact_force),
+              1e-7)
         << variant.label;
-    EXPECT_LE(relative_difference(state.normal_trace1, monolithic.normal_trace1), 1e-7)
+    EXPECT_LE(relative_difference(state.state.bodies[0].normal_trace, monolithic.normal_traces[0]),
+              1e-7)
         << variant.label;
-    EXPECT_LE(relative_difference(state.normal_trace2, monolithic.normal_trace2), 1e-7)
+    EXPECT_LE(relative_difference(state.state.bodies[1].normal_trace, monolithic.normal_traces[1]),
+              1e-7)
         << variant.label;
   }
   EXPECT_EQ(server1.failure(), "");

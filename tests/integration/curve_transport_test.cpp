@@ -77,16 +77,21 @@ void expect_equal_to_in_process(const CoupledRunResult& remote) {
   EXPECT_EQ(remote.iteration.history.size(), reference.iteration.history.size());
   const RobinResult& a = remote.iteration;
   const RobinResult& b = reference.iteration;
-  EXPECT_GT(b.contact_force1.maxCoeff(), 0.0);  // the comparison is about a real contact state
-  std::cout << "largest differences to the in-process run: contact force "
-            << (a.contact_force1 - b.contact_force1).lpNorm<Eigen::Infinity>() << " (of "
-            << b.contact_force1.lpNorm<Eigen::Infinity>() << "), normal trace "
-            << (a.normal_trace2 - b.normal_trace2).lpNorm<Eigen::Infinity>() << " (of "
-            << b.normal_trace2.lpNorm<Eigen::Infinity>() << ")\n";
-  EXPECT_TRUE(vectors_close(a.contact_force1, b.contact_force1, 1e-12));
-  EXPECT_TRUE(vectors_close(a.contact_force2, b.contact_force2, 1e-12));
-  EXPECT_TRUE(vectors_close(a.normal_trace1, b.normal_trace1, 1e-12));
-  EXPECT_TRUE(vectors_close(a.normal_trace2, b.normal_trace2, 1e-12));
+  EXPECT_GT(b.state.bodies[0].contact_force.maxCoeff(),
+            0.0);  // the comparison is about a real contact state
+  std::cout
+      << "largest differences to the in-process run: contact force "
+      << (a.state.bodies[0].contact_force - b.state.bodies[0].contact_force)
+             .lpNorm<Eigen::Infinity>()
+      << " (of " << b.state.bodies[0].contact_force.lpNorm<Eigen::Infinity>() << "), normal trace "
+      << (a.state.bodies[1].normal_trace - b.state.bodies[1].normal_trace).lpNorm<Eigen::Infinity>()
+      << " (of " << b.state.bodies[1].normal_trace.lpNorm<Eigen::Infinity>() << ")\n";
+  EXPECT_TRUE(
+      vectors_close(a.state.bodies[0].contact_force, b.state.bodies[0].contact_force, 1e-12));
+  EXPECT_TRUE(
+      vectors_close(a.state.bodies[1].contact_force, b.state.bodies[1].contact_force, 1e-12));
+  EXPECT_TRUE(vectors_close(a.state.bodies[0].normal_trace, b.state.bodies[0].normal_trace, 1e-12));
+  EXPECT_TRUE(vectors_close(a.state.bodies[1].normal_trace, b.state.bodies[1].normal_trace, 1e-12));
   for (int alpha = 0; alpha < 2; ++alpha) {
     EXPECT_TRUE(vectors_close(displacement(remote.outputs[alpha]),
                               displacement(reference.outputs[alpha]), 1e-12))
@@ -298,8 +303,7 @@ void expect_contact_csv_of_in_process_run(const std::filesystem::path& contact_c
   const CoupledRunResult& reference = in_process_reference();
   const TemporaryDirectory expected("contact-csv-reference");
   write_contact_csv(expected.path() / "contact.csv", reference.pairing,
-                    {reference.iteration.normal_trace1, reference.iteration.normal_trace2,
-                     reference.iteration.contact_force1, reference.iteration.contact_force2});
+                    two_body_interface_state(reference.iteration.state));
   const auto rows = contact_rows(contact_csv);
   const auto expected_rows = contact_rows(expected.path() / "contact.csv");
   ASSERT_EQ(rows.size(), expected_rows.size()) << contact_csv;

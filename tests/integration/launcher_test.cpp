@@ -113,8 +113,8 @@ double in_process_resultant_y() {
   InProcessPort body1, body2;
   const CoupledRunResult result =
       run_coupled_case(definition, {&body1, &body2}, definition.coupling);
-  const Eigen::VectorXd mean =
-      0.5 * (result.iteration.contact_force1 + result.iteration.contact_force2);
+  const Eigen::VectorXd mean = 0.5 * (result.iteration.state.bodies[0].contact_force +
+                                      result.iteration.state.bodies[1].contact_force);
   return contact_resultant(result.pairing, mean).y();
 }
 

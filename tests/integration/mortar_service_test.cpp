@@ -81,8 +81,10 @@ void expect_python_and_cpp_equal_monolithic(const std::string& case_file) {
   ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
   std::printf("%s, C++ and Python servers: %zu iterations\n", case_file.c_str(),
               run.iteration.history.size());
-  EXPECT_TRUE(testing::vectors_close(run.iteration.contact_force1, monolithic.contact_force, 1e-8));
-  EXPECT_TRUE(testing::vectors_close(run.iteration.contact_force2, monolithic.contact_force, 1e-8));
+  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[0].contact_force,
+                                     monolithic.contact_force, 1e-8));
+  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[1].contact_force,
+                                     monolithic.contact_force, 1e-8));
 }
 
 TEST(MortarService, PythonServerWithItsOwnMeshAgainstTheCppServerEqualsMonolithic) {

@@ -165,12 +165,12 @@ TEST(NeumannSolveRemote, ServerWithoutTheCapabilityServesRobinButRefusesTheNeuma
       run_coupled_case(definition, {&local1, &local2}, definition.coupling);
   ASSERT_EQ(remote.iteration.status, IterationStatus::converged) << remote.iteration.message;
   EXPECT_EQ(remote.iteration.history.size(), reference.iteration.history.size());
-  EXPECT_TRUE(
-      vectors_close(remote.iteration.contact_force1, reference.iteration.contact_force1, 1e-12));
+  EXPECT_TRUE(vectors_close(remote.iteration.state.bodies[0].contact_force,
+                            reference.iteration.state.bodies[0].contact_force, 1e-12));
   EXPECT_FALSE(body1.offers("neumann_solve"));
   EXPECT_TRUE(body2.offers("neumann_solve"));
 
-  const Eigen::VectorXd& force = remote.iteration.contact_force1;
+  const Eigen::VectorXd& force = remote.iteration.state.bodies[0].contact_force;
   try {
     body1.start_neumann_solve(force, 7);
     FAIL() << "the Neumann solve was started on a server without the capability";
@@ -186,10 +186,11 @@ TEST(NeumannSolveRemote, ServerWithoutTheCapabilityServesRobinButRefusesTheNeuma
   // Nothing was sent: the port has no request in flight and the server still serves.
   const BodyOutput output = body1.fields(force);
   EXPECT_EQ(output.mesh.nodes.size(), reference.outputs[0].mesh.nodes.size());
-  body2.start_neumann_solve(remote.iteration.contact_force2, 7);
+  body2.start_neumann_solve(remote.iteration.state.bodies[1].contact_force, 7);
   const CorrectionSolveResult neumann = body2.finish_neumann_solve();
   // At convergence the Neumann body's u_N under lambda is the contact solve's trace.
-  EXPECT_TRUE(vectors_close(neumann.normal_trace, remote.iteration.normal_trace2, 1e-9));
+  EXPECT_TRUE(
+      vectors_close(neumann.normal_trace, remote.iteration.state.bodies[1].normal_trace, 1e-9));
   for (SubdomainPort* port :
        {static_cast<SubdomainPort*>(&body1), static_cast<SubdomainPort*>(&body2),
         static_cast<SubdomainPort*>(&local1), static_cast<SubdomainPort*>(&local2)}) {

@@ -74,13 +74,19 @@ TEST(LoadSteps, PatchTestPressureIsTheLoadFactorTimesTheExactPressureAtEveryStep
     const double pressure = step.factor * exact_patch_pressure();
     std::printf("patch test step %d (factor %g): %zu iterations, pressure error %.2e\n", step.step,
                 step.factor, step.iteration.history.size(),
-                largest_pressure_error(robin.pairing, step.iteration.contact_force1, pressure));
-    EXPECT_LE(largest_pressure_error(robin.pairing, step.iteration.contact_force1, pressure), 1e-8);
-    EXPECT_LE(largest_pressure_error(robin.pairing, step.iteration.contact_force2, pressure), 1e-8);
+                largest_pressure_error(robin.pairing, step.iteration.state.bodies[0].contact_force,
+                                       pressure));
+    EXPECT_LE(largest_pressure_error(robin.pairing, step.iteration.state.bodies[0].contact_force,
+                                     pressure),
+              1e-8);
+    EXPECT_LE(largest_pressure_error(robin.pairing, step.iteration.state.bodies[1].contact_force,
+                                     pressure),
+              1e-8);
     EXPECT_EQ(step.warm_started, step.step > 1);
   }
   // The last step is what the run reports as its result.
-  EXPECT_EQ(robin.iteration.contact_force1, robin.steps.back().iteration.contact_force1);
+  EXPECT_EQ(robin.iteration.state.bodies[0].contact_force,
+            robin.steps.back().iteration.state.bodies[0].contact_force);
 
   LocalProblem problem = prepare_local_problem(definition);
   MprgpParameters parameters = definition.solver.qp;
@@ -127,10 +133,12 @@ TEST_P(HertzStepsTest, StepsEqualFreshMonolithicSolvesAndWarmStartsSaveIteration
     ASSERT_EQ(reference.qp.status, QpStatus::converged);
     const double scale = reference.contact_force.lpNorm<Eigen::Infinity>();
     ASSERT_GT(scale, 0.0);
-    const double error1 =
-        (step.iteration.contact_force1 - reference.contact_force).lpNorm<Eigen::Infinity>() / scale;
-    const double error2 =
-        (step.iteration.contact_force2 - reference.contact_force).lpNorm<Eigen::Infinity>() / scale;
+    const double error1 = (step.iteration.state.bodies[0].contact_force - reference.contact_force)
+                              .lpNorm<Eigen::Infinity>() /
+                          scale;
+    const double error2 = (step.iteration.state.bodies[1].contact_force - reference.contact_force)
+                              .lpNorm<Eigen::Infinity>() /
+                          scale;
     EXPECT_LE(error1, 1e-8) << "step " << step.step;
     EXPECT_LE(error2, 1e-8) << "step " << step.step;
     int active = 0;

@@ -213,7 +213,7 @@ TEST(MonolithicContact, PartialContactSatisfiesKktAndEquilibrium) {
   // lambda >= 0 by construction of the dual; the rest of KKT measured independently here.
   EXPECT_GE(result.contact_force.minCoeff(), 0.0);
   const Eigen::VectorXd clearance =
-      problem.pairing.gaps() - result.normal_trace1 - result.normal_trace2;
+      problem.pairing.gaps() - result.normal_traces[0] - result.normal_traces[1];
   const double displacement_scale = problem.pairing.gaps().cwiseAbs().maxCoeff();
   const double force_scale = result.contact_force.maxCoeff();
   const double penetration = std::max(0.0, -clearance.minCoeff()) / displacement_scale;
@@ -230,7 +230,7 @@ TEST(MonolithicContact, PartialContactSatisfiesKktAndEquilibrium) {
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodySolver& body = *problem.bodies[alpha];
     const double imbalance = free_dof_imbalance(body, problem.pairing, alpha, result.contact_force);
-    const Eigen::VectorXd returned = alpha == 0 ? result.normal_trace1 : result.normal_trace2;
+    const Eigen::VectorXd returned = alpha == 0 ? result.normal_traces[0] : result.normal_traces[1];
     const double trace_error =
         (normal_trace(problem.pairing, alpha, body.displacement(result.contact_force)) - returned)
             .cwiseAbs()

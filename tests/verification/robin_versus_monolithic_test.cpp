@@ -74,18 +74,23 @@ std::size_t expect_matches_monolithic(const CaseDefinition& definition,
   EXPECT_EQ(robin.pairing.size(), reference.pairing.size());
   if (robin.pairing.size() != reference.pairing.size()) return iterations;
   const RobinResult& state = robin.iteration;
-  EXPECT_LE(relative_difference(state.contact_force1, monolithic.contact_force), 1e-7);
-  EXPECT_LE(relative_difference(state.contact_force2, monolithic.contact_force), 1e-7);
-  EXPECT_LE(relative_difference(state.normal_trace1, monolithic.normal_trace1), 1e-7);
-  EXPECT_LE(relative_difference(state.normal_trace2, monolithic.normal_trace2), 1e-7);
+  EXPECT_LE(relative_difference(state.state.bodies[0].contact_force, monolithic.contact_force),
+            1e-7);
+  EXPECT_LE(relative_difference(state.state.bodies[1].contact_force, monolithic.contact_force),
+            1e-7);
+  EXPECT_LE(relative_difference(state.state.bodies[0].normal_trace, monolithic.normal_traces[0]),
+            1e-7);
+  EXPECT_LE(relative_difference(state.state.bodies[1].normal_trace, monolithic.normal_traces[1]),
+            1e-7);
   // Proposition 3.2: lambda1 = lambda2 and w = 0 at the fixed point.
   const double force_scale = monolithic.contact_force.lpNorm<Eigen::Infinity>();
-  EXPECT_LE((state.contact_force1 - state.contact_force2).lpNorm<Eigen::Infinity>(),
+  EXPECT_LE((state.state.bodies[0].contact_force - state.state.bodies[1].contact_force)
+                .lpNorm<Eigen::Infinity>(),
             1e-8 * force_scale);
-  const double trace_scale = monolithic.normal_trace1.lpNorm<Eigen::Infinity>() +
-                             monolithic.normal_trace2.lpNorm<Eigen::Infinity>();
-  EXPECT_LE(state.correction1.lpNorm<Eigen::Infinity>(), 1e-8 * trace_scale);
-  EXPECT_LE(state.correction2.lpNorm<Eigen::Infinity>(), 1e-8 * trace_scale);
+  const double trace_scale = monolithic.normal_traces[0].lpNorm<Eigen::Infinity>() +
+                             monolithic.normal_traces[1].lpNorm<Eigen::Infinity>();
+  EXPECT_LE(state.state.bodies[0].correction.lpNorm<Eigen::Infinity>(), 1e-8 * trace_scale);
+  EXPECT_LE(state.state.bodies[1].correction.lpNorm<Eigen::Infinity>(), 1e-8 * trace_scale);
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodySolver& body = *reference.bodies[alpha];
     const Eigen::VectorXd expected = body.displacement(monolithic.contact_force);
