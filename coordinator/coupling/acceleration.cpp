@@ -38,7 +38,8 @@ QuasiNewtonMixing parse_mixing(const std::string& mixing) {
   return QuasiNewtonMixing::aitken;
 }
 
-/// delta of block `block`: relaxation1 for the first, relaxation2 for the second.
+/// delta of block `block`: relaxation1 for the first, relaxation2 for the second and every
+/// further block (the bodies of a contact graph beyond the second).
 RelaxationBlock relaxation_block(const AccelerationOptions& options, int block, int size) {
   return {size, block == 0 ? options.relaxation1 : options.relaxation2};
 }
@@ -93,9 +94,7 @@ void validate(const AccelerationOptions& options) {
 std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options,
                                                 const std::vector<int>& block_sizes) {
   validate(options);
-  if (block_sizes.empty() || block_sizes.size() > 2) {
-    throw std::invalid_argument("make_acceleration: one or two blocks");
-  }
+  if (block_sizes.empty()) throw std::invalid_argument("make_acceleration: no blocks");
   if (options.method == "none") {
     std::vector<RelaxationBlock> blocks;
     for (std::size_t block = 0; block < block_sizes.size(); ++block) {

@@ -79,7 +79,8 @@ class Acceleration {
 /// options first (throws InputError as validate does).
 std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options, int size1,
                                                 int size2);
-/// The same for one block (single-sequence algorithms: relaxation1 applies) or two blocks.
+/// The same for one block (single-sequence algorithms: relaxation1 applies) or one block per
+/// body of a contact graph (body 1: relaxation1; every other body: relaxation2).
 std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& options,
                                                 const std::vector<int>& block_sizes);
 
