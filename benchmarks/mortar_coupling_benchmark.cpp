@@ -23,9 +23,11 @@ robin::InterfaceDescription straight(int count, double y, const Eigen::Vector2d&
     side.x_fixed.push_back(false);
     side.y_fixed.push_back(false);
   }
+  side.surfaces.emplace_back();
+  side.surfaces.back().boundary = "contact";
   for (int i = 0; i < count; ++i) {
-    side.segments.push_back(body_on_left_forward ? i : i + 1);
-    side.segments.push_back(body_on_left_forward ? i + 1 : i);
+    side.surfaces.back().segments.push_back(body_on_left_forward ? i : i + 1);
+    side.surfaces.back().segments.push_back(body_on_left_forward ? i + 1 : i);
   }
   return side;
 }

@@ -245,7 +245,15 @@ std::string join_boundary_names(const Mesh& mesh) {
 }
 
 std::vector<BoundaryReference> references_of(const BodyDefinition& definition) {
-  std::vector<BoundaryReference> references{{definition.contact_boundary, "contact_boundary", ""}};
+  std::vector<BoundaryReference> references;
+  const std::vector<std::string>& contact = definition.contact_boundaries;
+  for (std::size_t i = 0; i < contact.size(); ++i) {
+    // one contact boundary: the case file's key; several (hand-built): numbered like the others
+    references.push_back({contact[i],
+                          contact.size() == 1 ? std::string("contact_boundary")
+                                              : "contact_boundaries[" + std::to_string(i + 1) + "]",
+                          ""});
+  }
   for (std::size_t i = 0; i < definition.dirichlet.size(); ++i) {
     references.push_back({definition.dirichlet[i].boundary,
                           "dirichlet[" + std::to_string(i + 1) + "].boundary", ""});

@@ -183,8 +183,9 @@ BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
   body.context = file.file + ": body '" + definition.name + "'";
   read_mesh(table, directory, body);
   const PlaneModel model = read_model(table);
-  definition.contact_boundary =
-      read_boundary_name(table, "contact_boundary", body.boundary_references);
+  // One contact boundary per body in the case file (for now): a one-element list.
+  definition.contact_boundaries = {
+      read_boundary_name(table, "contact_boundary", body.boundary_references)};
   definition.body_force = table.optional_vector("body_force").value_or(Eigen::Vector2d::Zero());
   definition.material = read_material(table, model);
   for (const TableEntry& item : table.array_of_tables("dirichlet")) {

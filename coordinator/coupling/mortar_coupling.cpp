@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <utility>
 
 #include "numerics/errors.hpp"
 #include "numerics/finite_element.hpp"
@@ -14,19 +15,32 @@
 namespace robin {
 namespace {
 
-/// One contact boundary: its interface description seen as segments.
+/// One contact boundary: its interface description (of that one boundary) seen as segments.
 struct Side {
+  Side(const InterfaceDescription& description, std::string body_name, int body_index)
+      : interface(&description), name(std::move(body_name)), body(body_index) {
+    if (description.surfaces.size() > 1) {
+      throw InputError("mortar coupling: body '" + name + "' has " +
+                       std::to_string(description.surfaces.size()) +
+                       " contact boundaries; couple one boundary of each body "
+                       "(restrict_to_boundary)");
+    }
+    if (!description.surfaces.empty()) surface = &description.surfaces.front();
+  }
+
   const InterfaceDescription* interface = nullptr;
+  const ContactSurfaceDescription* surface = nullptr;  // null: no segments
   std::string name;
   int body = 0;  // 0 or 1
 
-  int nodes_per_segment() const { return nodes_per_edge(interface->segment_type); }
+  EdgeType segment_type() const { return surface ? surface->segment_type : EdgeType::line2; }
+  int nodes_per_segment() const { return nodes_per_edge(segment_type()); }
   int segment_count() const {
-    return static_cast<int>(interface->segments.size()) / nodes_per_segment();
+    return surface ? static_cast<int>(surface->segments.size()) / nodes_per_segment() : 0;
   }
   /// Position (into node_ids) of local node `local` of `segment`.
   int node(int segment, int local) const {
-    return interface->segments[static_cast<std::size_t>(segment * nodes_per_segment() + local)];
+    return surface->segments[static_cast<std::size_t>(segment * nodes_per_segment() + local)];
   }
   const Eigen::Vector2d& coordinates(int position) const {
     return interface->coordinates[static_cast<std::size_t>(position)];
@@ -42,7 +56,7 @@ struct SegmentPoint {
 SegmentPoint evaluate(const Side& side, int segment, double reference) {
   SegmentPoint point;
   Eigen::VectorXd derivatives;
-  edge_shape_functions(side.interface->segment_type, reference, point.values, derivatives);
+  edge_shape_functions(side.segment_type(), reference, point.values, derivatives);
   for (int a = 0; a < side.nodes_per_segment(); ++a) {
     point.position += point.values[a] * side.coordinates(side.node(segment, a));
     point.tangent += derivatives[a] * side.coordinates(side.node(segment, a));
@@ -423,7 +437,7 @@ ContactPairing assemble_rows(const Side& nonmortar, const Side& mortar, const Co
 }
 
 void require_segments(const Side& side) {
-  if (side.interface->segments.empty() || side.interface->node_ids.empty()) {
+  if (side.segment_count() == 0 || side.interface->node_ids.empty()) {
     throw InputError("mortar coupling: the contact boundary of body '" + side.name +
                      "' has no segments");
   }
@@ -432,14 +446,14 @@ void require_segments(const Side& side) {
 }  // namespace
 
 int finer_side(const InterfaceDescription& body1, const InterfaceDescription& body2) {
-  const Side first{&body1, "", 0}, second{&body2, "", 1};
+  const Side first(body1, "", 0), second(body2, "", 1);
   return mean_segment_length(second) < mean_segment_length(first) ? 1 : 0;
 }
 
 ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const std::string& name1,
                                      const InterfaceDescription& body2, const std::string& name2,
                                      const GapFunction* gap, const MortarOptions& options) {
-  const std::array<Side, 2> sides = {Side{&body1, name1, 0}, Side{&body2, name2, 1}};
+  const std::array<Side, 2> sides = {Side(body1, name1, 0), Side(body2, name2, 1)};
   for (const Side& side : sides) require_segments(side);
   const int nonmortar_body =
       options.non_mortar_body >= 0 ? options.non_mortar_body : finer_side(body1, body2);

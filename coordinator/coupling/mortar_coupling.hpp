@@ -47,8 +47,9 @@ struct MortarOptions {
 /// weight m_j, and both bodies' constraint operators (ContactPairing::operators). Rows whose
 /// normal displacement is prescribed go to `excluded`, as in node-to-node pairing.
 /// Throws InputError naming both bodies when no non-mortar node faces the mortar side (the
-/// boundaries do not face each other, or their outward normals point the same way), or when a
-/// boundary has no segments.
+/// boundaries do not face each other, or their outward normals point the same way), when a
+/// boundary has no segments, or when a description has several contact boundaries (surfaces):
+/// couple one boundary of each body, restrict_to_boundary() gives its description.
 ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const std::string& name1,
                                      const InterfaceDescription& body2, const std::string& name2,
                                      const GapFunction* gap, const MortarOptions& options);

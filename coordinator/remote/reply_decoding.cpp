@@ -5,6 +5,9 @@
 #include <cmath>
 #include <map>
 
+#include "numerics/errors.hpp"
+#include "numerics/interface_description.hpp"
+
 namespace robin {
 
 namespace {
@@ -165,30 +168,55 @@ ElementType element_type_of_vtk_cell(unsigned cell_type) {
   }
 }
 
-/// The segments of the one contact surface (positions into node_ids, checked in range).
-void decode_surface(const protocol::InterfaceDescription& message,
-                    InterfaceDescription& interface) {
-  if (message.surfaces_size() != 1) {
-    throw MalformedReply("surfaces has " + std::to_string(message.surfaces_size()) +
-                         " entries, expected one (the body's contact boundary)");
-  }
-  const protocol::ContactSurface& surface = message.surfaces(0);
+/// One contact surface: its segments (positions into node_ids, checked in range), and its own
+/// nodes with their normals and weights (fill_surface_nodes).
+ContactSurfaceDescription decode_surface(const protocol::InterfaceDescription& message, int k) {
+  const protocol::ContactSurface& surface = message.surfaces(k);
+  const std::string field = "surfaces[" + std::to_string(k) + "]";
   const int nodes_per_segment = surface.segment_type() == protocol::LINE3 ? 3 : 2;
   if (surface.segment_type() != protocol::LINE2 && surface.segment_type() != protocol::LINE3) {
-    throw MalformedReply("surfaces[0].segment_type is not LINE2 or LINE3");
+    throw MalformedReply(field + ".segment_type is not LINE2 or LINE3");
   }
   if (surface.segments_size() % nodes_per_segment != 0) {
-    throw MalformedReply("surfaces[0].segments has " + std::to_string(surface.segments_size()) +
+    throw MalformedReply(field + ".segments has " + std::to_string(surface.segments_size()) +
                          " entries, not a multiple of " + std::to_string(nodes_per_segment));
   }
   for (const std::uint32_t position : surface.segments()) {
     if (position >= static_cast<std::uint32_t>(message.node_ids_size())) {
-      throw MalformedReply("surfaces[0].segments names position " + std::to_string(position) +
+      throw MalformedReply(field + ".segments names position " + std::to_string(position) +
                            ", beyond the " + std::to_string(message.node_ids_size()) + " nodes");
     }
   }
-  interface.segment_type = nodes_per_segment == 3 ? EdgeType::line3 : EdgeType::line2;
-  interface.segments.assign(surface.segments().begin(), surface.segments().end());
+  ContactSurfaceDescription decoded;
+  decoded.boundary = surface.boundary();
+  decoded.segment_type = nodes_per_segment == 3 ? EdgeType::line3 : EdgeType::line2;
+  decoded.segments.assign(surface.segments().begin(), surface.segments().end());
+  return decoded;
+}
+
+/// The contact surfaces: at least one, names distinct; then each one's own nodes.
+void decode_surfaces(const protocol::InterfaceDescription& message,
+                     InterfaceDescription& interface) {
+  if (message.surfaces_size() == 0) {
+    throw MalformedReply("surfaces is empty, expected one per contact boundary");
+  }
+  for (int k = 0; k < message.surfaces_size(); ++k) {
+    interface.surfaces.push_back(decode_surface(message, k));
+    for (int j = 0; j < k; ++j) {
+      if (interface.surfaces[static_cast<std::size_t>(j)].boundary ==
+          interface.surfaces.back().boundary) {
+        throw MalformedReply("surfaces[" + std::to_string(k) + "] repeats the boundary '" +
+                             interface.surfaces.back().boundary + "'");
+      }
+    }
+  }
+  for (ContactSurfaceDescription& surface : interface.surfaces) {
+    try {
+      fill_surface_nodes(interface, surface);
+    } catch (const InputError& error) {
+      throw MalformedReply(std::string("surfaces: ") + error.what());
+    }
+  }
 }
 
 InterfaceDescription decode_interface(const protocol::InterfaceDescription& message) {
@@ -214,7 +242,7 @@ InterfaceDescription decode_interface(const protocol::InterfaceDescription& mess
     interface.x_fixed.push_back(message.fixed(static_cast<int>(2 * i)));
     interface.y_fixed.push_back(message.fixed(static_cast<int>(2 * i + 1)));
   }
-  decode_surface(message, interface);
+  decode_surfaces(message, interface);
   interface.dof_count = static_cast<int>(message.dof_count());
   return interface;
 }

@@ -18,8 +18,10 @@ class MalformedReply : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The body's contact boundary. Node ids, coordinates, normals, weights and fixed flags must
-/// describe the same number of nodes.
+/// The body's contact boundaries. Node ids, coordinates, normals, weights and fixed flags must
+/// describe the same number of nodes; one surface per contact boundary (at least one, names
+/// distinct), its segments' positions in range. Each surface's own nodes, normals and weights
+/// are filled in (fill_surface_nodes), so restrict_to_boundary() works on the result.
 InterfaceDescription decode_interface(const protocol::InterfaceDescription& message);
 
 /// A contact solve result for `contact_size` contact nodes (pair order). `active` defaults to

@@ -108,7 +108,9 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
   for (const TractionCondition& condition : definition.tractions) {
     encode_traction(condition, *message.add_traction());
   }
-  message.add_contact_boundaries(definition.contact_boundary);
+  for (const std::string& boundary : definition.contact_boundaries) {
+    message.add_contact_boundaries(boundary);
+  }
   encode_solver(solver, *message.mutable_solver());
   return message;
 }

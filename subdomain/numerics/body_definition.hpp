@@ -1,6 +1,6 @@
 #pragma once
 // Everything that defines one elastic body: mesh, material, loads, Dirichlet
-// conditions and the name of its contact boundary. Plain data; no files.
+// conditions and the names of its contact boundaries. Plain data; no files.
 
 #include <Eigen/Core>
 #include <optional>
@@ -29,13 +29,15 @@ struct TractionCondition {
 };
 
 struct BodyDefinition {
-  std::string name;                 // used in every message about this body
+  std::string name;  // used in every message about this body
   Mesh mesh;
   Material material;
   Eigen::Vector2d body_force = Eigen::Vector2d::Zero();  // force per unit area
   std::vector<DirichletCondition> dirichlet;
   std::vector<TractionCondition> tractions;
-  std::string contact_boundary;     // name of the boundary group that may touch the other body
+  /// The names of the boundary groups that may touch other bodies: at least one, distinct (a
+  /// body of an N-body stack touches its neighbours with several).
+  std::vector<std::string> contact_boundaries;
 };
 
 }  // namespace robin

@@ -186,7 +186,7 @@ void BodySolver::assemble() {
   if (mesh.node_count() == 0 || mesh.element_count() == 0) {
     throw InputError("body '" + name() + "': the mesh has no elements");
   }
-  mesh.boundary(definition_.contact_boundary);  // throws InputError for an unknown name
+  check_contact_boundaries();
   const long dof_count = 2L * static_cast<long>(mesh.node_count());
   if (options_.maximum_dofs > 0 && dof_count > options_.maximum_dofs) {
     throw ResourceLimitError("body '" + name() + "': " + std::to_string(dof_count) +
@@ -206,7 +206,15 @@ void BodySolver::assemble() {
   full_load_ = assemble_external_load(definition_);
   const SparseMatrix reduced_stiffness = dofs_->reduce_matrix(full_stiffness_);
   reduced_load_ = dofs_->reduce_load(full_stiffness_, full_load_);
-  boundary_weights_ = robin::boundary_weights(mesh, mesh.boundary(definition_.contact_boundary));
+  for (std::size_t k = 0; k < definition_.contact_boundaries.size(); ++k) {
+    const Eigen::VectorXd weights =
+        robin::boundary_weights(mesh, mesh.boundary(definition_.contact_boundaries[k]));
+    if (k == 0) {
+      boundary_weights_ = weights;
+    } else {
+      boundary_weights_ += weights;
+    }
+  }
   timings_.assembly_seconds = seconds_since(start);
 
   start = std::chrono::steady_clock::now();
@@ -222,7 +230,7 @@ void BodySolver::assemble() {
 std::vector<int> BodySolver::trailing_unknowns() const {
   std::vector<int> unknowns;
   if (!options_.contact_unknowns_last) return unknowns;
-  for (int node : definition_.mesh.boundary(definition_.contact_boundary).nodes()) {
+  for (int node : contact_nodes()) {
     for (int dof : {2 * node, 2 * node + 1}) {
       if (!dofs_->is_prescribed(dof)) unknowns.push_back(dofs_->free_index(dof));
     }
@@ -231,13 +239,36 @@ std::vector<int> BodySolver::trailing_unknowns() const {
   return unknowns;
 }
 
+void BodySolver::check_contact_boundaries() const {
+  const std::vector<std::string>& names = definition_.contact_boundaries;
+  if (names.empty()) throw InputError("body '" + name() + "': no contact boundary is named");
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    definition_.mesh.boundary(names[k]);  // throws InputError for an unknown name
+    if (std::find(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(k), names[k]) !=
+        names.begin() + static_cast<std::ptrdiff_t>(k)) {
+      throw InputError("body '" + name() + "': contact boundary '" + names[k] + "' is named twice");
+    }
+  }
+}
+
+std::vector<int> BodySolver::contact_nodes() const {
+  const std::vector<std::string>& names = definition_.contact_boundaries;
+  if (names.size() == 1) return definition_.mesh.boundary(names.front()).nodes();
+  std::vector<int> nodes;
+  for (const std::string& boundary : names) {
+    const std::vector<int> group_nodes = definition_.mesh.boundary(boundary).nodes();
+    nodes.insert(nodes.end(), group_nodes.begin(), group_nodes.end());
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
 InterfaceDescription BodySolver::contact_boundary() const {
   const Mesh& mesh = definition_.mesh;
-  const BoundaryGroup& group = mesh.boundary(definition_.contact_boundary);
   InterfaceDescription interface;
   interface.dof_count = dofs_->free_count();
-  interface.node_ids = group.nodes();
-  interface.normals = boundary_node_normals(mesh, group);
+  interface.node_ids = contact_nodes();
   const Eigen::VectorXd& weights = boundary_weights_;
   for (int node : interface.node_ids) {
     interface.node_tags.push_back(mesh.node_tags[node]);
@@ -246,17 +277,49 @@ InterfaceDescription BodySolver::contact_boundary() const {
     interface.x_fixed.push_back(dofs_->is_prescribed(2 * node));
     interface.y_fixed.push_back(dofs_->is_prescribed(2 * node + 1));
   }
-  interface.segment_type = group.type;
-  interface.segments = oriented_segments(mesh, group, interface.node_ids);
+  // Per boundary its own normals and weights; the union's normal at a node is the normalized
+  // sum of every boundary's length-weighted normals there (numerics/interface_description.hpp).
+  std::vector<Eigen::Vector2d> sums;
+  for (const std::string& boundary : definition_.contact_boundaries) {
+    const BoundaryGroup& group = mesh.boundary(boundary);
+    ContactSurfaceDescription surface;
+    surface.boundary = boundary;
+    surface.segment_type = group.type;
+    surface.segments = oriented_segments(mesh, group, interface.node_ids);
+    const std::vector<int> nodes = group.nodes();
+    const std::vector<Eigen::Vector2d> group_sums = boundary_normal_sums(mesh, group);
+    surface.normals =
+        unit_normals(mesh, group_sums, nodes, "boundary " + mesh.boundary_label(group));
+    const Eigen::VectorXd group_weights = robin::boundary_weights(mesh, group);
+    for (const int node : nodes) {
+      surface.positions.push_back(static_cast<int>(
+          std::lower_bound(interface.node_ids.begin(), interface.node_ids.end(), node) -
+          interface.node_ids.begin()));
+      surface.weights.push_back(group_weights[node]);
+    }
+    if (sums.empty()) {
+      sums = group_sums;
+    } else {
+      for (std::size_t node = 0; node < sums.size(); ++node) sums[node] += group_sums[node];
+    }
+    interface.surfaces.push_back(std::move(surface));
+  }
+  if (interface.surfaces.size() == 1) {
+    interface.normals = interface.surfaces.front().normals;
+  } else {
+    std::string names;
+    for (const std::string& boundary : definition_.contact_boundaries) {
+      names += (names.empty() ? "'" : ", '") + boundary + "'";
+    }
+    interface.normals = unit_normals(mesh, sums, interface.node_ids, "contact boundaries " + names);
+  }
   return interface;
 }
 
 void BodySolver::assign_contact(const ContactOperator& contact) {
   const auto start = std::chrono::steady_clock::now();
   report(SetupStage::interface_operator);
-  const std::vector<int> boundary_nodes =
-      definition_.mesh.boundary(definition_.contact_boundary).nodes();
-  check_contact_operator(contact, boundary_nodes, "body '" + name() + "'");
+  check_contact_operator(contact, contact_nodes(), "body '" + name() + "'");
   const bool keep_compliance = compliance_ != nullptr && contact == contact_;
   if (!keep_compliance) {
     const int row_count = contact.row_count();
@@ -296,7 +359,7 @@ void BodySolver::update_free_trace() {
 
 bool BodySolver::has_same_stiffness(const BodyDefinition& definition,
                                     const BodySolverOptions& options) const {
-  if (definition.contact_boundary != definition_.contact_boundary ||
+  if (definition.contact_boundaries != definition_.contact_boundaries ||
       !same_factor_options(options, options_) ||
       !same_material(definition.material, definition_.material) ||
       !same_geometry(definition.mesh, definition_.mesh)) {

@@ -28,28 +28,12 @@
 #include "numerics/contact_operator.hpp"
 #include "numerics/dof_map.hpp"
 #include "numerics/elasticity.hpp"
+#include "numerics/interface_description.hpp"
 #include "numerics/linear_operator.hpp"
 #include "numerics/mprgp.hpp"
 #include "numerics/setup_progress.hpp"
 
 namespace robin {
-
-/// The candidate contact nodes of a body as the body sees them.
-struct InterfaceDescription {
-  std::vector<int> node_ids;                 // mesh node indices, ascending
-  std::vector<std::size_t> node_tags;        // the nodes' tags in the mesh file (for messages)
-  std::vector<Eigen::Vector2d> coordinates;  // reference positions
-  std::vector<Eigen::Vector2d> normals;      // unit outward normals from the geometry
-  std::vector<double> weights;               // m_i = int_{contact boundary} phi_i ds (length)
-  std::vector<bool> x_fixed;                 // u_x prescribed by a Dirichlet condition
-  std::vector<bool> y_fixed;                 // u_y prescribed by a Dirichlet condition
-  /// The contact boundary's segments as positions into node_ids, nodes_per_edge(segment_type)
-  /// per segment (endpoints, then the midpoint), each oriented with the body on its left: the
-  /// outward normal is the direction from the first to the second endpoint turned clockwise.
-  EdgeType segment_type = EdgeType::line2;
-  std::vector<int> segments;
-  int dof_count = 0;  // free degrees of freedom of the body
-};
 
 enum class InterfaceOperatorKind {
   automatic,  // dense when the contact size is at most dense_limit
@@ -60,7 +44,7 @@ enum class InterfaceOperatorKind {
 struct BodySolverOptions {
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
   int dense_limit = 3000;
-  /// Eliminate the free dofs of the contact boundary last in the Cholesky factor (when there
+  /// Eliminate the free dofs of the contact boundaries last in the Cholesky factor (when there
   /// are at most 2 dense_limit of them), so a dense F comes from the factor's trailing block in
   /// O(m^2 n_c) instead of n_c solves with the whole factor (see numerics/cholesky.hpp).
   bool contact_unknowns_last = true;
@@ -120,13 +104,17 @@ class BodySolver {
   long factor_nonzeros() const { return factor_->factor_nonzeros(); }
   long solve_count() const { return factor_->solve_count(); }
 
-  /// The nodes of the contact boundary with geometric normals and weights.
+  /// The nodes of the contact boundaries with geometric normals and weights, and per contact
+  /// boundary its segments and its own nodes (numerics/interface_description.hpp).
   InterfaceDescription contact_boundary() const;
+  /// The nodes of all contact boundaries (mesh node indices, ascending, each once).
+  std::vector<int> contact_nodes() const;
 
   /// Whether `definition` set up with `options` has this body's stiffness factor and contact
   /// boundary: the same mesh (node coordinates, element blocks, boundary groups: bit for bit),
-  /// material, prescribed degrees of freedom (which ones, not their values), contact boundary
-  /// and factor options. Its name, loads, prescribed values and tags may differ.
+  /// material, prescribed degrees of freedom (which ones, not their values), contact boundaries
+  /// (the same names in the same order) and factor options. Its name, loads, prescribed values and
+  /// tags may differ.
   bool has_same_stiffness(const BodyDefinition& definition, const BodySolverOptions& options) const;
   /// Takes the name, loads, prescribed values and tags of `definition`, for which
   /// has_same_stiffness() holds, and keeps the factor of K: f is assembled again and K^{-1} f
@@ -137,7 +125,7 @@ class BodySolver {
   /// Sets the contact constraint operator B and builds e and F (F is kept when B equals the
   /// assigned one, e.g. a later run of the same body). Resets the warm start.
   /// Throws InputError (check_contact_operator) when B is malformed or uses a node that is not
-  /// on the contact boundary.
+  /// on a contact boundary.
   void assign_contact(const ContactOperator& contact);
   /// The number of constraints (rows of B).
   int contact_size() const { return contact_.row_count(); }
@@ -179,17 +167,19 @@ class BodySolver {
   Eigen::Vector2d applied_force() const;
   /// Contact force field as nodal vectors, full size: -B' lambda (force acting on this body).
   Eigen::VectorXd contact_force_field(const Eigen::VectorXd& contact_force) const;
-  /// Boundary weight of every mesh node on the contact boundary (zero elsewhere): the integral
-  /// of its shape function over the contact boundary (length).
+  /// Boundary weight of every mesh node on the contact boundaries (zero elsewhere): the integral
+  /// of its shape function over the contact boundaries (length; summed over the boundaries).
   const Eigen::VectorXd& boundary_weights() const { return boundary_weights_; }
 
  private:
   void assemble();
+  /// At least one contact boundary, each a boundary of the mesh, none named twice (InputError).
+  void check_contact_boundaries() const;
   void report(SetupStage stage) const;
   void build_interface_operator();
   /// e = B K^{-1} f + B u_p at load factor 1 and at the current one, for the assigned B.
   void update_free_trace();
-  /// Free dofs of the contact boundary nodes, to be eliminated last (empty when disabled).
+  /// Free dofs of the contact boundaries' nodes, to be eliminated last (empty when disabled).
   std::vector<int> trailing_unknowns() const;
   Eigen::VectorXd apply_transpose_trace(const Eigen::VectorXd& contact_force) const;  // B' lambda
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "numerics/errors.hpp"
@@ -168,13 +169,16 @@ Eigen::VectorXd boundary_weights(const Mesh& mesh, const BoundaryGroup& group) {
   return weights;
 }
 
-std::vector<Eigen::Vector2d> boundary_node_normals(const Mesh& mesh, const BoundaryGroup& group) {
-  const NodeElementMap adjacency(mesh);
+std::vector<Eigen::Vector2d> boundary_normal_sums(const Mesh& mesh, const BoundaryGroup& group,
+                                                  bool edges_have_body_on_left) {
+  std::optional<NodeElementMap> adjacency;
+  if (!edges_have_body_on_left) adjacency.emplace(mesh);
   const int count = nodes_per_edge(group.type);
   const std::vector<double> node_references = edge_reference_nodes(group.type);
   std::vector<Eigen::Vector2d> sums(mesh.node_count(), Eigen::Vector2d::Zero());
   for (std::size_t e = 0; e < group.edge_count(); ++e) {
-    const EdgeGeometry edge(mesh, group, e, adjacency);
+    const EdgeGeometry edge =
+        adjacency ? EdgeGeometry(mesh, group, e, *adjacency) : EdgeGeometry(mesh, group, e);
     const double length = edge.length();
     for (int i = 0; i < count; ++i) {
       // Each node receives its edges' outward normals (taken at the node) times their lengths.
@@ -182,16 +186,28 @@ std::vector<Eigen::Vector2d> boundary_node_normals(const Mesh& mesh, const Bound
           length * edge.evaluate(node_references[i]).outward_normal;
     }
   }
+  return sums;
+}
+
+std::vector<Eigen::Vector2d> unit_normals(const Mesh& mesh,
+                                          const std::vector<Eigen::Vector2d>& sums,
+                                          const std::vector<int>& nodes, const std::string& what) {
   std::vector<Eigen::Vector2d> normals;
-  for (const int node : group.nodes()) {
+  normals.reserve(nodes.size());
+  for (const int node : nodes) {
     const double norm = sums[node].norm();
     if (norm == 0.0) {
-      throw InputError("boundary " + mesh.boundary_label(group) + ": the normals at node " +
-                       std::to_string(mesh.node_tags[node]) + " cancel out (a cusp or a fold)");
+      throw InputError(what + ": the normals at node " + std::to_string(mesh.node_tags[node]) +
+                       " cancel out (a cusp or a fold)");
     }
     normals.push_back(sums[node] / norm);
   }
   return normals;
+}
+
+std::vector<Eigen::Vector2d> boundary_node_normals(const Mesh& mesh, const BoundaryGroup& group) {
+  return unit_normals(mesh, boundary_normal_sums(mesh, group), group.nodes(),
+                      "boundary " + mesh.boundary_label(group));
 }
 
 StressField recover_stress(const Mesh& mesh, const Material& material,

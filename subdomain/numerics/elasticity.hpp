@@ -37,6 +37,19 @@ Eigen::VectorXd boundary_weights(const Mesh& mesh, const BoundaryGroup& group);
 /// Returned in the order of group.nodes().
 std::vector<Eigen::Vector2d> boundary_node_normals(const Mesh& mesh, const BoundaryGroup& group);
 
+/// Per mesh node, the sum over the edges of `group` at the node of the edge's outward normal
+/// (taken at the node) times the edge's length; zero off the group. The edges are oriented by
+/// the adjacent area element, or, with `edges_have_body_on_left`, taken as they are (the
+/// outward normal is the edge direction turned clockwise; the mesh needs no elements then).
+std::vector<Eigen::Vector2d> boundary_normal_sums(const Mesh& mesh, const BoundaryGroup& group,
+                                                  bool edges_have_body_on_left = false);
+
+/// sums[node] / |sums[node]| for each of `nodes`, in their order. Throws InputError
+/// "<what>: the normals at node <tag> cancel out (a cusp or a fold)" for a zero sum.
+std::vector<Eigen::Vector2d> unit_normals(const Mesh& mesh,
+                                          const std::vector<Eigen::Vector2d>& sums,
+                                          const std::vector<int>& nodes, const std::string& what);
+
 /// Stress (s_xx, s_yy, s_xy) per element (at its centroid) and per node (average over
 /// the elements touching the node, each evaluated at that node).
 struct StressField {

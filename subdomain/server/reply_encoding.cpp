@@ -41,8 +41,7 @@ void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
 
 }  // namespace
 
-void encode_interface(const std::string& body_name, const std::string& contact_boundary,
-                      const InterfaceDescription& interface,
+void encode_interface(const std::string& body_name, const InterfaceDescription& interface,
                       protocol::InterfaceDescription& message) {
   message.set_body_name(body_name);
   message.set_dimension(2);
@@ -55,11 +54,14 @@ void encode_interface(const std::string& body_name, const std::string& contact_b
     message.add_fixed(interface.x_fixed[i]);
     message.add_fixed(interface.y_fixed[i]);
   }
-  protocol::ContactSurface& surface = *message.add_surfaces();
-  surface.set_boundary(contact_boundary);
-  surface.set_segment_type(interface.segment_type == EdgeType::line3 ? protocol::LINE3
-                                                                     : protocol::LINE2);
-  surface.mutable_segments()->Assign(interface.segments.begin(), interface.segments.end());
+  for (const ContactSurfaceDescription& contact_surface : interface.surfaces) {
+    protocol::ContactSurface& surface = *message.add_surfaces();
+    surface.set_boundary(contact_surface.boundary);
+    surface.set_segment_type(contact_surface.segment_type == EdgeType::line3 ? protocol::LINE3
+                                                                             : protocol::LINE2);
+    surface.mutable_segments()->Assign(contact_surface.segments.begin(),
+                                       contact_surface.segments.end());
+  }
 }
 
 protocol::SolveStatus to_protocol(QpStatus status) {

@@ -11,10 +11,10 @@
 
 namespace robin {
 
-/// The contact boundary as InterfaceDescription: per-node values in the order of
-/// interface.node_ids, interleaved (x, y) vectors.
-void encode_interface(const std::string& body_name, const std::string& contact_boundary,
-                      const InterfaceDescription& interface,
+/// The contact boundaries as InterfaceDescription: per-node values in the order of
+/// interface.node_ids, interleaved (x, y) vectors; one ContactSurface per contact boundary, in
+/// the order of interface.surfaces.
+void encode_interface(const std::string& body_name, const InterfaceDescription& interface,
                       protocol::InterfaceDescription& message);
 
 /// A contact solve result; compute_seconds = result.seconds.

@@ -197,20 +197,35 @@ void decode_solver(const protocol::SolverSettings& message, const std::string& c
   }
 }
 
-}  // namespace
-
-/// The one contact boundary robin-subdomain serves (several per body come with many-body
-/// contact; the protocol carries them already).
-std::string decode_contact_boundary(const protocol::SetupBody& message, const Mesh& mesh,
-                                    const std::string& context) {
-  if (message.contact_boundaries_size() != 1) {
+/// SetupBody.contact_boundaries: 1 to maximum_contact_boundaries names, each a boundary of the
+/// mesh, none repeated (as the Python server checks them).
+std::vector<std::string> decode_contact_boundaries(const protocol::SetupBody& message,
+                                                   const Mesh& mesh, const std::string& context) {
+  const int count = message.contact_boundaries_size();
+  if (count == 0) {
     fail(context, "contact_boundaries",
-         "has " + std::to_string(message.contact_boundaries_size()) +
-             " names: robin-subdomain serves exactly one contact boundary per body");
+         "is empty: name at least one boundary that may touch another body");
   }
-  check_boundary(mesh, message.contact_boundaries(0), context, "contact_boundaries[0]");
-  return message.contact_boundaries(0);
+  if (count > maximum_contact_boundaries) {
+    fail(context, "contact_boundaries",
+         "has " + std::to_string(count) + " names, more than the " +
+             std::to_string(maximum_contact_boundaries) + " contact boundaries a body may have");
+  }
+  std::vector<std::string> names;
+  names.reserve(static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    const std::string& name = message.contact_boundaries(k);
+    const std::string field = "contact_boundaries[" + std::to_string(k) + "]";
+    check_boundary(mesh, name, context, field);
+    if (std::find(names.begin(), names.end(), name) != names.end()) {
+      fail(context, field, "repeats '" + name + "'");
+    }
+    names.push_back(name);
+  }
+  return names;
 }
+
+}  // namespace
 
 DecodedSetup decode_setup_body(const protocol::SetupBody& message,
                                const std::filesystem::path& data_directory) {
@@ -224,7 +239,7 @@ DecodedSetup decode_setup_body(const protocol::SetupBody& message,
   }
   decode_solver(message.solver(), context, setup);
   definition.mesh = decode_body_mesh(message, context, data_directory);
-  definition.contact_boundary = decode_contact_boundary(message, definition.mesh, context);
+  definition.contact_boundaries = decode_contact_boundaries(message, definition.mesh, context);
   for (int k = 0; k < message.dirichlet_size(); ++k) {
     definition.dirichlet.push_back(decode_dirichlet(message.dirichlet(k), definition.mesh, context,
                                                     "dirichlet[" + std::to_string(k) + "]"));

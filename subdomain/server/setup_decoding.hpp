@@ -11,6 +11,9 @@
 
 namespace robin {
 
+/// The most contact boundaries a SetupBody may name (checked before anything is allocated).
+constexpr int maximum_contact_boundaries = 64;
+
 /// Everything a SetupBody defines: the body and how to solve its contact problems.
 struct DecodedSetup {
   BodyDefinition definition;
@@ -22,9 +25,11 @@ struct DecodedSetup {
 /// checked by decode_mesh; or mesh_path, a file under `data_directory`, refused when that is
 /// empty), plane model (must be given), material (young_modulus/poisson_ratio, or 9 `voigt`
 /// values, not both), body force (0 or 2 values), Dirichlet (at least one of x/y) and traction
-/// conditions, exactly one contact boundary, and the solver settings (0 or empty = server
-/// default). Every boundary name is checked against the mesh. Throws InputError naming the body
-/// and the field, e.g. "body 'upper': SetupBody.voigt has 4 values, expected 9".
+/// conditions, 1 to maximum_contact_boundaries distinct contact boundaries (a repeated one is
+/// refused naming its field, "SetupBody.contact_boundaries[1] repeats 'top'"), and the solver
+/// settings (0 or empty = server default). Every boundary name is checked against the mesh. Throws
+/// InputError naming the body and the field, e.g. "body 'upper': SetupBody.voigt has 4 values,
+/// expected 9".
 DecodedSetup decode_setup_body(const protocol::SetupBody& message,
                                const std::filesystem::path& data_directory);
 

@@ -497,7 +497,7 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   }
   const InterfaceDescription interface = body->contact_boundary();
   protocol::InterfaceDescription& description = *reply.mutable_interface();
-  encode_interface(body->name(), body->definition().contact_boundary, interface, description);
+  encode_interface(body->name(), interface, description);
   description.set_dof_count(static_cast<std::uint64_t>(body->free_dof_count()));
   const BodyTimings& timings = body->timings();
   description.set_setup_seconds(timings.setup_seconds());

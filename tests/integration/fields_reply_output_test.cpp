@@ -30,7 +30,7 @@ BodyOutput block_output() {
   definition.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 4, 2, ElementType::triangle6);
   definition.material = make_isotropic_material(100.0, 0.25, PlaneModel::plane_strain, "test");
   definition.dirichlet = {{"bottom", 0.0, 0.0}};
-  definition.contact_boundary = "top";
+  definition.contact_boundaries = {"top"};
   BodySolver body(definition);
   const InterfaceDescription top = body.contact_boundary();
   body.assign_contact(node_to_node_operator(

@@ -9,7 +9,8 @@
 // SetupBody.mesh_content (hand-encoded wire bytes), mesh_path reads outside --data-directory,
 // write_directory writes outside --output-root (also through a symbolic link at the target),
 // a 100,000-character body name and an inverted cell; bodies above --max-dofs and
-// --max-factor-memory.
+// --max-factor-memory. A body with two contact boundaries, and the refusal of a repeated or
+// unknown one.
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -36,6 +37,7 @@
 #include "numerics/gmsh_reader.hpp"
 #include "numerics/material.hpp"
 #include "protocol_version.hpp"
+#include "remote/reply_decoding.hpp"
 #include "robin.pb.h"
 
 extern char** environ;
@@ -238,7 +240,7 @@ BodyDefinition lower_block_definition() {
   definition.mesh = lower_mesh();
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
   definition.dirichlet.push_back({"bottom", 0.0, 0.0});
-  definition.contact_boundary = "contact";
+  definition.contact_boundaries = {"contact"};
   return definition;
 }
 
@@ -600,7 +602,7 @@ TEST(SubdomainProcess, MeshPathOutsideTheDataDirectoryIsRefusedUnread) {
   definition.mesh = read_gmsh_mesh(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_v41.msh");
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
   definition.dirichlet.push_back({"bottom", 0.0, 0.0});
-  definition.contact_boundary = "top";
+  definition.contact_boundaries = {"top"};
   const BodySolver reference(definition);
   const InterfaceDescription expected = reference.contact_boundary();
   ASSERT_EQ(reply.interface().node_ids_size(), static_cast<int>(expected.node_ids.size()));
@@ -757,6 +759,92 @@ TEST(SubdomainProcess, BodiesAboveTheResourceLimitsAreBadInputNamingTheLimit) {
   }
   ConnectedServer server({"--max-dofs", std::to_string(dof_count)});
   EXPECT_TRUE(exchange(server.socket, lower_block_data_setup(id++)).has_interface());
+}
+
+/// lower_block_data_setup with `names` as its contact boundaries.
+protocol::Envelope lower_block_contact_setup(std::uint64_t id,
+                                             const std::vector<std::string>& names) {
+  protocol::Envelope setup = lower_block_data_setup(id);
+  setup.mutable_setup_body()->clear_contact_boundaries();
+  for (const std::string& name : names) setup.mutable_setup_body()->add_contact_boundaries(name);
+  return setup;
+}
+
+// A body with two contact boundaries (the lower block's top "contact" and its side "left",
+// which share the corner (-1, 0)): one ContactSurface per boundary, the union of their nodes
+// with the values a BodySolver of the same body gives in this process (weights adding up to the
+// boundaries' lengths 2 + 1), and, decoded as the coordinator decodes it, the description of
+// each boundary alone that a body with only that boundary gives. A repeated, unknown, missing
+// or excessive list is BAD_INPUT naming the field, and the server keeps serving.
+TEST(SubdomainProcess, TwoContactBoundariesAreServedAndARepeatedOrUnknownOneIsRefused) {
+  ConnectedServer server({});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  std::uint64_t id = 1;
+  const protocol::Envelope reply =
+      exchange(server.socket, lower_block_contact_setup(id++, {"contact", "left"}));
+  ASSERT_TRUE(reply.has_interface()) << reply.DebugString();
+  const protocol::InterfaceDescription& message = reply.interface();
+  ASSERT_EQ(message.surfaces_size(), 2);
+  EXPECT_EQ(message.surfaces(0).boundary(), "contact");
+  EXPECT_EQ(message.surfaces(1).boundary(), "left");
+
+  BodyDefinition definition = lower_block_definition();
+  definition.contact_boundaries = {"contact", "left"};
+  const InterfaceDescription expected = BodySolver(definition).contact_boundary();
+  ASSERT_EQ(message.node_ids_size(), static_cast<int>(expected.node_ids.size()));
+  double weight_sum = 0.0;
+  for (std::size_t i = 0; i < expected.node_ids.size(); ++i) {
+    const int k = static_cast<int>(i);
+    EXPECT_EQ(message.node_ids(k), expected.node_ids[i]);
+    EXPECT_EQ(message.normals(2 * k), expected.normals[i].x());
+    EXPECT_EQ(message.normals(2 * k + 1), expected.normals[i].y());
+    EXPECT_EQ(message.weights(k), expected.weights[i]);
+    weight_sum += message.weights(k);
+  }
+  EXPECT_NEAR(weight_sum, 3.0, 1e-12);
+  for (int k = 0; k < 2; ++k) {
+    const std::vector<int>& segments = expected.surfaces[static_cast<std::size_t>(k)].segments;
+    EXPECT_EQ(std::vector<int>(message.surfaces(k).segments().begin(),
+                               message.surfaces(k).segments().end()),
+              segments);
+  }
+
+  const InterfaceDescription decoded = decode_interface(message);
+  for (const std::string boundary : {"contact", "left"}) {
+    SCOPED_TRACE(boundary);
+    BodyDefinition alone = lower_block_definition();
+    alone.contact_boundaries = {boundary};
+    const InterfaceDescription own = BodySolver(alone).contact_boundary();
+    const InterfaceDescription restricted = restrict_to_boundary(decoded, boundary);
+    EXPECT_EQ(restricted.node_ids, own.node_ids);
+    EXPECT_EQ(restricted.coordinates, own.coordinates);
+    ASSERT_EQ(restricted.weights.size(), own.weights.size());
+    for (std::size_t i = 0; i < own.weights.size(); ++i) {
+      EXPECT_NEAR(restricted.weights[i], own.weights[i], 1e-15);
+      EXPECT_NEAR((restricted.normals[i] - own.normals[i]).norm(), 0.0, 1e-14);
+    }
+    ASSERT_EQ(restricted.surfaces.size(), 1u);
+    EXPECT_EQ(restricted.surfaces.front().segments, own.surfaces.front().segments);
+  }
+
+  expect_error(
+      exchange(server.socket, lower_block_contact_setup(id++, {"contact", "left", "contact"})),
+      protocol::BAD_INPUT, "SetupBody.contact_boundaries[2] repeats 'contact'");
+  expect_hello(server.socket, id++);
+  expect_error(exchange(server.socket, lower_block_contact_setup(id++, {"contact", "nowhere"})),
+               protocol::BAD_INPUT,
+               "SetupBody.contact_boundaries[1] 'nowhere' is not a boundary of the mesh");
+  expect_hello(server.socket, id++);
+  expect_error(exchange(server.socket, lower_block_contact_setup(id++, {})), protocol::BAD_INPUT,
+               "SetupBody.contact_boundaries is empty");
+  expect_hello(server.socket, id++);
+  expect_error(exchange(server.socket,
+                        lower_block_contact_setup(id++, std::vector<std::string>(65, "contact"))),
+               protocol::BAD_INPUT, "SetupBody.contact_boundaries has 65 names, more than the 64");
+  expect_hello(server.socket, id++);
+  // and the server still sets a body up
+  EXPECT_TRUE(exchange(server.socket, lower_block_contact_setup(id++, {"left", "contact"}))
+                  .has_interface());
 }
 
 }  // namespace

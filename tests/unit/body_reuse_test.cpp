@@ -40,7 +40,7 @@ BodyDefinition loaded_block(double lift, const Eigen::Vector2d& body_force,
   condition.boundary = "right";
   condition.vector = traction;
   body.tractions.push_back(condition);
-  body.contact_boundary = "top";
+  body.contact_boundaries = {"top"};
   return body;
 }
 
@@ -156,7 +156,7 @@ TEST(BodyReuse, OnlyLoadsNameAndPrescribedValuesMayChange) {
   EXPECT_FALSE(body.has_same_stiffness(sliding, options));
 
   BodyDefinition other_contact = first_loads();
-  other_contact.contact_boundary = "right";
+  other_contact.contact_boundaries = {"right"};
   EXPECT_FALSE(body.has_same_stiffness(other_contact, options));
 
   EXPECT_FALSE(

@@ -55,7 +55,7 @@ BodyDefinition test_body() {
   traction.boundary = "right";
   traction.vector = Eigen::Vector2d(-4.0, 1.5);
   body.tractions.push_back(traction);
-  body.contact_boundary = "top";
+  body.contact_boundaries = {"top"};
   return body;
 }
 
@@ -194,7 +194,7 @@ std::unique_ptr<BodySolver> make_solver(const OperatorChoice& choice,
   options.interface_operator = choice.kind;
   options.contact_unknowns_last = choice.contact_unknowns_last;
   BodyDefinition body = test_body();
-  body.contact_boundary = contact_boundary;
+  body.contact_boundaries = {contact_boundary};
   auto solver = std::make_unique<BodySolver>(std::move(body), options);
   if (contact_boundary == "top") solver->assign_contact(top_assignment(solver->mesh()));
   return solver;
@@ -315,7 +315,7 @@ Eigen::VectorXd varying_force(Eigen::Index size) {
 TEST(BodySolver, GeneralOperatorEqualsTheIndependentSolve) {
   for (const std::string boundary : {"top", "right"}) {
     BodyDefinition body = test_body();
-    body.contact_boundary = boundary;
+    body.contact_boundaries = {boundary};
     const ContactOperator contact = two_node_operator(body.mesh, boundary);
     const ReferenceBody reference(body, contact);
     if (boundary == "right") {
@@ -375,7 +375,7 @@ TEST(BodySolver, GeneralOperatorEqualsTheIndependentSolve) {
 // nodes in reversed order and on the boundary "right" whose first node is prescribed.
 TEST(BodySolver, NodeToNodeOperatorIsTheNodeNormalTrace) {
   BodyDefinition body = test_body();
-  body.contact_boundary = "right";
+  body.contact_boundaries = {"right"};
   std::vector<int> nodes = body.mesh.boundary("right").nodes();
   std::reverse(nodes.begin(), nodes.end());
   std::vector<Eigen::Vector2d> normals;

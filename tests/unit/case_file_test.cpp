@@ -224,7 +224,7 @@ TEST(CaseFile, FullCaseFirstBody) {
   EXPECT_EQ(upper.material.model, PlaneModel::plane_stress);
   expect_matrix_near(upper.material.stiffness,
                      isotropic_stiffness(210e3, 0.3, PlaneModel::plane_stress));
-  EXPECT_EQ(upper.contact_boundary, "contact");
+  EXPECT_EQ(upper.contact_boundaries, std::vector<std::string>{"contact"});
   EXPECT_EQ(upper.body_force, Eigen::Vector2d(0.5, -1.5));
   EXPECT_TRUE(upper.mesh.nodes.empty());  // meshes are read by load_body
 
@@ -277,7 +277,7 @@ TEST(CaseFile, FullCaseSecondBody) {
   Eigen::Matrix3d voigt;
   voigt << 300.0, 100.0, 10.0, 100.0, 200.0, 20.0, 10.0, 20.0, 50.0;
   EXPECT_EQ(lower.material.stiffness, voigt);
-  EXPECT_EQ(lower.contact_boundary, "contact");
+  EXPECT_EQ(lower.contact_boundaries, std::vector<std::string>{"contact"});
   EXPECT_EQ(lower.body_force, Eigen::Vector2d::Zero());
   ASSERT_EQ(lower.dirichlet.size(), 1u);
   EXPECT_EQ(lower.dirichlet[0].boundary, "bottom");
@@ -1056,7 +1056,7 @@ TEST(LoadBody, MeshReaderErrorsCarryTheCaseContext) {
 TEST(LoadBody, HandBuiltBodyCaseIsCheckedToo) {
   BodyCase body;
   body.definition.name = "x";
-  body.definition.contact_boundary = "nowhere";
+  body.definition.contact_boundaries = {"nowhere"};
   body.mesh_path = data("case_upper.geo");
   body.context = "hand: body 'x'";
   try {

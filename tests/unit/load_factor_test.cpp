@@ -109,7 +109,7 @@ BodyDefinition loaded_block(double factor) {
   pressure.is_pressure = true;
   pressure.pressure = 3.0 * factor;
   definition.tractions.push_back(pressure);
-  definition.contact_boundary = "contact";
+  definition.contact_boundaries = {"contact"};
   return definition;
 }
 

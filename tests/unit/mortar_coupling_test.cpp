@@ -32,9 +32,11 @@ InterfaceDescription straight_boundary(const Eigen::Vector2d& start, const Eigen
   }
   const Eigen::Vector2d tangent = (end - start).normalized();
   const bool body_on_left = Eigen::Vector2d(tangent.y(), -tangent.x()).dot(outward) > 0.0;
+  side.surfaces.emplace_back();
+  side.surfaces.back().boundary = "contact";
   for (int i = 0; i < count; ++i) {
-    side.segments.push_back(body_on_left ? i : i + 1);
-    side.segments.push_back(body_on_left ? i + 1 : i);
+    side.surfaces.back().segments.push_back(body_on_left ? i : i + 1);
+    side.surfaces.back().segments.push_back(body_on_left ? i + 1 : i);
   }
   return side;
 }
@@ -166,7 +168,8 @@ TEST(MortarCoupling, ANonMortarNodeWithPrescribedNormalDisplacementIsExcluded) {
   const InterfaceDescription upper = upper_edge(0.0, 0.0, 1.0, 0.0, 3);
   MortarOptions options;
   options.non_mortar_body = 0;
-  const ContactPairing pairing = build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
+  const ContactPairing pairing =
+      build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
   EXPECT_EQ(pairing.size(), 4u);
   ASSERT_EQ(pairing.excluded.size(), 1u);
   EXPECT_NE(pairing.excluded.front().find("body 'lower' contact node (tag 1)"), std::string::npos)

@@ -214,7 +214,7 @@ struct CompressedBlock {
     body.mesh = make_rectangle_mesh(0.0, 0.0, width, 1.0, 4, 2, ElementType::quadrilateral4);
     body.material = make_isotropic_material(young, poisson, model, "test");
     body.dirichlet = {{"bottom", std::nullopt, 0.0}, {"left", 0.0, std::nullopt}};
-    body.contact_boundary = "top";
+    body.contact_boundaries = {"top"};
     return body;
   }
   /// Trapezoidal weight of a node at abscissa x on a face [0, width] of spacing h.

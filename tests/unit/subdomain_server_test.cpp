@@ -81,7 +81,7 @@ BodyDefinition lower_block_definition() {
   definition.mesh = lower_mesh();
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
   definition.dirichlet.push_back({"bottom", 0.0, 0.0});
-  definition.contact_boundary = "contact";
+  definition.contact_boundaries = {"contact"};
   return definition;
 }
 
@@ -219,7 +219,7 @@ void expect_interface(const protocol::InterfaceDescription& message,
   EXPECT_EQ(surface.segment_type(), protocol::LINE2);
   ASSERT_EQ(surface.segments_size(), 40);
   EXPECT_EQ(std::vector<int>(surface.segments().begin(), surface.segments().end()),
-            expected.segments);
+            expected.surfaces.at(0).segments);
   std::set<std::uint32_t> covered;
   double length = 0.0;
   for (int e = 0; e < 20; ++e) {
@@ -992,7 +992,7 @@ TEST(SubdomainServer, MeshPathOutsideTheDataDirectoryIsRefusedUnread) {
   definition.mesh = read_gmsh_mesh(square_msh);
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
   definition.dirichlet.push_back({"bottom", 0.0, 0.0});
-  definition.contact_boundary = "top";
+  definition.contact_boundaries = {"top"};
   const BodySolver reference(definition);
   const InterfaceDescription expected = reference.contact_boundary();
   ASSERT_EQ(reply.interface().node_ids_size(), static_cast<int>(expected.node_ids.size()));
