@@ -14,7 +14,12 @@ packages=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-scipy python3-matplotlib python3-zmq python3-protobuf
   iproute2 procps shellcheck python3-yaml
-  zlib1g-dev python3-vtk9
+  zlib1g-dev
+  # ParaView 5.11 and its Python (paraview.simple, and the vtkmodules of its VTK 9.2, which the
+  # tests read .vtu files with: python3-paraview conflicts with python3-vtk9 and replaces it on a
+  # machine set up before), and a virtual X display for robin-paraview --screenshot
+  # (tests/integration/robin_paraview_test.sh). 152 MB to download (python3-vtk9 was 49 MB).
+  paraview python3-paraview xvfb xauth
   # tests/network/slurm_namespaces_test.sh runs deploy/slurm/robin-contact.sbatch on a SLURM
   # cluster it starts itself (its own munged, slurmctld and slurmds, configuration and key in
   # its work directory). On a host run by systemd, Debian enables munge.service (its own key

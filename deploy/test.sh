@@ -12,6 +12,9 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # deploy/setup.sh installed SLURM and munge: the slurm_namespaces test fails without them
 # instead of skipping (it still skips where it cannot make network namespaces or is not root).
 export ROBIN_REQUIRE_SLURM=1
+# It installed ParaView (paraview, python3-paraview) and xvfb: robin_paraview_script fails
+# without them instead of skipping.
+export ROBIN_REQUIRE_PARAVIEW=1
 
 ./deploy/build.sh
 ctest --test-dir build --output-on-failure -j "$jobs"

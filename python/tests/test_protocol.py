@@ -703,7 +703,7 @@ class FieldsOutput(ServerTestCase):
         self.assertTrue(expected.read_bytes().startswith(b'<?xml version="1.0"?>'))
 
     def test_the_file_holds_the_reply_fields_as_vtk_reads_them(self):
-        """The written .vtu read by VTK's reader (python3-vtk9, ParaView's): binary and
+        """The written .vtu read by VTK's reader (ParaView's, python3-paraview): binary and
         zlib-compressed; the reply's points and fields; the stress as (XX, YY, ZZ, XY, YZ, XZ)
         with ZZ = nu (XX + YY) (plane strain, nu = 0.3) and YZ = XZ = 0; the reply's named
         boundaries as line cells (VTK_LINE) with boundary_id k naming boundary_names[k - 1]."""

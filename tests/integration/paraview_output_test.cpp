@@ -1,5 +1,5 @@
-// The .vtu files the tools write, read by VTK's own reader (python3-vtk9, the reader ParaView
-// uses), against the analytic solution of the contact patch test examples/non_matching_blocks.toml:
+// The .vtu files the tools write, read by VTK's own reader (ParaView's VTK, python3-paraview),
+// against the analytic solution of the contact patch test examples/non_matching_blocks.toml:
 // robin-monolithic (fields computed in-process) and robin-run (fields computed by two
 // robin-subdomain servers and sent in FieldsReply, boundaries included).
 //

@@ -18,8 +18,8 @@
 //                "Points": [...], "Cells": [...]}]}                 (UnstructuredGrid files)
 // with array = {"attributes": {...}, "values": [numbers]} (integers for Int*/UInt* types).
 //
-// read_vtu_with_vtk: the file read by VTK's own vtkXMLUnstructuredGridReader (python3-vtk9, the
-// reader ParaView uses), as JSON:
+// read_vtu_with_vtk: the file read by VTK's own vtkXMLUnstructuredGridReader (ParaView's VTK,
+// python3-paraview's vtkmodules), as JSON:
 //   {"points": [x, y, z, ...], "connectivity": [...], "offsets": [...] (end of each cell),
 //    "types": [...], "point_data": {name: {"components": n, "component_names": [...],
 //    "values": [...]}}, "cell_data": {...}, "field_data": {name: [strings]}}
