@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -128,27 +129,40 @@ CheckpointWriter::CheckpointWriter(std::filesystem::path directory)
     : directory_(std::move(directory)) {}
 
 void CheckpointWriter::write(const RunCheckpoint& checkpoint) {
-  const std::vector<Eigen::VectorXd>& iterates = checkpoint.iteration.iterates;
+  // the completed steps' iterates, then the current loop's (without copying them)
+  std::vector<const Eigen::VectorXd*> iterates;
+  for (const LoadStepCheckpoint& step : checkpoint.steps) {
+    for (const Eigen::VectorXd& iterate : step.iteration.iterates) iterates.push_back(&iterate);
+  }
+  for (const Eigen::VectorXd& iterate : checkpoint.iteration.iterates) iterates.push_back(&iterate);
   const std::filesystem::path iterates_path = directory_ / checkpoint_iterates_file_name;
   if (first_ || iterates.size() < iterates_written_) {
     std::string bytes;
-    for (const Eigen::VectorXd& iterate : iterates) bytes += iterate_record(iterate);
+    for (const Eigen::VectorXd* iterate : iterates) bytes += iterate_record(*iterate);
     write_file_atomically(iterates_path, bytes);
     first_ = false;
   } else {
     std::string bytes;
     for (std::size_t index = iterates_written_; index < iterates.size(); ++index) {
-      bytes += iterate_record(iterates[index]);
+      bytes += iterate_record(*iterates[index]);
     }
     append_to_file(iterates_path, bytes);
   }
   iterates_written_ = iterates.size();
-  const nlohmann::json document = {
-      {"format", RunCheckpoint::current_format}, {"run_id", checkpoint.run_id},
-      {"first_run_id", checkpoint.first_run_id}, {"started", checkpoint.started},
-      {"case_file", checkpoint.case_file},       {"case_sha256", checkpoint.case_sha256},
-      {"case_text", checkpoint.case_text},       {"overrides", checkpoint.overrides},
-      {"options", checkpoint.options},           {"loop", to_json(checkpoint.iteration)}};
+  nlohmann::json steps = nlohmann::json::array();
+  for (const LoadStepCheckpoint& step : checkpoint.steps) steps.push_back(to_json(step));
+  const nlohmann::json document = {{"format", RunCheckpoint::current_format},
+                                   {"run_id", checkpoint.run_id},
+                                   {"first_run_id", checkpoint.first_run_id},
+                                   {"started", checkpoint.started},
+                                   {"case_file", checkpoint.case_file},
+                                   {"case_sha256", checkpoint.case_sha256},
+                                   {"case_text", checkpoint.case_text},
+                                   {"overrides", checkpoint.overrides},
+                                   {"options", checkpoint.options},
+                                   {"step", checkpoint.step},
+                                   {"load_steps", steps},
+                                   {"loop", to_json(checkpoint.iteration)}};
   write_file_atomically(
       directory_ / checkpoint_file_name,
       document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
@@ -184,9 +198,34 @@ RunCheckpoint read_checkpoint(const std::filesystem::path& directory) {
       checkpoint.overrides.push_back(value.get<std::string>());
     }
     checkpoint.options = member(document, "options");
+    checkpoint.step = decode_integer(document, "step");
+    const nlohmann::json& steps = member(document, "load_steps");
+    if (!steps.is_array()) throw CheckpointFormatError("'load_steps' is not an array");
+    for (const nlohmann::json& step : steps) {
+      checkpoint.steps.push_back(load_step_checkpoint_from_json(step));
+      if (checkpoint.steps.back().step != static_cast<int>(checkpoint.steps.size())) {
+        throw CheckpointFormatError("'load_steps' holds step " +
+                                    std::to_string(checkpoint.steps.back().step) + " at place " +
+                                    std::to_string(checkpoint.steps.size()));
+      }
+    }
+    if (checkpoint.step < 0 ||
+        (checkpoint.step == 0 ? !checkpoint.steps.empty()
+                              : checkpoint.step != static_cast<int>(checkpoint.steps.size()) + 1)) {
+      throw CheckpointFormatError("its 'step' " + std::to_string(checkpoint.step) + " follows " +
+                                  std::to_string(checkpoint.steps.size()) + " completed steps");
+    }
     checkpoint.iteration = iteration_checkpoint_from_json(member(document, "loop"));
-    checkpoint.iteration.iterates =
-        read_iterates(directory / checkpoint_iterates_file_name, checkpoint.iteration.iteration);
+    int count = checkpoint.iteration.iteration;
+    for (const LoadStepCheckpoint& step : checkpoint.steps) count += step.iteration.iteration;
+    std::vector<Eigen::VectorXd> iterates =
+        read_iterates(directory / checkpoint_iterates_file_name, count);
+    auto next = std::make_move_iterator(iterates.begin());
+    for (LoadStepCheckpoint& step : checkpoint.steps) {
+      step.iteration.iterates.assign(next, next + step.iteration.iteration);
+      next += step.iteration.iteration;
+    }
+    checkpoint.iteration.iterates.assign(next, std::make_move_iterator(iterates.end()));
     return checkpoint;
   } catch (const CheckpointFormatError& error) {
     throw CheckpointFormatError("the checkpoint '" + path.string() +

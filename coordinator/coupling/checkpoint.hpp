@@ -4,12 +4,16 @@
 // DIR`:
 //   DIR/checkpoint-iterates.bin  the iterates x_1, x_2, ... of the iteration, one record per
 //                                iteration appended (an unsigned 64-bit count n, then n
-//                                IEEE 754 doubles, both in the machine's byte order);
+//                                IEEE 754 doubles, both in the machine's byte order); with
+//                                [loading], those of the completed load steps first, in
+//                                order, then those of the current step;
 //   DIR/checkpoint.json          written atomically (write_file_atomically: a temporary
 //                                name, flushed, renamed) after the record is appended: the
 //                                loop's state after iteration k (iteration_checkpoint.hpp),
-//                                which says how many records are valid (k; a record beyond,
-//                                from an append cut short, is ignored), and the run it belongs
+//                                which says how many records are valid (k, plus those of
+//                                the completed load steps; a record beyond, from an append
+//                                cut short, is ignored), the completed load steps
+//                                (iteration_checkpoint.hpp), and the run it belongs
 //                                to, so that a resume with a changed case or changed options is
 //                                refused: the case file's path, SHA-256 and text (the text
 //                                names the changed keys), the --set overrides and the
@@ -30,8 +34,9 @@ extern const char* const checkpoint_file_name;
 extern const char* const checkpoint_iterates_file_name;
 
 struct RunCheckpoint {
-  /// 2: the iteration state per body (contact graphs); 1 had fixed pairs of vectors.
-  static constexpr int current_format = 2;
+  /// 3: with the load steps of a case with [loading]; 2: without them (a run with [loading]
+  /// was not checkpointed); 1 had fixed pairs of vectors instead of per-body states.
+  static constexpr int current_format = 3;
   std::string run_id;        // the run that wrote it (ResultDirectory::run_id)
   std::string first_run_id;  // the run that started from scratch (itself, or resumed ones')
   std::string started;       // when that first run started (UTC, ISO 8601)
@@ -42,6 +47,10 @@ struct RunCheckpoint {
   /// The command-line options that change the computation, name -> value ("--tolerance":
   /// 1e-6); an option not given is absent.
   nlohmann::json options = nlohmann::json::object();
+  /// The load step `iteration` belongs to (1-based), 0 for a case without [loading].
+  int step = 0;
+  /// The load steps completed before it (steps 1 ... step - 1).
+  std::vector<LoadStepCheckpoint> steps;
   IterationCheckpoint iteration;
 };
 

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include "coupling/checkpoint_encoding.hpp"
 #include "coupling/iteration_checkpoint.hpp"
 #include "coupling/local_problem.hpp"
 
@@ -163,13 +164,18 @@ std::array<PortTimings, 2> port_timings(const RecoverablePorts& ports) {
 }
 
 /// The iteration on the recoverable ports: after a lost server, it continues from its last
-/// checkpoint (or `resume`, or starts again when there is none).
+/// checkpoint (or `resume`, or starts again when there is none). `catch_up` brings the servers'
+/// contact warm start to where the iteration found it (the load steps before it) and is called
+/// before every attempt after a lost server, and before the first when `behind`. The iteration's
+/// last checkpoint goes to `last` when it is not null.
 RobinResult recoverable_iteration(RecoverablePorts& ports, const ContactPairing& pairing,
                                   const CouplingOptions& options,
                                   const Eigen::VectorXd* initial_iterate,
                                   const IterationCheckpoint* resume,
                                   const std::function<void(const IterationCheckpoint&)>& observe,
-                                  const RunObserver& observer) {
+                                  const RunObserver& observer,
+                                  const std::function<void()>& catch_up = {}, bool behind = false,
+                                  std::optional<IterationCheckpoint>* last = nullptr) {
   std::optional<IterationCheckpoint> latest;
   if (resume != nullptr) latest = *resume;
   IterationContinuation loop;
@@ -177,19 +183,26 @@ RobinResult recoverable_iteration(RecoverablePorts& ports, const ContactPairing&
     latest = checkpoint;
     if (observe) observe(checkpoint);
   };
-  return ports.run([&] {
+  bool first_attempt = true;
+  RobinResult result = ports.run([&] {
+    if (catch_up && (behind || !first_attempt)) catch_up();
+    first_attempt = false;
     const IterationCheckpoint* start = nullptr;
     std::optional<IterationCheckpoint> from;  // a copy: `latest` changes as the loop goes on
     if (latest) {
       from = *latest;
       start = &*from;
-      report_stage(observer, "continuing the iteration after iteration " +
-                                 std::to_string(start->iteration) + " (checkpoint)");
+      if (!start->stopped) {
+        report_stage(observer, "continuing the iteration after iteration " +
+                                   std::to_string(start->iteration) + " (checkpoint)");
+      }
     }
     loop.resume = start;
     return run_robin_iteration(ports.port(0), ports.port(1), pairing, options, initial_iterate,
                                loop, observer.iteration);
   });
+  if (last != nullptr) *last = std::move(latest);
+  return result;
 }
 
 /// Both bodies' fields for the iteration's contact forces.
@@ -201,40 +214,123 @@ std::array<BodyOutput, 2> collect_fields(RecoverablePorts& ports, const RobinRes
   });
 }
 
+/// Only the contact solves of the iterations at `iterates` (x_1, x_2, ...) of a run of the
+/// iteration with `options` on `pairing` (the two-body problem of run_robin_iteration), results
+/// discarded: the servers' contact warm start after them is the one that run left
+/// (CouplingScheme::repeat_contact_solves). Throws PortError as the iteration does.
+void repeat_contact_solves(SubdomainPort& body1, SubdomainPort& body2,
+                           const ContactPairing& pairing, const CouplingOptions& options,
+                           const std::vector<Eigen::VectorXd>& iterates) {
+  if (iterates.empty()) return;
+  const CouplingProblem problem{ContactGraph::two_bodies(pairing.gaps().size()), pairing.gaps(),
+                                pairing.weights(), short_wavelength_forces(pairing)};
+  const std::unique_ptr<CouplingScheme> scheme =
+      make_coupling_scheme(options, {&body1, &body2}, problem);
+  for (std::size_t index = 0; index < iterates.size(); ++index) {
+    scheme->repeat_contact_solves(iterates[index], static_cast<int>(index) + 1);
+  }
+}
+
+/// Sets the load factor of both bodies (and of their replacements).
+void set_load_factor(RecoverablePorts& ports, double factor) {
+  ports.run([&] {
+    on_both_ports(ports.ports(), [&](SubdomainPort& port, int) {
+      port.set_load_factor(factor);
+      return 0;
+    });
+  });
+  ports.load_factor_set(factor);
+}
+
+/// Checks that the checkpointed load steps are those of `loading`; throws CheckpointFormatError.
+void check_resumed_steps(const LoadingOptions& loading,
+                         const std::vector<LoadStepCheckpoint>& steps) {
+  if (steps.size() >= loading.factors.size()) {
+    throw CheckpointFormatError("the checkpoint has " + std::to_string(steps.size()) +
+                                " completed load steps, the case " +
+                                std::to_string(loading.factors.size()));
+  }
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    if (steps[k].step != static_cast<int>(k + 1) || steps[k].factor != loading.factors[k] ||
+        steps[k].iteration.status != IterationStatus::converged) {
+      throw CheckpointFormatError("the checkpoint's load step " + std::to_string(k + 1) +
+                                  " is not the case's, or did not converge");
+    }
+  }
+}
+
 /// The load steps of a case with [loading] on ports whose contact is assigned (see
 /// run_coupled_case). Fills result.steps and, from the last step computed, result.iteration,
 /// outputs and iteration_port_timings; result.excluded_clearance is the worst over the steps.
+/// With continuation.resume, the steps before it are taken from continuation.resume_steps
+/// (their fields collected again) and the step it belongs to continues after it.
 void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
                     const CouplingOptions& options, const RunObserver& observer,
-                    CoupledRunResult& result) {
+                    const RunContinuation& continuation, CoupledRunResult& result) {
   const std::size_t count = loading.factors.size();
+  static const std::vector<LoadStepCheckpoint> none;
+  const std::vector<LoadStepCheckpoint>& resumed =
+      continuation.resume == nullptr || continuation.resume_steps == nullptr
+          ? none
+          : *continuation.resume_steps;
+  if (continuation.resume != nullptr) check_resumed_steps(loading, resumed);
   // The fixed points (restart iterates) of the steps so far, with their load factors.
   std::vector<std::pair<double, Eigen::VectorXd>> points;
+  // The load factors and iterates of the steps so far: their contact solves, repeated in order
+  // on servers that have not seen them, give the servers the uninterrupted run's warm start.
+  std::vector<std::pair<double, std::vector<Eigen::VectorXd>>> solved;
+  // Whether the servers' contact warm start lacks the steps so far: after a resume, or once a
+  // server was replaced (result.recoveries grew) since the last step's iteration.
+  bool behind = continuation.resume != nullptr;
+  std::size_t recoveries = result.recoveries.size();
+  const auto catch_up = [&](double factor) {
+    return [&, factor] {
+      report_stage(observer, "repeating the contact solves of the " +
+                                 std::to_string(solved.size()) +
+                                 " load steps before (the servers' warm start)");
+      for (const auto& [earlier, iterates] : solved) {
+        set_load_factor(ports, earlier);
+        repeat_contact_solves(ports.port(0), ports.port(1), result.pairing, options, iterates);
+      }
+      set_load_factor(ports, factor);
+    };
+  };
   for (std::size_t k = 0; k < count; ++k) {
     const auto step_start = Clock::now();
     LoadStepResult step;
     step.step = static_cast<int>(k + 1);
     step.factor = loading.factors[k];
     step.warm_started = loading.warm_start && !points.empty();
+    const bool done_before = k < resumed.size();  // completed before the checkpoint
+    const IterationCheckpoint* resume =
+        done_before ? &resumed[k].iteration : (k == resumed.size() ? continuation.resume : nullptr);
     std::ostringstream stage;
     stage << "load step " << step.step << "/" << count << ": load factor " << step.factor
-          << (step.warm_started ? ", starting from the previous steps" : "");
+          << (step.warm_started ? ", starting from the previous steps" : "")
+          << (done_before ? " (completed before the checkpoint: collecting its fields)" : "");
     report_stage(observer, stage.str());
     const std::array<PortTimings, 2> before = port_timings(ports);
-    ports.run([&] {
-      on_both_ports(ports.ports(), [&](SubdomainPort& port, int) {
-        port.set_load_factor(step.factor);
-        return 0;
-      });
-    });
-    ports.load_factor_set(step.factor);
+    set_load_factor(ports, step.factor);
     const std::array<PortTimings, 2> before_iteration = port_timings(ports);
     const Eigen::VectorXd start =
         step.warm_started ? predicted_start(points, step.factor) : Eigen::VectorXd();
     const auto iteration_start = Clock::now();
-    step.iteration =
-        recoverable_iteration(ports, result.pairing, options, step.warm_started ? &start : nullptr,
-                              nullptr, {}, observer);
+    std::optional<IterationCheckpoint> last;
+    if (done_before) {
+      step.iteration = recoverable_iteration(ports, result.pairing, options, nullptr, resume, {},
+                                             observer, {}, false, &last);
+    } else {
+      // a loop resumed after it stopped makes no request: the servers stay behind
+      const bool stopped = resume != nullptr && resume->stopped;
+      behind = behind || result.recoveries.size() != recoveries;
+      step.iteration = recoverable_iteration(
+          ports, result.pairing, options, step.warm_started ? &start : nullptr, resume,
+          continuation.checkpoint, observer,
+          solved.empty() ? std::function<void()>() : catch_up(step.factor), behind && !stopped,
+          &last);
+      behind = stopped;
+      recoveries = result.recoveries.size();
+    }
     result.profile.iterations_seconds += seconds_since(iteration_start);
     for (int alpha = 0; alpha < 2; ++alpha) {
       result.iteration_port_timings[alpha] =
@@ -251,7 +347,7 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
     for (int alpha = 0; alpha < 2; ++alpha) {
       step.port_timings[alpha] = difference(ports.timings(alpha), before[alpha]);
     }
-    step.seconds = seconds_since(step_start);
+    step.seconds = done_before ? resumed[k].seconds : seconds_since(step_start);
     if (result.steps.empty() || step.excluded_clearance.relative_penetration >
                                     result.excluded_clearance.relative_penetration) {
       result.excluded_clearance = step.excluded_clearance;
@@ -260,7 +356,14 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
       points.emplace_back(0.0, step.iteration.initial_iterate);
     }
     points.emplace_back(step.factor, step.iteration.restart_iterate);
+    if (last) solved.emplace_back(step.factor, last->iterates);
     const bool converged = step.iteration.status == IterationStatus::converged;
+    if (!done_before && continuation.step_completed && last) {
+      LoadStepCheckpoint completed{step.step, step.factor, step.warm_started, step.seconds,
+                                   std::move(*last)};
+      completed.iteration.acceleration = nlohmann::json();  // a completed step does not go on
+      continuation.step_completed(completed);
+    }
     result.steps.push_back(std::move(step));
     if (!converged) {
       report_stage(observer, "load step " + std::to_string(k + 1) +
@@ -334,7 +437,7 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   result.setup_seconds = seconds_since(start);
 
   if (definition.loading.stepped()) {
-    run_load_steps(definition.loading, recoverable, options, observer, result);
+    run_load_steps(definition.loading, recoverable, options, observer, continuation, result);
   } else {
     const std::array<PortTimings, 2> before = port_timings(recoverable);
     const auto iteration_start = Clock::now();

@@ -9,6 +9,7 @@
 
 #include "coupling/case_file.hpp"
 #include "coupling/contact_pairing.hpp"
+#include "coupling/iteration_checkpoint.hpp"
 #include "coupling/port_recovery.hpp"
 #include "coupling/robin_iteration.hpp"
 #include "coupling/run_profile.hpp"
@@ -59,10 +60,19 @@ struct CoupledRunResult {
 /// resume").
 struct RunContinuation {
   /// The iteration continues after this checkpoint instead of starting (the bodies are set up
-  /// and the contact assigned as usual first). Cases without [loading] only.
+  /// and the contact assigned as usual first). With [loading], the checkpoint of load step
+  /// resume_steps->size() + 1.
   const IterationCheckpoint* resume = nullptr;
-  /// Told the iteration's state after every iteration (cases without [loading]).
+  /// [loading]: the load steps completed before `resume`'s (their results are taken from here,
+  /// their fields collected again, and their contact solves repeated before the resumed step,
+  /// so that the servers' contact warm start is the uninterrupted run's). Null: none.
+  const std::vector<LoadStepCheckpoint>* resume_steps = nullptr;
+  /// Told the iteration's state after every iteration (with [loading], of the current step).
   std::function<void(const IterationCheckpoint&)> checkpoint;
+  /// [loading]: told each load step once it is completed (its loop stopped, its fields
+  /// collected), before the next step's first checkpoint; not the resumed steps before
+  /// `resume`'s.
+  std::function<void(const LoadStepCheckpoint&)> step_completed;
   /// Replaces lost servers (port_recovery.hpp); empty: a lost server fails the run.
   ServerReplacement replacement;
 };
@@ -84,7 +94,9 @@ struct RunObserver {
 /// fields; it stops after the first step that does not converge.
 /// With `continuation`, the iteration is checkpointed and may resume, and a lost server is
 /// replaced: its body set up again and the stage it was lost in repeated, the iteration from
-/// its last checkpoint (port_recovery.hpp).
+/// its last checkpoint (port_recovery.hpp). With [loading], a load step that starts on servers
+/// that have not seen the steps before it (a resume, a replaced server) first repeats those
+/// steps' contact solves at their load factors (their contact warm start).
 CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                   const std::array<SubdomainPort*, 2>& ports,
                                   const CouplingOptions& options, const RunObserver& observer = {},

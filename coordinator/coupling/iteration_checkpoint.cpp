@@ -190,4 +190,26 @@ IterationCheckpoint iteration_checkpoint_from_json(const nlohmann::json& documen
   return checkpoint;
 }
 
+nlohmann::json to_json(const LoadStepCheckpoint& step) {
+  return {{"step", step.step},
+          {"factor", encode_number(step.factor)},
+          {"warm_started", step.warm_started},
+          {"seconds", encode_number(step.seconds)},
+          {"loop", to_json(step.iteration)}};
+}
+
+LoadStepCheckpoint load_step_checkpoint_from_json(const nlohmann::json& document) {
+  LoadStepCheckpoint step;
+  step.step = decode_integer(document, "step");
+  step.factor = decode_number(document, "factor");
+  step.warm_started = decode_flag(document, "warm_started");
+  step.seconds = decode_number(document, "seconds");
+  step.iteration = iteration_checkpoint_from_json(member(document, "loop"));
+  if (!step.iteration.stopped) {
+    throw CheckpointFormatError("the checkpoint's completed load step " +
+                                std::to_string(step.step) + " has a loop that did not stop");
+  }
+  return step;
+}
+
 }  // namespace robin

@@ -61,10 +61,27 @@ struct IterationCheckpoint {
   double wall_seconds = 0.0;              // the loop's wall time, up to iteration k
 };
 
+/// A load step of a case with [loading] (case_file_loading.hpp) that was completed (its loop
+/// stopped and its fields were collected) before a checkpoint: what the step outputs need
+/// (the loop's stopped state: status, history, the state of its last iteration, its initial and
+/// restart iterates) and its iterates x_1 ... x_k, whose contact solves a resumed run repeats
+/// so that the servers' contact warm start is the uninterrupted run's. Its fields are collected
+/// again; the acceleration's state is not kept (a completed step does not continue).
+struct LoadStepCheckpoint {
+  int step = 0;  // 1, 2, ...
+  double factor = 1.0;
+  bool warm_started = false;
+  double seconds = 0.0;  // the step's wall time
+  IterationCheckpoint iteration;
+};
+
 /// The checkpoint as JSON (checkpoint_encoding.hpp: every double exact), without `iterates`,
 /// and back (with `iterates` empty). from_json throws CheckpointFormatError naming the field
 /// that is missing or malformed.
 nlohmann::json to_json(const IterationCheckpoint& checkpoint);
 IterationCheckpoint iteration_checkpoint_from_json(const nlohmann::json& document);
+/// The same for a completed load step (its loop under "loop", stopped).
+nlohmann::json to_json(const LoadStepCheckpoint& step);
+LoadStepCheckpoint load_step_checkpoint_from_json(const nlohmann::json& document);
 
 }  // namespace robin

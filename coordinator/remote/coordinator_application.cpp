@@ -387,7 +387,7 @@ std::optional<CaseDefinition> load_case(CoordinatorSettings& settings) {
       settings.resume = std::make_shared<const RunCheckpoint>(prepare_resume(settings));
     }
     CaseDefinition definition = read_case_file(settings.case_file, settings.overrides);
-    if (settings.resume) check_resumable(definition);
+    if (settings.resume) check_resumable(definition, *settings.resume);
     return definition;
   } catch (const std::exception& error) {
     coordinator_logger()->error("{}", error.what());
@@ -410,12 +410,16 @@ namespace {
 
 /// The directory's record of a resumed run, and a log line about it.
 void record_resume(ResultDirectory& results, const RunCheckpoint& checkpoint, spdlog::logger& log) {
-  results.add_to_record("resumed_from", {{"run_id", checkpoint.run_id},
-                                         {"first_run_id", checkpoint.first_run_id},
-                                         {"first_started", checkpoint.started},
-                                         {"iteration", checkpoint.iteration.iteration}});
-  log.info("resuming run {} after iteration {} (checkpoint in {})", checkpoint.run_id,
-           checkpoint.iteration.iteration, results.directory().string());
+  nlohmann::json from = {{"run_id", checkpoint.run_id},
+                         {"first_run_id", checkpoint.first_run_id},
+                         {"first_started", checkpoint.started},
+                         {"iteration", checkpoint.iteration.iteration}};
+  if (checkpoint.step > 0) from["load_step"] = checkpoint.step;
+  results.add_to_record("resumed_from", from);
+  log.info("resuming run {} after iteration {}{} (checkpoint in {})", checkpoint.run_id,
+           checkpoint.iteration.iteration,
+           checkpoint.step > 0 ? fmt::format(" of load step {}", checkpoint.step) : "",
+           results.directory().string());
 }
 
 /// The identity of this run in its checkpoints (checkpoint.hpp); the loop state is added per
@@ -478,11 +482,20 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     log->info("body {} '{}' on server {}", alpha + 1, body, endpoint);
   };
   RunContinuation continuation;
-  if (settings.resume) continuation.resume = &settings.resume->iteration;
+  if (settings.resume) {
+    continuation.resume = &settings.resume->iteration;
+    continuation.resume_steps = &settings.resume->steps;
+    checkpoint.steps = settings.resume->steps;
+  }
   CheckpointWriter writer(settings.output_directory);
   continuation.checkpoint = [&](const IterationCheckpoint& iteration) {
+    checkpoint.step =
+        definition.loading.stepped() ? static_cast<int>(checkpoint.steps.size()) + 1 : 0;
     checkpoint.iteration = iteration;
     writer.write(checkpoint);
+  };
+  continuation.step_completed = [&](const LoadStepCheckpoint& step) {
+    checkpoint.steps.push_back(step);
   };
   std::array<int, 2> restarts{0, 0};
   nlohmann::json restart_records = nlohmann::json::array();

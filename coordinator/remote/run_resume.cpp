@@ -111,6 +111,7 @@ RunCheckpoint prepare_resume(CoordinatorSettings& settings) {
   std::ostringstream text;
   text << "cannot resume the run in '" << settings.resume_directory.string()
        << "' (checkpoint after iteration " << checkpoint.iteration.iteration
+       << (checkpoint.step > 0 ? " of load step " + std::to_string(checkpoint.step) : "")
        << "): it would not compute the interrupted run:";
   for (const std::string& problem : problems) text << "\n  " << problem;
   text << "\nStart a new run (--output) instead, or resume with the interrupted run's case and "
@@ -118,10 +119,20 @@ RunCheckpoint prepare_resume(CoordinatorSettings& settings) {
   throw ResumeRefused(text.str());
 }
 
-void check_resumable(const CaseDefinition& definition) {
-  if (!definition.loading.stepped()) return;
-  throw ResumeRefused("cannot resume a run of '" + definition.file.string() +
-                      "': its [loading] steps are not checkpointed; start a new run instead");
+void check_resumable(const CaseDefinition& definition, const RunCheckpoint& checkpoint) {
+  const std::size_t steps = definition.loading.factors.size();
+  if (definition.loading.stepped()
+          ? checkpoint.step >= 1 && static_cast<std::size_t>(checkpoint.step) <= steps
+          : checkpoint.step == 0) {
+    return;
+  }
+  throw ResumeRefused(
+      "cannot resume a run of '" + definition.file.string() + "': its checkpoint is of " +
+      (checkpoint.step == 0 ? std::string("a run without load steps")
+                            : "load step " + std::to_string(checkpoint.step)) +
+      ", the case has " +
+      (steps == 0 ? std::string("no [loading] steps") : std::to_string(steps) + " load steps") +
+      "; start a new run instead");
 }
 
 }  // namespace robin

@@ -7,7 +7,8 @@
 //   both hashes and the keys whose values changed),
 //   a --set override or an option that changes the computation (--tolerance, --algorithm, ...)
 //   is given with another value than the interrupted run had (or was not given then),
-//   the case has [loading] steps (their runs are not checkpointed).
+//   the checkpoint's load step does not fit the case's [loading] (a checkpoint of a run with
+//   load steps for a case without, or the reverse; the case's hash makes this unlikely).
 
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -33,7 +34,8 @@ nlohmann::json computation_options(const CoordinatorSettings& settings);
 /// CheckpointFormatError when the checkpoint cannot be used.
 RunCheckpoint prepare_resume(CoordinatorSettings& settings);
 
-/// Throws ResumeRefused for a case with [loading] steps (checked once the case is read).
-void check_resumable(const CaseDefinition& definition);
+/// Throws ResumeRefused when the checkpoint's load step (RunCheckpoint::step) does not fit the
+/// case's [loading] steps (checked once the case is read).
+void check_resumable(const CaseDefinition& definition, const RunCheckpoint& checkpoint);
 
 }  // namespace robin

@@ -19,7 +19,12 @@
 //    started again at the same endpoint within --server-grace-period; the run carries on to
 //    the same contact.csv;
 //  - a server that is lost at every start is replaced --max-server-restarts times (2), then
-//    the run fails naming the body and the limit.
+//    the run fails naming the body and the limit;
+//  - examples/hertz_steps.toml ([loading], four steps, coarser mesh): robin-run killed with
+//    SIGKILL in step 2 and resumed, and a robin-subdomain killed in step 2 (robin-run restarts
+//    it): steps.csv, history.csv (but the wall times), every step's contact.csv and
+//    summary.json's load_steps equal the uninterrupted run's (1e-12 relative, iteration counts
+//    exactly), after the contact solves of step 1 were repeated.
 // The case: examples/asymmetric.toml with `--stopping joint` (85 iterations of a few ms) and,
 // for the setup and fields kills, finer meshes so that those stages last long enough to be hit.
 
@@ -27,6 +32,7 @@
 #include <sys/prctl.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <csignal>
 #include <fstream>
 #include <functional>
@@ -405,6 +411,170 @@ TEST(ServerRecovery, RestartsAreBounded) {
             std::string::npos)
       << text;
   EXPECT_EQ(read_summary(directory.path() / "out").value("status", ""), "failed");
+}
+
+// ---- Load steps ----------------------------------------------------------------------------
+
+/// A wrapper robin-subdomain in `directory`/delayed that makes the first server it starts
+/// wait `seconds` at the start of the correction of iteration `iteration` of every load step
+/// (--testing-stage-delay) and starts the later ones as they are. It is called robin-subdomain
+/// so that robin-run's log names it as it names the real one.
+std::filesystem::path delaying_server(const std::filesystem::path& directory, int iteration,
+                                      int seconds) {
+  const std::filesystem::path wrapper = directory / "delayed" / "robin-subdomain";
+  std::filesystem::create_directories(wrapper.parent_path());
+  const std::string server = testing::tool("robin-subdomain").string();
+  std::ofstream(wrapper) << "#!/bin/sh\nif mkdir '" << (directory / "first-start").string()
+                         << "' 2>/dev/null; then\n  exec '" << server
+                         << "' \"$@\" --testing-stage-delay correction@" << iteration << "="
+                         << seconds << "\nfi\nexec '" << server << "' \"$@\"\n";
+  std::filesystem::permissions(wrapper, std::filesystem::perms(0755));
+  return wrapper;
+}
+
+/// Whether `log` shows iteration `iteration` of load step `step` done ("load step 2/4" and then
+/// "iteration 1:").
+bool shows_step_iteration(const std::string& log, int step, int iteration) {
+  const auto at = log.find("load step " + std::to_string(step) + "/");
+  return at != std::string::npos &&
+         log.find("iteration " + std::to_string(iteration) + ":", at) != std::string::npos;
+}
+
+/// steps.csv of `directory` as numbers (csv_values, written to `copy` first), with its status
+/// column (text) as 1 for "converged" and 0 otherwise, and without its wall times.
+std::vector<std::vector<double>> steps_table(const std::filesystem::path& directory,
+                                             const std::filesystem::path& copy) {
+  std::ofstream(copy) << std::regex_replace(
+      std::regex_replace(read_text(directory / "steps.csv"), std::regex(",converged,"), ",1,"),
+      std::regex(",[a-z_]+,"), ",0,");
+  return csv_values(copy, "seconds");
+}
+
+/// The result files of a run with load steps equal the reference's: steps.csv, history.csv
+/// (every iteration of every step) and each step's contact.csv (but the wall times), the
+/// top-level contact.csv, and summary.json's load_steps.
+void expect_same_steps(const std::filesystem::path& output, const std::filesystem::path& reference,
+                       const std::string& name, double tolerance) {
+  expect_same_table(steps_table(output, output.parent_path() / (name + "-steps.csv")),
+                    steps_table(reference, output.parent_path() / "reference-steps.csv"), tolerance,
+                    name + " steps.csv");
+  expect_same_table(csv_values(output / "history.csv", "seconds"),
+                    csv_values(reference / "history.csv", "seconds"), tolerance,
+                    name + " history.csv");
+  for (const char* step : {"step_001", "step_002", "step_003", "step_004"}) {
+    const std::filesystem::path contact = std::filesystem::path("steps") / step / "contact.csv";
+    ASSERT_TRUE(std::filesystem::exists(reference / contact)) << contact;
+    expect_same_table(csv_values(output / contact), csv_values(reference / contact), tolerance,
+                      name + " " + contact.string());
+  }
+  expect_same_table(csv_values(output / "contact.csv"), csv_values(reference / "contact.csv"),
+                    tolerance, name + " contact.csv");
+  const nlohmann::json steps = read_summary(output)["load_steps"];
+  const nlohmann::json expected = read_summary(reference)["load_steps"];
+  ASSERT_EQ(steps.size(), expected.size()) << name;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    for (const char* key :
+         {"status", "iterations", "qp_iterations", "warm_started", "active_pairs"}) {
+      EXPECT_EQ(steps[k][key], expected[k][key]) << name << " step " << k + 1 << " " << key;
+    }
+    EXPECT_NEAR(steps[k].value("largest_pressure", 0.0), expected[k].value("largest_pressure", 1.0),
+                tolerance * std::abs(expected[k].value("largest_pressure", 1.0)))
+        << name << " step " << k + 1;
+  }
+}
+
+/// robin-run on `case_file` into `output` with the cylinder's first server waiting 3 s at the
+/// start of the correction of iteration 2 of every load step (delaying_server).
+std::unique_ptr<ChildProcess> start_delayed_steps(const std::filesystem::path& directory,
+                                                  const std::filesystem::path& case_file,
+                                                  const std::filesystem::path& output,
+                                                  const std::filesystem::path& log) {
+  const std::filesystem::path wrapper = delaying_server(directory, 2, 3);
+  return start_tool(
+      "robin-run",
+      with({case_file.string(), "--output", output.string(), "--server-executable",
+            testing::tool("robin-subdomain").string(), "--server-executable", wrapper.string()},
+           joint_stopping),
+      log);
+}
+
+TEST(Resume, KilledLoadStepRunResumesAtTheInterruptedStep) {
+  ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
+  const TemporaryDirectory directory("robin-resume-steps");
+  // The Hertz contact in four load steps (examples/hertz_steps.toml) on a coarser mesh.
+  const std::filesystem::path case_file = case_copy(directory.path(), 0.2, "hertz_steps.toml");
+  const std::filesystem::path reference = reference_run(directory.path(), case_file);
+  ASSERT_EQ(read_summary(reference)["load_steps"].size(), 4u);
+
+  // Killed while the cylinder's server waits in iteration 2 of step 2: after the checkpoint of
+  // that step's iteration 1.
+  const std::filesystem::path output = directory.path() / "resumed";
+  const std::filesystem::path first_log = directory.path() / "killed.stderr";
+  const auto run = start_delayed_steps(directory.path(), case_file, output, first_log);
+  ASSERT_TRUE(wait_until([&] { return shows_step_iteration(read_text(first_log), 2, 1); }, 60.0))
+      << read_text(first_log);
+  ASSERT_EQ(kill(run->pid(), SIGKILL), 0);
+  ASSERT_TRUE(run->wait_for_exit(10.0));
+  ASSERT_EQ(run->exit_description(), "was killed by signal 9 (Killed)");
+  EXPECT_TRUE(wait_until([] { return waitpid(-1, nullptr, WNOHANG) == -1; }, 10.0));
+  std::ifstream checkpoint_file(output / "checkpoint.json");
+  const nlohmann::json checkpoint = nlohmann::json::parse(checkpoint_file, nullptr, false);
+  ASSERT_TRUE(checkpoint.is_object()) << "no checkpoint.json";
+  EXPECT_EQ(checkpoint.value("format", 0), 3);
+  EXPECT_EQ(checkpoint.value("step", 0), 2);
+  EXPECT_EQ(checkpoint["load_steps"].size(), 1u);
+  EXPECT_EQ(checkpoint["loop"].value("iteration", 0), 1);
+  EXPECT_FALSE(checkpoint["loop"].value("stopped", true));
+
+  const std::filesystem::path resume_log = directory.path() / "resume.stderr";
+  EXPECT_EQ(run_to_end("robin-run", {"--resume", output.string()}, resume_log),
+            "exited with status 0")
+      << read_text(resume_log);
+  const std::string resumed = read_text(resume_log);
+  EXPECT_NE(resumed.find("repeating the contact solves of the 1 load steps before"),
+            std::string::npos)
+      << resumed;
+  EXPECT_NE(resumed.find("continuing the iteration after iteration 1"), std::string::npos)
+      << resumed;
+  expect_same_steps(output, reference, "resumed", 1e-12);
+  const nlohmann::json summary = read_summary(output);
+  EXPECT_EQ(summary.value("status", ""), "converged");
+  EXPECT_EQ(summary["resumed_from"].value("load_step", 0), 2);
+  EXPECT_EQ(summary["resumed_from"].value("iteration", 0), 1);
+  EXPECT_FALSE(std::filesystem::exists(output / "checkpoint.json"));
+  EXPECT_FALSE(std::filesystem::exists(output / "checkpoint-iterates.bin"));
+}
+
+TEST(ServerRecovery, RobinRunRestartsAServerKilledDuringALoadStep) {
+  ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
+  const TemporaryDirectory directory("robin-recovery-steps");
+  const std::filesystem::path case_file = case_copy(directory.path(), 0.2, "hertz_steps.toml");
+  const std::filesystem::path reference = reference_run(directory.path(), case_file);
+  // The cylinder's server is killed while it waits in iteration 2 of step 2.
+  const std::filesystem::path output = directory.path() / "recovered";
+  const std::filesystem::path log = directory.path() / "recovered.stderr";
+  const auto run = start_delayed_steps(directory.path(), case_file, output, log);
+  int pid = 0;
+  ASSERT_TRUE(wait_until(
+      [&] {
+        const std::string text = read_text(log);
+        pid = server_pid(text, "cylinder");
+        return pid != 0 && shows_step_iteration(text, 2, 1);
+      },
+      60.0))
+      << read_text(log);
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  while (run->read_line(ChildProcess::Clock::now() + std::chrono::seconds(120))) {
+  }
+  ASSERT_TRUE(run->wait_for_exit(120.0));
+  const std::string text = read_text(log);
+  EXPECT_EQ(run->exit_description(), "exited with status 0") << text;
+  EXPECT_NE(text.find("lost the server of body 'cylinder'"), std::string::npos) << text;
+  EXPECT_NE(text.find("(restart 1 of 2)"), std::string::npos) << text;
+  EXPECT_NE(text.find("repeating the contact solves of the 1 load steps before"), std::string::npos)
+      << text;
+  expect_same_steps(output, reference, "recovered", 1e-12);
+  EXPECT_EQ(read_summary(output)["server_restarts"].size(), 1u);
 }
 
 }  // namespace
