@@ -222,10 +222,8 @@ void repeat_contact_solves(SubdomainPort& body1, SubdomainPort& body2,
                            const ContactPairing& pairing, const CouplingOptions& options,
                            const std::vector<Eigen::VectorXd>& iterates) {
   if (iterates.empty()) return;
-  const CouplingProblem problem{ContactGraph::two_bodies(pairing.gaps().size()), pairing.gaps(),
-                                pairing.weights(), short_wavelength_forces(pairing)};
   const std::unique_ptr<CouplingScheme> scheme =
-      make_coupling_scheme(options, {&body1, &body2}, problem);
+      make_coupling_scheme(options, {&body1, &body2}, two_body_problem(pairing));
   for (std::size_t index = 0; index < iterates.size(); ++index) {
     scheme->repeat_contact_solves(iterates[index], static_cast<int>(index) + 1);
   }

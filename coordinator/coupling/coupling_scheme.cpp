@@ -73,15 +73,8 @@ void solve_all_contacts(const std::vector<SubdomainPort*>& ports, int iteration,
   evaluation.critical_compute_seconds += slowest(seconds);
 }
 
-/// Body `body`'s block of an iterate stacked in body order.
-Eigen::VectorXd body_block(const ContactGraph& graph, const Eigen::VectorXd& iterate, int body) {
-  Eigen::Index offset = 0;
-  for (int other = 0; other < body; ++other) offset += graph.body_rows(other);
-  return iterate.segment(offset, graph.body_rows(body));
-}
-
-/// The vectors of every body stacked in body order.
-Eigen::VectorXd stack(const std::vector<Eigen::VectorXd>& per_body) {
+/// The vectors stacked in order.
+Eigen::VectorXd concatenate(const std::vector<Eigen::VectorXd>& per_body) {
   Eigen::Index size = 0;
   for (const Eigen::VectorXd& part : per_body) size += part.size();
   Eigen::VectorXd stacked(size);
@@ -96,41 +89,50 @@ Eigen::VectorXd stack(const std::vector<Eigen::VectorXd>& per_body) {
 /// "robin" and "robin-constant" (alpha > 0): one obstacle sequence per colour class.
 class RobinScheme final : public CouplingScheme {
  public:
+  /// The iterate x stacks the bodies' obstacles colour class by colour class (class 0's bodies
+  /// in body order, then class 1's; body order on a graph with an odd cycle): H of a class reads
+  /// only the contact solutions of the same class (H^a = -(e^b - F^b lambda^across(b)) + d with
+  /// b a neighbour of a and across(b) of a's class), so each class is a block of its own.
   RobinScheme(std::vector<SubdomainPort*> ports, CouplingProblem problem, double constant_alpha)
       : ports_(std::move(ports)),
         problem_(std::move(problem)),
         constant_alpha_(constant_alpha),
-        colouring_(problem_.graph.two_colouring()) {}
+        colouring_(problem_.graph.two_colouring()) {
+    for (const int colour : {0, 1}) {
+      ObstacleSequence sequence;
+      for (int body = 0; body < problem_.graph.body_count(); ++body) {
+        if ((colouring_ ? (*colouring_)[static_cast<std::size_t>(body)] : 0) == colour) {
+          sequence.bodies.push_back(body);
+          order_.push_back(body);
+        }
+      }
+      if (sequence.bodies.empty()) continue;
+      // robin-constant: one block (H^a depends on g^b through lambda^b); an odd cycle: one.
+      sequence.blocks = {constant_alpha_ > 0.0 || !colouring_ ? 0 : colour};
+      if (colouring_) sequences_.push_back(sequence);
+      Eigen::Index size = 0;
+      for (const int body : sequence.bodies) size += problem_.graph.body_rows(body);
+      if (sequence.blocks.front() == colour) {
+        block_sizes_.push_back(static_cast<int>(size));
+      } else {
+        block_sizes_.front() += static_cast<int>(size);
+      }
+    }
+  }
 
-  std::vector<int> block_sizes() const override {
-    const ContactGraph& graph = problem_.graph;
-    if (constant_alpha_ > 0.0) {  // H^a depends on g^b through lambda^b
-      return {static_cast<int>(stack(all_body_parts(problem_.gaps)).size())};
-    }
-    std::vector<int> sizes;
-    for (int body = 0; body < graph.body_count(); ++body) {
-      sizes.push_back(static_cast<int>(graph.body_rows(body)));
-    }
-    return sizes;
-  }
-  std::vector<ObstacleSequence> sequences() const override {
-    if (!colouring_) return {};
-    std::vector<ObstacleSequence> sequences(2);
-    for (int body = 0; body < problem_.graph.body_count(); ++body) {
-      ObstacleSequence& sequence = sequences[static_cast<std::size_t>((*colouring_)[body])];
-      sequence.bodies.push_back(body);
-      sequence.blocks.push_back(constant_alpha_ > 0.0 ? 0 : body);
-    }
-    if (sequences[1].bodies.empty()) sequences.pop_back();  // a single body
-    return sequences;
-  }
+  std::vector<int> block_sizes() const override { return block_sizes_; }
+  std::vector<ObstacleSequence> sequences() const override { return sequences_; }
   std::string describe() const override {
     return constant_alpha_ > 0.0
                ? "robin-constant (alpha = " + std::to_string(constant_alpha_) + ")"
                : std::string("robin");
   }
   Eigen::VectorXd initial_iterate(const Eigen::VectorXd& initial_obstacle) const override {
-    return stack(all_body_parts(initial_obstacle));
+    std::vector<Eigen::VectorXd> parts;
+    for (int body = 0; body < problem_.graph.body_count(); ++body) {
+      parts.push_back(problem_.graph.body_part(body, initial_obstacle));
+    }
+    return stack(parts);
   }
 
   void repeat_contact_solves(const Eigen::VectorXd& iterate, int iteration) override {
@@ -186,19 +188,22 @@ class RobinScheme final : public CouplingScheme {
   }
 
  private:
-  std::vector<Eigen::VectorXd> all_body_parts(const Eigen::VectorXd& global) const {
-    std::vector<Eigen::VectorXd> parts;
-    for (int body = 0; body < problem_.graph.body_count(); ++body) {
-      parts.push_back(problem_.graph.body_part(body, global));
+  /// Per body (body order) its block of an iterate stacked in iterate order.
+  std::vector<Eigen::VectorXd> split(const Eigen::VectorXd& iterate) const {
+    std::vector<Eigen::VectorXd> parts(ports_.size());
+    Eigen::Index offset = 0;
+    for (const int body : order_) {
+      const Eigen::Index size = problem_.graph.body_rows(body);
+      parts[static_cast<std::size_t>(body)] = iterate.segment(offset, size);
+      offset += size;
     }
     return parts;
   }
-  std::vector<Eigen::VectorXd> split(const Eigen::VectorXd& iterate) const {
-    std::vector<Eigen::VectorXd> parts;
-    for (int body = 0; body < problem_.graph.body_count(); ++body) {
-      parts.push_back(body_block(problem_.graph, iterate, body));
-    }
-    return parts;
+  /// Per-body vectors (body order) stacked in iterate order.
+  Eigen::VectorXd stack(const std::vector<Eigen::VectorXd>& per_body) const {
+    std::vector<Eigen::VectorXd> ordered;
+    for (const int body : order_) ordered.push_back(per_body[static_cast<std::size_t>(body)]);
+    return concatenate(ordered);
   }
 
   /// The complete state of `sequence`: its bodies keep (u, lambda); every other body (all its
@@ -223,6 +228,9 @@ class RobinScheme final : public CouplingScheme {
   const CouplingProblem problem_;
   const double constant_alpha_;  // 0: the Steklov-Poincare choice (correction solves)
   const std::optional<std::vector<int>> colouring_;
+  std::vector<int> order_;  // the bodies in iterate order
+  std::vector<int> block_sizes_;
+  std::vector<ObstacleSequence> sequences_;
 };
 
 /// The two obstacle sequences of a two-body scheme with one block.
@@ -395,6 +403,11 @@ Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing) {
     forces[static_cast<Eigen::Index>(order[rank])] *= -1.0;
   }
   return forces;
+}
+
+CouplingProblem two_body_problem(const ContactPairing& pairing) {
+  return {ContactGraph::two_bodies(static_cast<Eigen::Index>(pairing.size())), pairing.gaps(),
+          pairing.weights(), short_wavelength_forces(pairing)};
 }
 
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,

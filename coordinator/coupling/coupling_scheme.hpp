@@ -93,7 +93,9 @@ class CouplingScheme {
  public:
   virtual ~CouplingScheme() = default;
   /// Sizes of the independent blocks of x (accelerated per block): for "robin" one block per
-  /// body. "robin-constant" has one block of all obstacles: its map couples them.
+  /// obstacle sequence (two bodies: per body; a bipartite graph: per colour class, whose
+  /// bodies' obstacles x stacks together), one block on a graph with an odd cycle.
+  /// "robin-constant" has one block of all obstacles: its map couples them.
   virtual std::vector<int> block_sizes() const = 0;
   /// The obstacle sequences whose forces the loop follows (ForceSequence) and whose complete
   /// states evaluate() returns as completions (same order).
@@ -128,6 +130,10 @@ struct CouplingProblem {
   /// A short-wavelength probe (for "dirichlet-neumann" with contact_body "auto").
   Eigen::VectorXd probe_forces;
 };
+
+/// The problem of two bodies and one interface: the pairing's gaps, weights and
+/// short-wavelength probe (body order = pair order).
+CouplingProblem two_body_problem(const ContactPairing& pairing);
 
 /// The scheme of options.algorithm on ports (one per body of problem.graph, in body order)
 /// whose contact has been assigned (body alpha: its rows in body order). "dirichlet-neumann"

@@ -359,14 +359,10 @@ std::string to_string(IterationStatus status) {
 
 namespace {
 
-/// The problem of two bodies and one interface.
+/// The problem of two bodies and one interface from its vectors.
 CouplingProblem two_body_problem(const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                                  const Eigen::VectorXd& probe_forces) {
   return {ContactGraph::two_bodies(gaps.size()), gaps, weights, probe_forces};
-}
-
-CouplingProblem two_body_problem(const ContactPairing& pairing) {
-  return two_body_problem(pairing.gaps(), pairing.weights(), short_wavelength_forces(pairing));
 }
 
 }  // namespace

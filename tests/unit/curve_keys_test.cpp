@@ -159,7 +159,11 @@ TEST_F(CurveKeys, AllowListTakesBareKeysPublicFileLinesAndComments) {
 TEST_F(CurveKeys, MalformedAllowListsAreRefusedNamingTheLine) {
   const std::string key = generate_curve_key_pair().public_key;
   const std::vector<std::pair<std::string, std::string>> cases{
-      {"# a comment\n" + key.substr(2) + "\n", "line 2: the key '" + key.substr(2) + "' has 38"},
+      // The first 38 characters: a key's first character is never '#' (a comment), while a
+      // later one may be (it is a Z85 character), which made key.substr(2) a comment line in
+      // about one run of 85.
+      {"# a comment\n" + key.substr(0, 38) + "\n",
+       "line 2: the key '" + key.substr(0, 38) + "' has 38"},
       {key + " trailing\n", "line 1: unexpected text 'trailing' after the key"},
       {"public-key = " + key + "\n", "line 1: expected public-key = \"KEY\" (the key in quotes)"},
       {"# only comments\n\n", "holds no key"},
