@@ -128,12 +128,20 @@ def _check_boundary(mesh, name, context, field):
               (quoted(name), known))
 
 
+# The most contact boundaries a body may name (robin-subdomain's limit, setup_decoding.hpp).
+MAXIMUM_CONTACT_BOUNDARIES = 64
+
+
 def _contact_boundaries(message, mesh, context):
-    """SetupBody.contact_boundaries: at least one, each a distinct named boundary."""
-    names = list(message.contact_boundaries)
-    if not names:
+    """SetupBody.contact_boundaries: 1 to MAXIMUM_CONTACT_BOUNDARIES distinct named boundaries."""
+    count = len(message.contact_boundaries)
+    if count == 0:
         _fail(context, "contact_boundaries", "is empty: name at least one boundary that may "
               "touch another body")
+    if count > MAXIMUM_CONTACT_BOUNDARIES:
+        _fail(context, "contact_boundaries", "has %d names, more than the %d contact boundaries "
+              "a body may have" % (count, MAXIMUM_CONTACT_BOUNDARIES))
+    names = list(message.contact_boundaries)
     for index, name in enumerate(names):
         _check_boundary(mesh, name, context, "contact_boundaries[%d]" % index)
         if name in names[:index]:

@@ -428,6 +428,8 @@ class BadBodies(ServerTestCase):
         self.refused(setup_body(contact_boundaries=[]), "SetupBody.contact_boundaries is empty")
         self.refused(setup_body(contact_boundaries=["contact", "contact"]),
                      "contact_boundaries[1] repeats 'contact'")
+        self.refused(setup_body(contact_boundaries=["contact"] * 65),
+                     "SetupBody.contact_boundaries has 65 names, more than the 64")
         self.refused(setup_body(body_name="b" * 65), "SetupBody.body_name", "1 to 64 characters")
         self.refused(setup_body(body_name="../lower"), "SetupBody.body_name")
         singular = setup_body()
