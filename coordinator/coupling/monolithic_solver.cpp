@@ -40,10 +40,10 @@ double maximum_absolute(const Eigen::VectorXd& values) {
 
 InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::VectorXd& trace1,
                                        const Eigen::VectorXd& trace2, const Eigen::VectorXd& force1,
-                                       const Eigen::VectorXd& force2) {
+                                       const Eigen::VectorXd& force2, double displacement_floor) {
   constexpr double tiny = std::numeric_limits<double>::min();
-  const double displacement_scale =
-      std::max({maximum_absolute(gap), maximum_absolute(trace1), maximum_absolute(trace2), tiny});
+  const double displacement_scale = std::max({maximum_absolute(gap), maximum_absolute(trace1),
+                                              maximum_absolute(trace2), displacement_floor, tiny});
   const double force_scale = std::max({maximum_absolute(force1), maximum_absolute(force2), tiny});
   InterfaceResiduals residuals;
   for (Eigen::Index i = 0; i < gap.size(); ++i) {

@@ -69,9 +69,11 @@ std::vector<MonolithicStep> solve_monolithic_steps(BodySolver& body1, BodySolver
                                                    const MprgpParameters& parameters);
 
 /// Residuals of (u1_N, u2_N, lambda1, lambda2) against the gaps d. Displacement scale:
-/// max(max|d|, max|u1_N|, max|u2_N|, tiny); force scale: max(max lambda, tiny).
+/// max(max|d|, max|u1_N|, max|u2_N|, displacement_floor, tiny); force scale:
+/// max(max lambda, tiny).
 InterfaceResiduals interface_residuals(const Eigen::VectorXd& gap, const Eigen::VectorXd& trace1,
                                        const Eigen::VectorXd& trace2, const Eigen::VectorXd& force1,
-                                       const Eigen::VectorXd& force2);
+                                       const Eigen::VectorXd& force2,
+                                       double displacement_floor = 0.0);
 
 }  // namespace robin

@@ -103,21 +103,30 @@ double maximum_absolute(const std::vector<Eigen::VectorXd>& vectors) {
   return largest;
 }
 
+/// The local indentation of the state's contact forces: c max|lambda|, with c the local
+/// interface compliance measured by measure_interface_compliance. A floor of the displacement
+/// scale: when the interface barely moves (a symmetry plane between two equally loaded bodies,
+/// d = 0), |d| and |u_N| are round-off, and residuals relative to them alone never fall below
+/// the tolerance although the state is converged.
+double force_displacement(const CouplingState& state, double compliance) {
+  return compliance * maximum_absolute(state.contact_forces());
+}
+
 /// Scaled residuals of a state (IterationRecord's definitions; obstacle_change is set apart).
 IterationRecord residual_record(int iteration, const CouplingProblem& problem,
-                                const CouplingState& state) {
+                                const CouplingState& state, double compliance) {
   IterationRecord record;
   record.iteration = iteration;
   const std::vector<Eigen::VectorXd> traces = state.normal_traces();
   const std::vector<Eigen::VectorXd> forces = state.contact_forces();
   const ContactGraph& graph = problem.graph;
-  const InterfaceResiduals residuals =
-      interface_residuals(problem.gaps, graph.side(0, traces), graph.side(1, traces),
-                          graph.side(0, forces), graph.side(1, forces));
+  const InterfaceResiduals residuals = interface_residuals(
+      problem.gaps, graph.side(0, traces), graph.side(1, traces), graph.side(0, forces),
+      graph.side(1, forces), force_displacement(state, compliance));
   const double correction = maximum_absolute(state.corrections());
   const double displacement_scale =
       std::max({maximum_absolute(problem.gaps), maximum_absolute(traces), correction,
-                std::numeric_limits<double>::min()});
+                force_displacement(state, compliance), std::numeric_limits<double>::min()});
   record.penetration = residuals.penetration;
   record.force_balance = residuals.force_balance;
   record.complementarity = residuals.complementarity;
@@ -126,7 +135,7 @@ IterationRecord residual_record(int iteration, const CouplingProblem& problem,
 }
 
 /// Per block (max norms): the step |x_{k+1} - x_k| and the fixed-point residual |H(x_k) - x_k|,
-/// and the scale that makes them relative: max(|x_{k+1}|, |d|, |u1_N|, |u2_N|).
+/// and the scale that makes them relative: max(|x_{k+1}|, |d|, |u1_N|, |u2_N|, c max|lambda|).
 struct ObstacleChange {
   std::vector<double> per_block;
   std::vector<double> residual_per_block;
@@ -136,11 +145,12 @@ struct ObstacleChange {
 
 ObstacleChange obstacle_change(const Eigen::VectorXd& iterate, const Eigen::VectorXd& mapped,
                                const Eigen::VectorXd& next, const std::vector<int>& block_sizes,
-                               const Eigen::VectorXd& gaps, const CouplingState& state) {
+                               const Eigen::VectorXd& gaps, const CouplingState& state,
+                               double compliance) {
   ObstacleChange change;
-  change.scale =
-      std::max({maximum_absolute(next), maximum_absolute(gaps),
-                maximum_absolute(state.normal_traces()), std::numeric_limits<double>::min()});
+  change.scale = std::max(
+      {maximum_absolute(next), maximum_absolute(gaps), maximum_absolute(state.normal_traces()),
+       force_displacement(state, compliance), std::numeric_limits<double>::min()});
   Eigen::Index offset = 0;
   for (const int size : block_sizes) {
     change.per_block.push_back(
@@ -204,10 +214,10 @@ class ForceSequence {
 /// complementarity, the change of its own obstacle blocks, and the estimated relative error of
 /// its contact forces (ForceSequence).
 SequenceResiduals completion_residuals(const CouplingState& completion,
-                                       const CouplingProblem& problem, double block_change,
-                                       double obstacle_residual, const Eigen::VectorXd& force,
-                                       const ForceSequence& forces) {
-  const IterationRecord record = residual_record(0, problem, completion);
+                                       const CouplingProblem& problem, double compliance,
+                                       double block_change, double obstacle_residual,
+                                       const Eigen::VectorXd& force, const ForceSequence& forces) {
+  const IterationRecord record = residual_record(0, problem, completion, compliance);
   SequenceResiduals residuals;
   residuals.obstacle_change = block_change;
   residuals.penetration = record.penetration;
@@ -261,11 +271,11 @@ RobinResult stopped_result(const IterationCheckpoint& checkpoint) {
 
 /// The record of one iteration: the joint state's residuals, the obstacle change, the
 /// counters and, per obstacle sequence, the largest residual of its complete state.
-IterationRecord iteration_record(int iteration, const CouplingProblem& problem,
+IterationRecord iteration_record(int iteration, const CouplingProblem& problem, double compliance,
                                  const CouplingScheme& scheme, const CouplingEvaluation& evaluation,
                                  const ObstacleChange& change,
                                  const std::vector<ForceSequence>& force_sequences) {
-  IterationRecord record = residual_record(iteration, problem, evaluation.state);
+  IterationRecord record = residual_record(iteration, problem, evaluation.state, compliance);
   if (scheme.shares_contact_force()) {
     record.force_balance = force_sequences[0].relative_error_estimate(
         evaluation.state.bodies[0].contact_force,
@@ -278,7 +288,7 @@ IterationRecord iteration_record(int iteration, const CouplingProblem& problem,
   const std::vector<ObstacleSequence> sequences = scheme.sequences();
   for (std::size_t k = 0; k < evaluation.completions.size(); ++k) {
     record.sequences.push_back(
-        completion_residuals(evaluation.completions[k], problem,
+        completion_residuals(evaluation.completions[k], problem, compliance,
                              sequence_block_value(change.per_block, sequences[k]) / change.scale,
                              sequence_block_value(change.residual_per_block, sequences[k]),
                              sequence_forces(evaluation.state, sequences[k]), force_sequences[k]));
@@ -409,6 +419,32 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
 
 namespace {
 
+/// The local interface compliance c = max over bodies of |F^a r^a| / |r^a| (max norms), r^a the
+/// short-wavelength probe on body a's rows (boundary weights of alternating sign,
+/// coupling_scheme.hpp): the interface displacement per unit nodal force of a load that does
+/// not bend the body as a whole, so c F is the local indentation of forces of size F, a scale
+/// below that of the displacements contact forces spread over a zone cause. Measured by one
+/// correction solve per body (iteration 0, all bodies in parallel; the factor only, so no contact
+/// warm start changes). It scales the displacement floor of the residuals (force_displacement) and,
+/// like them, scales with the loads.
+double measure_interface_compliance(const std::vector<SubdomainPort*>& ports,
+                                    const CouplingProblem& problem) {
+  std::vector<Eigen::VectorXd> weights;
+  for (std::size_t body = 0; body < ports.size(); ++body) {
+    weights.push_back(problem.graph.body_part(static_cast<int>(body), problem.probe_forces));
+    if (weights.back().size() > 0) ports[body]->start_correction(weights.back(), 0);
+  }
+  double compliance = 0.0;
+  for (std::size_t body = 0; body < ports.size(); ++body) {
+    if (weights[body].size() == 0) continue;
+    const CorrectionSolveResult response = ports[body]->finish_correction();
+    const double load = maximum_absolute(weights[body]);
+    if (load > 0.0)
+      compliance = std::max(compliance, maximum_absolute(response.normal_trace) / load);
+  }
+  return compliance;
+}
+
 /// What the loop carries from one iteration to the next, besides the ports.
 struct LoopMemory {
   Acceleration& acceleration;
@@ -497,6 +533,7 @@ RobinResult run_robin_iteration(const std::vector<SubdomainPort*>& ports,
   double port_seconds = resume != nullptr ? resume->port_seconds : 0.0;
   const auto setup_start = Clock::now();
   const std::unique_ptr<CouplingScheme> scheme = make_coupling_scheme(options, ports, problem);
+  const double compliance = measure_interface_compliance(ports, problem);
   port_seconds += seconds_between(setup_start, Clock::now());
   const std::vector<int> block_sizes = scheme->block_sizes();
   const std::unique_ptr<Acceleration> acceleration =
@@ -540,10 +577,10 @@ RobinResult run_robin_iteration(const std::vector<SubdomainPort*>& ports,
     result.critical_compute_seconds += evaluation.critical_compute_seconds;
     // The obstacle update x_{k+1} = A(x_k, H(x_k)); "none" is the paper's (1 - delta) x + delta H.
     const Eigen::VectorXd next = acceleration->next(iterate, evaluation.mapped);
-    const ObstacleChange change =
-        obstacle_change(iterate, evaluation.mapped, next, block_sizes, gaps, evaluation.state);
-    IterationRecord record =
-        iteration_record(iteration, problem, *scheme, evaluation, change, force_sequences);
+    const ObstacleChange change = obstacle_change(iterate, evaluation.mapped, next, block_sizes,
+                                                  gaps, evaluation.state, compliance);
+    IterationRecord record = iteration_record(iteration, problem, compliance, *scheme, evaluation,
+                                              change, force_sequences);
     for (std::size_t k = 0; k < sequences.size(); ++k) {
       force_sequences[k].push(sequence_forces(evaluation.state, sequences[k]),
                               sequence_block_value(change.per_block, sequences[k]));

@@ -39,8 +39,10 @@ struct SequenceResiduals {
 };
 
 /// Residuals of one iteration, all dimensionless: displacement-like quantities are divided by
-/// the displacement scale D = max(|d|, |u1_N|, |u2_N|) (and |w_N| for the correction), forces by
-/// F = max(|lambda1|, |lambda2|). On a contact graph the same over every row, with 1 and 2 the
+/// the displacement scale D = max(|d|, |u1_N|, |u2_N|, c F) (and |w_N| for the correction), forces
+/// by F = max(|lambda1|, |lambda2|); c = max_a |F^a r| / |r|, the local interface compliance
+/// measured by one correction solve per body with the short-wavelength probe r at the start of
+/// the loop (iteration 0). On a contact graph the same over every row, with 1 and 2 the
 /// row's two sides (bodies a and b of its interface) and every body's u_N, w_N and lambda.
 ///
 /// Stopping, on the value progress() below (history.csv: stopping_residual): converged when it

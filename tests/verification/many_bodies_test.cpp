@@ -221,6 +221,46 @@ TEST(ManyBodies, StiffMiddleBlockStillEqualsTheMonolithicSolution) {
   expect_equals_monolithic(robin, row, reference.result);
 }
 
+/// Two equal blocks [0, 1] and [1, 2] pressed together by equal pressures on their outer faces:
+/// mirror symmetric about x = 1, so the contact interface does not move (u_N is round-off and
+/// d = 0). The residuals' displacement scale then comes from the interface compliance times the
+/// contact force (robin_iteration.cpp, force_displacement); before that floor every residual
+/// was round-off over round-off and a converged state was reported as diverged.
+TEST(ManyBodies, SymmetricPairWhoseInterfaceDoesNotMoveConverges) {
+  BodyDefinition left = row_block("left", 1000.0);
+  BodyDefinition right = row_block("middle", 1000.0);
+  right.contact_boundaries = {"left"};
+  right.tractions.push_back({"right", true, Eigen::Vector2d::Zero(), 1.0});
+  Row row;
+  row.definitions = {left, right};
+  ContactOptions contact;
+  contact.method = ContactMethod::node_to_node;
+  GraphCoupling coupling = couple_contact_graph(
+      {BodySolver(left).contact_boundary(), BodySolver(right).contact_boundary()},
+      {"left", "right"}, {{0, 1, "right", "left"}}, nullptr, contact, 1e-6);
+  row.pairings = std::move(coupling.pairings);
+  row.operators = std::move(coupling.operators);
+  row.problem = std::move(coupling.problem);
+  const MonolithicRow reference = solve_monolithic_row(row);
+  ASSERT_EQ(reference.result.qp.status, QpStatus::converged);
+  const double force = reference.result.contact_force.maxCoeff();
+  ASSERT_GT(force, 0.0);
+  // The interface stays put: its motion is round-off next to the blocks' shortening (1e-3).
+  EXPECT_LT(reference.result.normal_traces[0].lpNorm<Eigen::Infinity>(), 1e-12);
+  for (const std::string acceleration : {"iqn-ils", "aitken", "none"}) {
+    const RobinResult robin = run_row(row, acceleration);
+    std::printf("symmetric pair, %s: %s after %zu iterations\n", acceleration.c_str(),
+                to_string(robin.status).c_str(), robin.history.size());
+    ASSERT_EQ(robin.status, IterationStatus::converged) << acceleration << ": " << robin.message;
+    for (int body = 0; body < 2; ++body) {
+      EXPECT_LE(
+          relative_difference(robin.state.bodies[static_cast<std::size_t>(body)].contact_force,
+                              reference.result.contact_force),
+          1e-8);
+    }
+  }
+}
+
 TEST(ManyBodies, TwoBodyAlgorithmsRefuseAGraphOfThree) {
   const Row row = make_row(1000.0);
   std::vector<InProcessPort> ports(3);
