@@ -137,6 +137,18 @@ ContactOperator stack_operators(const std::vector<const ContactOperator*>& parts
   return stacked;
 }
 
+Eigen::VectorXd concatenate(const std::vector<Eigen::VectorXd>& parts) {
+  Eigen::Index size = 0;
+  for (const Eigen::VectorXd& part : parts) size += part.size();
+  Eigen::VectorXd values(size);
+  Eigen::Index offset = 0;
+  for (const Eigen::VectorXd& part : parts) {
+    values.segment(offset, part.size()) = part;
+    offset += part.size();
+  }
+  return values;
+}
+
 std::string describe_bodies(const std::vector<int>& bodies) {
   if (bodies.size() == 1) return "body " + std::to_string(bodies.front() + 1);
   std::string text = "bodies ";

@@ -84,6 +84,9 @@ class ContactGraph {
 /// interfaces' B^alpha_k).
 ContactOperator stack_operators(const std::vector<const ContactOperator*>& parts);
 
+/// The vectors one after the other (per-interface or per-body parts into one vector).
+Eigen::VectorXd concatenate(const std::vector<Eigen::VectorXd>& parts);
+
 /// "body 1", "bodies 1 and 3", "bodies 1, 3 and 5" for the 0-based `bodies` (for messages).
 std::string describe_bodies(const std::vector<int>& bodies);
 

@@ -73,19 +73,6 @@ void solve_all_contacts(const std::vector<SubdomainPort*>& ports, int iteration,
   evaluation.critical_compute_seconds += slowest(seconds);
 }
 
-/// The vectors stacked in order.
-Eigen::VectorXd concatenate(const std::vector<Eigen::VectorXd>& per_body) {
-  Eigen::Index size = 0;
-  for (const Eigen::VectorXd& part : per_body) size += part.size();
-  Eigen::VectorXd stacked(size);
-  Eigen::Index offset = 0;
-  for (const Eigen::VectorXd& part : per_body) {
-    stacked.segment(offset, part.size()) = part;
-    offset += part.size();
-  }
-  return stacked;
-}
-
 /// "robin" and "robin-constant" (alpha > 0): one obstacle sequence per colour class.
 class RobinScheme final : public CouplingScheme {
  public:
@@ -343,12 +330,15 @@ class NeumannNeumannScheme final : public CouplingScheme {
 };
 
 /// "auto": the body that is more compliant at short wavelengths takes the obstacle.
-int more_compliant_body(const std::vector<SubdomainPort*>& ports,
-                        const Eigen::VectorXd& probe_forces) {
-  const auto response = correction_solves(ports, {probe_forces, probe_forces}, 0);
-  const double compliance1 = probe_forces.dot(response[0].normal_trace);
-  const double compliance2 = probe_forces.dot(response[1].normal_trace);
-  return compliance1 >= compliance2 ? 0 : 1;
+int more_compliant_body(const std::vector<SubdomainPort*>& ports, const CouplingProblem& problem) {
+  const Eigen::VectorXd& probe = problem.probe_forces;
+  std::vector<Eigen::VectorXd> responses = problem.probe_responses;
+  if (responses.size() != 2) {
+    for (const CorrectionSolveResult& response : correction_solves(ports, {probe, probe}, 0)) {
+      responses.push_back(response.normal_trace);
+    }
+  }
+  return probe.dot(responses[0]) >= probe.dot(responses[1]) ? 0 : 1;
 }
 
 /// Throws InputError unless the graph is two bodies with one interface.
@@ -407,7 +397,7 @@ Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing) {
 
 CouplingProblem two_body_problem(const ContactPairing& pairing) {
   return {ContactGraph::two_bodies(static_cast<Eigen::Index>(pairing.size())), pairing.gaps(),
-          pairing.weights(), short_wavelength_forces(pairing)};
+          pairing.weights(), short_wavelength_forces(pairing), {}};
 }
 
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
@@ -433,10 +423,9 @@ std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& opti
   }
   if (options.algorithm == "dirichlet-neumann") {
     require_two_bodies(options, graph);
-    const int contact_body = options.contact_body == "1" ? 0
-                             : options.contact_body == "2"
-                                 ? 1
-                                 : more_compliant_body(ports, problem.probe_forces);
+    const int contact_body = options.contact_body == "1"   ? 0
+                             : options.contact_body == "2" ? 1
+                                                           : more_compliant_body(ports, problem);
     return std::make_unique<DirichletNeumannScheme>(ports, problem.gaps, contact_body);
   }
   if (options.algorithm == "neumann-neumann") {

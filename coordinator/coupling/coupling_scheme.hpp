@@ -129,6 +129,10 @@ struct CouplingProblem {
   Eigen::VectorXd weights;  // m (needed by "robin-constant")
   /// A short-wavelength probe (for "dirichlet-neumann" with contact_body "auto").
   Eigen::VectorXd probe_forces;
+  /// F^a r^a per body (body order, r^a body a's part of probe_forces) when the caller has
+  /// measured them (the Robin loop does, for its residuals' scale); empty: a scheme that needs
+  /// them solves them itself.
+  std::vector<Eigen::VectorXd> probe_responses;
 };
 
 /// The problem of two bodies and one interface: the pairing's gaps, weights and

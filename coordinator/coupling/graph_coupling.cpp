@@ -6,19 +6,6 @@
 namespace robin {
 namespace {
 
-/// The vectors stacked in order.
-Eigen::VectorXd concatenate(const std::vector<Eigen::VectorXd>& parts) {
-  Eigen::Index size = 0;
-  for (const Eigen::VectorXd& part : parts) size += part.size();
-  Eigen::VectorXd values(size);
-  Eigen::Index offset = 0;
-  for (const Eigen::VectorXd& part : parts) {
-    values.segment(offset, part.size()) = part;
-    offset += part.size();
-  }
-  return values;
-}
-
 ContactPairing couple_interface(const std::vector<InterfaceDescription>& bodies,
                                 const std::vector<std::string>& names,
                                 const InterfaceDefinition& interface, std::size_t index,

@@ -104,10 +104,10 @@ double maximum_absolute(const std::vector<Eigen::VectorXd>& vectors) {
 }
 
 /// The local indentation of the state's contact forces: c max|lambda|, with c the local
-/// interface compliance measured by measure_interface_compliance. A floor of the displacement
-/// scale: when the interface barely moves (a symmetry plane between two equally loaded bodies,
-/// d = 0), |d| and |u_N| are round-off, and residuals relative to them alone never fall below
-/// the tolerance although the state is converged.
+/// interface compliance measured by probe_responses and interface_compliance. A floor of the
+/// displacement scale: when the interface barely moves (a symmetry plane between two equally loaded
+/// bodies, d = 0), |d| and |u_N| are round-off, and residuals relative to them alone never fall
+/// below the tolerance although the state is converged.
 double force_displacement(const CouplingState& state, double compliance) {
   return compliance * maximum_absolute(state.contact_forces());
 }
@@ -228,18 +228,11 @@ SequenceResiduals completion_residuals(const CouplingState& completion,
 
 /// The contact forces of a sequence's bodies, stacked in body order.
 Eigen::VectorXd sequence_forces(const CouplingState& state, const ObstacleSequence& sequence) {
-  Eigen::Index size = 0;
+  std::vector<Eigen::VectorXd> forces;
   for (const int body : sequence.bodies) {
-    size += state.bodies[static_cast<std::size_t>(body)].contact_force.size();
+    forces.push_back(state.bodies[static_cast<std::size_t>(body)].contact_force);
   }
-  Eigen::VectorXd forces(size);
-  Eigen::Index offset = 0;
-  for (const int body : sequence.bodies) {
-    const Eigen::VectorXd& part = state.bodies[static_cast<std::size_t>(body)].contact_force;
-    forces.segment(offset, part.size()) = part;
-    offset += part.size();
-  }
-  return forces;
+  return concatenate(forces);
 }
 
 /// The largest of `per_block` over the sequence's blocks.
@@ -372,7 +365,7 @@ namespace {
 /// The problem of two bodies and one interface from its vectors.
 CouplingProblem two_body_problem(const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                                  const Eigen::VectorXd& probe_forces) {
-  return {ContactGraph::two_bodies(gaps.size()), gaps, weights, probe_forces};
+  return {ContactGraph::two_bodies(gaps.size()), gaps, weights, probe_forces, {}};
 }
 
 }  // namespace
@@ -426,21 +419,30 @@ namespace {
 /// below that of the displacements contact forces spread over a zone cause. Measured by one
 /// correction solve per body (iteration 0, all bodies in parallel; the factor only, so no contact
 /// warm start changes). It scales the displacement floor of the residuals (force_displacement) and,
-/// like them, scales with the loads.
-double measure_interface_compliance(const std::vector<SubdomainPort*>& ports,
-                                    const CouplingProblem& problem) {
-  std::vector<Eigen::VectorXd> weights;
+/// like them, scales with the loads. The responses also choose the contact body of
+/// "dirichlet-neumann" with contact_body "auto" (CouplingProblem::probe_responses).
+std::vector<Eigen::VectorXd> probe_responses(const std::vector<SubdomainPort*>& ports,
+                                             const CouplingProblem& problem) {
+  std::vector<Eigen::VectorXd> probes;
   for (std::size_t body = 0; body < ports.size(); ++body) {
-    weights.push_back(problem.graph.body_part(static_cast<int>(body), problem.probe_forces));
-    if (weights.back().size() > 0) ports[body]->start_correction(weights.back(), 0);
+    probes.push_back(problem.graph.body_part(static_cast<int>(body), problem.probe_forces));
+    if (probes.back().size() > 0) ports[body]->start_correction(probes.back(), 0);
   }
-  double compliance = 0.0;
+  std::vector<Eigen::VectorXd> responses(ports.size());
   for (std::size_t body = 0; body < ports.size(); ++body) {
-    if (weights[body].size() == 0) continue;
-    const CorrectionSolveResult response = ports[body]->finish_correction();
-    const double load = maximum_absolute(weights[body]);
-    if (load > 0.0)
-      compliance = std::max(compliance, maximum_absolute(response.normal_trace) / load);
+    if (probes[body].size() > 0) responses[body] = ports[body]->finish_correction().normal_trace;
+  }
+  return responses;
+}
+
+/// c from the probe responses F^a r^a of probe_responses().
+double interface_compliance(const CouplingProblem& problem,
+                            const std::vector<Eigen::VectorXd>& responses) {
+  double compliance = 0.0;
+  for (std::size_t body = 0; body < responses.size(); ++body) {
+    const double load =
+        maximum_absolute(problem.graph.body_part(static_cast<int>(body), problem.probe_forces));
+    if (load > 0.0) compliance = std::max(compliance, maximum_absolute(responses[body]) / load);
   }
   return compliance;
 }
@@ -532,8 +534,10 @@ RobinResult run_robin_iteration(const std::vector<SubdomainPort*>& ports,
   const double earlier_wall = resume != nullptr ? resume->wall_seconds : 0.0;
   double port_seconds = resume != nullptr ? resume->port_seconds : 0.0;
   const auto setup_start = Clock::now();
-  const std::unique_ptr<CouplingScheme> scheme = make_coupling_scheme(options, ports, problem);
-  const double compliance = measure_interface_compliance(ports, problem);
+  CouplingProblem probed = problem;
+  probed.probe_responses = probe_responses(ports, problem);
+  const double compliance = interface_compliance(problem, probed.probe_responses);
+  const std::unique_ptr<CouplingScheme> scheme = make_coupling_scheme(options, ports, probed);
   port_seconds += seconds_between(setup_start, Clock::now());
   const std::vector<int> block_sizes = scheme->block_sizes();
   const std::unique_ptr<Acceleration> acceleration =

@@ -38,6 +38,7 @@ using testing::example;
 using testing::seconds_since;
 using testing::server_options;
 using testing::TemporaryDirectory;
+using testing::expect_same_interface_state;
 using testing::vectors_close;
 
 /// examples/two_blocks.toml with both meshes loaded (SubdomainPort::setup needs them).
@@ -101,23 +102,7 @@ void expect_equal_to_in_process(const CoupledRunResult& remote) {
   ASSERT_EQ(reference.iteration.status, IterationStatus::converged) << reference.iteration.message;
   EXPECT_EQ(remote.iteration.status, IterationStatus::converged) << remote.iteration.message;
   EXPECT_EQ(remote.iteration.history.size(), reference.iteration.history.size());
-  const RobinResult& a = remote.iteration;
-  const RobinResult& b = reference.iteration;
-  EXPECT_GT(b.state.bodies[0].contact_force.maxCoeff(),
-            0.0);  // the comparison is about a real contact state
-  std::cout
-      << "largest differences to the in-process run: contact force "
-      << (a.state.bodies[0].contact_force - b.state.bodies[0].contact_force)
-             .lpNorm<Eigen::Infinity>()
-      << " (of " << b.state.bodies[0].contact_force.lpNorm<Eigen::Infinity>() << "), normal trace "
-      << (a.state.bodies[1].normal_trace - b.state.bodies[1].normal_trace).lpNorm<Eigen::Infinity>()
-      << " (of " << b.state.bodies[1].normal_trace.lpNorm<Eigen::Infinity>() << ")\n";
-  EXPECT_TRUE(
-      vectors_close(a.state.bodies[0].contact_force, b.state.bodies[0].contact_force, 1e-12));
-  EXPECT_TRUE(
-      vectors_close(a.state.bodies[1].contact_force, b.state.bodies[1].contact_force, 1e-12));
-  EXPECT_TRUE(vectors_close(a.state.bodies[0].normal_trace, b.state.bodies[0].normal_trace, 1e-12));
-  EXPECT_TRUE(vectors_close(a.state.bodies[1].normal_trace, b.state.bodies[1].normal_trace, 1e-12));
+  expect_same_interface_state(remote.iteration, reference.iteration, 1e-12, "in-process run");
   for (int alpha = 0; alpha < 2; ++alpha) {
     EXPECT_TRUE(vectors_close(field_values(point_field(remote.outputs[alpha], "displacement")),
                               field_values(point_field(reference.outputs[alpha], "displacement")),

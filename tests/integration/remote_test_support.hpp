@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "../test_files.hpp"
+#include "coupling/robin_iteration.hpp"
 #include "remote/child_process.hpp"
 #include "remote/server_launcher.hpp"
 
@@ -69,6 +70,29 @@ inline ::testing::AssertionResult vectors_close(const Eigen::VectorXd& a, const 
   if (difference <= tolerance * scale) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure()
          << "max difference " << difference << " > " << tolerance << " x " << scale;
+}
+
+/// Expects every body's contact force and normal trace in `actual` within `tolerance` of
+/// `reference` (vectors_close), after printing `label` and the largest differences (body 1's
+/// force, body 2's trace); `reference` must be a real contact state (some force > 0).
+inline void expect_same_interface_state(const RobinResult& actual, const RobinResult& reference,
+                                        double tolerance, const std::string& label) {
+  const std::vector<BodyInterfaceState>& a = actual.state.bodies;
+  const std::vector<BodyInterfaceState>& b = reference.state.bodies;
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GE(b.size(), 2u);
+  EXPECT_GT(b[0].contact_force.maxCoeff(), 0.0);  // the comparison is about a real contact state
+  std::cout << label << ": largest differences: contact force "
+            << (a[0].contact_force - b[0].contact_force).lpNorm<Eigen::Infinity>() << " (of "
+            << b[0].contact_force.lpNorm<Eigen::Infinity>() << "), normal trace "
+            << (a[1].normal_trace - b[1].normal_trace).lpNorm<Eigen::Infinity>() << " (of "
+            << b[1].normal_trace.lpNorm<Eigen::Infinity>() << ")\n";
+  for (std::size_t body = 0; body < b.size(); ++body) {
+    EXPECT_TRUE(vectors_close(a[body].contact_force, b[body].contact_force, tolerance))
+        << "body " << body + 1;
+    EXPECT_TRUE(vectors_close(a[body].normal_trace, b[body].normal_trace, tolerance))
+        << "body " << body + 1;
+  }
 }
 
 /// What a finished tool process left behind.
