@@ -12,6 +12,13 @@ a = sqrt(4PR/(pi E*)) and peak pressure p0 = 2P/(pi a) computed here from the ca
 materials and the run's contact resultant. Its command line: --help, --version (the project
 version), exit status 2 for a bad command line and 1 for a directory without results.
 
+Result directories of a contact graph (ContactGraphDirectory) are written by the test itself,
+with numbers chosen here: three bodies, two interfaces (one horizontal, one vertical), their
+contact_<k>_<a>_<b>.csv files, summary.json with its "interfaces" array and a history.csv with
+the per-body columns of three bodies; robin-plot draws one row of panels per interface whose
+curves are those numbers, and names the contact file that is missing. These need no build of
+the C++ tools (robin-plot of the build when there is one, else the source copy).
+
 The tools are those of the build directory named by ROBIN_CONTACT_BIN (set by CTest), default
 build/bin. Needs Debian's matplotlib and numpy (/usr/bin/python3).
 """
@@ -52,9 +59,15 @@ def read_csv(path):
         return list(csv.DictReader(handle))
 
 
-def load_plot_module():
+def plot_executable():
+    """The build's robin-plot, else the source copy (for the tests that need no other tool)."""
+    return BIN / "robin-plot" if (BIN / "robin-plot").exists() else SOURCE_PLOT
+
+
+def load_plot_module(path=None):
     """The build's robin-plot as a module (it has no .py suffix), for its figures."""
-    loader = importlib.machinery.SourceFileLoader("robin_plot", str(BIN / "robin-plot"))
+    path = BIN / "robin-plot" if path is None else path
+    loader = importlib.machinery.SourceFileLoader("robin_plot", str(path))
     spec = importlib.util.spec_from_loader("robin_plot", loader)
     module = importlib.util.module_from_spec(spec)
     loader.exec_module(module)
@@ -320,6 +333,238 @@ class MonolithicRun(unittest.TestCase):
             self.assertAlmostEqual(peak, 12.2154, delta=1e-4)
             self.assertAlmostEqual(half_width_error, -1.36, delta=0.01)
             self.assertAlmostEqual(peak_error, 1.25, delta=0.01)
+
+
+# --- A contact graph: result files written by the test ----------------------------------------
+
+CONTACT_HEADER = ["pair", "x", "y", "nx", "ny", "gap0", "un1", "un2", "lambda1", "lambda2",
+                  "pressure"]
+# Interface 1: 'lower' (its boundary 'top') under 'middle' ('bottom') along y = 0, five nodes
+# 0.25 apart; interface 2: 'middle' ('right') beside 'side-block' ('left') along x = 1, four
+# nodes from y = 0 to y = 0.6 (0.2 apart): not flat in x, so drawn over the arc length.
+INTERFACE1 = {"x": [0.0, 0.25, 0.5, 0.75, 1.0], "y": [0.0] * 5, "nx": [0.0] * 5, "ny": [1.0] * 5,
+              "gap0": [0.0, 0.0, 0.0, 0.0, 0.0], "un1": [0.001, 0.002, 0.003, 0.002, 0.0005],
+              "un2": [-0.001, -0.002, -0.003, -0.002, 0.0005],
+              "pressure": [0.0, 2.0, 3.5, 2.0, 0.0]}
+INTERFACE2 = {"x": [1.0] * 4, "y": [0.0, 0.2, 0.4, 0.6], "nx": [1.0] * 4, "ny": [0.0] * 4,
+              "gap0": [0.01, 0.01, 0.01, 0.01], "un1": [0.004, 0.006, 0.002, 0.001],
+              "un2": [0.006, 0.004, 0.002, 0.001], "pressure": [1.25, 0.75, 0.0, 0.0]}
+WEIGHTS = (0.25, 0.2)  # the nodal lengths: lambda = pressure * weight on both sides
+
+
+def write_contact_file(path, values, weight):
+    with open(path, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(CONTACT_HEADER)
+        for pair in range(len(values["x"])):
+            force = values["pressure"][pair] * weight
+            writer.writerow([pair] + [repr(values[name][pair]) for name in CONTACT_HEADER[1:8]]
+                            + [repr(force), repr(force), repr(values["pressure"][pair])])
+
+
+def graph_summary(files=("contact_1_lower_middle.csv", "contact_2_middle_side-block.csv")):
+    interfaces = []
+    for values, weight, bodies, boundaries, file in (
+            (INTERFACE1, WEIGHTS[0], ["lower", "middle"], ["top", "bottom"], files[0]),
+            (INTERFACE2, WEIGHTS[1], ["middle", "side-block"], ["right", "left"], files[1])):
+        pressures = values["pressure"]
+        interfaces.append({
+            "bodies": bodies, "boundaries": boundaries,
+            "contact_discretization": "node-to-node, %d pairs" % len(pressures),
+            "contact_pairs": len(pressures), "active_pairs": sum(p > 0 for p in pressures),
+            "largest_pressure": max(pressures), "excluded_pairs": [], "initial_overlap": "",
+            "contact_force_resultant": [0.0, sum(pressures) * weight], "file": file})
+    return {"status": "converged", "converged": True, "title": "three bodies",
+            "algorithm": "robin", "stopping": "either-sequence", "tolerance": 1e-8,
+            "iterations": 4, "completed_by_sequence": 2,
+            "final_residuals": {"obstacle_change": 4e-9, "penetration": 0.0,
+                                "force_balance": 0.0, "complementarity": 2e-9,
+                                "correction": 0.0, "force_error_estimate": 6e-9},
+            "contact_pairs": 9, "contact_force_resultant": None, "interfaces": interfaces}
+
+
+# history.csv of three bodies: activeN and qp_iterationsN per body, two obstacle sequences.
+HISTORY_HEADER = ("iteration,obstacle_change,penetration,force_balance,complementarity,"
+                  "correction,active1,active2,active3,qp_iterations1,qp_iterations2,"
+                  "qp_iterations3,seconds,sequence1,sequence2,stopping_residual,tolerance")
+HISTORY_ROWS = [
+    "1,0.5,0.1,0.3,0.02,0.4,3,5,2,12,15,9,0.01,0.2,0.1,0.1,1e-08",
+    "2,0.01,0.002,0.004,0.0003,0.005,3,5,2,8,9,7,0.01,0.003,0.001,0.001,1e-08",
+    "3,1e-05,2e-06,3e-06,0,4e-06,3,5,2,4,5,3,0.01,2e-06,5e-07,5e-07,1e-08",
+    "4,1e-08,0,2e-08,3e-09,1e-08,3,5,2,2,2,2,0.01,8e-09,6e-09,6e-09,1e-08"]
+
+
+def write_graph_directory(directory, summary=True, history=True):
+    directory.mkdir(parents=True)
+    write_contact_file(directory / "contact_1_lower_middle.csv", INTERFACE1, WEIGHTS[0])
+    write_contact_file(directory / "contact_2_middle_side-block.csv", INTERFACE2, WEIGHTS[1])
+    if summary:
+        (directory / "summary.json").write_text(json.dumps(graph_summary(), indent=2))
+    if history:
+        (directory / "history.csv").write_text("\n".join([HISTORY_HEADER] + HISTORY_ROWS) + "\n")
+    return directory
+
+
+def final_gap(values):
+    return [d - u1 - u2 for d, u1, u2 in zip(values["gap0"], values["un1"], values["un2"])]
+
+
+class ContactGraphDirectory(unittest.TestCase):
+    """robin-plot on result directories of three bodies and two interfaces, written here."""
+
+    def setUp(self):
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-plot-graph-"))
+        self.tool = plot_executable()
+        self.plot = load_plot_module(self.tool)
+
+    def tearDown(self):
+        shutil.rmtree(self.scratch, ignore_errors=True)
+
+    def test_robin_plot_draws_every_interface(self):
+        directory = write_graph_directory(self.scratch / "graph")
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 0, stderr)
+        for name in ("contact.png", "history.png"):
+            with open(directory / name, "rb") as handle:
+                self.assertEqual(handle.read(8), b"\x89PNG\r\n\x1a\n", name)
+        self.assertIn("robin-plot: contact.png: interface 1: lower / middle (top / bottom): "
+                      "5 contact rows, 3 active, largest pressure 3.5 "
+                      "(contact_1_lower_middle.csv)", stdout)
+        self.assertIn("robin-plot: contact.png: interface 2: middle / side-block (right / left): "
+                      "4 contact rows, 2 active, largest pressure 1.25 "
+                      "(contact_2_middle_side-block.csv)", stdout)
+        self.assertIn("history.png: converged after 4 iterations: obstacle sequence 2 reached "
+                      "6.0e-09 < tolerance 1e-08", stdout)
+        self.assertNotIn("Hertz", stdout)
+
+    def test_one_row_of_panels_per_interface_with_its_numbers(self):
+        directory = write_graph_directory(self.scratch / "graph")
+        summary = json.loads((directory / "summary.json").read_text())
+        tables = self.plot.contact_tables(directory, summary)
+        self.assertEqual([table["file"] for table in tables],
+                         ["contact_1_lower_middle.csv", "contact_2_middle_side-block.csv"])
+        figure, lines = self.plot.interfaces_figure(tables, summary)
+        self.assertEqual(len(figure.axes), 4)  # (pressure, gap) per interface
+        pressure1, gap1, pressure2, gap2 = figure.axes
+        self.assertEqual(pressure1.get_title(), "interface 1: lower / middle (top / bottom): "
+                                                "largest pressure 3.5, 3 of 5 rows active")
+        self.assertEqual(pressure2.get_title(), "interface 2: middle / side-block (right / "
+                                                "left): largest pressure 1.25, 2 of 4 rows active")
+        self.assertIn("interface 2: middle / side-block (right / left): final gap",
+                      gap2.get_title())
+        curve = pressure1.get_lines()[0]
+        self.assertEqual(list(curve.get_xdata()), INTERFACE1["x"])
+        self.assertEqual(list(curve.get_ydata()), INTERFACE1["pressure"])
+        self.assertEqual(pressure1.get_xlabel(), "x")
+        np.testing.assert_allclose(gap1.get_lines()[0].get_ydata(), final_gap(INTERFACE1),
+                                   rtol=0, atol=1e-15)
+        np.testing.assert_allclose(gap1.get_lines()[0].get_ydata(), [0.0, 0.0, 0.0, 0.0, -0.001],
+                                   atol=1e-15)
+        # The vertical interface over its arc length from its first node: 0, 0.2, 0.4, 0.6.
+        curve = pressure2.get_lines()[0]
+        np.testing.assert_allclose(curve.get_xdata(), [0.0, 0.2, 0.4, 0.6], atol=1e-15)
+        self.assertEqual(list(curve.get_ydata()), INTERFACE2["pressure"])
+        self.assertEqual(pressure2.get_xlabel(), "arc length along the interface")
+        np.testing.assert_allclose(gap2.get_lines()[0].get_ydata(), [0.0, 0.0, 0.006, 0.008],
+                                   atol=1e-15)
+        self.assertEqual(figure._suptitle.get_text(),
+                         "contact pressure and final gap on 2 interfaces (three bodies)")
+        self.assertEqual(len(lines), 2)
+
+    def test_history_of_three_bodies(self):
+        directory = write_graph_directory(self.scratch / "graph")
+        summary = json.loads((directory / "summary.json").read_text())
+        columns = self.plot.read_columns(directory / "history.csv")
+        self.assertEqual(self.plot.sequence_numbers(columns), [1, 2])
+        figure, lines = self.plot.history_figure(columns, summary)
+        axis = figure.axes[0]
+        by_label = {line.get_label(): line for line in axis.get_lines()}
+        rows = [row.split(",") for row in HISTORY_ROWS]
+        header = HISTORY_HEADER.split(",")
+        for k in (1, 2):
+            label = (f"obstacle sequence {k}: largest residual of its complete state")
+            expected = [float(row[header.index(f"sequence{k}")]) for row in rows]
+            self.assertEqual(list(by_label[label].get_ydata()), expected)
+        # A zero residual is drawn at 1e-17 on the logarithmic axis.
+        self.assertEqual(list(by_label["joint: penetration"].get_ydata()),
+                         [0.1, 0.002, 2e-06, 1e-17])
+        self.assertEqual(list(by_label["joint: obstacle change"].get_xdata()), [1, 2, 3, 4])
+        self.assertEqual(list(by_label["tolerance 1e-08"].get_ydata()), [1e-8, 1e-8])
+        self.assertIn("accepted: obstacle sequence 2, largest residual 6.0e-09", by_label)
+        self.assertEqual(list(by_label["accepted: obstacle sequence 2, largest residual "
+                                       "6.0e-09"].get_ydata()), [6e-9])
+        self.assertIn("converged after 4 iterations", axis.get_title())
+        self.assertEqual(len(lines), 1)
+
+    def test_without_summary_the_files_on_disk_are_the_interfaces(self):
+        directory = write_graph_directory(self.scratch / "bare", summary=False, history=False)
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 0, stderr)
+        self.assertIn("contact.png: interface 1: contact_1_lower_middle.csv: 5 contact rows, "
+                      "3 active, largest pressure 3.5", stdout)
+        self.assertIn("contact.png: interface 2: contact_2_middle_side-block.csv: 4 contact "
+                      "rows, 2 active, largest pressure 1.25", stdout)
+        self.assertTrue((directory / "contact.png").exists())
+        self.assertFalse((directory / "history.png").exists())
+
+    def test_a_missing_contact_file_is_named(self):
+        directory = write_graph_directory(self.scratch / "missing")
+        (directory / "contact_2_middle_side-block.csv").unlink()
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 1)
+        self.assertEqual(stdout, "")
+        self.assertIn(f"{directory}: summary.json lists 2 contact interfaces, but "
+                      "contact_2_middle_side-block.csv (interface 2: middle / side-block) is "
+                      "missing", stderr)
+        self.assertFalse((directory / "contact.png").exists())
+        # Without summary.json: the gap in the numbering of the files on disk.
+        (directory / "summary.json").unlink()
+        write_contact_file(directory / "contact_3_lower_side-block.csv", INTERFACE2, WEIGHTS[1])
+        status, _, stderr = run(self.tool, directory)
+        self.assertEqual(status, 1)
+        self.assertIn("the contact file of interface 2 (contact_2_<a>_<b>.csv) is missing beside "
+                      "contact_1_lower_middle.csv, contact_3_lower_side-block.csv", stderr)
+
+    def test_a_failed_run_without_contact_files(self):
+        directory = self.scratch / "failed"
+        directory.mkdir()
+        (directory / "summary.json").write_text(json.dumps(
+            {"status": "failed", "message": "server 3 did not answer", "interfaces": []}))
+        status, _, stderr = run(self.tool, directory)
+        self.assertEqual(status, 1)
+        self.assertIn("contact.csv is missing, and so are the contact_<k>_<a>_<b>.csv files",
+                      stderr)
+        self.assertIn("summary.json is there: the run failed before writing its results", stderr)
+
+    def test_reference_table_is_not_drawn_over_several_interfaces(self):
+        directory = write_graph_directory(self.scratch / "graph")
+        case = self.scratch / "case.toml"
+        case.write_text('[reference]\nkind = "hertz_cylinder"\nradius = 1.0\n')
+        status, stdout, stderr = run(self.tool, "--case", case, directory)
+        self.assertEqual(status, 0, stderr)
+        self.assertIn("contact.png: the case's [reference] table describes one contact; it is "
+                      "not drawn for the 2 interfaces", stdout)
+
+    def test_two_body_layout_keeps_its_figure(self):
+        # A two-body run: contact.csv and an "interfaces" array of one entry naming it.
+        directory = self.scratch / "two"
+        directory.mkdir()
+        write_contact_file(directory / "contact.csv", INTERFACE1, WEIGHTS[0])
+        summary = graph_summary(files=("contact.csv", "unused"))
+        summary["interfaces"] = summary["interfaces"][:1]
+        summary["contact_force_resultant"] = summary["interfaces"][0]["contact_force_resultant"]
+        (directory / "summary.json").write_text(json.dumps(summary))
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 0, stderr)
+        self.assertIn("robin-plot: contact.png: 5 contact rows, largest pressure 3.5", stdout)
+        tables = self.plot.contact_tables(directory, summary)
+        self.assertEqual(len(tables), 1)
+        figure, _, comparison = self.plot.contact_figure(tables[0]["columns"], summary, None)
+        self.assertIsNone(comparison)
+        pressure_axis, gap_axis = figure.axes
+        self.assertEqual(pressure_axis.get_ylabel(), "contact pressure (force / length)")
+        self.assertEqual(list(pressure_axis.get_lines()[0].get_ydata()), INTERFACE1["pressure"])
+        self.assertEqual(gap_axis.get_ylabel(), "final normal gap d - u1_N - u2_N")
 
 
 if __name__ == "__main__":
