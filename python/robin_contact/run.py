@@ -6,6 +6,7 @@ import math
 import numbers
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import tempfile
@@ -30,12 +31,45 @@ class RunError(Exception):
         self.log = log
 
 
+class Interface:
+    """One contact interface of a run (docs/outputs.md, "Several bodies"):
+
+    - `number`: its number k, 1-based, in the order of the case's [[interface]] tables;
+    - `bodies`: its two bodies (a, b), `boundaries`: their contact boundaries (a's, b's), each
+      a tuple of two names (None when the result directory does not say: an older run);
+    - `file`: its contact file, `contact_<k>_<a>_<b>.csv` (`contact.csv` for a run of one
+      interface);
+    - `contact`: that file, one NumPy array per column as `Results.contact` (un1, lambda1 and
+      nx, ny are body a's; un2, lambda2 body b's);
+    - `summary`: its entry of summary.json's "interfaces" array (contact_pairs, active_pairs,
+      largest_pressure, excluded_pairs, initial_overlap, contact_force_resultant, ...), {}
+      when there is none.
+    """
+
+    def __init__(self, number, bodies, boundaries, file, contact, summary=None):
+        self.number = number
+        self.bodies = tuple(bodies) if bodies is not None else None
+        self.boundaries = tuple(boundaries) if boundaries is not None else None
+        self.file = file
+        self.contact = contact
+        self.summary = summary if summary is not None else {}
+
+    def __repr__(self):
+        between = " / ".join(self.bodies) if self.bodies else self.file
+        return "<Interface %d: %s, %d rows>" % (self.number, between, len(self.contact["pair"]))
+
+
 class Results:
     """The results of one run (README.md, "Results"):
 
     - `summary`: summary.json as a dict;
-    - `contact`: contact.csv, one NumPy array per column (pair, x, y, nx, ny, gap0, un1, un2,
-      lambda1, lambda2, pressure), one entry per contact pair;
+    - `interfaces`: the contact interfaces, a list of Interface in the case's order
+      (`interfaces[0]` is interface 1): its bodies, boundaries and contact table; one entry for
+      a run of two bodies;
+    - `contact`: the contact table of a run of one interface (contact.csv), one NumPy array per
+      column (pair, x, y, nx, ny, gap0, un1, un2, lambda1, lambda2, pressure), one entry per
+      contact pair. With several interfaces there is no single table: reading `contact` raises
+      ValueError naming `interfaces` (use `interfaces[k].contact` or `interface(a, b)`);
     - `history`: history.csv the same way (residuals per iteration), None when the run wrote
       none (robin-monolithic);
     - `bodies`: the body files named in solution.pvd, by body name, each a VtuFile (points,
@@ -43,14 +77,46 @@ class Results:
     - `directory`, `exit_code` and `log` (the tool's standard error; empty for read_results).
     """
 
-    def __init__(self, directory, summary, contact, history, bodies, exit_code=0, log=""):
+    def __init__(self, directory, summary, contact, history, bodies, exit_code=0, log="",
+                 interfaces=None):
         self.directory = directory
         self.summary = summary
-        self.contact = contact
+        if interfaces is None:
+            interfaces = [] if contact is None else [Interface(1, None, None, "contact.csv",
+                                                               contact)]
+        self.interfaces = list(interfaces)
         self.history = history
         self.bodies = bodies
         self.exit_code = exit_code
         self.log = log
+
+    @property
+    def contact(self):
+        if len(self.interfaces) == 1:
+            return self.interfaces[0].contact
+        if not self.interfaces:
+            return None
+        raise ValueError(
+            "the run has %d contact interfaces, so no single contact table: use "
+            "results.interfaces[k].contact (k from 0) or results.interface(a, b); files: %s"
+            % (len(self.interfaces), ", ".join(interface.file for interface in self.interfaces)))
+
+    def interface(self, body_a, body_b):
+        """The Interface between the bodies named body_a and body_b (either order). Raises
+        KeyError when there is none, ValueError when they touch on several interfaces (use
+        `interfaces`)."""
+        found = [interface for interface in self.interfaces if interface.bodies is not None
+                 and set(interface.bodies) == {body_a, body_b} and body_a != body_b]
+        if not found:
+            raise KeyError("no contact interface between %r and %r (interfaces: %s)"
+                           % (body_a, body_b, ", ".join(
+                               " / ".join(i.bodies) if i.bodies else i.file
+                               for i in self.interfaces)))
+        if len(found) > 1:
+            raise ValueError("%r and %r touch on %d interfaces (%s): pick one from "
+                             "results.interfaces" % (body_a, body_b, len(found),
+                                                     ", ".join(i.file for i in found)))
+        return found[0]
 
 
 def toml_value(value):
@@ -136,13 +202,36 @@ def _columns(path):
     return columns
 
 
+_INTERFACE_FILE = re.compile(r"^contact_([0-9]+)_.+[.]csv$")
+
+
+def _read_interfaces(directory, summary):
+    """The Interface list of a result directory: the files summary.json's "interfaces" names,
+    else contact.csv, else the contact_<k>_*.csv files on disk (in the order of k)."""
+    entries = summary.get("interfaces") or []
+    if entries and all(entry.get("file") for entry in entries):
+        return [Interface(number, entry.get("bodies"), entry.get("boundaries"), entry["file"],
+                          _columns(directory / entry["file"]), entry)
+                for number, entry in enumerate(entries, start=1)]
+    if (directory / "contact.csv").is_file():
+        return [Interface(1, None, None, "contact.csv", _columns(directory / "contact.csv"))]
+    on_disk = sorted((int(match.group(1)), path.name) for path in directory.iterdir()
+                     for match in [_INTERFACE_FILE.match(path.name)] if match)
+    if not on_disk:
+        raise FileNotFoundError("%s holds no contact file (contact.csv, or contact_<k>_<a>_<b>.csv "
+                                "for a run of several interfaces)" % directory)
+    return [Interface(number, None, None, name, _columns(directory / name))
+            for number, name in on_disk]
+
+
 def read_results(directory):
     """The Results of a result directory written by robin-run, robin-coordinator or
-    robin-monolithic."""
+    robin-monolithic: two bodies (contact.csv) or a contact graph (one contact_<k>_<a>_<b>.csv
+    per interface, listed in summary.json's "interfaces")."""
     directory = pathlib.Path(directory)
     with open(directory / "summary.json", encoding="utf-8") as file:
         summary = json.load(file)
-    contact = _columns(directory / "contact.csv")
+    interfaces = _read_interfaces(directory, summary)
     history_path = directory / "history.csv"
     history = _columns(history_path) if history_path.is_file() else None
     bodies = {}
@@ -150,13 +239,16 @@ def read_results(directory):
     for dataset in pvd.iter("DataSet"):
         file_name = dataset.get("file")
         bodies[pathlib.Path(file_name).stem] = read_vtu(directory / file_name)
-    return Results(directory, summary, contact, history, bodies)
+    if len(interfaces) == 1 and interfaces[0].bodies is None and len(bodies) == 2:
+        interfaces[0].bodies = tuple(bodies)  # an older two-body run: body 1, body 2
+    return Results(directory, summary, None, history, bodies, interfaces=interfaces)
 
 
 def run_case(case, overrides=None, output=None, tool="robin-run", bin_directory=None,
              arguments=(), quiet=True, timeout=None):
-    """Runs the case file `case` with `tool` ("robin-run": the coupled Robin solve with two
-    local servers; "robin-monolithic": the single-process reference) and returns its Results.
+    """Runs the case file `case` with `tool` ("robin-run": the coupled Robin solve with one
+    local server per body; "robin-monolithic": the single-process reference) and returns its
+    Results.
 
     `overrides`: case-file keys to change for this run (--set, docs/case-format.md,
     "Overrides"), e.g. {"coupling.tolerance": 1e-10, "body[2].dirichlet[1].y": -0.02}.

@@ -8,8 +8,14 @@ with the top displacement d, H1 = 0.5, H2 = 0.4, nu1 = 0.3, nu2 = 0.25, E2 = 400
 file's comment). In the lower block [0, 1] x [-0.5, 0] (rollers below and on the left) the
 displacement is u_x = nu1 (1 + nu1) p / E1 x, u_y = -(1 - nu1^2) p / E1 (y + 0.5) (plane strain,
 sigma_yy = -p, sigma_xx = 0). An override sweep of d and E1 follows p; a bad override is a
-RunError naming it."""
+RunError naming it.
 
+ContactGraphResults needs no build: read_results on result directories the test writes itself
+(three bodies, two interfaces, their contact_<k>_<a>_<b>.csv files and summary.json's
+"interfaces"; a two-body directory; an older one without "interfaces"), with numbers chosen
+here."""
+
+import json
 import os
 import pathlib
 import shutil
@@ -144,6 +150,168 @@ class TomlValues(unittest.TestCase):
         self.assertEqual(robin_contact.override_arguments({"a.b": 1, "c": "x"}),
                          ["--set", "a.b=1", "--set", 'c="x"'])
         self.assertEqual(robin_contact.override_arguments(["a=1"]), ["--set", "a=1"])
+
+
+# --- Result directories of a contact graph, written by the test --------------------------------
+
+CONTACT_HEADER = "pair,x,y,nx,ny,gap0,un1,un2,lambda1,lambda2,pressure"
+
+
+def contact_text(rows):
+    return "\n".join([CONTACT_HEADER] + [",".join(repr(value) for value in row)
+                                         for row in rows]) + "\n"
+
+
+# Interface 1, 'lower' (top) / 'middle' (bottom), three pairs along y = 0; interface 2,
+# 'middle' (top) / 'upper' (bottom), two pairs along y = 1. Columns as CONTACT_HEADER.
+ROWS1 = [(0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.001, -0.001, 0.5, 0.5, 2.0),
+         (1, 0.5, 0.0, 0.0, 1.0, 0.0, 0.002, -0.002, 1.0, 1.0, 4.0),
+         (2, 1.0, 0.0, 0.0, 1.0, 0.0, 0.001, -0.001, 0.5, 0.5, 2.0)]
+ROWS2 = [(0, 0.0, 1.0, 0.0, 1.0, 0.01, 0.003, 0.002, 0.0, 0.0, 0.0),
+         (1, 1.0, 1.0, 0.0, 1.0, 0.0, 0.004, -0.004, 0.75, 0.75, 1.5)]
+
+
+def vtu_text(offset):
+    """A one-triangle UnstructuredGrid in text form, its displacement (offset, 2 offset, 0)."""
+    return ("""<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian">
+<UnstructuredGrid><Piece NumberOfPoints="3" NumberOfCells="1">
+<Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">
+0 0 0 1 0 0 0 1 0</DataArray></Points>
+<Cells>
+<DataArray type="Int64" Name="connectivity" format="ascii">0 1 2</DataArray>
+<DataArray type="Int64" Name="offsets" format="ascii">3</DataArray>
+<DataArray type="UInt8" Name="types" format="ascii">5</DataArray>
+</Cells>
+<PointData><DataArray type="Float64" Name="displacement" NumberOfComponents="3" format="ascii">
+%r %r 0 %r %r 0 %r %r 0</DataArray></PointData>
+</Piece></UnstructuredGrid></VTKFile>
+""" % ((offset, 2 * offset) * 3))
+
+
+def write_result_directory(directory, bodies, contact_files, interfaces):
+    """summary.json (with `interfaces` unless None), solution.pvd naming one .vtu per body, and
+    the contact files {name: rows}."""
+    directory.mkdir()
+    summary = {"status": "converged", "converged": True, "iterations": 7,
+               "contact_pairs": sum(len(rows) for rows in contact_files.values())}
+    if interfaces is not None:
+        summary["interfaces"] = interfaces
+        summary["contact_force_resultant"] = (interfaces[0]["contact_force_resultant"]
+                                              if len(interfaces) == 1 else None)
+    (directory / "summary.json").write_text(json.dumps(summary))
+    datasets = "".join('<DataSet timestep="0" part="%d" file="%s.vtu"/>' % (part, name)
+                       for part, name in enumerate(bodies))
+    (directory / "solution.pvd").write_text(
+        '<?xml version="1.0"?><VTKFile type="Collection" version="0.1"><Collection>%s'
+        '</Collection></VTKFile>\n' % datasets)
+    for index, name in enumerate(bodies):
+        (directory / ("%s.vtu" % name)).write_text(vtu_text(0.001 * (index + 1)))
+    for name, rows in contact_files.items():
+        (directory / name).write_text(contact_text(rows))
+    return directory
+
+
+def interface_entry(bodies, boundaries, rows, file):
+    return {"bodies": bodies, "boundaries": boundaries,
+            "contact_discretization": "node-to-node, %d pairs" % len(rows),
+            "contact_pairs": len(rows), "active_pairs": sum(row[10] > 0 for row in rows),
+            "largest_pressure": max(row[10] for row in rows), "excluded_pairs": [],
+            "initial_overlap": "", "contact_force_resultant": [0.0, sum(row[8] for row in rows)],
+            "file": file}
+
+
+class ContactGraphResults(unittest.TestCase):
+    def setUp(self):
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-scripting-graph-"))
+
+    def tearDown(self):
+        shutil.rmtree(self.scratch, ignore_errors=True)
+
+    def write_graph(self, name="graph", with_summary_interfaces=True):
+        files = {"contact_1_lower_middle.csv": ROWS1, "contact_2_middle_upper.csv": ROWS2}
+        interfaces = [interface_entry(["lower", "middle"], ["top", "bottom"], ROWS1,
+                                      "contact_1_lower_middle.csv"),
+                      interface_entry(["middle", "upper"], ["top", "bottom"], ROWS2,
+                                      "contact_2_middle_upper.csv")]
+        return write_result_directory(self.scratch / name, ["lower", "middle", "upper"], files,
+                                      interfaces if with_summary_interfaces else None)
+
+    def test_every_interface_has_its_bodies_and_table(self):
+        results = robin_contact.read_results(self.write_graph())
+        self.assertEqual(len(results.interfaces), 2)
+        first, second = results.interfaces
+        self.assertEqual((first.number, first.bodies, first.boundaries, first.file),
+                         (1, ("lower", "middle"), ("top", "bottom"),
+                          "contact_1_lower_middle.csv"))
+        self.assertEqual((second.number, second.bodies, second.file),
+                         (2, ("middle", "upper"), "contact_2_middle_upper.csv"))
+        np.testing.assert_array_equal(first.contact["pressure"], [2.0, 4.0, 2.0])
+        np.testing.assert_array_equal(first.contact["x"], [0.0, 0.5, 1.0])
+        np.testing.assert_array_equal(second.contact["pressure"], [0.0, 1.5])
+        np.testing.assert_array_equal(second.contact["lambda1"], [0.0, 0.75])
+        self.assertEqual(second.contact["pair"].dtype, np.int64)
+        # The final gap d - u_N(a) - u_N(b) of interface 2: 0.01 - 0.005 open, 0 closed.
+        gap = second.contact["gap0"] - second.contact["un1"] - second.contact["un2"]
+        np.testing.assert_allclose(gap, [0.005, 0.0], atol=1e-15)
+        self.assertEqual(first.summary["active_pairs"], 3)
+        self.assertEqual(second.summary["largest_pressure"], 1.5)
+        self.assertEqual(second.summary["contact_force_resultant"], [0.0, 0.75])
+        self.assertIsNone(results.summary["contact_force_resultant"])
+        # Lookup by bodies, in either order.
+        self.assertIs(results.interface("upper", "middle"), second)
+        self.assertIs(results.interface("lower", "middle"), first)
+        with self.assertRaises(KeyError) as raised:
+            results.interface("lower", "upper")
+        self.assertIn("no contact interface between 'lower' and 'upper'", str(raised.exception))
+        # The bodies: every part of solution.pvd.
+        self.assertEqual(list(results.bodies), ["lower", "middle", "upper"])
+        np.testing.assert_allclose(results.bodies["upper"].point_data["displacement"][:, 1],
+                                   0.006)
+
+    def test_contact_of_several_interfaces_is_an_error_naming_them(self):
+        results = robin_contact.read_results(self.write_graph())
+        with self.assertRaises(ValueError) as raised:
+            results.contact
+        self.assertIn("the run has 2 contact interfaces", str(raised.exception))
+        self.assertIn("results.interfaces[k].contact", str(raised.exception))
+        self.assertIn("contact_1_lower_middle.csv, contact_2_middle_upper.csv",
+                      str(raised.exception))
+
+    def test_without_summary_interfaces_the_files_on_disk(self):
+        results = robin_contact.read_results(self.write_graph("bare", False))
+        self.assertEqual([(i.number, i.file, i.bodies) for i in results.interfaces],
+                         [(1, "contact_1_lower_middle.csv", None),
+                          (2, "contact_2_middle_upper.csv", None)])
+        np.testing.assert_array_equal(results.interfaces[1].contact["pressure"], [0.0, 1.5])
+
+    def test_a_missing_contact_file_is_named(self):
+        directory = self.write_graph()
+        (directory / "contact_2_middle_upper.csv").unlink()
+        with self.assertRaises(FileNotFoundError) as raised:
+            robin_contact.read_results(directory)
+        self.assertIn("contact_2_middle_upper.csv", str(raised.exception))
+
+    def test_two_bodies_keep_contact(self):
+        interfaces = [interface_entry(["lower", "upper"], ["contact", "contact"], ROWS1,
+                                      "contact.csv")]
+        directory = write_result_directory(self.scratch / "two", ["lower", "upper"],
+                                           {"contact.csv": ROWS1}, interfaces)
+        results = robin_contact.read_results(directory)
+        np.testing.assert_array_equal(results.contact["pressure"], [2.0, 4.0, 2.0])
+        self.assertEqual(len(results.interfaces), 1)
+        self.assertIs(results.interfaces[0].contact, results.contact)
+        self.assertEqual(results.interfaces[0].bodies, ("lower", "upper"))
+        self.assertEqual(results.interfaces[0].boundaries, ("contact", "contact"))
+        self.assertEqual(results.summary["contact_force_resultant"], [0.0, 2.0])
+        # A result directory of an older version (no "interfaces"): body 1 and body 2.
+        older = write_result_directory(self.scratch / "older", ["flat", "punch"],
+                                       {"contact.csv": ROWS2}, None)
+        results = robin_contact.read_results(older)
+        np.testing.assert_array_equal(results.contact["pressure"], [0.0, 1.5])
+        self.assertEqual(results.interfaces[0].bodies, ("flat", "punch"))
+        self.assertIsNone(results.interfaces[0].boundaries)
+        self.assertEqual(results.interface("punch", "flat").file, "contact.csv")
 
 
 if __name__ == "__main__":
