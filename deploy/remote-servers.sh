@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Starts robin-subdomain servers through a command prefix (ssh, srun, ip netns exec, ...), runs
-# robin-coordinator against the endpoints they announce, and stops the servers on exit,
-# failure or interruption (SIGINT, SIGTERM, SIGHUP).
+# Starts robin-subdomain servers, one per body of the case, through a command prefix (ssh, srun,
+# ip netns exec, ...), runs robin-coordinator against the endpoints they announce (in body
+# order), and stops the servers on exit, failure or interruption (SIGINT, SIGTERM, SIGHUP).
 #
 # Usage:
 #   deploy/remote-servers.sh [SERVER OPTIONS] CASE --output DIR [robin-coordinator options]
@@ -12,8 +12,14 @@
 #                           "ssh -tt node1" or "srun --nodes=1 --ntasks=1 --nodelist=node1";
 #                           "" runs them here. Default: $ROBIN_LAUNCH (empty: here).
 #   --listen ENDPOINT       declares one server binding ENDPOINT (on its own host), e.g.
-#                           tcp://10.0.0.7:5555 or 'tcp://*:5555'. Without any --listen: two
-#                           servers on tcp://127.0.0.1:* (ephemeral ports) with $ROBIN_LAUNCH.
+#                           tcp://10.0.0.7:5555 or 'tcp://*:5555'; give one per body. Without
+#                           any --listen: one server per body (see --servers) on
+#                           tcp://127.0.0.1:* (ephemeral ports) through the last --launch
+#                           (default $ROBIN_LAUNCH) and --connect-host.
+#   --servers N             the number of servers (one per body). Default: the number of
+#                           --listen options, else the number of [[body]] tables of CASE when
+#                           it is readable here, else 2. When CASE is readable here, a number
+#                           of servers that is not its number of bodies is refused (exit 2).
 #   --connect-host HOST     the coordinator connects to HOST (with the announced port) instead
 #                           of the announced address; needed when a server binds a wildcard.
 #   --coordinator-launch PREFIX
@@ -43,8 +49,9 @@
 # arguments into one remote shell command line: paths with spaces need quoting for that shell.
 #
 # Exit code: robin-coordinator's (0 converged, 1 error, 2 bad command line, 3 iteration limit,
-# 4 diverged, 5 stagnated), 1 when a server could not be started, 128 + signal when
-# interrupted. Progress goes to standard error, prefixed "remote-servers:".
+# 4 diverged, 5 stagnated), 1 when a server could not be started, 2 for a bad command line of
+# this script (an unknown option, a number of servers other than the case's bodies), 128 +
+# signal when interrupted. Progress goes to standard error, prefixed "remote-servers:".
 set -euo pipefail
 
 script_directory=$(cd "$(dirname "$0")" && pwd)
@@ -54,6 +61,16 @@ log() { echo "remote-servers: $*" >&2; }
 die() {
   log "$*"
   exit 1
+}
+usage_error() {
+  log "$*"
+  exit 2
+}
+
+# The number of [[body]] tables of a case file (0 when it cannot be read here).
+case_body_count() {
+  [ -r "$1" ] || { echo 0; return; }
+  grep -c '^[[:space:]]*\[\[[[:space:]]*body[[:space:]]*\]\]' "$1" || true
 }
 
 default_binary() {  # NAME ENVIRONMENT_VALUE
@@ -79,9 +96,10 @@ grace=5
 server_listen=()   # per server: the endpoint it binds
 server_launch=()   # per server: its prefix (one string)
 server_connect=()  # per server: the host the coordinator connects to ("" = announced)
+server_count=""    # --servers
 
 require_value() {  # OPTION COUNT_OF_REMAINING_ARGUMENTS
-  [ "$2" -ge 2 ] || die "option $1 needs a value"
+  [ "$2" -ge 2 ] || usage_error "option $1 needs a value"
 }
 
 while [ $# -gt 0 ]; do
@@ -92,6 +110,10 @@ while [ $# -gt 0 ]; do
       server_listen+=("$2"); server_launch+=("$launch"); server_connect+=("$connect_host")
       shift 2 ;;
     --connect-host) require_value "$1" $#; connect_host=$2; shift 2 ;;
+    --servers)
+      require_value "$1" $#
+      [[ $2 =~ ^[1-9][0-9]*$ ]] || usage_error "--servers needs a positive number, got '$2'"
+      server_count=$2; shift 2 ;;
     --coordinator-launch) require_value "$1" $#; coordinator_launch=$2; shift 2 ;;
     --subdomain-binary) require_value "$1" $#; subdomain_binary=$2; shift 2 ;;
     --coordinator-binary) require_value "$1" $#; coordinator_binary=$2; shift 2 ;;
@@ -102,17 +124,34 @@ while [ $# -gt 0 ]; do
     --grace) require_value "$1" $#; grace=$2; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "$0" | sed -e '$d' -e 's/^# \{0,1\}//'; exit 0 ;;
     --) shift; break ;;
-    -*) die "unknown option $1 (robin-coordinator options go after CASE; see --help)" ;;
+    -*) usage_error "unknown option $1 (robin-coordinator options go after CASE; see --help)" ;;
     *) break ;;
   esac
 done
-[ $# -ge 1 ] || die "missing CASE (see --help)"
+[ $# -ge 1 ] || usage_error "missing CASE (see --help)"
 coordinator_arguments=("$@")
 
+# One server per body: the case's [[body]] tables, when the case is readable here.
+bodies=$(case_body_count "$1")
+if [ ${#server_listen[@]} -gt 0 ]; then
+  if [ -n "$server_count" ] && [ "$server_count" -ne ${#server_listen[@]} ]; then
+    usage_error "--servers $server_count, but ${#server_listen[@]} servers declared with --listen"
+  fi
+  server_count=${#server_listen[@]}
+elif [ -z "$server_count" ]; then
+  server_count=2
+  [ "$bodies" -lt 2 ] || server_count=$bodies
+fi
+if [ "$bodies" -ge 2 ] && [ "$server_count" -ne "$bodies" ]; then
+  usage_error "the case $1 has $bodies bodies, but $server_count servers were declared: give" \
+    "one --listen per body (body order), or --servers $bodies"
+fi
 if [ ${#server_listen[@]} -eq 0 ]; then
-  server_listen=("tcp://127.0.0.1:*" "tcp://127.0.0.1:*")
-  server_launch=("$launch" "$launch")
-  server_connect=("$connect_host" "$connect_host")
+  for ((index = 0; index < server_count; ++index)); do
+    server_listen+=("tcp://127.0.0.1:*")
+    server_launch+=("$launch")
+    server_connect+=("$connect_host")
+  done
 fi
 
 if [ -z "$log_directory" ]; then
