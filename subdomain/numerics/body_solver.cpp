@@ -26,7 +26,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 /// F = B K^{-1} B' applied through the factor: one solve (two triangular solves) per product.
 class FactorComplianceOperator final : public LinearOperator {
  public:
-  FactorComplianceOperator(const SparseMatrix& trace, const CholeskyFactor& factor)
+  FactorComplianceOperator(const SparseMatrix& trace, const GeneralizedInverse& factor)
       : trace_(trace), trace_transpose_(trace.transpose()), factor_(factor) {}
   int size() const override { return static_cast<int>(trace_.rows()); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
@@ -37,11 +37,12 @@ class FactorComplianceOperator final : public LinearOperator {
  private:
   const SparseMatrix& trace_;
   SparseMatrix trace_transpose_;
-  const CholeskyFactor& factor_;
+  const GeneralizedInverse& factor_;
 };
 
 /// F assembled column block by column block: F(:, J) = B K^{-1} B'(:, J).
-Eigen::MatrixXd assemble_dense_compliance(const SparseMatrix& trace, const CholeskyFactor& factor) {
+Eigen::MatrixXd assemble_dense_compliance(const SparseMatrix& trace,
+                                          const GeneralizedInverse& factor) {
   const Eigen::Index contact_count = trace.rows();
   const SparseMatrix trace_transpose = trace.transpose();
   Eigen::MatrixXd compliance(contact_count, contact_count);
@@ -164,7 +165,8 @@ bool same_factor_options(const BodySolverOptions& left, const BodySolverOptions&
          left.dense_limit == right.dense_limit &&
          left.contact_unknowns_last == right.contact_unknowns_last &&
          left.maximum_dofs == right.maximum_dofs &&
-         left.maximum_factor_bytes == right.maximum_factor_bytes;
+         left.maximum_factor_bytes == right.maximum_factor_bytes &&
+         left.rigid_motions == right.rigid_motions;
 }
 
 }  // namespace
@@ -196,7 +198,7 @@ void BodySolver::assemble() {
   }
   report(SetupStage::assembly);
   dofs_ = std::make_unique<DofMap>(prescribed_dofs(definition_));
-  if (!removes_rigid_motions(mesh, *dofs_)) {
+  if (options_.rigid_motions == RigidMotions::refuse && !removes_rigid_motions(mesh, *dofs_)) {
     throw SingularBodyError(
         "body '" + name() +
         "': the Dirichlet conditions leave a rigid motion free (translation or rotation); "
@@ -219,8 +221,12 @@ void BodySolver::assemble() {
 
   start = std::chrono::steady_clock::now();
   report(SetupStage::ordering);
-  factor_ = std::make_unique<CholeskyFactor>(reduced_stiffness, name(), trailing_unknowns(),
-                                             options_.maximum_factor_bytes, options_.observer);
+  Eigen::MatrixXd kernel = options_.rigid_motions == RigidMotions::refuse
+                               ? Eigen::MatrixXd(dofs_->free_count(), 0)
+                               : rigid_body_modes(mesh, *dofs_);
+  factor_ = std::make_unique<GeneralizedInverse>(reduced_stiffness, std::move(kernel), name(),
+                                                 trailing_unknowns(), options_.maximum_factor_bytes,
+                                                 options_.observer);
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
   // the ordering as the factor measured it; the rest (numerical factorization, K^{-1} f) here
   timings_.ordering_seconds = factor_->ordering_seconds();
@@ -268,6 +274,7 @@ InterfaceDescription BodySolver::contact_boundary() const {
   const Mesh& mesh = definition_.mesh;
   InterfaceDescription interface;
   interface.dof_count = dofs_->free_count();
+  interface.rigid_modes = rigid_mode_count();
   interface.node_ids = contact_nodes();
   const Eigen::VectorXd& weights = boundary_weights_;
   for (int node : interface.node_ids) {
@@ -336,9 +343,11 @@ void BodySolver::assign_contact(const ContactOperator& contact) {
     trace_.resize(row_count, dofs_->free_count());
     trace_.setFromTriplets(triplets.begin(), triplets.end());
   }
+  rigid_trace_ = trace_ * rigid_modes();  // B R
   update_free_trace();
   if (!keep_compliance) build_interface_operator();
   reset_warm_start();
+  check_held_by_contact();
   timings_.interface_seconds = seconds_since(start);
 }
 
@@ -411,6 +420,8 @@ void BodySolver::build_interface_operator() {
 
 void BodySolver::reset_warm_start() {
   warm_start_ = Eigen::VectorXd::Zero(contact_size());
+  warm_multiplier_ = Eigen::VectorXd::Zero(rigid_mode_count());
+  rigid_amplitudes_ = Eigen::VectorXd::Zero(rigid_mode_count());
 }
 
 void BodySolver::set_load_factor(double factor) {
@@ -429,6 +440,7 @@ ContactSolveResult BodySolver::solve_contact(const Eigen::VectorXd& obstacle,
     throw InputError("body '" + name() + "': obstacle has " + std::to_string(obstacle.size()) +
                      " values for " + std::to_string(contact_size()) + " contact nodes");
   }
+  if (rigid_mode_count() > 0) return solve_floating_contact(obstacle, parameters);
   // Dual problem: minimise 1/2 l'F l - l'(e - g), l >= 0. Its gradient F l - (e - g) equals
   // g - u_N, so u_N = g - gradient and the KKT conditions are the Signorini conditions.
   const Eigen::VectorXd right_hand_side = free_trace_ - obstacle;
@@ -465,11 +477,22 @@ Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_fo
                      std::to_string(contact_size()) + " contact nodes");
   }
   Eigen::VectorXd trace;
+  if (rigid_mode_count() > 0) {
+    // w_N = B K^dagger B' r = B P K^+ P B' r, P = I - R R'
+    return trace_ * factor_->solve_minimum_norm(apply_transpose_trace(interface_force));
+  }
   compliance_->apply(interface_force, trace);  // w_N = B K^{-1} B' r
   return trace;
 }
 
 Eigen::VectorXd BodySolver::solve_neumann(const Eigen::VectorXd& contact_force) const {
+  if (rigid_mode_count() > 0) {
+    throw SingularBodyError("body '" + name() + "' is a floating body (" +
+                            std::to_string(rigid_mode_count()) +
+                            " rigid motions free): its Neumann solve K u = f - B' lambda has no "
+                            "solution for a contact force that does not balance its loads; it "
+                            "must solve the contact problem instead");
+  }
   return free_trace_ - solve_correction(contact_force);  // e - F lambda
 }
 
@@ -478,10 +501,23 @@ Eigen::VectorXd BodySolver::apply_transpose_trace(const Eigen::VectorXd& contact
 }
 
 Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force) const {
-  // u_f = K^{-1} (t f - B' lambda), u_p = t u_p1 (t the load factor)
+  return displacement(contact_force, rigid_amplitudes_);
+}
+
+Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force,
+                                         const Eigen::VectorXd& rigid_amplitudes) const {
+  // u_f = K^{-1} (t f - B' lambda) (+ R alpha with K^+), u_p = t u_p1 (t the load factor)
   Eigen::VectorXd free_values = load_factor_ * free_solution_;
   if (contact_force.size() > 0 && contact_force.lpNorm<Eigen::Infinity>() > 0) {
     free_values -= factor_->solve(apply_transpose_trace(contact_force));
+  }
+  if (rigid_mode_count() > 0) {
+    if (rigid_amplitudes.size() != rigid_mode_count()) {
+      throw InputError("body '" + name() + "': " + std::to_string(rigid_amplitudes.size()) +
+                       " rigid amplitudes for " + std::to_string(rigid_mode_count()) +
+                       " rigid motions");
+    }
+    free_values += rigid_modes() * rigid_amplitudes;
   }
   Eigen::VectorXd full = dofs_->expand(free_values);  // prescribed values at factor 1
   if (load_factor_ != 1.0) full += (load_factor_ - 1.0) * dofs_->prescribed_values();

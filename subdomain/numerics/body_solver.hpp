@@ -14,6 +14,27 @@
 // in its dual form  minimise 1/2 lambda'F lambda - lambda'(e - g), lambda >= 0, by MPRGP.
 // Correction problem (paper (11)-(12)): K w = B' r, returns w_N = B w = F r.
 //
+// Floating bodies (BodySolverOptions::rigid_motions = held_by_contact; docs/method.md, "Floating
+// bodies"). When the Dirichlet conditions leave rigid motions free, K has the kernel R (free x k,
+// orthonormal, dof_map.hpp) and K^+ is the generalized inverse of generalized_inverse.hpp. Then
+//   e = B K^+ f + B u_p,  F = B K^+ B',  G = (B R)' (k x n_c),  h = R'f,
+// and u = K^+ (f - B' lambda) + R alpha solves K u = f - B' lambda iff G lambda = h. The local
+// contact problem's dual gains that equality:
+//   minimise 1/2 lambda'F lambda - lambda'(e - g)  s.t.  lambda >= 0,  G lambda = h,
+// solved by SMALBE-M (smalbe.hpp) with multiplier mu; alpha = -mu, and
+//   u_N = e - F lambda + G' alpha = g - (F lambda - (e - g) + G'mu),
+// g minus the gradient of the Lagrangian, as without rigid motions. Refused (SingularBodyError
+// naming the body): B R rank-deficient, at assign_contact (a free sliding direction: a rigid motion
+// that moves no contact row, which contact cannot hold), and an equality without a solution
+// lambda >= 0 (nonnegative_least_squares.hpp), at assign_contact and every contact solve (the loads
+// push the body away from every contact). The correction solve of a floating body returns
+//   w_N = B K^dagger B' r,  K^dagger = P K^+ P,  P = I - R R'
+// (the Moore-Penrose inverse): K w = B'r is solvable only when G r = 0, and then w is its solution
+// orthogonal to R; otherwise the unbalanced rigid part R R'B'r of the load is removed first. The
+// coupling uses the correction of a floating body only where it is well defined
+// (coupling_scheme.hpp). Its Neumann solve, K u = f - B'lambda for a given lambda, is defined
+// only for balanced lambda, which a Neumann body does not get: solve_neumann refuses it.
+//
 // Load factor t (quasi-static load steps): every load of the body (body force, tractions,
 // pressures) and every prescribed displacement is multiplied by t, so f(t) = t f, u_p(t) = t u_p
 // and e(t) = t e, by linearity; K, its factor and F do not depend on t and are kept.
@@ -28,6 +49,7 @@
 #include "numerics/contact_operator.hpp"
 #include "numerics/dof_map.hpp"
 #include "numerics/elasticity.hpp"
+#include "numerics/generalized_inverse.hpp"
 #include "numerics/interface_description.hpp"
 #include "numerics/linear_operator.hpp"
 #include "numerics/mprgp.hpp"
@@ -41,7 +63,14 @@ enum class InterfaceOperatorKind {
   factor,     // F applied through the factor: one solve (two triangular solves) per product
 };
 
+/// What a body whose Dirichlet conditions leave a rigid motion free is.
+enum class RigidMotions {
+  refuse,           // an error at setup (SingularBodyError): a forgotten support
+  held_by_contact,  // a floating body, held by its contact rows (see the file comment)
+};
+
 struct BodySolverOptions {
+  RigidMotions rigid_motions = RigidMotions::refuse;
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
   int dense_limit = 3000;
   /// Eliminate the free dofs of the contact boundaries last in the Cholesky factor (when there
@@ -89,7 +118,8 @@ struct BodyTimings {
 class BodySolver {
  public:
   /// Assembles and factorizes. Throws InputError for an unknown boundary name and
-  /// SingularBodyError when the Dirichlet conditions leave a rigid motion free.
+  /// SingularBodyError when the Dirichlet conditions leave a rigid motion free and
+  /// options.rigid_motions is refuse.
   explicit BodySolver(BodyDefinition definition, BodySolverOptions options = {});
   ~BodySolver();
   BodySolver(const BodySolver&) = delete;
@@ -103,6 +133,16 @@ class BodySolver {
   const BodyTimings& timings() const { return timings_; }
   long factor_nonzeros() const { return factor_->factor_nonzeros(); }
   long solve_count() const { return factor_->solve_count(); }
+  /// k, the number of rigid motions the Dirichlet conditions leave free (0: K is SPD).
+  int rigid_mode_count() const { return factor_->rigid_mode_count(); }
+  /// R (free x k, orthonormal columns).
+  const Eigen::MatrixXd& rigid_modes() const { return factor_->kernel(); }
+  /// G' = B R (n_c x k), valid after assign_contact.
+  const Eigen::MatrixXd& rigid_trace() const { return rigid_trace_; }
+  /// h = R'f at the current load factor (k values).
+  Eigen::VectorXd rigid_load() const;
+  /// alpha of the last contact solve (k values; zero before the first).
+  const Eigen::VectorXd& rigid_amplitudes() const { return rigid_amplitudes_; }
 
   /// The nodes of the contact boundaries with geometric normals and weights, and per contact
   /// boundary its segments and its own nodes (numerics/interface_description.hpp).
@@ -125,7 +165,8 @@ class BodySolver {
   /// Sets the contact constraint operator B and builds e and F (F is kept when B equals the
   /// assigned one, e.g. a later run of the same body). Resets the warm start.
   /// Throws InputError (check_contact_operator) when B is malformed or uses a node that is not
-  /// on a contact boundary.
+  /// on a contact boundary; for a floating body SingularBodyError when B R is rank-deficient or
+  /// G lambda = h has no solution lambda >= 0 (the file comment).
   void assign_contact(const ContactOperator& contact);
   /// The number of constraints (rows of B).
   int contact_size() const { return contact_.row_count(); }
@@ -152,15 +193,21 @@ class BodySolver {
   /// The largest magnitude set_load_factor accepts.
   static constexpr double maximum_load_factor = 1e6;
 
-  /// Paper step 2: w_N = B K^{-1} B' r for an interface force vector r (force).
+  /// Paper step 2: w_N = B K^{-1} B' r for an interface force vector r (force); for a floating
+  /// body w_N = B K^dagger B' r (the file comment).
   Eigen::VectorXd solve_correction(const Eigen::VectorXd& interface_force) const;
   /// The Neumann solve of the Dirichlet-Neumann iteration: u_N = B K^{-1} (f - B' lambda)
   /// = e - F lambda for a nodal contact force lambda (compression positive). Same cost as a
-  /// correction solve (one product with F).
+  /// correction solve (one product with F). Throws SingularBodyError for a floating body.
   Eigen::VectorXd solve_neumann(const Eigen::VectorXd& contact_force) const;
 
-  /// Full displacement (2 per node, prescribed values included) under contact forces lambda.
+  /// Full displacement (2 per node, prescribed values included) under contact forces lambda:
+  /// u_f = K^+ (t f - B' lambda) + R alpha, alpha the rigid amplitudes of the last contact solve
+  /// (none without rigid motions).
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force) const;
+  /// The same with given rigid amplitudes alpha (k values), e.g. the monolithic reference's.
+  Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force,
+                               const Eigen::VectorXd& rigid_amplitudes) const;
   /// Reaction forces K u - f at prescribed dofs (zero at free dofs), full size.
   Eigen::VectorXd reactions(const Eigen::VectorXd& displacement) const;
   /// Total applied external force (body force + tractions), (F_x, F_y).
@@ -182,6 +229,11 @@ class BodySolver {
   /// Free dofs of the contact boundaries' nodes, to be eliminated last (empty when disabled).
   std::vector<int> trailing_unknowns() const;
   Eigen::VectorXd apply_transpose_trace(const Eigen::VectorXd& contact_force) const;  // B' lambda
+  /// Floating bodies: B R of full column rank and G lambda = h solvable with lambda >= 0.
+  void check_held_by_contact() const;
+  /// The local contact problem of a floating body (SMALBE).
+  ContactSolveResult solve_floating_contact(const Eigen::VectorXd& obstacle,
+                                            const MprgpParameters& parameters);
 
   BodyDefinition definition_;
   BodySolverOptions options_;
@@ -190,8 +242,8 @@ class BodySolver {
   SparseMatrix full_stiffness_;
   Eigen::VectorXd full_load_;
   Eigen::VectorXd reduced_load_;
-  std::unique_ptr<CholeskyFactor> factor_;
-  Eigen::VectorXd free_solution_;  // K^{-1} f (free dofs) at load factor 1
+  std::unique_ptr<GeneralizedInverse> factor_;  // K^{-1}, or K^+ for a floating body
+  Eigen::VectorXd free_solution_;               // K^{-1} f (free dofs) at load factor 1
 
   ContactOperator contact_;
   Eigen::VectorXd boundary_weights_;
@@ -201,7 +253,10 @@ class BodySolver {
   std::unique_ptr<LinearOperator> compliance_;
   Eigen::VectorXd warm_start_;
   double load_factor_ = 1.0;
-  Eigen::VectorXd unit_free_trace_;  // e at load factor 1
+  Eigen::VectorXd unit_free_trace_;   // e at load factor 1
+  Eigen::MatrixXd rigid_trace_;       // B R (n_c x k)
+  Eigen::VectorXd rigid_amplitudes_;  // alpha of the last contact solve
+  Eigen::VectorXd warm_multiplier_;   // mu of the last contact solve (SMALBE warm start)
 };
 
 }  // namespace robin

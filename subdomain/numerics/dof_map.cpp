@@ -1,7 +1,9 @@
 #include "numerics/dof_map.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <stdexcept>
+#include <utility>
 
 namespace robin {
 
@@ -70,32 +72,80 @@ Eigen::VectorXd DofMap::restrict(const Eigen::VectorXd& full) const {
   return free_values;
 }
 
-bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs) {
-  if (dofs.total_count() != static_cast<int>(2 * mesh.node_count())) {
-    throw std::invalid_argument("removes_rigid_motions: dof count is not 2 x nodes");
-  }
-  if (mesh.node_count() == 0) return false;
-  // Centred, scaled coordinates make the test independent of position and size.
+namespace {
+
+/// The mesh's centre and the largest distance of a node from it (1 for a single point).
+std::pair<Eigen::Vector2d, double> centre_and_scale(const Mesh& mesh) {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const Eigen::Vector2d& node : mesh.nodes) centre += node;
   centre /= static_cast<double>(mesh.node_count());
   double scale = 0.0;
   for (const Eigen::Vector2d& node : mesh.nodes) scale = std::max(scale, (node - centre).norm());
   if (scale == 0.0) scale = 1.0;
-  // Gram matrix G = R^T R of the rigid modes (1, 0), (0, 1), (-(y - yc), x - xc) / scale,
-  // restricted to the prescribed dofs (rows of R).
+  return {centre, scale};
+}
+
+/// Row `dof` of the rigid modes (1, 0), (0, 1), (-(y - yc), x - xc) / scale.
+Eigen::Vector3d rigid_mode_row(const Mesh& mesh, int dof, const Eigen::Vector2d& centre,
+                               double scale) {
+  const Eigen::Vector2d relative = (mesh.nodes[dof / 2] - centre) / scale;
+  return dof % 2 == 0 ? Eigen::Vector3d(1.0, 0.0, -relative.y())
+                      : Eigen::Vector3d(0.0, 1.0, relative.x());
+}
+
+/// Eigen decomposition of the Gram matrix Q_p'Q_p of the rigid modes on the prescribed dofs
+/// (eigenvalues ascending).
+Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> prescribed_gram(const Mesh& mesh,
+                                                               const DofMap& dofs) {
+  if (dofs.total_count() != static_cast<int>(2 * mesh.node_count())) {
+    throw std::invalid_argument("rigid motions: dof count is not 2 x nodes");
+  }
+  const auto [centre, scale] = centre_and_scale(mesh);
   Eigen::Matrix3d gram = Eigen::Matrix3d::Zero();
   for (int dof = 0; dof < dofs.total_count(); ++dof) {
     if (!dofs.is_prescribed(dof)) continue;
-    const Eigen::Vector2d relative = (mesh.nodes[dof / 2] - centre) / scale;
-    const Eigen::Vector3d row = dof % 2 == 0 ? Eigen::Vector3d(1.0, 0.0, -relative.y())
-                                             : Eigen::Vector3d(0.0, 1.0, relative.x());
+    const Eigen::Vector3d row = rigid_mode_row(mesh, dof, centre, scale);
     gram += row * row.transpose();
   }
-  const Eigen::Vector3d eigenvalues =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(gram, Eigen::EigenvaluesOnly).eigenvalues();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(gram);
+}
+
+/// Whether eigenvalue `index` of the Gram matrix is zero relative to the largest.
+bool is_free_motion(const Eigen::Vector3d& eigenvalues, int index) {
+  return !(eigenvalues(2) > 0.0 && eigenvalues(index) > 1e-10 * eigenvalues(2));
+}
+
+}  // namespace
+
+bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs) {
+  if (dofs.total_count() != static_cast<int>(2 * mesh.node_count())) {
+    throw std::invalid_argument("removes_rigid_motions: dof count is not 2 x nodes");
+  }
+  if (mesh.node_count() == 0) return false;
   // Rank 3 when the smallest eigenvalue is not negligible relative to the largest.
-  return eigenvalues(2) > 0.0 && eigenvalues(0) > 1e-10 * eigenvalues(2);
+  return !is_free_motion(prescribed_gram(mesh, dofs).eigenvalues(), 0);
+}
+
+Eigen::MatrixXd rigid_body_modes(const Mesh& mesh, const DofMap& dofs) {
+  if (mesh.node_count() == 0) return Eigen::MatrixXd(dofs.free_count(), 0);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> gram = prescribed_gram(mesh, dofs);
+  std::vector<int> free_motions;
+  for (int index = 0; index < 3; ++index) {
+    if (is_free_motion(gram.eigenvalues(), index)) free_motions.push_back(index);
+  }
+  const int count = static_cast<int>(free_motions.size());
+  Eigen::MatrixXd coefficients(3, count);  // c: the null space of Q_p
+  for (int k = 0; k < count; ++k) coefficients.col(k) = gram.eigenvectors().col(free_motions[k]);
+  const auto [centre, scale] = centre_and_scale(mesh);
+  Eigen::MatrixXd modes(dofs.free_count(), count);  // Q_f c
+  for (int dof = 0; dof < dofs.total_count(); ++dof) {
+    if (dofs.is_prescribed(dof)) continue;
+    modes.row(dofs.free_index(dof)) =
+        rigid_mode_row(mesh, dof, centre, scale).transpose() * coefficients;
+  }
+  // Orthonormal columns: the thin Q of a Householder QR.
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(modes);
+  return qr.householderQ() * Eigen::MatrixXd::Identity(dofs.free_count(), count);
 }
 
 }  // namespace robin

@@ -43,4 +43,14 @@ class DofMap {
 /// rotation) of the mesh: the 3 rigid modes restricted to the prescribed dofs have rank 3.
 bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs);
 
+/// The rigid motions the prescribed dofs leave free, on the free dofs: R (free x k, k <= 3) with
+/// orthonormal columns spanning { r = Q c : (Q c)_p = 0 on every prescribed dof p }, Q the rigid
+/// modes (1, 0), (0, 1), (-(y - yc), x - xc) / s of the mesh (centred and scaled, so the test
+/// does not depend on position and size). c runs over the null space of Q_p'Q_p (3 x 3; its
+/// eigenvalues below 1e-10 times the largest, the test of removes_rigid_motions, count as zero),
+/// so k = 3 - rank(Q_p) and k = 0 exactly when removes_rigid_motions() holds. Since K Q = 0 on
+/// the whole mesh and R vanishes on the prescribed dofs, K_ff R = 0: R spans the kernel of the
+/// reduced stiffness (a connected mesh has no other).
+Eigen::MatrixXd rigid_body_modes(const Mesh& mesh, const DofMap& dofs);
+
 }  // namespace robin

@@ -48,6 +48,10 @@ struct InterfaceDescription {
   /// One per contact boundary, in the order of BodyDefinition::contact_boundaries.
   std::vector<ContactSurfaceDescription> surfaces;
   int dof_count = 0;  // free degrees of freedom of the body
+  /// k: the rigid motions the body's Dirichlet conditions leave free (0..3; 0 unless the body
+  /// is a floating body held by contact, body_solver.hpp). The coupling needs it: a floating
+  /// body's Neumann response is not defined (coupling_scheme.hpp).
+  int rigid_modes = 0;
 };
 
 /// The description of the nodes of the contact boundary `boundary` alone, as a body with only

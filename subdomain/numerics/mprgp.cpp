@@ -193,6 +193,10 @@ void MprgpIteration::run(const Eigen::VectorXd& initial, double expansion_step) 
 /// threshold = max(relative_tolerance * scale, absolute_tolerance) with scale = ||b||, or, for
 /// a solution-scaled tolerance, ||A|| ||x - l|| over the finite bounds (||b|| while that is 0).
 void MprgpIteration::update_threshold() {
+  if (parameters_.iterate_threshold) {
+    threshold_ = std::max(parameters_.iterate_threshold(x_), parameters_.absolute_tolerance);
+    return;
+  }
   double scale = right_hand_side_.norm();
   if (parameters_.solution_scaled_tolerance) {
     double distance_squared = 0.0;

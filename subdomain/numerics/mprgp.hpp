@@ -16,6 +16,7 @@
 // relative to ||A|| ||x - l|| (MprgpParameters::solution_scaled_tolerance).
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 
 #include "numerics/linear_operator.hpp"
@@ -39,6 +40,10 @@ struct MprgpParameters {
   double step_factor = 1.9;
   /// ||A|| estimate; computed with power iterations when <= 0.
   double operator_norm = 0.0;
+  /// When set, the stopping threshold at the iterate x is max(iterate_threshold(x),
+  /// absolute_tolerance) instead of the relative tolerance's: the inner solves of SMALBE
+  /// (smalbe.hpp) stop at min(M ||C x - d||, eta). Empty (the default): the relative tolerance.
+  std::function<double(const Eigen::VectorXd&)> iterate_threshold;
 };
 
 enum class QpStatus { converged, not_converged, breakdown };
