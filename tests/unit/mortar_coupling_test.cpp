@@ -2,11 +2,13 @@
 // form: matching meshes give the node-to-node rows; on non-matching meshes the mortar
 // coefficients of a fully covered row sum to one (the mortar side's partition of unity), the
 // weights add up to the boundary's length, and the normalized weighted gap of a linear gap field
-// is its nodal value (biorthogonality of the dual basis); boundaries that do not face each other
-// are errors naming both bodies.
+// is its nodal value (biorthogonality of the dual basis); a zone that ends inside a non-mortar
+// segment gives rows equal to hand-computed integrals (dual and standard basis); boundaries that do
+// not face each other are errors naming both bodies.
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <numeric>
 
 #include "coupling/mortar_coupling.hpp"
@@ -157,6 +159,73 @@ TEST(MortarCoupling, NodesBeyondTheOtherBodyCarryNoConstraint) {
   }
   // A partly covered end node gets a positively weighted average: half its support.
   EXPECT_NEAR(pairing.pairs.front().weight, 0.05, 1e-12);
+}
+
+// The upper body's edge ends at x = 0.6, strictly inside the non-mortar segment [0.5, 0.75].
+// Non-mortar side: the lower edge y = 0 on [0, 1], nodes x_k = k h (h = 1/4, ids 0..4), hats
+// phi_k. Mortar side: y = 0.1 + 0.1 x on [0, 0.6], nodes X_l = l/5 (ids 1000..1003), hats
+// phi^_l(x) (the projection along the lower normal (0, 1) is vertical, so the mortar point of x
+// has the abscissa x). Normal gap g(x) = 0.1 + 0.1 x. Every integral below is over the part of
+// the lower edge the upper one covers, [0, 0.6], computed by hand (exact fractions: the
+// integrands are piecewise polynomials of degree <= 2 with breaks at the nodes of both sides).
+//  - x = 0 and x = 0.25: supports covered entirely, dual basis psi_j = 2 phi_j - phi_k on each
+//    segment (k its other node). Row j: u_y(x_j) - sum_l (M_jl / m_j) u^_y(X_l) <= G_j / m_j
+//    with m_j = int psi_j phi_j = int phi_j (1/8, 1/4), M_jl = int psi_j phi^_l,
+//    G_j = int psi_j g = g(x_j) m_j (biorthogonality, g linear):
+//      M_0 = (3/25, 1/100, -1/200, 0),  M_1 = (-1/50, 17/80, 29/400, -3/200).
+//  - x = 0.5 and x = 0.75: supports covered in part, standard basis. Row j:
+//    sum_k (D_jk / m_j) u_y(x_k) - sum_l (M_jl / m_j) u^_y(X_l) <= G_j / m_j with
+//    D_jk = int phi_j phi_k, M_jl = int phi_j phi^_l, G_j = int phi_j g, m_j = int phi_j:
+//      x = 0.5:  m = 41/200, D = (1/24, 223/1500, 11/750) at x = 0.25, 0.5, 0.75,
+//                M = (0, 9/800, 91/800, 2/25), G / m = 1203/8200;
+//      x = 0.75: m = 1/50, D = (11/750, 2/375) at x = 0.5, 0.75, M = (0, 0, 1/300, 1/60),
+//                G / m = 47/300 (the mean of g weighted by phi_3 over [0.5, 0.6]).
+//  - x = 1: not covered, no row.
+TEST(MortarCoupling, ZoneEndingInsideASegmentGivesTheExactRows) {
+  const InterfaceDescription lower = lower_edge(0.0, 1.0, 4);
+  const InterfaceDescription upper = upper_edge(0.0, 0.1, 0.6, 0.16, 3);
+  MortarOptions options;
+  options.non_mortar_body = 0;
+  const ContactPairing pairing =
+      build_mortar_coupling(lower, "lower", upper, "upper", nullptr, options);
+  ASSERT_EQ(pairing.size(), 4u);
+  EXPECT_EQ(pairing.uncovered, 1);
+  struct ExpectedRow {
+    double weight, gap;
+    std::map<int, double> own, other;  // by node id: the u_y coefficients
+  };
+  const std::map<int, ExpectedRow> expected = {
+      {0, {1.0 / 8, 0.1, {{0, 1.0}}, {{1000, -0.96}, {1001, -0.08}, {1002, 0.04}}}},
+      {1, {1.0 / 4, 0.125, {{1, 1.0}}, {{1000, 0.08}, {1001, -0.85}, {1002, -0.29}, {1003, 0.06}}}},
+      {2,
+       {41.0 / 200,
+        1203.0 / 8200,
+        {{1, 25.0 / 123}, {2, 446.0 / 615}, {3, 44.0 / 615}},
+        {{1001, -9.0 / 164}, {1002, -91.0 / 164}, {1003, -16.0 / 41}}}},
+      {3,
+       {1.0 / 50,
+        47.0 / 300,
+        {{2, 11.0 / 15}, {3, 4.0 / 15}},
+        {{1002, -1.0 / 6}, {1003, -5.0 / 6}}}}};
+  for (int row = 0; row < 4; ++row) {
+    const ContactPair& pair = pairing.pairs[static_cast<std::size_t>(row)];
+    const int node = static_cast<int>(std::lround(pair.position.x() * 4));
+    SCOPED_TRACE("row of the node at x = " + std::to_string(pair.position.x()));
+    ASSERT_EQ(expected.count(node), 1u);
+    const ExpectedRow& want = expected.at(node);
+    EXPECT_NEAR(pair.weight, want.weight, 1e-14);
+    EXPECT_NEAR(pair.gap, want.gap, 1e-13);
+    for (const auto& [operator_index, coefficients] :
+         {std::pair{0, want.own}, std::pair{1, want.other}}) {
+      const auto entries =
+          row_entries(pairing.operators[static_cast<std::size_t>(operator_index)], row);
+      EXPECT_EQ(entries.size(), coefficients.size());
+      for (const auto& [id, value] : coefficients) {
+        ASSERT_EQ(entries.count({id, 1}), 1u) << "node id " << id;
+        EXPECT_NEAR(entries.at({id, 1}), value, 1e-13) << "node id " << id;
+      }
+    }
+  }
 }
 
 TEST(MortarCoupling, ANonMortarNodeWithPrescribedNormalDisplacementIsExcluded) {
