@@ -134,3 +134,56 @@ def plane_strain_elasticity(young, poisson):
     factor = young / ((1.0 + poisson) * (1.0 - 2.0 * poisson))
     return factor * np.array([[1.0 - poisson, poisson, 0.0], [poisson, 1.0 - poisson, 0.0],
                               [0.0, 0.0, 0.5 - poisson]])
+
+
+def hostile_geo_scripts(witness):
+    """The Gmsh script attacks of issue 11 (tests/hostile_geo_scripts.hpp holds the same list),
+    as (label, .geo text to append to a valid script) pairs. Each is live under Gmsh 4: the
+    command ones run `touch witness`, ListFromFile prints the lines of /etc/passwd and
+    CurrentDirectory the script's directory. Five bypassed the keyword filter of the 1.x
+    servers: a backslash in a double-quoted string, single-quoted 'a"', '/*' and '//', a NUL in
+    a // comment."""
+    touch = 'SystemCall "touch %s";' % witness
+    return [
+        ("SystemCall", "\n%s\n" % touch),
+        ("ExternalProcess", '\nField[1] = ExternalProcess;\nField[1].CommandLine = "touch %s";'
+                            '\nBackground Field = 1;\n' % witness),
+        ("backslash in a double-quoted string", '\ns = "a\\"; %s // "\n' % touch),
+        ("single-quoted 'a\"'", "\nx = 'a\"';\n%s\n// \"\n" % touch),
+        ("single-quoted '/*'", "\nx = '/*';\n%s\nx = '*/';\n" % touch),
+        ("single-quoted '//'", "\nx = '//'; %s\n" % touch),
+        ("NUL in a // comment", "\n// comment\0 %s\n" % touch),
+        ("ListFromFile /etc/passwd",
+         '\nx[] = ListFromFile("/etc/passwd");\nError("leak %g", x[0]);\n'),
+        ("CurrentDirectory", '\nError(StrCat("cwd ", CurrentDirectory));\n'),
+    ]
+
+
+def _varint(value):
+    data = bytearray()
+    while value >= 0x80:
+        data.append((value & 0x7F) | 0x80)
+        value >>= 7
+    data.append(value)
+    return bytes(data)
+
+
+def _length_delimited(number, payload):
+    return _varint(number << 3 | 2) + _varint(len(payload)) + payload
+
+
+def with_1x_script(envelope_bytes, script):
+    """`envelope_bytes` (a SetupBody request) followed by, written by hand, the 1.x fields 2
+    (mesh_content) = `script` and 3 (mesh_extension) = ".geo" of Envelope.setup_body (field 12;
+    protobuf merges the two occurrences), as a 1.x coordinator sent a .geo body."""
+    return envelope_bytes + _length_delimited(
+        12, _length_delimited(2, script.encode()) + _length_delimited(3, b".geo"))
+
+
+def passwd_lines():
+    """The non-empty lines of /etc/passwd (none when it cannot be read)."""
+    try:
+        with open("/etc/passwd", encoding="utf-8", errors="replace") as stream:
+            return [line.rstrip("\n") for line in stream if line.strip()]
+    except OSError:
+        return []

@@ -4,7 +4,7 @@ server speaks plain ZeroMQ only and points to docs/security.md, before anything 
 --data-directory and --output-root must name existing directories (else exit status 2); a server
 started with them reads SetupBody.mesh_path only under the data directory and writes
 FieldsRequest.write_directory only under the output root, answers after refusals and exits 0
-after Shutdown.
+after Shutdown. The Gmsh script attacks of issue 11, in a 1.x SetupBody, run and read nothing.
 """
 
 import os
@@ -109,12 +109,13 @@ class Directories(unittest.TestCase):
         socket.setsockopt(zmq.RCVTIMEO, 30000)
         socket.connect(line.split()[-1])
 
-        def ask(**content):
+        def ask(raw=None, **content):
+            """The reply to `raw` (bytes, when given) or to an Envelope with `content`."""
             envelope = protocol.Envelope(request_id=3)
             envelope.version.major = 2
             for name, message in content.items():
                 getattr(envelope, name).CopyFrom(message)
-            socket.send(envelope.SerializeToString())
+            socket.send(raw if raw is not None else envelope.SerializeToString())
             reply = protocol.Envelope()
             reply.ParseFromString(socket.recv())
             return reply
@@ -147,6 +148,41 @@ class Directories(unittest.TestCase):
         self.assertTrue(os.path.isfile(written))
         self.assertEqual(sorted(os.listdir(self.scratch)), ["data", "output", "outside.msh"])
         self.assertEqual(ask(shutdown=protocol.Shutdown()).acknowledge.state, "ready")
+        self.assertEqual(process.wait(timeout=30), 0)
+
+    def test_version_1_geo_scripts_are_never_run(self):
+        """Each attack of support.hostile_geo_scripts in the removed 1.x SetupBody.mesh_content,
+        without and then with a MeshData: BAD_INPUT, then a body set up from the MeshData; the
+        witness never appears, no reply shows a line of /etc/passwd or the server's working
+        directory (this process's), and the server answers Hello after each request."""
+        process, ask = self.start_server()
+        witness = self.scratch / "witness"
+        script_start = (support.REPOSITORY / "examples" / "meshes" / "block_lower.geo").read_text()
+        mesh = support.mesh_data_from_msh(protocol, "case_lower.msh")
+        for label, text in support.hostile_geo_scripts(witness):
+            with self.subTest(label):
+                for body, content in ((self.setup_body(""), "error"),
+                                      (self.setup_body(""), "interface")):
+                    if content == "interface":
+                        body.mesh.CopyFrom(mesh)
+                    envelope = protocol.Envelope(request_id=4, setup_body=body)
+                    envelope.version.major = 2
+                    reply = ask(raw=support.with_1x_script(envelope.SerializeToString(),
+                                                           script_start + text))
+                    self.assertEqual(reply.WhichOneof("content"), content, reply)
+                    if content == "error":
+                        self.assertEqual(reply.error.code, protocol.BAD_INPUT)
+                        self.assertIn("SetupBody.mesh and SetupBody.mesh_path are both empty",
+                                      reply.error.message)
+                    reply_bytes = reply.SerializeToString()
+                    for line in support.passwd_lines():
+                        self.assertNotIn(line.encode(), reply_bytes)
+                    self.assertNotIn(os.getcwd().encode(), reply_bytes)
+                    self.assertIn(ask(hello=protocol.Hello()).hello_reply.state,
+                                  ("awaiting_setup", "awaiting_assignment"))
+                self.assertFalse(witness.exists(), "the script ran")
+        self.assertEqual(ask(shutdown=protocol.Shutdown()).acknowledge.state,
+                         "awaiting_assignment")
         self.assertEqual(process.wait(timeout=30), 0)
 
     @staticmethod

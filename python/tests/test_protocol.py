@@ -538,6 +538,56 @@ class BadBodies(ServerTestCase):
         self.inverted(clockwise, "cell tag 1 (triangle3)")
 
 
+class Version1GeoScripts(ServerTestCase):
+    """A 1.x SetupBody with a .geo script in the removed mesh_content (field 2, mesh_extension
+    ".geo" in field 3, hand-encoded as a 1.x coordinator sent them) holding each attack of
+    support.hostile_geo_scripts: SystemCall, an ExternalProcess mesh size field, the five
+    keyword-filter bypasses, ListFromFile("/etc/passwd") and CurrentDirectory. The server runs
+    no script and reads no mesh: without MeshData the body is BAD_INPUT, with MeshData the script
+    is ignored; the witness never appears, no reply shows a line of /etc/passwd or the working
+    directory, and the server answers Hello after each."""
+
+    def setUp(self):
+        super().setUp()
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-py-geo-"))
+        self.addCleanup(shutil.rmtree, self.scratch)
+
+    def expect_nothing_read(self, reply_bytes):
+        for line in support.passwd_lines():
+            self.assertNotIn(line.encode(), reply_bytes)
+        self.assertNotIn(os.getcwd().encode(), reply_bytes)
+
+    def test_scripts_are_never_run(self):
+        witness = self.scratch / "witness"
+        script_start = LOWER_GEO_PATH.read_text()
+        with mock.patch.object(setup_decoding.mesh_reader, "read_mesh") as reader:
+            for label, text in support.hostile_geo_scripts(witness):
+                with self.subTest(label):
+                    script = script_start + text
+                    data = support.with_1x_script(request(setup_body=setup_body(mesh=None)),
+                                                  script)
+                    self.assertIn(text.encode(), data)
+                    reply_bytes = self.server.handle(data)
+                    self.expect_nothing_read(reply_bytes)
+                    reply = protocol.Envelope.FromString(reply_bytes)
+                    self.assertEqual(protocol.ErrorCode.Name(reply.error.code), "BAD_INPUT")
+                    self.assertIn("body 'lower': SetupBody.mesh and SetupBody.mesh_path are "
+                                  "both empty", reply.error.message)
+                    self.assertEqual(self.ask(request(hello=protocol.Hello())).hello_reply.state,
+                                     "awaiting_setup")
+
+                    data = support.with_1x_script(request(setup_body=setup_body()), script)
+                    reply_bytes = self.server.handle(data)
+                    self.expect_nothing_read(reply_bytes)
+                    reply = protocol.Envelope.FromString(reply_bytes)
+                    self.assertEqual(reply.WhichOneof("content"), "interface", reply)
+                    self.assertEqual(self.ask(request(hello=protocol.Hello())).hello_reply.state,
+                                     "awaiting_assignment")
+                    self.assertFalse(witness.exists(), "the script ran")
+                    self.ask(request(end_run=protocol.EndRun()))
+            reader.assert_not_called()
+
+
 class MeshPath(ServerTestCase):
     """SetupBody.mesh_path: only files under the data directory, and nothing else is read."""
 

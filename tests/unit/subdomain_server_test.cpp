@@ -33,6 +33,7 @@
 #include <set>
 #include <sstream>
 
+#include "../hostile_geo_scripts.hpp"
 #include "../test_files.hpp"
 #include "mesh_codec.hpp"
 #include "numerics/body_output.hpp"
@@ -831,20 +832,6 @@ void expect_hello(SubdomainServer& server, std::uint64_t id) {
   EXPECT_TRUE(reply.has_hello_reply()) << reply.DebugString();
 }
 
-/// A Gmsh script that, if a server ran it, would create `witness` with a shell command:
-/// block_lower.geo followed by SystemCall "touch WITNESS"; (or, `external_process`, by a mesh
-/// size field that runs the command).
-std::string hostile_geo(const std::filesystem::path& witness, bool external_process) {
-  std::string script = file_text(lower_geo);
-  if (external_process) {
-    script += "\nField[1] = ExternalProcess;\nField[1].CommandLine = \"touch " + witness.string() +
-              "\";\nBackground Field = 1;\n";
-  } else {
-    script += "\nSystemCall \"touch " + witness.string() + "\";\n";
-  }
-  return script;
-}
-
 /// `setup` with the 1.x fields 2 (mesh_content) = `script` and 3 (mesh_extension) = ".geo",
 /// which 2.0 reserves: written as unknown fields, as a 1.x coordinator would send them.
 protocol::SetupBody with_1x_script(protocol::SetupBody setup, const std::string& script) {
@@ -865,40 +852,68 @@ std::filesystem::path witness_path(const std::string& label) {
   return path;
 }
 
-// Issue 11 (a), remote command execution: a 1.x SetupBody carrying a .geo script in
-// mesh_content (field 2) with mesh_extension ".geo" (field 3). A 2.0 server does not know these
-// fields, runs no script and, with no MeshData and no mesh_path, refuses the body as BAD_INPUT;
-// the command's file does not appear. Both ways a script can run a command are tried: SystemCall
-// and a mesh size field of type ExternalProcess. Sent together with a valid MeshData, the
-// script is ignored as well: the body is set up from the MeshData and nothing runs.
+/// The lines of /etc/passwd (none when it cannot be read).
+std::vector<std::string> passwd_lines() {
+  std::ifstream stream("/etc/passwd");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(stream, line);) {
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+/// Expects `reply_bytes` to show no line of /etc/passwd and not `directory` (the working
+/// directory).
+void expect_nothing_read(const std::string& reply_bytes, const std::string& directory) {
+  for (const std::string& line : passwd_lines()) {
+    EXPECT_EQ(reply_bytes.find(line), std::string::npos) << "the reply shows '" << line << "'";
+  }
+  EXPECT_EQ(reply_bytes.find(directory), std::string::npos) << "the reply shows " << directory;
+}
+
+// Issue 11 (a), remote command execution and file reads: a 1.x SetupBody carrying a .geo
+// script in mesh_content (field 2) with mesh_extension ".geo" (field 3), the script holding one
+// of the attacks of hostile_geo_scripts.hpp (SystemCall, an ExternalProcess mesh size field, the
+// five keyword-filter bypasses, ListFromFile("/etc/passwd"), CurrentDirectory). A 2.0 server
+// does not know these fields, runs no script and, with no MeshData and no mesh_path, refuses
+// the body as BAD_INPUT; the command's file does not appear and no reply shows a line of
+// /etc/passwd or the working directory. Sent together with a valid MeshData, the script is
+// ignored as well: the body is set up from the MeshData and nothing runs.
 TEST(SubdomainServer, Version1GeoScriptInMeshContentIsNeverRun) {
   SubdomainServer server(quiet_settings());
+  const std::string working_directory = std::filesystem::current_path().string();
+  ASSERT_GT(working_directory.size(), 1u);
   std::uint64_t id = 1;
-  for (const bool external_process : {false, true}) {
-    const std::filesystem::path witness = witness_path("geo");
-    const std::string script = hostile_geo(witness, external_process);
+  const std::filesystem::path witness = witness_path("geo");
+  for (const testing::HostileGeoScript& attack : testing::hostile_geo_scripts(witness)) {
+    SCOPED_TRACE(attack.label);
+    const std::string script = file_text(lower_geo) + attack.text;
     protocol::SetupBody without_mesh = lower_block_setup();
     without_mesh.clear_mesh();
     const protocol::SetupBody hostile = with_1x_script(without_mesh, script);
     // The bytes do carry the script (fields 2 and 3), as a 1.x coordinator sends it.
     const std::string bytes = setup_request(id, hostile).SerializeAsString();
-    ASSERT_NE(bytes.find("touch " + witness.string()), std::string::npos);
+    ASSERT_NE(bytes.find(attack.text), std::string::npos);
+    const std::string reply_bytes = server.handle(bytes);
     protocol::Envelope reply;
-    ASSERT_TRUE(reply.ParseFromString(server.handle(bytes)));
+    ASSERT_TRUE(reply.ParseFromString(reply_bytes));
     expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
     EXPECT_NE(reply.error().message().find(
                   "body 'lower': SetupBody.mesh and SetupBody.mesh_path are both absent"),
               std::string::npos)
         << reply.error().message();
-    EXPECT_FALSE(std::filesystem::exists(witness)) << "the script ran";
+    expect_nothing_read(reply_bytes, working_directory);
     expect_hello(server, ++id);
 
-    const protocol::Envelope with_mesh =
-        exchange(server, setup_request(++id, with_1x_script(lower_block_setup(), script)));
+    const std::string with_mesh_bytes = server.handle(
+        setup_request(++id, with_1x_script(lower_block_setup(), script)).SerializeAsString());
+    protocol::Envelope with_mesh;
+    ASSERT_TRUE(with_mesh.ParseFromString(with_mesh_bytes));
     EXPECT_TRUE(with_mesh.has_interface()) << with_mesh.DebugString();
-    EXPECT_FALSE(std::filesystem::exists(witness)) << "the script ran";
+    expect_nothing_read(with_mesh_bytes, working_directory);
     expect_hello(server, ++id);
     ++id;
+    EXPECT_FALSE(std::filesystem::exists(witness)) << "the script ran";
   }
 }
 
@@ -921,16 +936,6 @@ protocol::SetupBody square_path_setup(const std::string& mesh_path) {
 
 const std::filesystem::path square_msh =
     std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_v41.msh";
-
-/// The lines of /etc/passwd (none when it cannot be read).
-std::vector<std::string> passwd_lines() {
-  std::ifstream stream("/etc/passwd");
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(stream, line);) {
-    if (!line.empty()) lines.push_back(line);
-  }
-  return lines;
-}
 
 /// A BAD_INPUT reply naming SetupBody.mesh_path that contains no line of `secret` (a file's
 /// lines) anywhere in its bytes.
