@@ -89,6 +89,62 @@ void field_size_problems(const google::protobuf::RepeatedPtrField<protocol::Fiel
   }
 }
 
+/// The nodes per segment of a 2D segment type; 0 for any other type.
+int nodes_per_segment(protocol::CellType type) {
+  if (type == protocol::LINE2) return 2;
+  if (type == protocol::LINE3) return 3;
+  return 0;
+}
+
+Eigen::Vector2d point_of(const protocol::InterfaceDescription& description, std::uint32_t node) {
+  return {description.coordinates(static_cast<int>(2 * node)),
+          description.coordinates(static_cast<int>(2 * node + 1))};
+}
+
+Eigen::Vector2d normal_of(const protocol::InterfaceDescription& description, std::uint32_t node) {
+  return {description.normals(static_cast<int>(2 * node)),
+          description.normals(static_cast<int>(2 * node + 1))};
+}
+
+/// The problems of one segment (its node positions, already checked to be in range) of the top
+/// edge; returns its length.
+double segment_problems(const protocol::InterfaceDescription& description,
+                        const std::vector<std::uint32_t>& nodes, const std::string& segment,
+                        double tolerance, std::vector<std::string>& problems) {
+  for (const std::uint32_t node : nodes) {
+    const Eigen::Vector2d x = point_of(description, node);
+    if (std::abs(x.y() - 1.0) > tolerance || x.x() < -tolerance || x.x() > 1.0 + tolerance) {
+      problems.push_back(segment + ": its node at position " + std::to_string(node) + " (" +
+                         number(x.x()) + ", " + number(x.y()) + ") is not on the top edge");
+    }
+  }
+  const Eigen::Vector2d first = point_of(description, nodes[0]);
+  const Eigen::Vector2d direction = point_of(description, nodes[1]) - first;
+  const double length = direction.norm();
+  if (!(length > tolerance * contact_length)) {
+    problems.push_back(segment + " has length " + number(length) + ", expected > 0");
+    return 0.0;
+  }
+  if (nodes.size() == 3 &&
+      (point_of(description, nodes[2]) - (first + 0.5 * direction)).norm() > tolerance) {
+    problems.push_back(segment +
+                       ": its third node (LINE3 midpoint) is not halfway between its "
+                       "ends");
+  }
+  const Eigen::Vector2d outward(direction.y() / length, -direction.x() / length);
+  for (const std::uint32_t end : {nodes[0], nodes[1]}) {
+    const double agreement = outward.dot(normal_of(description, end));
+    if (agreement < 1.0 - tolerance) {
+      problems.push_back(
+          segment + " has the outward normal (" + number(outward.x()) + ", " + number(outward.y()) +
+          ") (its direction turned clockwise: the body on "
+          "its left), which disagrees with the normal of its node at position " +
+          std::to_string(end) + " (dot product " + number(agreement) + "): reversed segment?");
+      break;
+    }
+  }
+  return length;
+}
 }  // namespace
 
 double partial_obstacle(double x) {
@@ -291,6 +347,57 @@ std::vector<std::string> interface_weight_problems(
   if (std::abs(sum - contact_length) > tolerance * contact_length) {
     problems.push_back("the weights sum to " + number(sum) +
                        ", expected the contact boundary's length 1");
+  }
+  return problems;
+}
+
+std::vector<std::string> interface_surface_problems(
+    const protocol::InterfaceDescription& description, double tolerance) {
+  if (description.surfaces_size() != 1) {
+    return {"surfaces has " + std::to_string(description.surfaces_size()) +
+            " entries, expected one per contact boundary (the checker sends 'top' only)"};
+  }
+  const protocol::ContactSurface& surface = description.surfaces(0);
+  const int per_segment = nodes_per_segment(surface.segment_type());
+  const auto node_count = static_cast<std::uint32_t>(description.node_ids_size());
+  std::vector<std::string> problems;
+  if (surface.boundary() != "top") {
+    problems.push_back("surfaces[0].boundary is '" + surface.boundary() + "', expected 'top'");
+  }
+  if (per_segment == 0 || surface.segments_size() == 0 ||
+      surface.segments_size() % per_segment != 0) {
+    problems.push_back("surfaces[0] has segment_type " +
+                       protocol::CellType_Name(surface.segment_type()) + " and " +
+                       std::to_string(surface.segments_size()) +
+                       " segment entries: expected LINE2 or LINE3 and a positive multiple of its "
+                       "nodes per segment");
+    return problems;
+  }
+  for (const std::uint32_t position : surface.segments()) {
+    if (position >= node_count) {
+      problems.push_back("surfaces[0].segments holds the position " + std::to_string(position) +
+                         ", not less than the node count " + std::to_string(node_count));
+      return problems;
+    }
+  }
+  std::vector<bool> used(node_count, false);
+  double length = 0.0;
+  for (int first = 0; first < surface.segments_size(); first += per_segment) {
+    const std::vector<std::uint32_t> nodes(surface.segments().begin() + first,
+                                           surface.segments().begin() + first + per_segment);
+    for (const std::uint32_t node : nodes) used[node] = true;
+    length += segment_problems(description, nodes,
+                               "segment " + std::to_string(first / per_segment) + " of 'top'",
+                               tolerance, problems);
+  }
+  if (std::abs(length - contact_length) > tolerance * contact_length) {
+    problems.push_back("the segments of 'top' are " + number(length) +
+                       " long together, expected the edge's length 1");
+  }
+  const auto unused = std::find(used.begin(), used.end(), false);
+  if (unused != used.end()) {
+    problems.push_back("the node at position " + std::to_string(unused - used.begin()) +
+                       " is in no segment of 'top'");
   }
   return problems;
 }

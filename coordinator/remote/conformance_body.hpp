@@ -79,6 +79,16 @@ std::vector<std::string> interface_node_problems(const protocol::InterfaceDescri
 std::vector<std::string> interface_weight_problems(
     const protocol::InterfaceDescription& description, double tolerance);
 
+/// The surfaces of the top edge: exactly one ContactSurface, boundary "top", segment_type LINE2
+/// or LINE3, `segments` a multiple of its nodes per segment, every position < the node count;
+/// each segment of positive length with all its nodes on the top edge (a LINE3 midpoint halfway
+/// between its ends); each oriented with the body on its left, i.e. its outward normal, the
+/// direction t = x(second) - x(first) turned clockwise, (t_y, -t_x) / |t|, agreeing with the
+/// reported normals of its end nodes (dot product > 1 - tolerance); the segments' lengths
+/// summing to the edge's length 1 and every node in some segment. Sizes must be right.
+std::vector<std::string> interface_surface_problems(
+    const protocol::InterfaceDescription& description, double tolerance);
+
 struct ContactSolution {
   Eigen::VectorXd normal_trace;   // u_N
   Eigen::VectorXd contact_force;  // lambda

@@ -390,6 +390,8 @@ std::string ServerChecks::setup_body() {
   std::vector<std::string> problems = interface_node_problems(description, tolerance_);
   const std::vector<std::string> weights = interface_weight_problems(description, tolerance_);
   problems.insert(problems.end(), weights.begin(), weights.end());
+  const std::vector<std::string> surfaces = interface_surface_problems(description, tolerance_);
+  problems.insert(problems.end(), surfaces.begin(), surfaces.end());
   if (description.body_name() != body_name) {
     problems.push_back("body_name is '" + description.body_name() + "', expected the echo '" +
                        body_name + "'");

@@ -27,6 +27,14 @@ std::string format_seconds(double seconds) {
   return text.str();
 }
 
+/// `bytes` in MiB with three significant digits.
+std::string format_mebibytes(std::size_t bytes) {
+  std::ostringstream text;
+  text.precision(3);
+  text << static_cast<double>(bytes) / 1048576.0;
+  return text.str();
+}
+
 /// "not on its allow-list" style explanation of a ZAP status code (RFC 27).
 std::string zap_status_meaning(std::uint32_t status_code) {
   switch (status_code) {
@@ -117,6 +125,7 @@ std::uint64_t RequestChannel::send(protocol::Envelope& envelope, const Deadline&
                     dealer.send(zmq::buffer(payload), zmq::send_flags::none);
   if (!sent) throw ChannelFailure("the request could not be queued for sending");
   bytes_sent_ += static_cast<long>(payload.size());
+  unanswered_request_bytes_ = payload.size();
   return envelope.request_id();
 }
 
@@ -131,7 +140,10 @@ protocol::Envelope RequestChannel::receive(std::uint64_t request_id, const Deadl
     }
     wait_for(ZMQ_POLLIN, deadline, timeout_problem);
     protocol::Envelope reply = read_reply();
-    if (reply.request_id() == request_id) return reply;
+    if (reply.request_id() == request_id) {
+      unanswered_request_bytes_ = 0;
+      return reply;
+    }
     // A late reply to an abandoned request: discard it (counted) and keep waiting.
   }
 }
@@ -139,7 +151,10 @@ protocol::Envelope RequestChannel::receive(std::uint64_t request_id, const Deadl
 std::optional<protocol::Envelope> RequestChannel::try_receive(std::uint64_t request_id) {
   while (poll_dealer(ZMQ_POLLIN, std::chrono::milliseconds(0))) {
     protocol::Envelope reply = read_reply();
-    if (reply.request_id() == request_id) return reply;
+    if (reply.request_id() == request_id) {
+      unanswered_request_bytes_ = 0;
+      return reply;
+    }
   }
   check_connection();
   return std::nullopt;
@@ -185,7 +200,26 @@ void RequestChannel::check_connection() {
     }
     if (!hooks_enabled_ || !options_.server_failure) break;
   }
-  throw ChannelFailure("the connection to the server was lost (the server stopped or crashed)");
+  const bool server_watched = hooks_enabled_ && options_.server_failure;
+  throw ChannelFailure(lost_connection_message(server_watched));
+}
+
+std::string RequestChannel::lost_connection_message(bool server_still_running) const {
+  const std::string lost = "the connection to the server was lost";
+  if (unanswered_request_bytes_ == 0) return lost + " (the server stopped or crashed)";
+  const std::string request = "the request of " + std::to_string(unanswered_request_bytes_) +
+                              " bytes (" + format_mebibytes(unanswered_request_bytes_) + " MiB)";
+  const std::string refusal =
+      "a server closes the connection, without a reply, to a request larger than its maximum "
+      "message size (robin-subdomain --max-message-size BYTES, default 1073741824 = 1 GiB; "
+      "robin-subdomain-py the same)";
+  if (server_still_running) {
+    return lost + " while " + request + " was unanswered, and the server process is still " +
+           "running: it most likely refused the request as too large (" + refusal +
+           "); restart it with a larger --max-message-size";
+  }
+  return lost + " while " + request + " was unanswered: the server stopped or crashed, or " +
+         refusal;
 }
 
 std::string RequestChannel::server_failure_reason() const {

@@ -23,7 +23,10 @@
 //                          closing its TCP connection.
 // A socket monitor reports disconnects: a connection lost after it was established fails the
 // pending and every later request at once, instead of at the deadline (a server that crashed or
-// was killed lost the body's state, so there is nothing to resume).
+// was killed lost the body's state, so there is nothing to resume). A server also closes the
+// connection, without a reply, to a request above its --max-message-size (libzmq's
+// ZMQ_MAXMSGSIZE): the failure then names the size of the request left unanswered and that
+// limit, and says that the server is still running when the server_failure hook watched it.
 //
 // CurveZMQ (ChannelOptions::curve, docs/security.md): the dealer is a CURVE client with the
 // coordinator's key pair and the server's public key. The monitor also reports failed security
@@ -118,6 +121,11 @@ class RequestChannel {
   /// True when the dealer is ready for `events` within `timeout` (false on EINTR).
   bool poll_dealer(short events, std::chrono::milliseconds timeout);
   void check_connection();
+  /// Why the connection was lost, naming the size of the request left unanswered (if any):
+  /// a server refuses a request above its --max-message-size by closing the connection, which
+  /// looks like a crash. `server_still_running`: the server_failure hook watched the server
+  /// through the grace period and it did not stop.
+  std::string lost_connection_message(bool server_still_running) const;
   /// Reads the waiting message and parses its Envelope (ChannelFailure when it is none).
   protocol::Envelope read_reply();
   std::string server_failure_reason() const;
@@ -134,6 +142,7 @@ class RequestChannel {
   bool hooks_enabled_ = true;
   long bytes_sent_ = 0;
   long bytes_received_ = 0;
+  std::size_t unanswered_request_bytes_ = 0;  // the last request sent, until its reply; 0: none
 };
 
 }  // namespace robin

@@ -583,6 +583,59 @@ INSTANTIATE_TEST_SUITE_P(Conformance, DeviationTest,
                                            isotropic_only_material(), busy_while_idle()),
                          [](const auto& info) { return info.param.name; });
 
+// --- Contact surfaces (InterfaceDescription.surfaces) --------------------------------------------
+
+/// A proxy whose InterfaceDescription has its surfaces changed by `change`: setup_body must fail
+/// naming `words`.
+void expect_surface_deviation_fails(const std::string& endpoint,
+                                    const std::function<void(protocol::ContactSurface&)>& change,
+                                    const std::vector<std::string>& words) {
+  FakeServer proxy(proxy_to(endpoint, {}, [&change](Envelope& reply) {
+    if (!reply.has_interface()) return;
+    for (protocol::ContactSurface& surface : *reply.mutable_interface()->mutable_surfaces()) {
+      change(surface);
+    }
+  }));
+  ConformanceOptions options;
+  options.reply_timeout_seconds = 2.0;
+  options.oversized_message_bytes = 1L << 20;
+  const ConformanceReport report = check_server(proxy.endpoint(), options);
+  EXPECT_TRUE(passes(report, "hello"));
+  EXPECT_TRUE(fails_with(report, "setup_body", words));
+}
+
+// Issue 12: the checker judges the segments of the top edge. robin-subdomain passes
+// (ReferenceServerPassesEveryCheck); a server whose segments run the other way (the body on their
+// right: outward normal (0, -1) against the node normals (0, 1)), name a position beyond the
+// nodes, or leave a node out fails setup_body, naming the defect.
+TEST_F(ConformanceTest, SurfacesWithReversedOrMissingSegmentsFailTheSetupCheck) {
+  const ConformanceReport reference = check_server(reference_endpoint(), quick_options());
+  ASSERT_TRUE(passes(reference, "setup_body"));
+  expect_surface_deviation_fails(
+      reference_endpoint(),
+      [](protocol::ContactSurface& surface) {
+        auto& segments = *surface.mutable_segments();
+        for (int first = 0; first + 1 < segments.size(); first += 2) {
+          std::swap(segments[first], segments[first + 1]);
+        }
+      },
+      {"InterfaceDescription of the unit square's top edge", "segment 0 of 'top'",
+       "outward normal (0, -1)", "reversed segment?"});
+  expect_surface_deviation_fails(
+      reference_endpoint(),
+      [](protocol::ContactSurface& surface) { surface.set_segments(0, 1000); },
+      {"surfaces[0].segments holds the position 1000", "not less than the node count 5"});
+  expect_surface_deviation_fails(
+      reference_endpoint(),
+      [](protocol::ContactSurface& surface) {
+        surface.mutable_segments()->Truncate(surface.segments_size() - 2);
+      },
+      {"the segments of 'top' are 0.75 long together", "is in no segment of 'top'"});
+  expect_surface_deviation_fails(
+      reference_endpoint(), [](protocol::ContactSurface& surface) { surface.set_boundary("x"); },
+      {"surfaces[0].boundary is 'x', expected 'top'"});
+}
+
 // --- Shutdown (only with include_shutdown) ------------------------------------------------------
 
 /// Acknowledges Shutdown itself; `stops` says whether it then closes its socket.

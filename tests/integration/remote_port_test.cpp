@@ -10,7 +10,10 @@
 //  - when neither server answers, the error names both servers and bodies;
 //  - a server that answers the handshake but not SetupBody fails the setup at the setup
 //    timeout (3 s), not at the shorter request timeout (1 s);
-//  - a server speaking protocol 2.x is refused with both versions in the message;
+//  - a SetupBody above the server's --max-message-size fails at once naming the request's
+//    size and the option, and the server answers the next connection's Hello;
+//  - a server speaking protocol 3.x, and one speaking 1.x, is refused with both versions in
+//    the message;
 //  - protocol 1.2 runs: when a second coordinator (another RemotePort) sets up the server of a
 //    run in progress, the first run's next contact solve fails with a PortError saying that the
 //    body belongs to another run (before 1.2 it was answered from the other run's body), and
@@ -21,6 +24,7 @@
 
 #include <array>
 #include <iostream>
+#include <regex>
 #include <thread>
 #include <zmq.hpp>
 
@@ -35,10 +39,10 @@ namespace robin {
 namespace {
 
 using testing::example;
+using testing::expect_same_interface_state;
 using testing::seconds_since;
 using testing::server_options;
 using testing::TemporaryDirectory;
-using testing::expect_same_interface_state;
 using testing::vectors_close;
 
 /// examples/two_blocks.toml with both meshes loaded (SubdomainPort::setup needs them).
@@ -345,6 +349,88 @@ TEST(RemotePort, ServerOfAnotherMajorVersionIsRefused) {
     EXPECT_NE(message.find("speaks protocol 3."), std::string::npos) << message;
     EXPECT_NE(message.find("this coordinator speaks 2."), std::string::npos) << message;
   }
+}
+
+// Issue 12: a server of protocol 1.x (robin-subdomain --protocol-major 1 announces 1.x, as a
+// server built before protocol 2 does) gets a clear refusal naming both versions.
+TEST(RemotePort, ServerOfProtocolOneIsRefusedNamingBothVersions) {
+  const TemporaryDirectory logs("remote-port-version-1");
+  ServerLaunchOptions options = server_options(logs.path());
+  options.extra_arguments = {"--protocol-major", "1"};
+  SubdomainServer server("lower", options);
+  server.await_listening();
+  const CaseDefinition definition = two_blocks();
+  RemotePort port(server.endpoint(), "lower", port_options(5.0));
+  try {
+    port.setup(definition.bodies[0], definition.solver);
+    FAIL() << "a protocol 1 server was accepted";
+  } catch (const PortError& error) {
+    const std::string message = error.what();
+    std::cout << message << "\n";
+    EXPECT_NE(message.find("server " + server.endpoint()), std::string::npos) << message;
+    EXPECT_NE(message.find("step handshake"), std::string::npos) << message;
+    EXPECT_NE(message.find("speaks protocol 1." + std::to_string(protocol::protocol_minor)),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("this coordinator speaks 2." + std::to_string(protocol::protocol_minor)),
+              std::string::npos)
+        << message;
+  }
+}
+
+// Issue 11: robin-subdomain --max-message-size 1000 closes the connection, without a reply, to
+// a SetupBody above 1000 bytes (libzmq's ZMQ_MAXMSGSIZE). The setup fails at once (well
+// before the 10 s deadline) with a PortError naming the step, the size of the unanswered
+// request and the server's option; the server neither crashed nor hangs: it answers the Hello
+// of a new connection.
+TEST(RemotePort, RequestAboveTheServersMaximumMessageSizeIsNamed) {
+  const TemporaryDirectory logs("remote-port-message-size");
+  ServerLaunchOptions options = server_options(logs.path());
+  options.extra_arguments = {"--max-message-size", "1000"};
+  SubdomainServer server("lower", options);
+  server.await_listening();
+  const CaseDefinition definition = two_blocks();
+  {
+    RemotePort port(server.endpoint(), "lower", port_options(10.0));
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      port.setup(definition.bodies[0], definition.solver);
+      FAIL() << "a SetupBody above 1000 bytes was answered";
+    } catch (const PortError& error) {
+      const std::string message = error.what();
+      std::cout << message << "\n";
+      EXPECT_LT(seconds_since(start), 5.0) << message;
+      EXPECT_NE(message.find("step setup"), std::string::npos) << message;
+      const std::smatch size = [&message] {
+        std::smatch match;
+        std::regex_search(message, match, std::regex("the request of ([0-9]+) bytes"));
+        return match;
+      }();
+      ASSERT_FALSE(size.empty()) << message;
+      EXPECT_GT(std::stol(size[1].str()), 1000) << message;
+      EXPECT_NE(message.find("was unanswered"), std::string::npos) << message;
+      EXPECT_NE(message.find("larger than its maximum message size (robin-subdomain "
+                             "--max-message-size BYTES"),
+                std::string::npos)
+          << message;
+    }
+  }
+  zmq::context_t context;
+  zmq::socket_t socket(context, zmq::socket_type::req);
+  socket.set(zmq::sockopt::linger, 0);
+  socket.set(zmq::sockopt::rcvtimeo, 5000);
+  socket.connect(server.endpoint());
+  protocol::Envelope hello;
+  hello.set_request_id(1);
+  hello.mutable_version()->set_major(protocol::protocol_major);
+  hello.mutable_hello();
+  ASSERT_TRUE(socket.send(zmq::buffer(hello.SerializeAsString()), zmq::send_flags::none));
+  zmq::message_t answer;
+  ASSERT_TRUE(socket.recv(answer)) << "no reply to Hello after the refused request";
+  protocol::Envelope reply;
+  ASSERT_TRUE(reply.ParseFromArray(answer.data(), static_cast<int>(answer.size())));
+  EXPECT_TRUE(reply.has_hello_reply()) << reply.DebugString();
+  EXPECT_EQ(kill(server.pid(), 0), 0) << "the server process is gone";
 }
 
 TEST(RemotePort, SecondCoordinatorTakingTheServerOverFailsTheFirstRun) {
