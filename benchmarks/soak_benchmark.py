@@ -6,9 +6,13 @@ run on it: SetupBody (a structured mesh of the unit square sent as MeshData, 2 n
 AssignContact (node-to-node rows on the top edge), one ContactSolveRequest, a FieldsRequest and
 EndRun. Every `--every` setups it prints the server's resident set size (VmRSS of
 /proc/PID/status). A server that keeps nothing between runs has a flat RSS after warm-up.
+With --mesh-path the same mesh is written once as square.msh (MSH 2.2) into a temporary data
+directory given to the server (--data-directory), and every SetupBody names it in mesh_path
+instead of carrying MeshData: the server reads the file with Gmsh (robin-subdomain) or its own
+reader (robin-subdomain-py) at every setup.
 
 Usage: /usr/bin/python3 benchmarks/soak_benchmark.py [--build build] [--setups 2400] [--every 200]
-                                                    [--cells 20] [--python]
+                                                    [--cells 20] [--python] [--mesh-path]
 """
 
 import argparse
@@ -16,6 +20,7 @@ import os
 import pathlib
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -48,10 +53,38 @@ def square_mesh(cells):
     return data
 
 
-def setup_request(mesh):
+def write_msh(mesh, path):
+    """`mesh` (MeshData from square_mesh) as an MSH 2.2 file: physical curves bottom (1) and top
+    (2), physical surface body (3)."""
+    coordinates = np.reshape(list(mesh.coordinates), (-1, 2))
+    triangles = np.reshape(list(mesh.cells[0].connectivity), (-1, 3))
+    lines = [(tag, np.reshape(list(boundary.segments.connectivity), (-1, 2)))
+             for tag, boundary in enumerate(mesh.boundaries, start=1)]
+    with open(path, "w") as stream:
+        stream.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n%d\n"
+                     % (len(lines) + 1))
+        for tag, boundary in enumerate(mesh.boundaries, start=1):
+            stream.write('1 %d "%s"\n' % (tag, boundary.name))
+        stream.write('2 %d "body"\n$EndPhysicalNames\n$Nodes\n%d\n'
+                     % (len(lines) + 1, len(coordinates)))
+        for number, (x, y) in enumerate(coordinates, start=1):
+            stream.write("%d %.17g %.17g 0\n" % (number, x, y))
+        elements = [(1, tag, segment) for tag, segments in lines for segment in segments]
+        elements += [(2, len(lines) + 1, triangle) for triangle in triangles]
+        stream.write("$EndNodes\n$Elements\n%d\n" % len(elements))
+        for number, (kind, tag, nodes) in enumerate(elements, start=1):
+            stream.write("%d %d 2 %d %d %s\n" % (number, kind, tag, tag,
+                                                 " ".join(str(node + 1) for node in nodes)))
+        stream.write("$EndElements\n")
+
+
+def setup_request(mesh, mesh_path=None):
     body = protocol.SetupBody(body_name="soak", model=protocol.PLANE_STRAIN, young_modulus=1000.0,
                               poisson_ratio=0.3)
-    body.mesh.CopyFrom(mesh)
+    if mesh_path:
+        body.mesh_path = mesh_path
+    else:
+        body.mesh.CopyFrom(mesh)
     support = body.dirichlet.add(boundary="bottom")
     support.x, support.y = 0.0, 0.01
     body.contact_boundaries.append("top")
@@ -78,12 +111,15 @@ def resident_megabytes(pid):
     return float("nan")
 
 
-def start_server(arguments):
+def start_server(arguments, data_directory=None):
     if arguments.python:
         command = [sys.executable, str(repository / "python" / "robin-subdomain-py")]
     else:
         command = [str(repository / arguments.build / "bin" / "robin-subdomain")]
-    server = subprocess.Popen(command + ["--listen", "tcp://127.0.0.1:*", "--log-level", "warn"],
+    command += ["--listen", "tcp://127.0.0.1:*", "--log-level", "warn"]
+    if data_directory:
+        command += ["--data-directory", data_directory]
+    server = subprocess.Popen(command,
                               stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     line = server.stdout.readline().strip()
     if not line.startswith("listening on "):
@@ -99,21 +135,34 @@ def main():
     parser.add_argument("--every", type=int, default=200)
     parser.add_argument("--cells", type=int, default=20)
     parser.add_argument("--python", action="store_true")
+    parser.add_argument("--mesh-path", action="store_true",
+                        help="send mesh_path (a .msh in the server's data directory), not MeshData")
     arguments = parser.parse_args()
-    server, endpoint = start_server(arguments)
+    mesh = square_mesh(arguments.cells)
+    with tempfile.TemporaryDirectory(prefix="robin-soak-") as data_directory:
+        mesh_path = None
+        if arguments.mesh_path:
+            mesh_path = "square.msh"
+            write_msh(mesh, os.path.join(data_directory, mesh_path))
+        soak(arguments, mesh, mesh_path, data_directory if mesh_path else None)
+
+
+def soak(arguments, mesh, mesh_path, data_directory):
+    server, endpoint = start_server(arguments, data_directory)
     socket = zmq.Context.instance().socket(zmq.DEALER)
     socket.connect(endpoint)
-    mesh = square_mesh(arguments.cells)
-    print("server: %s, %d setups of %d triangles, RSS every %d" % (
+    print("server: %s, %d setups of %d triangles (%s), RSS every %d" % (
         "robin-subdomain-py" if arguments.python else "robin-subdomain", arguments.setups,
-        2 * arguments.cells ** 2, arguments.every))
+        2 * arguments.cells ** 2, "mesh_path " + mesh_path if mesh_path else "MeshData",
+        arguments.every))
     print("| setups | RSS (MiB) | seconds |")
     print("|---|---|---|")
     start, request_id = time.time(), 0
     try:
         for setup in range(1, arguments.setups + 1):
             request_id += 1
-            interface = exchange(socket, request_id, setup_body=setup_request(mesh)).interface
+            interface = exchange(socket, request_id,
+                                 setup_body=setup_request(mesh, mesh_path)).interface
             count = len(interface.node_ids)
             assign = protocol.AssignContact(row_offsets=range(0, 2 * count + 1, 2),
                                             node_ids=np.repeat(list(interface.node_ids), 2).tolist(),

@@ -36,13 +36,53 @@ std::mutex& gmsh_mutex() {
   return mutex;
 }
 
-/// One Gmsh initialize/finalize pair. `-setnumber h SIZE` defines the .geo variable h
-/// before any script is parsed. AbortOnError = 0 keeps Gmsh from throwing out of its
-/// parser (which would leave the parser's state corrupt for later reads); errors are
-/// collected from Gmsh's logger instead.
+/// Gmsh for one read. A .msh file is read by a Gmsh initialized once per process (under
+/// gmsh_mutex) and cleared (gmsh::clear) before and after each read: Gmsh 4.8 leaks memory in
+/// every initialize/finalize pair, more with every pair (a server reading a 800-triangle .msh
+/// by SetupBody.mesh_path grew from 60 to 185 MiB over 2400 reads; benchmarks/soak_benchmark.py
+/// --mesh-path). A .geo gets a fresh initialize/finalize pair: its script may set options that
+/// must not carry over to the next read, and `-setnumber h SIZE` defines the .geo variable h
+/// before any script is parsed. AbortOnError = 0 keeps Gmsh from throwing out of its parser
+/// (which would leave the parser's state corrupt for later reads); errors are collected from
+/// Gmsh's logger instead.
 class GmshSession {
  public:
-  explicit GmshSession(double size) {
+  GmshSession(bool script, double size) : kept_(!script) {
+    if (kept_ && initialized_for_files()) {
+      gmsh::clear();
+    } else {
+      end_kept_session();
+      initialize(size);
+      initialized_for_files() = kept_;
+    }
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.Verbosity", 1);
+    gmsh::option::setNumber("General.AbortOnError", 0);
+    gmsh::logger::start();
+  }
+  ~GmshSession() {
+    gmsh::logger::stop();
+    if (kept_) {
+      gmsh::clear();
+    } else {
+      gmsh::finalize();
+    }
+  }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+ private:
+  /// True while the Gmsh kept for .msh reads is initialized (in this process).
+  static bool& initialized_for_files() {
+    static bool initialized = false;
+    return initialized;
+  }
+  static void end_kept_session() {
+    if (!initialized_for_files()) return;
+    gmsh::finalize();
+    initialized_for_files() = false;
+  }
+  static void initialize(double size) {
     std::vector<std::string> arguments = {"robin"};
     if (size > 0.0) {
       std::ostringstream value;
@@ -53,17 +93,9 @@ class GmshSession {
     std::vector<char*> argv;
     for (std::string& argument : arguments) argv.push_back(argument.data());
     gmsh::initialize(static_cast<int>(argv.size()), argv.data(), false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("General.Verbosity", 1);
-    gmsh::option::setNumber("General.AbortOnError", 0);
-    gmsh::logger::start();
   }
-  ~GmshSession() {
-    gmsh::logger::stop();
-    gmsh::finalize();
-  }
-  GmshSession(const GmshSession&) = delete;
-  GmshSession& operator=(const GmshSession&) = delete;
+
+  bool kept_;
 };
 
 /// Builds error messages "<source>: <problem>", with Gmsh's mentions of the file read
@@ -366,7 +398,7 @@ Mesh read_mesh_file(const std::filesystem::path& path, const ErrorSource& source
     throw source.error("the file does not exist or is not a regular file");
   }
   const std::lock_guard<std::mutex> lock(gmsh_mutex());
-  const GmshSession session(options.size);
+  const GmshSession session(extension == ".geo", options.size);
   call_gmsh(source, "reading", [&] { gmsh::open(path.string()); });
   if (extension == ".geo") {
     call_gmsh(source, "meshing", [&] {
@@ -387,7 +419,7 @@ void mesh_to_file(const std::filesystem::path& geo, const MeshReadOptions& optio
                   const std::filesystem::path& output) {
   const ErrorSource source{"", "mesh file '" + geo.string() + "'"};
   check_options(source, options);
-  const GmshSession session(options.size);
+  const GmshSession session(true, options.size);
   call_gmsh(source, "reading", [&] { gmsh::open(geo.string()); });
   call_gmsh(source, "meshing", [&] {
     gmsh::option::setNumber("Mesh.ElementOrder", options.element_order);

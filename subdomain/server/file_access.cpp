@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <cerrno>
 #include <system_error>
 
 #include "numerics/errors.hpp"
@@ -74,6 +75,22 @@ std::filesystem::path resolve_data_file(const std::filesystem::path& data_direct
     throw InputError(field + " '" + requested + "' is not a regular file");
   }
   return real;
+}
+
+void check_data_file_size(const std::filesystem::path& path, const std::string& requested,
+                          std::uintmax_t maximum_bytes, const std::string& field) {
+  if (maximum_bytes == 0) return;
+  struct stat status {};
+  if (stat(path.c_str(), &status) != 0) {
+    throw InputError(field + " '" + requested + "' cannot be examined (" +
+                     std::generic_category().message(errno) + ")");
+  }
+  const auto size = static_cast<std::uintmax_t>(status.st_size);
+  if (size <= maximum_bytes) return;
+  throw InputError(field + " '" + requested + "' is " + std::to_string(size) +
+                   " bytes, above this server's limit of " + std::to_string(maximum_bytes) +
+                   " bytes for a mesh file (its operator raises it with robin-subdomain "
+                   "--max-mesh-file-size BYTES): not read");
 }
 
 std::filesystem::path resolve_output_directory(const std::filesystem::path& output_root,

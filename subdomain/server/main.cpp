@@ -98,6 +98,7 @@ StageDelay parse_stage_delay(const std::string& text) {
 struct CommandLine {
   robin::ServerLoopOptions loop;
   long maximum_dofs = 20'000'000;
+  std::uintmax_t maximum_mesh_file_bytes = std::uintmax_t{1} << 30;
   double maximum_factor_mebibytes = default_factor_memory_mebibytes();
   robin::ServerSettings server;
   std::string log_level = "info";
@@ -138,6 +139,12 @@ void add_options(CLI::App& app, CommandLine& command_line) {
                  "mesh_path is refused and meshes come only as data")
       ->type_name("DIR")
       ->check(CLI::ExistingDirectory);
+  app.add_option("--max-mesh-file-size", command_line.maximum_mesh_file_bytes,
+                 "largest mesh file a SetupBody.mesh_path may name, in bytes, checked before the "
+                 "file is read (as large as the largest message by default)")
+      ->type_name("BYTES")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--output-root", command_line.server.output_root,
                  "the directory under which FieldsRequest.write_directory may write <body>.vtu "
                  "(relative paths, no symbolic links followed); without it every "
@@ -234,6 +241,7 @@ int main(int argc, char** argv) {
     command_line.server.correction_delay_iteration = delay.iteration;
   }
   command_line.server.maximum_dofs = command_line.maximum_dofs;
+  command_line.server.maximum_mesh_file_bytes = command_line.maximum_mesh_file_bytes;
   command_line.server.maximum_factor_bytes = command_line.maximum_factor_mebibytes * 1048576.0;
   robin::SubdomainServer server(command_line.server);
   try {

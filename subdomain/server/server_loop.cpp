@@ -1,5 +1,6 @@
 #include "server/server_loop.hpp"
 
+#include <cholmod.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -103,6 +104,42 @@ std::string reply_to(SubdomainServer& server, const Request& request) {
                        " frames, expected one (a serialized Envelope)");
 }
 
+/// Runs CHOLMOD's supernodal factorization, and through it LAPACK's dpotrf and OpenBLAS, once
+/// on a small dense matrix, on the thread that will factorize the bodies. OpenBLAS takes its
+/// work buffer (128 MiB of address space) at its first call on a thread and keeps it; when that
+/// first call comes with memory short (under an address-space limit, after a body's factor took
+/// the rest), OpenBLAS 0.3.21 retries the allocation forever instead of failing, and the server
+/// hangs in the request. Taken here, at start, while memory is free, the buffer serves every
+/// later factorization, and a factorization short of memory fails in CHOLMOD (an error reply).
+void warm_up_dense_kernels() {
+  cholmod_common common;
+  cholmod_start(&common);
+  common.supernodal = CHOLMOD_SUPERNODAL;
+  common.print = 0;
+  constexpr int size = 8;
+  cholmod_sparse* matrix =
+      cholmod_allocate_sparse(size, size, size * (size + 1) / 2, 1, 1, -1, CHOLMOD_REAL, &common);
+  if (matrix != nullptr) {
+    auto* columns = static_cast<int*>(matrix->p);
+    auto* rows = static_cast<int*>(matrix->i);
+    auto* values = static_cast<double*>(matrix->x);
+    int entry = 0;
+    for (int column = 0; column < size; ++column) {  // lower triangle of 1 + size I: SPD
+      columns[column] = entry;
+      for (int row = column; row < size; ++row, ++entry) {
+        rows[entry] = row;
+        values[entry] = row == column ? 1.0 + size : 1.0;
+      }
+    }
+    columns[size] = entry;
+    cholmod_factor* factor = cholmod_analyze(matrix, &common);
+    if (factor != nullptr) cholmod_factorize(matrix, factor, &common);
+    cholmod_free_factor(&factor, &common);
+    cholmod_free_sparse(&matrix, &common);
+  }
+  cholmod_finish(&common);
+}
+
 /// The thread that runs SubdomainServer::handle, one request at a time, so that the socket's
 /// thread stays free to answer StatusRequest. It writes one byte into a pipe when a reply is
 /// ready, which the socket's poll watches.
@@ -163,6 +200,7 @@ class RequestWorker {
 
  private:
   void run() {
+    warm_up_dense_kernels();
     std::unique_lock lock(mutex_);
     while (true) {
       wake_.wait(lock, [this] { return stopping_ || pending_; });

@@ -8,8 +8,9 @@
 // maximum_queued_requests; beyond, they get a MALFORMED_MESSAGE reply saying the server is
 // busy). A socket monitor watches the connections: when a client's connection closes, its
 // queued requests are dropped and the request being handled for it is abandoned at its next
-// stage boundary (SubdomainServer::watch_abandonment). Clients speak REQ framing (an empty delimiter frame, then one serialized Envelope; a
-// DEALER may leave the delimiter out); the reply goes back with the request's routing frames.
+// stage boundary (SubdomainServer::watch_abandonment). Clients speak REQ framing (an empty
+// delimiter frame, then one serialized Envelope; a DEALER may leave the delimiter out); the reply
+// goes back with the request's routing frames.
 //
 // The socket is bound to `endpoint` (tcp://host:port, tcp://*:port, tcp://127.0.0.1:* for an
 // ephemeral port, ipc://path). Socket options:

@@ -33,8 +33,7 @@ std::string format_value(double value) {
 }
 
 std::string decode_body_name(const std::string& name) {
-  constexpr std::size_t maximum_length = 64;
-  if (name.size() > maximum_length) {
+  if (name.size() > maximum_body_name_length) {
     throw InputError("SetupBody.body_name has " + std::to_string(name.size()) +
                      " characters: at most 64 (letters, digits, '_' and '-')");
   }
@@ -48,18 +47,20 @@ std::string decode_body_name(const std::string& name) {
   return name;
 }
 
-/// The mesh from `mesh` (MeshData) or, when absent, `mesh_path` under the data directory. A
-/// reader error is rethrown with the body and field prepended. Nothing received is run: a
-/// MeshData is data, and a mesh_path names a file the server's operator put in the data
-/// directory.
+/// The mesh from `mesh` (MeshData) or, when absent, `mesh_path` under the data directory (not
+/// read when larger than the limit). A reader error is rethrown with the body and field
+/// prepended. Nothing received is run: a MeshData is data, and a mesh_path names a file the
+/// server's operator put in the data directory.
 Mesh decode_body_mesh(const protocol::SetupBody& message, const std::string& context,
-                      const std::filesystem::path& data_directory) {
+                      const MeshFiles& files) {
   if (message.has_mesh()) return decode_mesh(message.mesh(), context);
   if (message.mesh_path().empty()) {
     fail(context, "mesh", "and SetupBody.mesh_path are both absent: send the mesh as MeshData");
   }
+  const std::string field = context + ": SetupBody.mesh_path";
   const std::filesystem::path path =
-      resolve_data_file(data_directory, message.mesh_path(), context + ": SetupBody.mesh_path");
+      resolve_data_file(files.data_directory, message.mesh_path(), field);
+  check_data_file_size(path, message.mesh_path(), files.maximum_bytes, field);
   try {
     Mesh mesh = read_gmsh_mesh(path);
     check_element_validity(mesh, context + ": SetupBody.mesh_path");
@@ -227,8 +228,7 @@ std::vector<std::string> decode_contact_boundaries(const protocol::SetupBody& me
 
 }  // namespace
 
-DecodedSetup decode_setup_body(const protocol::SetupBody& message,
-                               const std::filesystem::path& data_directory) {
+DecodedSetup decode_setup_body(const protocol::SetupBody& message, const MeshFiles& files) {
   DecodedSetup setup;
   BodyDefinition& definition = setup.definition;
   definition.name = decode_body_name(message.body_name());
@@ -238,7 +238,7 @@ DecodedSetup decode_setup_body(const protocol::SetupBody& message,
     definition.body_force = decode_vector(message.body_force(), context, "body_force");
   }
   decode_solver(message.solver(), context, setup);
-  definition.mesh = decode_body_mesh(message, context, data_directory);
+  definition.mesh = decode_body_mesh(message, context, files);
   definition.contact_boundaries = decode_contact_boundaries(message, definition.mesh, context);
   for (int k = 0; k < message.dirichlet_size(); ++k) {
     definition.dirichlet.push_back(decode_dirichlet(message.dirichlet(k), definition.mesh, context,

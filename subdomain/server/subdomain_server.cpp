@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <new>
 #include <thread>
 
 #include "numerics/body_output.hpp"
@@ -168,6 +169,17 @@ std::string write_fields_file(const std::filesystem::path& directory, const Body
   }
 }
 
+/// The INTERNAL message of a request that could not allocate its memory (std::bad_alloc; the
+/// request's memory is freed by then).
+std::string out_of_memory_message(const std::string& request_type, const std::string& body) {
+  const std::string prefix =
+      body.empty() || body.size() > maximum_body_name_length ? "" : "body '" + body + "': ";
+  return prefix + "the server ran out of memory (std::bad_alloc) while handling " + request_type +
+         ": the request was abandoned and its memory freed; the server goes on. Its operator "
+         "can refuse such bodies before the work starts with lower --max-dofs or "
+         "--max-factor-memory limits, or give the server more memory";
+}
+
 void set_error(protocol::Envelope& reply, protocol::ErrorCode code, const std::string& message,
                ServerState state) {
   protocol::Error& error = *reply.mutable_error();
@@ -227,6 +239,8 @@ std::string SubdomainServer::handle(std::string_view request_bytes) noexcept {
     set_error(reply, protocol::SINGULAR_BODY, error.what(), state_);
   } catch (const InputError& error) {
     set_error(reply, protocol::BAD_INPUT, error.what(), state_);
+  } catch (const std::bad_alloc&) {
+    set_error(reply, protocol::INTERNAL, out_of_memory_message(record.type, record.body), state_);
   } catch (const std::exception& error) {
     set_error(reply, protocol::INTERNAL, std::string("internal error: ") + error.what(), state_);
   } catch (...) {
@@ -480,7 +494,8 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   }
   begin_stage(SetupStage::mesh, 0);
   const auto mesh_start = Clock::now();
-  DecodedSetup setup = decode_setup_body(request.setup_body(), settings_.data_directory);
+  DecodedSetup setup = decode_setup_body(
+      request.setup_body(), {settings_.data_directory, settings_.maximum_mesh_file_bytes});
   const double mesh_seconds = seconds_since(mesh_start);
   setup.body.maximum_dofs = settings_.maximum_dofs;
   setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;

@@ -98,6 +98,9 @@ struct ServerSettings {
   /// The directory under which SetupBody.mesh_path may name files (--data-directory); empty:
   /// every mesh_path is refused.
   std::filesystem::path data_directory;
+  /// The largest mesh file a mesh_path may name, in bytes (--max-mesh-file-size; 0 = none),
+  /// checked with stat before the file is read.
+  std::uintmax_t maximum_mesh_file_bytes = 0;
   /// The directory under which FieldsRequest.write_directory may write (--output-root); empty:
   /// every write_directory is refused.
   std::filesystem::path output_root;

@@ -5,8 +5,9 @@
 // the wire compared with a BodySolver built in this process (the mesh read by the server from
 // its --data-directory).
 // The attacks of issue 11 against the real process, which each fail to run or read anything
-// and leave the server answering Hello: a 1.x .geo script with a shell command in the removed
-// SetupBody.mesh_content (hand-encoded wire bytes), mesh_path reads outside --data-directory,
+// and leave the server answering Hello: a 1.x .geo script with a shell command or a file read
+// (the nine attacks of hostile_geo_scripts.hpp) in the removed SetupBody.mesh_content
+// (hand-encoded wire bytes), mesh_path reads outside --data-directory,
 // write_directory writes outside --output-root (also through a symbolic link at the target),
 // a 100,000-character body name and an inverted cell; bodies above --max-dofs and
 // --max-factor-memory. A body with two contact boundaries, and the refusal of a repeated or
@@ -17,10 +18,12 @@
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -30,12 +33,14 @@
 #include <thread>
 #include <zmq.hpp>
 
+#include "../hostile_geo_scripts.hpp"
 #include "../test_files.hpp"
 #include "mesh_codec.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/contact_operator.hpp"
 #include "numerics/gmsh_reader.hpp"
 #include "numerics/material.hpp"
+#include "numerics/rectangle_mesher.hpp"
 #include "protocol_version.hpp"
 #include "remote/reply_decoding.hpp"
 #include "robin.pb.h"
@@ -136,6 +141,7 @@ class ServerProcess {
   }
 
   void signal(int number) { kill(pid_, number); }
+  pid_t pid() const { return pid_; }
 
   std::string stderr_text() const {
     std::ifstream stream(stderr_path_);
@@ -522,22 +528,46 @@ struct ConnectedServer {
   zmq::socket_t socket;
 };
 
+/// The non-empty lines of /etc/passwd (none when it cannot be read).
+std::vector<std::string> passwd_lines() {
+  std::ifstream stream("/etc/passwd");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(stream, line);) {
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+/// Expects `reply` to show no line of /etc/passwd and not `directory` (the server's working
+/// directory, inherited from this process).
+void expect_nothing_read(const protocol::Envelope& reply, const std::string& directory) {
+  const std::string bytes = reply.SerializeAsString();
+  for (const std::string& line : passwd_lines()) {
+    EXPECT_EQ(bytes.find(line), std::string::npos) << "the reply shows '" << line << "'";
+  }
+  EXPECT_EQ(bytes.find(directory), std::string::npos) << "the reply shows " << directory;
+}
+
 // Issue 11 (a): the wire bytes of a 1.x SetupBody with a .geo script in mesh_content (field 2)
-// and ".geo" in mesh_extension (field 3), the script running "touch WITNESS" by SystemCall or by
-// an ExternalProcess mesh size field. robin-subdomain 2.0 runs no script: without MeshData or
-// mesh_path the body is BAD_INPUT, with a valid MeshData the script is ignored; the witness
-// file never appears and the server answers Hello after each request.
+// and ".geo" in mesh_extension (field 3), the script holding one of the attacks of
+// hostile_geo_scripts.hpp: "touch WITNESS" by SystemCall, by an ExternalProcess mesh size field
+// or hidden from a keyword filter (backslash, three single-quote tricks, NUL in a comment), or
+// a read of /etc/passwd (ListFromFile) or of the working directory (CurrentDirectory).
+// robin-subdomain 2.0 runs no script: without MeshData or mesh_path the body is BAD_INPUT, with
+// a valid MeshData the script is ignored; the witness file never appears, no reply shows a
+// line of /etc/passwd or the server's working directory, and the server answers Hello after
+// each request.
 TEST(SubdomainProcess, Version1GeoScriptIsNeverRun) {
   ConnectedServer server({});
   ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  const std::string working_directory = std::filesystem::current_path().string();
+  ASSERT_GT(working_directory.size(), 1u);
   std::uint64_t id = 1;
-  for (const bool external_process : {false, true}) {
-    const std::filesystem::path witness = temporary_path("witness");
+  const std::filesystem::path witness = temporary_path("witness");
+  for (const testing::HostileGeoScript& attack : testing::hostile_geo_scripts(witness)) {
+    SCOPED_TRACE(attack.label);
     std::filesystem::remove(witness);
-    std::string script = file_text(lower_geo);
-    script += external_process ? "\nField[1] = ExternalProcess;\nField[1].CommandLine = \"touch " +
-                                     witness.string() + "\";\nBackground Field = 1;\n"
-                               : "\nSystemCall \"touch " + witness.string() + "\";\n";
+    const std::string script = file_text(lower_geo) + attack.text;
     protocol::Envelope without_mesh = lower_block_setup(id++);
     without_mesh.mutable_setup_body()->clear_mesh_path();
     const std::string bytes = with_1x_script(without_mesh, script);
@@ -550,12 +580,14 @@ TEST(SubdomainProcess, Version1GeoScriptIsNeverRun) {
     ASSERT_TRUE(reply);
     expect_error(*reply, protocol::BAD_INPUT,
                  "body 'lower': SetupBody.mesh and SetupBody.mesh_path are both absent");
+    expect_nothing_read(*reply, working_directory);
     expect_hello(server.socket, id++);
 
     const std::optional<protocol::Envelope> with_mesh =
         exchange_bytes(server.socket, with_1x_script(lower_block_data_setup(id++), script));
     ASSERT_TRUE(with_mesh);
     EXPECT_TRUE(with_mesh->has_interface()) << with_mesh->DebugString();
+    expect_nothing_read(*with_mesh, working_directory);
     expect_hello(server.socket, id++);
     EXPECT_FALSE(std::filesystem::exists(witness)) << "the script ran";
   }
@@ -569,13 +601,7 @@ TEST(SubdomainProcess, Version1GeoScriptIsNeverRun) {
 // file; a server without --data-directory refuses every mesh_path.
 TEST(SubdomainProcess, MeshPathOutsideTheDataDirectoryIsRefusedUnread) {
   const AttackFiles files;
-  std::vector<std::string> secret;
-  {
-    std::ifstream passwd("/etc/passwd");
-    for (std::string line; std::getline(passwd, line);) {
-      if (!line.empty()) secret.push_back(line);
-    }
-  }
+  const std::vector<std::string> secret = passwd_lines();
   ConnectedServer server({"--data-directory", files.data.string()});
   ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
   std::uint64_t id = 1;
@@ -759,6 +785,87 @@ TEST(SubdomainProcess, BodiesAboveTheResourceLimitsAreBadInputNamingTheLimit) {
   }
   ConnectedServer server({"--max-dofs", std::to_string(dof_count)});
   EXPECT_TRUE(exchange(server.socket, lower_block_data_setup(id++)).has_interface());
+}
+
+// Issue 11 (b): a mesh file larger than --max-mesh-file-size (default 1 GiB) is refused before
+// it is read, naming its size, the limit and the option. A 2 GiB + 1 byte sparse file in the
+// data directory is refused at once (the server only stats it); with --max-mesh-file-size 1000
+// the 1024-byte square.msh is refused, and the server answers Hello after each.
+TEST(SubdomainProcess, MeshFileAboveTheSizeLimitIsRefusedUnread) {
+  const AttackFiles files;
+  const std::uintmax_t huge_size = (std::uintmax_t{2} << 30) + 1;
+  { std::ofstream create(files.data / "huge.msh"); }
+  std::filesystem::resize_file(files.data / "huge.msh", huge_size);  // sparse: no disk used
+  std::uint64_t id = 1;
+  {
+    ConnectedServer server({"--data-directory", files.data.string()});
+    ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+    const auto start = std::chrono::steady_clock::now();
+    const protocol::Envelope reply = exchange(server.socket, square_path_setup(id++, "huge.msh"));
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    expect_error(reply, protocol::BAD_INPUT,
+                 "body 'square': SetupBody.mesh_path 'huge.msh' is " + std::to_string(huge_size) +
+                     " bytes, above this server's limit of 1073741824 bytes for a mesh file "
+                     "(its operator raises it with robin-subdomain --max-mesh-file-size BYTES): "
+                     "not read");
+    EXPECT_LT(seconds, 1.0) << "the file was read";
+    expect_hello(server.socket, id++);
+    EXPECT_TRUE(exchange(server.socket, square_path_setup(id++, "square.msh")).has_interface());
+  }
+  ConnectedServer server({"--data-directory", files.data.string(), "--max-mesh-file-size", "1000"});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  const std::uintmax_t square_size = std::filesystem::file_size(files.data / "square.msh");
+  ASSERT_GT(square_size, 1000u);
+  expect_error(exchange(server.socket, square_path_setup(id++, "square.msh")), protocol::BAD_INPUT,
+               "SetupBody.mesh_path 'square.msh' is " + std::to_string(square_size) +
+                   " bytes, above this server's limit of 1000 bytes");
+  expect_hello(server.socket, id++);
+}
+
+/// The virtual memory size of process `pid` in bytes (VmSize of /proc/PID/status; 0 if unknown).
+std::uint64_t virtual_memory_bytes(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmSize:", 0) == 0) return std::stoull(line.substr(7)) * 1024;  // in kB
+  }
+  return 0;
+}
+
+// Issue 11 (c): an allocation failure inside a request is an Error reply, not an abort. The
+// server's address space is capped (prlimit, RLIMIT_AS) 64 MiB above its size after a Hello;
+// a legal SetupBody of a 400 x 400 square of linear triangles (160,801 nodes, a message of a
+// few MB, far below every limit of the server) then cannot allocate its assembly and
+// factorization (hundreds of MB). The reply is an Error saying the server ran out of memory;
+// the server answers Hello, still under the cap sets up the small lower block, and exits 0
+// after Shutdown.
+TEST(SubdomainProcess, AllocationFailureIsAnErrorReplyAndTheServerGoesOn) {
+  ConnectedServer server({});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  server.socket.set(zmq::sockopt::rcvtimeo, 120000);
+  std::uint64_t id = 1;
+  expect_hello(server.socket, id++);
+  const std::uint64_t size = virtual_memory_bytes(server.process.pid());
+  ASSERT_GT(size, 0u);
+  const rlimit cap{size + (std::uint64_t{64} << 20), size + (std::uint64_t{64} << 20)};
+  ASSERT_EQ(prlimit(server.process.pid(), RLIMIT_AS, &cap, nullptr), 0) << std::strerror(errno);
+
+  protocol::Envelope large = lower_block_data_setup(id++);
+  Mesh square = make_rectangle_mesh(0.0, -1.0, 1.0, 0.0, 400, 400, ElementType::triangle3);
+  *large.mutable_setup_body()->mutable_mesh() = encode_mesh(square);
+  large.mutable_setup_body()->set_contact_boundaries(0, "top");
+  const std::size_t message_bytes = large.ByteSizeLong();
+  std::cout << "capped at " << cap.rlim_cur / 1048576 << " MiB; the request has " << message_bytes
+            << " bytes\n";
+  ASSERT_LT(message_bytes, std::size_t{16} << 20);
+  const protocol::Envelope reply = exchange(server.socket, large);
+  expect_error(reply, protocol::INTERNAL, "body 'lower': the server ran out of memory");
+  std::cout << reply.error().message() << "\n";
+
+  expect_hello(server.socket, id++);
+  EXPECT_TRUE(exchange(server.socket, lower_block_data_setup(id++)).has_interface());
+  ASSERT_TRUE(exchange(server.socket, shutdown(id)).has_acknowledge());
+  EXPECT_EQ(server.process.wait_for_exit(), 0) << server.process.stderr_text();
 }
 
 /// lower_block_data_setup with `names` as its contact boundaries.
