@@ -341,7 +341,7 @@ CONTACT_HEADER = ["pair", "x", "y", "nx", "ny", "gap0", "un1", "un2", "lambda1",
                   "pressure"]
 # Interface 1: 'lower' (its boundary 'top') under 'middle' ('bottom') along y = 0, five nodes
 # 0.25 apart; interface 2: 'middle' ('right') beside 'side-block' ('left') along x = 1, four
-# nodes from y = 0 to y = 0.6 (0.2 apart): not flat in x, so drawn over the arc length.
+# nodes from y = 0 to y = 0.6 (0.2 apart): vertical, so drawn over y.
 INTERFACE1 = {"x": [0.0, 0.25, 0.5, 0.75, 1.0], "y": [0.0] * 5, "nx": [0.0] * 5, "ny": [1.0] * 5,
               "gap0": [0.0, 0.0, 0.0, 0.0, 0.0], "un1": [0.001, 0.002, 0.003, 0.002, 0.0005],
               "un2": [-0.001, -0.002, -0.003, -0.002, 0.0005],
@@ -460,11 +460,19 @@ class ContactGraphDirectory(unittest.TestCase):
                                    rtol=0, atol=1e-15)
         np.testing.assert_allclose(gap1.get_lines()[0].get_ydata(), [0.0, 0.0, 0.0, 0.0, -0.001],
                                    atol=1e-15)
-        # The vertical interface over its arc length from its first node: 0, 0.2, 0.4, 0.6.
+        # The vertical interface (x = 1) over y.
         curve = pressure2.get_lines()[0]
-        np.testing.assert_allclose(curve.get_xdata(), [0.0, 0.2, 0.4, 0.6], atol=1e-15)
+        self.assertEqual(list(curve.get_xdata()), INTERFACE2["y"])
         self.assertEqual(list(curve.get_ydata()), INTERFACE2["pressure"])
-        self.assertEqual(pressure2.get_xlabel(), "arc length along the interface")
+        self.assertEqual(pressure2.get_xlabel(), "y")
+        # A curved interface over the arc length from its first row: (0, 0), (0.3, 0.4),
+        # (0.3, 1.4): 0, 0.5, 1.5.
+        curved = dict(tables[1], columns=dict(tables[1]["columns"], x=[0.0, 0.3, 0.3, 0.3],
+                                              y=[0.0, 0.4, 1.4, 1.4]))
+        figure, _ = self.plot.interfaces_figure([tables[0], curved], summary)
+        np.testing.assert_allclose(figure.axes[2].get_lines()[0].get_xdata(),
+                                   [0.0, 0.5, 1.5, 1.5], atol=1e-15)
+        self.assertEqual(figure.axes[2].get_xlabel(), "arc length along the interface")
         np.testing.assert_allclose(gap2.get_lines()[0].get_ydata(), [0.0, 0.0, 0.006, 0.008],
                                    atol=1e-15)
         self.assertEqual(figure._suptitle.get_text(),
