@@ -123,6 +123,32 @@ std::optional<std::vector<int>> ContactGraph::two_colouring() const {
   return colour;
 }
 
+std::vector<int> ContactGraph::components() const {
+  std::vector<int> component(static_cast<std::size_t>(body_count_), -1);
+  std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(body_count_));
+  for (const GraphInterface& interface : interfaces_) {
+    neighbours[static_cast<std::size_t>(interface.body_a)].push_back(interface.body_b);
+    neighbours[static_cast<std::size_t>(interface.body_b)].push_back(interface.body_a);
+  }
+  int count = 0;
+  for (int start = 0; start < body_count_; ++start) {
+    if (component[static_cast<std::size_t>(start)] >= 0) continue;
+    component[static_cast<std::size_t>(start)] = count;
+    std::deque<int> queue{start};
+    while (!queue.empty()) {
+      const int body = queue.front();
+      queue.pop_front();
+      for (const int neighbour : neighbours[static_cast<std::size_t>(body)]) {
+        if (component[static_cast<std::size_t>(neighbour)] >= 0) continue;
+        component[static_cast<std::size_t>(neighbour)] = count;
+        queue.push_back(neighbour);
+      }
+    }
+    ++count;
+  }
+  return component;
+}
+
 ContactOperator stack_operators(const std::vector<const ContactOperator*>& parts) {
   ContactOperator stacked;
   for (const ContactOperator* part : parts) {

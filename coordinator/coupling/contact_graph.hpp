@@ -72,6 +72,8 @@ class ContactGraph {
   /// connected component, and every body without interfaces, get colour 0), or nothing when
   /// the graph has an odd cycle.
   std::optional<std::vector<int>> two_colouring() const;
+  /// The connected component of every body (0, 1, ... in the order of their lowest body).
+  std::vector<int> components() const;
 
  private:
   int body_count_ = 0;

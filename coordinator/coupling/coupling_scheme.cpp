@@ -80,11 +80,17 @@ class RobinScheme final : public CouplingScheme {
   /// in body order, then class 1's; body order on a graph with an odd cycle): H of a class reads
   /// only the contact solutions of the same class (H^a = -(e^b - F^b lambda^across(b)) + d with
   /// b a neighbour of a and across(b) of a's class), so each class is a block of its own.
-  RobinScheme(std::vector<SubdomainPort*> ports, CouplingProblem problem, double constant_alpha)
+  /// `colouring`: a 2-colouring of the graph, or nothing for a graph with an odd cycle.
+  /// `frozen_class` (0 or 1, or -1 for none): the colour class whose obstacles stay at their
+  /// initial values (H = x) because its sequence would need a floating body's Neumann response
+  /// (coupling_scheme.hpp, "Floating bodies"); that class has no obstacle sequence.
+  RobinScheme(std::vector<SubdomainPort*> ports, CouplingProblem problem, double constant_alpha,
+              std::optional<std::vector<int>> colouring, int frozen_class)
       : ports_(std::move(ports)),
         problem_(std::move(problem)),
         constant_alpha_(constant_alpha),
-        colouring_(problem_.graph.two_colouring()) {
+        colouring_(std::move(colouring)),
+        frozen_class_(frozen_class) {
     for (const int colour : {0, 1}) {
       ObstacleSequence sequence;
       for (int body = 0; body < problem_.graph.body_count(); ++body) {
@@ -96,7 +102,7 @@ class RobinScheme final : public CouplingScheme {
       if (sequence.bodies.empty()) continue;
       // robin-constant: one block (H^a depends on g^b through lambda^b); an odd cycle: one.
       sequence.blocks = {constant_alpha_ > 0.0 || !colouring_ ? 0 : colour};
-      if (colouring_) sequences_.push_back(sequence);
+      if (colouring_ && colour != frozen_class_) sequences_.push_back(sequence);
       Eigen::Index size = 0;
       for (const int body : sequence.bodies) size += problem_.graph.body_rows(body);
       if (sequence.blocks.front() == colour) {
@@ -110,9 +116,12 @@ class RobinScheme final : public CouplingScheme {
   std::vector<int> block_sizes() const override { return block_sizes_; }
   std::vector<ObstacleSequence> sequences() const override { return sequences_; }
   std::string describe() const override {
-    return constant_alpha_ > 0.0
-               ? "robin-constant (alpha = " + std::to_string(constant_alpha_) + ")"
-               : std::string("robin");
+    if (constant_alpha_ > 0.0) {
+      return "robin-constant (alpha = " + std::to_string(constant_alpha_) + ")";
+    }
+    return frozen_class_ < 0 ? std::string("robin")
+                             : "robin (floating bodies: only the obstacle sequence of " +
+                                   describe_bodies(sequences_.front().bodies) + ")";
   }
   Eigen::VectorXd initial_iterate(const Eigen::VectorXd& initial_obstacle) const override {
     std::vector<Eigen::VectorXd> parts;
@@ -168,7 +177,9 @@ class RobinScheme final : public CouplingScheme {
     }
     std::vector<Eigen::VectorXd> mapped;
     for (int body = 0; body < graph.body_count(); ++body) {
-      mapped.push_back(graph.across(body, sent) + graph.body_part(body, problem_.gaps));
+      mapped.push_back(is_frozen(body) ? obstacles[static_cast<std::size_t>(body)]
+                                       : Eigen::VectorXd(graph.across(body, sent) +
+                                                         graph.body_part(body, problem_.gaps)));
     }
     evaluation.mapped = stack(mapped);
     return evaluation;
@@ -211,10 +222,17 @@ class RobinScheme final : public CouplingScheme {
     return complete;
   }
 
+  /// Whether `body`'s obstacles are frozen (its class's sequence is not well defined).
+  bool is_frozen(int body) const {
+    return colouring_ && frozen_class_ >= 0 &&
+           (*colouring_)[static_cast<std::size_t>(body)] == frozen_class_;
+  }
+
   const std::vector<SubdomainPort*> ports_;
   const CouplingProblem problem_;
   const double constant_alpha_;  // 0: the Steklov-Poincare choice (correction solves)
   const std::optional<std::vector<int>> colouring_;
+  const int frozen_class_;
   std::vector<int> order_;  // the bodies in iterate order
   std::vector<int> block_sizes_;
   std::vector<ObstacleSequence> sequences_;
@@ -351,6 +369,95 @@ void require_two_bodies(const CouplingOptions& options, const ContactGraph& grap
                    " contact interfaces: use \"robin\" or \"robin-constant\"");
 }
 
+/// The bodies whose supports leave rigid motions free (body order).
+std::vector<int> floating_bodies(const CouplingProblem& problem) {
+  std::vector<int> floating;
+  for (std::size_t body = 0; body < problem.rigid_modes.size(); ++body) {
+    if (problem.rigid_modes[body] > 0) floating.push_back(static_cast<int>(body));
+  }
+  return floating;
+}
+
+/// The colouring of "robin" with floating bodies: two_colouring() with every connected component
+/// that holds floating bodies coloured so that they lie in class 0. Throws InputError when that
+/// is impossible (an odd cycle, or floating bodies in both classes of a component) or when
+/// stopping "joint" is asked for (class 1 is frozen, so the joint state is not a solution).
+std::vector<int> floating_colouring(const CouplingProblem& problem, const CouplingOptions& options,
+                                    const std::vector<int>& floating) {
+  const std::string named = "the floating " + describe_bodies(floating);
+  const std::optional<std::vector<int>> colouring = problem.graph.two_colouring();
+  if (!colouring) {
+    throw InputError("coupling.algorithm \"robin\": " + named +
+                     " lie in a contact graph with an odd cycle, which has no obstacle sequence "
+                     "that avoids their Neumann response; use \"robin-constant\"");
+  }
+  std::vector<int> colours = *colouring;
+  const std::vector<int> component = problem.graph.components();
+  for (const int body : floating) {
+    const int flip = colours[static_cast<std::size_t>(body)];
+    std::vector<int> members;
+    for (std::size_t other = 0; other < colours.size(); ++other) {
+      if (component[other] != component[static_cast<std::size_t>(body)]) continue;
+      colours[other] ^= flip;  // the body's class becomes 0
+      members.push_back(static_cast<int>(other));
+    }
+    for (const int other : floating) {
+      if (component[static_cast<std::size_t>(other)] == component[static_cast<std::size_t>(body)] &&
+          colours[static_cast<std::size_t>(other)] != 0) {
+        throw InputError("coupling.algorithm \"robin\": the floating " +
+                         describe_bodies({body, other}) +
+                         " touch through an odd number of interfaces (they lie in both colour "
+                         "classes), so each obstacle sequence needs a floating body's Neumann "
+                         "response; use \"robin-constant\"");
+      }
+    }
+  }
+  if (options.stopping == "joint") {
+    throw InputError("coupling.stopping \"joint\" with " + named +
+                     ": only the obstacle sequence of the floating bodies' colour class is "
+                     "defined and the joint state never becomes a solution; use "
+                     "\"either-sequence\"");
+  }
+  return colours;
+}
+
+/// The "robin" scheme: with floating bodies, their class 0 runs and class 1 is frozen.
+std::unique_ptr<CouplingScheme> make_robin_scheme(const CouplingOptions& options,
+                                                  const std::vector<SubdomainPort*>& ports,
+                                                  const CouplingProblem& problem) {
+  const std::vector<int> floating = floating_bodies(problem);
+  if (floating.empty()) {
+    return std::make_unique<RobinScheme>(ports, problem, 0.0, problem.graph.two_colouring(), -1);
+  }
+  return std::make_unique<RobinScheme>(ports, problem, 0.0,
+                                       floating_colouring(problem, options, floating), 1);
+}
+
+/// "dirichlet-neumann": the contact body, which must be the floating one when there is one.
+int dirichlet_neumann_contact_body(const CouplingOptions& options,
+                                   const std::vector<SubdomainPort*>& ports,
+                                   const CouplingProblem& problem) {
+  const std::vector<int> floating = floating_bodies(problem);
+  if (floating.size() == 2) {
+    throw InputError(
+        "coupling.algorithm \"dirichlet-neumann\": both bodies are floating "
+        "bodies, and the Neumann body must not be (its Neumann solve needs a contact "
+        "force that balances its loads); use \"robin\"");
+  }
+  const int chosen = options.contact_body == "1"   ? 0
+                     : options.contact_body == "2" ? 1
+                     : floating.empty()            ? more_compliant_body(ports, problem)
+                                                   : floating.front();
+  if (!floating.empty() && chosen != floating.front()) {
+    throw InputError("coupling.algorithm \"dirichlet-neumann\": body " +
+                     std::to_string(floating.front() + 1) +
+                     " is a floating body and must be the contact body (its Neumann solve needs "
+                     "a contact force that balances its loads): set coupling.contact_body = \"" +
+                     std::to_string(floating.front() + 1) + "\" or \"auto\"");
+  }
+  return chosen;
+}
+
 }  // namespace
 
 std::vector<Eigen::VectorXd> CouplingState::normal_traces() const {
@@ -396,8 +503,12 @@ Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing) {
 }
 
 CouplingProblem two_body_problem(const ContactPairing& pairing) {
-  return {ContactGraph::two_bodies(static_cast<Eigen::Index>(pairing.size())), pairing.gaps(),
-          pairing.weights(), short_wavelength_forces(pairing), {}};
+  CouplingProblem problem;
+  problem.graph = ContactGraph::two_bodies(static_cast<Eigen::Index>(pairing.size()));
+  problem.gaps = pairing.gaps();
+  problem.weights = pairing.weights();
+  problem.probe_forces = short_wavelength_forces(pairing);
+  return problem;
 }
 
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
@@ -408,9 +519,13 @@ std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& opti
     throw InputError("the coupling has " + std::to_string(ports.size()) + " ports for " +
                      std::to_string(graph.body_count()) + " bodies");
   }
-  if (options.algorithm == "robin") {
-    return std::make_unique<RobinScheme>(ports, problem, 0.0);
+  if (!problem.rigid_modes.empty() &&
+      static_cast<int>(problem.rigid_modes.size()) != graph.body_count()) {
+    throw InputError("the coupling has rigid mode counts for " +
+                     std::to_string(problem.rigid_modes.size()) + " of " +
+                     std::to_string(graph.body_count()) + " bodies");
   }
+  if (options.algorithm == "robin") return make_robin_scheme(options, ports, problem);
   if (options.algorithm == "robin-constant") {
     if (!(options.alpha > 0.0)) {
       throw InputError("coupling.alpha must be > 0 for the algorithm \"robin-constant\"");
@@ -419,17 +534,25 @@ std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& opti
       throw InputError(
           "the algorithm \"robin-constant\" needs a positive boundary weight per pair");
     }
-    return std::make_unique<RobinScheme>(ports, problem, options.alpha);
+    return std::make_unique<RobinScheme>(ports, problem, options.alpha,
+                                         problem.graph.two_colouring(), -1);
   }
   if (options.algorithm == "dirichlet-neumann") {
     require_two_bodies(options, graph);
-    const int contact_body = options.contact_body == "1"   ? 0
-                             : options.contact_body == "2" ? 1
-                                                           : more_compliant_body(ports, problem);
+    const int contact_body = dirichlet_neumann_contact_body(options, ports, problem);
     return std::make_unique<DirichletNeumannScheme>(ports, problem.gaps, contact_body);
   }
   if (options.algorithm == "neumann-neumann") {
     require_two_bodies(options, graph);
+    if (const std::vector<int> floating = floating_bodies(problem); !floating.empty()) {
+      throw InputError(
+          "coupling.algorithm \"neumann-neumann\" corrects both bodies by Neumann "
+          "solves, which the floating " +
+          describe_bodies(floating) +
+          " does not have (its loads need not balance the force jump); use "
+          "\"robin\" or \"dirichlet-neumann\" with the floating body as contact "
+          "body");
+    }
     return std::make_unique<NeumannNeumannScheme>(ports, problem.gaps);
   }
   throw InputError(

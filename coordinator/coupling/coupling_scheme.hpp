@@ -38,6 +38,28 @@
 // sequence c is colour class c: its bodies keep (u, lambda), every other body takes its
 // neighbours' forces, lambda^across, with the trace u_N - w_N. A graph with an odd cycle has no
 // completions (the loop stops on the joint state).
+//
+// Floating bodies (CouplingProblem::rigid_modes; body_solver.hpp, "Floating bodies"): a body
+// whose supports leave k > 0 rigid motions has a contact solve (its dual carries the equality
+// G lambda = h) but no Neumann response: K u = f - B' lambda^across is solvable only for a
+// lambda^across that balances its loads, which nothing guarantees during the iteration (its
+// correction solve returns the Moore-Penrose w_N = B K^dagger B' r, well defined but not the
+// correction of the iteration). Obstacle sequence c reads the contact solves of class c and the
+// Neumann responses (u - w)_N = e - F lambda^across of the other class, so it is well defined
+// iff no floating body lies in the other class.
+//   "robin": each connected component of the graph is coloured so that its floating bodies lie
+//            in class 0 (refused, InputError naming the bodies, when they cannot: floating
+//            bodies in both classes of a component, or any floating body in a graph with an odd
+//            cycle). Sequence 1 (class 0) runs and is the only sequence; class 1's block is
+//            frozen, H = x on it (its bodies' contact solves keep their initial obstacles; the
+//            joint state is not a solution, so stopping "joint" is refused). The accepted state
+//            is sequence 1's complete state, whose fixed point is the monolithic solution
+//            (docs/method.md, "Floating bodies").
+//   "robin-constant": uses only each body's own contact solve, defined for floating bodies;
+//            runs unchanged (its fixed point: lambda^a = lambda^b and g^a = d - u^b_N).
+//   "dirichlet-neumann": the floating body must be the contact body ("auto" chooses it); a
+//            floating Neumann body, or two floating bodies, are refused.
+//   "neumann-neumann": corrects both bodies by Neumann solves: refused with a floating body.
 
 #include <Eigen/Core>
 #include <memory>
@@ -133,6 +155,10 @@ struct CouplingProblem {
   /// measured them (the Robin loop does, for its residuals' scale); empty: a scheme that needs
   /// them solves them itself.
   std::vector<Eigen::VectorXd> probe_responses;
+  /// k per body (body order): the rigid motions its supports leave free
+  /// (InterfaceDescription::rigid_modes, filled by the caller from the ports' setup); empty: no
+  /// floating bodies.
+  std::vector<int> rigid_modes;
 };
 
 /// The problem of two bodies and one interface: the pairing's gaps, weights and
@@ -145,8 +171,9 @@ CouplingProblem two_body_problem(const ContactPairing& pairing);
 /// the obstacle; its sequence is the well-conditioned one, the error being multiplied by
 /// I - delta (I + F^N (F^D)^-1). Short wavelengths decide, as the few smooth modes, such as a
 /// cantilever's bending, are absorbed by the accelerator.
-/// Throws InputError for an unknown algorithm, a missing alpha, or an algorithm that couples
-/// exactly two bodies ("dirichlet-neumann", "neumann-neumann") on another graph.
+/// Throws InputError for an unknown algorithm, a missing alpha, an algorithm that couples
+/// exactly two bodies ("dirichlet-neumann", "neumann-neumann") on another graph, or floating
+/// bodies where the algorithm would need their Neumann response (the header comment).
 std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& options,
                                                      const std::vector<SubdomainPort*>& ports,
                                                      const CouplingProblem& problem);

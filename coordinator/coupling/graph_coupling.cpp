@@ -77,4 +77,7 @@ GraphCoupling couple_contact_graph(const std::vector<InterfaceDescription>& bodi
   return coupling;
 }
 
+  for (const InterfaceDescription& body : bodies) {
+    coupling.problem.rigid_modes.push_back(body.rigid_modes);
+  }
 }  // namespace robin

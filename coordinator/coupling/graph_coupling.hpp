@@ -24,7 +24,7 @@ struct InterfaceDefinition {
 struct GraphCoupling {
   std::vector<ContactPairing> pairings;    // per interface, its rows in global order
   std::vector<ContactOperator> operators;  // per body, its rows in body order
-  CouplingProblem problem;                 // graph, gaps, weights, probe forces (global order)
+  CouplingProblem problem;  // graph, gaps, weights, probe forces (global order), rigid modes
 };
 
 /// Discretizes every interface of `interfaces` between the bodies described by `bodies`

@@ -4,7 +4,11 @@
 #include <chrono>
 #include <limits>
 
+#include <Eigen/SVD>
+
 #include "numerics/errors.hpp"
+#include "numerics/nonnegative_least_squares.hpp"
+#include "numerics/smalbe.hpp"
 
 namespace robin {
 namespace {
@@ -34,6 +38,88 @@ class GraphComplianceOperator final : public LinearOperator {
 
 double maximum_absolute(const Eigen::VectorXd& values) {
   return values.size() == 0 ? 0.0 : values.lpNorm<Eigen::Infinity>();
+}
+
+/// The equality G lambda = h of the floating bodies, in global row order.
+struct GraphEquality {
+  Eigen::MatrixXd matrix;           // G: the rows (B^a R^a)' C_a of every floating body a
+  Eigen::VectorXd target;           // h: the R^a'f^a
+  std::vector<int> floating;        // the floating bodies, in body order
+  std::vector<Eigen::Index> first;  // their first row in G
+};
+
+GraphEquality graph_equality(const std::vector<const BodySolver*>& bodies,
+                             const ContactGraph& graph) {
+  GraphEquality equality;
+  std::vector<Eigen::VectorXd> rows, targets;
+  Eigen::Index count = 0;
+  for (std::size_t body = 0; body < bodies.size(); ++body) {
+    const int modes = bodies[body]->rigid_mode_count();
+    if (modes == 0) continue;
+    equality.floating.push_back(static_cast<int>(body));
+    equality.first.push_back(count);
+    for (int mode = 0; mode < modes; ++mode) {
+      Eigen::VectorXd row = Eigen::VectorXd::Zero(graph.total_rows());
+      graph.add_body_part(static_cast<int>(body), bodies[body]->rigid_trace().col(mode), row);
+      rows.push_back(row);
+    }
+    targets.push_back(bodies[body]->rigid_load());
+    count += modes;
+  }
+  equality.matrix.resize(count, graph.total_rows());
+  for (Eigen::Index row = 0; row < count; ++row) {
+    equality.matrix.row(row) = rows[static_cast<std::size_t>(row)].transpose();
+  }
+  equality.target = concatenate(targets);
+  return equality;
+}
+
+/// Throws SingularBodyError when G is rank-deficient or G lambda = h has no lambda >= 0.
+void check_graph_equality(const GraphEquality& equality) {
+  const std::string floating = "the floating " + describe_bodies(equality.floating);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(equality.matrix);
+  const Eigen::VectorXd& singular = svd.singularValues();
+  if (equality.matrix.cols() < equality.matrix.rows() ||
+      !(singular[singular.size() - 1] > 1e-8 * singular[0])) {
+    throw SingularBodyError(floating +
+                            " have a free sliding direction: a rigid motion of them "
+                            "together moves none of the contact rows (e.g. floating bodies that "
+                            "touch only each other), so contact cannot hold them");
+  }
+  const NonnegativeLeastSquaresResult balance =
+      solve_nonnegative_least_squares(equality.matrix, equality.target);
+  if (balance.residual_norm > 1e-8 * equality.target.norm()) {
+    throw SingularBodyError(floating +
+                            ": the loads push them away from every contact: no "
+                            "compressive contact forces balance their loads along their free "
+                            "rigid motions");
+  }
+}
+
+/// The dual with the floating bodies' equality rows, by SMALBE-M; the result as MPRGP's.
+MprgpResult solve_with_equality(const LinearOperator& compliance,
+                                const Eigen::VectorXd& right_hand_side,
+                                const GraphEquality& equality, const Eigen::VectorXd& initial,
+                                const MprgpParameters& parameters, Eigen::VectorXd& multiplier) {
+  check_graph_equality(equality);
+  SmalbeParameters smalbe;
+  smalbe.relative_tolerance = parameters.relative_tolerance;
+  smalbe.max_iterations = parameters.max_iterations;
+  smalbe.operator_norm = parameters.operator_norm;
+  const SmalbeResult result =
+      solve_smalbe(compliance, right_hand_side, Eigen::VectorXd::Zero(initial.size()),
+                   equality.matrix, equality.target, initial, Eigen::VectorXd(), smalbe);
+  multiplier = result.multiplier;
+  MprgpResult qp;
+  qp.solution = result.solution;
+  qp.gradient = result.gradient;
+  qp.status = result.status;
+  qp.iterations = result.iterations;
+  qp.operator_applications = result.operator_applications;
+  qp.projected_gradient_norm = result.projected_gradient_norm;
+  qp.operator_norm = result.operator_norm;
+  qp.message = result.message;
+  return qp;
 }
 
 }  // namespace
@@ -91,19 +177,32 @@ MonolithicResult solve_monolithic(const std::vector<const BodySolver*>& bodies,
   const Eigen::VectorXd initial = initial_force.size() == size
                                       ? Eigen::VectorXd(initial_force.cwiseMax(0.0))
                                       : Eigen::VectorXd(Eigen::VectorXd::Zero(size));
+  const GraphEquality equality = graph_equality(bodies, graph);
+  Eigen::VectorXd multiplier;
   result.qp =
-      solve_mprgp(compliance, right_hand_side, Eigen::VectorXd::Zero(size), initial, scaled);
+      equality.floating.empty()
+          ? solve_mprgp(compliance, right_hand_side, Eigen::VectorXd::Zero(size), initial, scaled)
+          : solve_with_equality(compliance, right_hand_side, equality, initial, scaled, multiplier);
   result.contact_force = result.qp.solution;
-  // u_N = e - F lambda on each body
+  result.rigid_amplitudes.resize(bodies.size());
+  for (std::size_t k = 0; k < equality.floating.size(); ++k) {
+    const int body = equality.floating[k];
+    result.rigid_amplitudes[static_cast<std::size_t>(body)] = -multiplier.segment(
+        equality.first[k], bodies[static_cast<std::size_t>(body)]->rigid_mode_count());
+  }
+  // u_N = e - F lambda (+ B R alpha) on each body
   std::vector<Eigen::VectorXd> forces;
   for (std::size_t body = 0; body < bodies.size(); ++body) {
     const int index = static_cast<int>(body);
     Eigen::VectorXd product = Eigen::VectorXd::Zero(graph.body_rows(index));
     const Eigen::VectorXd force = graph.body_part(index, result.contact_force);
     if (force.size() > 0) bodies[body]->compliance().apply(force, product);
-    result.normal_traces.push_back(force.size() > 0
-                                       ? Eigen::VectorXd(bodies[body]->free_trace() - product)
-                                       : Eigen::VectorXd());
+    Eigen::VectorXd trace = force.size() > 0 ? Eigen::VectorXd(bodies[body]->free_trace() - product)
+                                             : Eigen::VectorXd();
+    if (result.rigid_amplitudes[body].size() > 0) {
+      trace += bodies[body]->rigid_trace() * result.rigid_amplitudes[body];
+    }
+    result.normal_traces.push_back(trace);
     forces.push_back(force);
   }
   result.residuals = interface_residuals(gaps, graph.side(0, result.normal_traces),

@@ -8,6 +8,15 @@
 //   minimise 1/2 lambda'(sum_alpha C_alpha' F^alpha C_alpha) lambda
 //            - lambda'(sum_alpha C_alpha' e^alpha - d),  lambda >= 0,
 // u^alpha_N = e^alpha - F^alpha C_alpha lambda.
+//
+// Floating bodies (body_solver.hpp, "Floating bodies"): body alpha with k_alpha > 0 rigid
+// motions R^alpha adds the equality rows G^alpha C_alpha lambda = h^alpha (G^alpha = (B^alpha
+// R^alpha)', h^alpha = R^alpha'f^alpha) to the dual, which SMALBE-M (smalbe.hpp) solves instead
+// of MPRGP; alpha^alpha = -mu^alpha (the multiplier of its rows) and
+//   u^alpha_N = e^alpha - F^alpha C_alpha lambda + B^alpha R^alpha alpha^alpha.
+// Refused (SingularBodyError naming the floating bodies): the stacked G not of full row rank
+// (a rigid motion of floating bodies together that moves no row, e.g. two floating bodies that
+// touch only each other), or no lambda >= 0 with G lambda = h (the loads pull them away).
 
 #include <Eigen/Core>
 #include <vector>
@@ -32,6 +41,9 @@ struct MonolithicResult {
   /// u_N per body, body order (two bodies: u1_N, u2_N in pair order)
   std::vector<Eigen::VectorXd> normal_traces;
   MprgpResult qp;
+  /// alpha per body (k values; empty for a body without rigid motions): its displacement is
+  /// BodySolver::displacement(C_alpha lambda, alpha).
+  std::vector<Eigen::VectorXd> rigid_amplitudes;
   InterfaceResiduals residuals;
   double solve_seconds = 0.0;
 };

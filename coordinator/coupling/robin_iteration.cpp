@@ -365,7 +365,12 @@ namespace {
 /// The problem of two bodies and one interface from its vectors.
 CouplingProblem two_body_problem(const Eigen::VectorXd& gaps, const Eigen::VectorXd& weights,
                                  const Eigen::VectorXd& probe_forces) {
-  return {ContactGraph::two_bodies(gaps.size()), gaps, weights, probe_forces, {}};
+  CouplingProblem problem;
+  problem.graph = ContactGraph::two_bodies(gaps.size());
+  problem.gaps = gaps;
+  problem.weights = weights;
+  problem.probe_forces = probe_forces;
+  return problem;
 }
 
 }  // namespace

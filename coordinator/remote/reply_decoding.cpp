@@ -244,6 +244,11 @@ InterfaceDescription decode_interface(const protocol::InterfaceDescription& mess
   }
   decode_surfaces(message, interface);
   interface.dof_count = static_cast<int>(message.dof_count());
+  if (message.rigid_modes() > 3) {
+    throw MalformedReply("rigid_modes is " + std::to_string(message.rigid_modes()) +
+                         ", at most 3 in two dimensions");
+  }
+  interface.rigid_modes = static_cast<int>(message.rigid_modes());
   return interface;
 }
 

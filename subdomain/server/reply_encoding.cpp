@@ -45,6 +45,7 @@ void encode_interface(const std::string& body_name, const InterfaceDescription& 
                       protocol::InterfaceDescription& message) {
   message.set_body_name(body_name);
   message.set_dimension(2);
+  message.set_rigid_modes(static_cast<std::uint32_t>(interface.rigid_modes));
   for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
     message.add_node_ids(interface.node_ids[i]);
     message.add_node_tags(static_cast<std::int64_t>(interface.node_tags[i]));
