@@ -29,7 +29,8 @@ std::string format_number(double value) {
 }
 
 /// "(u_x, u_y, rotation) ~ (a, b, c)" for the rigid motion `motion` (free dofs): its
-/// least-squares coefficients on (1, 0), (0, 1), (-(y - yc), x - xc), scaled to max |.| = 1.
+/// least-squares coefficients on (1, 0), (0, 1), (-(y - yc), x - xc), scaled so that the
+/// largest in magnitude is 1.
 std::string describe_rigid_motion(const Mesh& mesh, const DofMap& dofs,
                                   const Eigen::VectorXd& motion) {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
@@ -46,7 +47,9 @@ std::string describe_rigid_motion(const Mesh& mesh, const DofMap& dofs,
     projection += row * motion[dofs.free_index(dof)];
   }
   Eigen::Vector3d coefficients = normal.ldlt().solve(projection);
-  coefficients /= coefficients.cwiseAbs().maxCoeff();
+  Eigen::Index largest = 0;
+  coefficients.cwiseAbs().maxCoeff(&largest);
+  coefficients /= coefficients[largest];  // the largest coefficient 1
   for (double& value : coefficients) {
     if (std::abs(value) < 1e-9) value = 0.0;
   }
