@@ -11,6 +11,8 @@
 //  - a floating block with a body force (u_x = 0 on its left side only: a genuine 2D state)
 //    resting on a clamped block: the Robin iteration equals the monolithic solution to 1e-8 and
 //    the total contact force equals the body force (equilibrium of the floating block, exact);
+//  - a block with no support at all (three rigid motions) in a cup of three clamped blocks: the
+//    same, with the moment of the contact forces zero (the rotation held by contact);
 //  - the ill-posed cases are refused with the errors that name the body: a floating block whose
 //    loads pull it away from its only contact, and one whose horizontal motion no contact row
 //    sees (no lateral support on a flat interface);
@@ -65,18 +67,15 @@ BodySolverOptions floating_allowed() {
   return options;
 }
 
-/// Interface k joins body k (its "top") and body k + 1 (its "bottom").
-Assembly couple_stack(std::vector<BodyDefinition> definitions) {
+/// The bodies coupled node to node through `edges`.
+Assembly couple(std::vector<BodyDefinition> definitions,
+                const std::vector<InterfaceDefinition>& edges) {
   Assembly assembly;
   std::vector<InterfaceDescription> interfaces;
   std::vector<std::string> names;
-  std::vector<InterfaceDefinition> edges;
-  for (std::size_t body = 0; body < definitions.size(); ++body) {
-    interfaces.push_back(BodySolver(definitions[body], floating_allowed()).contact_boundary());
-    names.push_back(definitions[body].name);
-    if (body + 1 < definitions.size()) {
-      edges.push_back({static_cast<int>(body), static_cast<int>(body) + 1, "top", "bottom"});
-    }
+  for (const BodyDefinition& definition : definitions) {
+    interfaces.push_back(BodySolver(definition, floating_allowed()).contact_boundary());
+    names.push_back(definition.name);
   }
   ContactOptions contact;
   contact.method = ContactMethod::node_to_node;
@@ -86,6 +85,15 @@ Assembly couple_stack(std::vector<BodyDefinition> definitions) {
   assembly.operators = std::move(coupling.operators);
   assembly.problem = std::move(coupling.problem);
   return assembly;
+}
+
+/// Interface k joins body k (its "top") and body k + 1 (its "bottom").
+Assembly couple_stack(std::vector<BodyDefinition> definitions) {
+  std::vector<InterfaceDefinition> edges;
+  for (std::size_t body = 0; body + 1 < definitions.size(); ++body) {
+    edges.push_back({static_cast<int>(body), static_cast<int>(body) + 1, "top", "bottom"});
+  }
+  return couple(std::move(definitions), edges);
 }
 
 /// The stack: u_x = 0 on every lateral side; bottom clamped; top pushed down by `push`.
@@ -317,6 +325,68 @@ TEST(FloatingBody, BlockWithBodyForceOnAClampedBlockRobinEqualsMonolithicInEquil
     expect_equals_monolithic(robin, assembly.problem, reference.result, 1e-8);
     EXPECT_NEAR(robin.state.bodies[1].contact_force.sum(), weight, 1e-9 * weight);
   }
+}
+
+/// A block [1, 2] x [0, 1] with no support at all (three rigid motions free) in a cup: a wall on
+/// its left ([0, 1] x [0, 1], clamped on its left side), one on its right ([2, 3] x [0, 1],
+/// clamped on its right side) and a bottom ([1, 2] x [-1, 0], clamped at its bottom), pushed
+/// down and to the right by a body force. Contact holds all three motions (the rotation by the
+/// bottom and the walls together).
+Assembly block_in_a_cup(const Eigen::Vector2d& body_force) {
+  const auto read = [](const std::string& name, const std::string& file, double young) {
+    BodyDefinition body;
+    body.name = name;
+    body.mesh = read_gmsh_mesh(data / file, {0.125, 1, false});
+    body.material = make_isotropic_material(young, poisson, PlaneModel::plane_strain, name);
+    return body;
+  };
+  BodyDefinition left = read("left wall", "row_block_left.geo", 1000.0);
+  left.dirichlet.push_back({"left", 0.0, 0.0});
+  left.contact_boundaries = {"right"};
+  BodyDefinition floating = read("block", "row_block_middle.geo", 300.0);
+  floating.body_force = body_force;
+  floating.contact_boundaries = {"left", "right", "bottom"};
+  BodyDefinition right = read("right wall", "row_block_right.geo", 1000.0);
+  right.dirichlet.push_back({"right", 0.0, 0.0});
+  right.contact_boundaries = {"left"};
+  BodyDefinition bottom = read("bottom", "cup_bottom.geo", 2000.0);
+  bottom.dirichlet.push_back({"bottom", 0.0, 0.0});
+  bottom.contact_boundaries = {"top"};
+  return couple({left, floating, right, bottom},
+                {{0, 1, "right", "left"}, {1, 2, "right", "left"}, {3, 1, "top", "bottom"}});
+}
+
+TEST(FloatingBody, UnsupportedBlockInACupRobinEqualsMonolithicInEquilibrium) {
+  const Eigen::Vector2d body_force(2.0, -5.0);
+  const Assembly cup = block_in_a_cup(body_force);
+  ASSERT_EQ(cup.problem.rigid_modes, (std::vector<int>{0, 3, 0, 0}));
+  const MonolithicAssembly reference = solve_monolithic_assembly(cup);
+  ASSERT_EQ(reference.result.qp.status, QpStatus::converged) << reference.result.qp.message;
+  // Equilibrium of the block (area 1): the contact forces on it, -B' lambda, balance the body
+  // force, and their moment about its centre (1.5, 0.5) is zero as the body force's.
+  const Eigen::VectorXd force = cup.problem.graph.body_part(1, reference.result.contact_force);
+  const Eigen::VectorXd field = reference.bodies[1]->contact_force_field(force);
+  const Mesh& mesh = reference.bodies[1]->mesh();
+  Eigen::Vector2d resultant = Eigen::Vector2d::Zero();
+  double moment = 0.0;
+  for (std::size_t node = 0; node < mesh.node_count(); ++node) {
+    const Eigen::Vector2d nodal = field.segment<2>(2 * static_cast<Eigen::Index>(node));
+    const Eigen::Vector2d arm = mesh.nodes[node] - Eigen::Vector2d(1.5, 0.5);
+    resultant += nodal;
+    moment += arm.x() * nodal.y() - arm.y() * nodal.x();
+  }
+  const double scale = body_force.norm();
+  std::printf("block in a cup: contact resultant + body force = (%.2e, %.2e), moment %.2e\n",
+              resultant.x() + body_force.x(), resultant.y() + body_force.y(), moment);
+  EXPECT_LE((resultant + body_force).norm(), 1e-11 * scale);
+  EXPECT_LE(std::abs(moment), 1e-11 * scale);
+  Ports ports;
+  set_up_ports(cup, ports);
+  const RobinResult robin = run_robin(ports, "iqn-ils", 1e-10);
+  std::printf("block in a cup, iqn-ils: %s after %zu iterations (%s)\n",
+              to_string(robin.status).c_str(), robin.history.size(), robin.algorithm.c_str());
+  ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
+  expect_equals_monolithic(robin, cup.problem, reference.result, 1e-8);
 }
 
 /// The message of the SingularBodyError thrown by `action`, or "" when none is thrown.
