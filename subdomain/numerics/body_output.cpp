@@ -58,13 +58,18 @@ const std::vector<std::string>& stress_tensor_components() {
 }
 
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force) {
+  return make_body_output(body, contact_force, body.rigid_amplitudes());
+}
+
+BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force,
+                            const Eigen::VectorXd& rigid_amplitudes) {
   if (contact_force.size() != body.contact_size()) {
     throw std::invalid_argument(
         "body '" + body.name() + "': " + std::to_string(contact_force.size()) +
         " contact forces for " + std::to_string(body.contact_size()) + " contact constraints");
   }
   const Material& material = body.definition().material;
-  const Eigen::VectorXd displacement = body.displacement(contact_force);
+  const Eigen::VectorXd displacement = body.displacement(contact_force, rigid_amplitudes);
   const StressField stress = recover_stress(body.mesh(), material, displacement);
   const Eigen::VectorXd reaction = body.reactions(displacement);
   const Eigen::VectorXd force_field = body.contact_force_field(contact_force);

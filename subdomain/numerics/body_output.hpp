@@ -29,8 +29,13 @@ struct BodyOutput {
 /// a Voigt material (numerics/material.hpp); von_mises is of the same three-dimensional tensor.
 const std::vector<std::string>& stress_tensor_components();
 
-/// Fields of `body` under contact forces lambda (constraint order of its assignment).
+/// Fields of `body` under contact forces lambda (constraint order of its assignment); a floating
+/// body (body_solver.hpp) with the rigid amplitudes of its last contact solve.
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force);
+/// The same with given rigid amplitudes alpha (k values, empty for k = 0), e.g. the monolithic
+/// reference's (MonolithicResult::rigid_amplitudes).
+BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force,
+                            const Eigen::VectorXd& rigid_amplitudes);
 
 /// Writes <directory>/<body_name>.vtu (numerics/vtu_writer.hpp: binary zlib-compressed, with the
 /// mesh's named boundaries as line cells); returns the file name.

@@ -228,6 +228,7 @@ void BodySolver::assemble() {
                                                  trailing_unknowns(), options_.maximum_factor_bytes,
                                                  options_.observer);
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
+  rigid_amplitudes_ = Eigen::VectorXd::Zero(rigid_mode_count());
   // the ordering as the factor measured it; the rest (numerical factorization, K^{-1} f) here
   timings_.ordering_seconds = factor_->ordering_seconds();
   timings_.factorization_seconds = seconds_since(start) - timings_.ordering_seconds;
