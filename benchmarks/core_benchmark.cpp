@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
   robin::BodySolver& body = *problem.bodies[1];  // the pushed body: its local problem has contact
   const int dofs = problem.bodies[0]->free_dof_count() + problem.bodies[1]->free_dof_count();
   std::printf("h=%g dofs=%d contact_pairs=%zu mesh_seconds=%.3f", size, dofs,
-              problem.pairing.size(), problem.mesh_seconds);
+              problem.pairing().size(), problem.mesh_seconds);
   double assembly = 0, factorization = 0, interface = 0;
   long factor_nonzeros = 0;
   for (const auto& each : problem.bodies) {
@@ -76,17 +76,17 @@ int main(int argc, char** argv) {
   const Eigen::VectorXd field = body.displacement(ones);  // one solve with the factor
   std::printf(" one_solve_seconds=%.4f", seconds_since(start));
 
-  const Eigen::VectorXd gaps = problem.pairing.gaps();
+  const Eigen::VectorXd gaps = problem.pairing().gaps();
   report_contact_solve("dense", body, gaps, definition.solver.qp);
   robin::BodySolverOptions factor_options;
   factor_options.interface_operator = robin::InterfaceOperatorKind::factor;
   robin::BodySolver matrix_free(body.definition(), factor_options);
-  matrix_free.assign_contact(problem.pairing.assignment(1));
+  matrix_free.assign_contact(problem.pairing().assignment(1));
   report_contact_solve("factor", matrix_free, gaps, definition.solver.qp);
 
   start = Clock::now();
   const robin::MonolithicResult monolithic = robin::solve_monolithic(
-      *problem.bodies[0], *problem.bodies[1], problem.pairing, definition.solver.qp);
+      *problem.bodies[0], *problem.bodies[1], problem.pairing(), definition.solver.qp);
   std::printf(" monolithic_seconds=%.4f monolithic_iterations=%d monolithic_status=%s",
               seconds_since(start), monolithic.qp.iterations,
               robin::to_string(monolithic.qp.status).c_str());

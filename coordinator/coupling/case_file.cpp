@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "coupling/case_file_body.hpp"
+#include "coupling/case_file_interface.hpp"
 #include "coupling/case_file_loading.hpp"
 #include "coupling/case_file_overrides.hpp"
 #include "coupling/case_file_table.hpp"
@@ -15,7 +16,7 @@ namespace robin {
 namespace {
 
 const std::vector<std::string> root_keys{"title",   "gap",  "solver",  "coupling",
-                                         "contact", "body", "loading", "reference"};
+                                         "contact", "body", "loading", "reference", "interface"};
 const std::vector<std::string> contact_keys{"method", "non_mortar"};
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
@@ -216,26 +217,43 @@ void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
   read_algorithm(*table, coupling);
 }
 
-void read_bodies(const CheckedTable& root, const std::filesystem::path& directory,
-                 CaseDefinition& definition) {
+/// The [[body]] tables: exactly two without [[interface]] tables, 2 to maximum_body_count with
+/// them; names unique. Returns the entries (for the lines of later messages).
+std::vector<TableEntry> read_bodies(const CheckedTable& root, const std::filesystem::path& directory,
+                                    CaseDefinition& definition) {
   const std::vector<TableEntry> entries = root.array_of_tables("body");
-  if (entries.size() != 2) {
-    const int line = entries.size() > 2      ? line_of(*entries[2].table)
+  const bool graph = root.contains("interface");
+  const std::size_t most = graph ? maximum_body_count : 2;
+  if (entries.size() < 2 || entries.size() > most) {
+    const int line = entries.size() > most   ? line_of(*entries[most].table)
                      : root.contains("body") ? root.line("body")
                                              : 0;
-    throw InputError(root.context().prefix(line) +
-                     ": expected exactly two [[body]] tables, found " +
-                     std::to_string(entries.size()));
+    const std::string expected =
+        graph ? "between two and " + std::to_string(most) + " [[body]] tables"
+              : std::string("exactly two [[body]] tables");
+    const std::string hint = graph || entries.size() < 2
+                                 ? ""
+                                 : " (a case of more bodies names its contact interfaces in "
+                                   "[[interface]] tables)";
+    throw InputError(root.context().prefix(line) + ": expected " + expected + ", found " +
+                     std::to_string(entries.size()) + hint);
   }
-  for (std::size_t index = 0; index < 2; ++index) {
-    definition.bodies[index] = read_body_case(entries[index], root.context(), directory);
+  const ContactBoundaryKey contact_key =
+      graph ? ContactBoundaryKey::refused : ContactBoundaryKey::required;
+  for (std::size_t index = 0; index < entries.size(); ++index) {
+    definition.bodies.push_back(
+        read_body_case(entries[index], root.context(), directory, contact_key));
+    for (std::size_t earlier = 0; earlier < index; ++earlier) {
+      if (definition.bodies[earlier].definition.name != definition.bodies[index].definition.name)
+        continue;
+      CaseContext context = root.context();
+      context.body = definition.bodies[index].definition.name;
+      throw InputError(context.prefix(line_of(*(*entries[index].table).get("name"))) + ": body[" +
+                       std::to_string(index + 1) + "].name: duplicates the name of body[" +
+                       std::to_string(earlier + 1) + "]; body names must differ");
+    }
   }
-  if (definition.bodies[0].definition.name == definition.bodies[1].definition.name) {
-    CaseContext second = root.context();
-    second.body = definition.bodies[1].definition.name;
-    throw InputError(second.prefix(line_of(*(*entries[1].table).get("name"))) +
-                     ": body[2].name: duplicates the name of body[1]; body names must differ");
-  }
+  return entries;
 }
 
 std::string join_boundary_names(const Mesh& mesh) {
@@ -274,6 +292,20 @@ AccelerationOptions effective_acceleration(const CouplingOptions& options) {
   return acceleration;
 }
 
+std::vector<InterfaceDefinition> interface_definitions(const CaseDefinition& definition) {
+  std::vector<InterfaceDefinition> interfaces;
+  for (const InterfaceCase& interface : definition.interfaces) {
+    interfaces.push_back(interface.definition);
+  }
+  return interfaces;
+}
+
+std::vector<std::string> body_names(const CaseDefinition& definition) {
+  std::vector<std::string> names;
+  for (const BodyCase& body : definition.bodies) names.push_back(body.definition.name);
+  return names;
+}
+
 /// read_case_file without the mention of the overrides in its errors.
 static CaseDefinition read_case_document(const std::filesystem::path& path,
                                          const std::vector<std::string>& overrides) {
@@ -291,15 +323,16 @@ static CaseDefinition read_case_document(const std::filesystem::path& path,
   read_coupling(root, definition.coupling);
   read_contact(root, definition.contact);
   definition.loading = read_loading(root);  // [loading]: coupling/case_file_loading.hpp
-  read_bodies(root, path.parent_path(), definition);
-  definition.reference = read_reference(root);  // after the bodies: their materials give E*
+  const std::vector<TableEntry> bodies = read_bodies(root, path.parent_path(), definition);
+  const std::vector<std::string> names = body_names(definition);
   if (!definition.contact.non_mortar.empty() &&
-      definition.contact.non_mortar != definition.bodies[0].definition.name &&
-      definition.contact.non_mortar != definition.bodies[1].definition.name) {
+      std::find(names.begin(), names.end(), definition.contact.non_mortar) == names.end()) {
     const auto table = root.optional_table("contact", contact_keys);
     table->fail("non_mortar",
                 "'" + definition.contact.non_mortar + "' is not the name of a body (nor \"auto\")");
   }
+  read_interfaces(root, bodies, definition);  // [[interface]]: coupling/case_file_interface.hpp
+  definition.reference = read_reference(root);  // after the bodies: their materials give E*
   return definition;
 }
 

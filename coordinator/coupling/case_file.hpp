@@ -1,6 +1,7 @@
 #pragma once
-// The TOML case format (docs/case-format.md): two bodies, an optional gap function,
-// solver and coupling options. Unknown keys are errors.
+// The TOML case format (docs/case-format.md): the bodies (two, or N >= 2 with their contact
+// interfaces in [[interface]] tables), an optional gap function, solver and coupling options.
+// Unknown keys are errors.
 
 #include <array>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "coupling/case_file_loading.hpp"
 #include "coupling/case_file_reference.hpp"
 #include "coupling/contact_discretization.hpp"
+#include "coupling/contact_interface.hpp"
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/gmsh_reader.hpp"
@@ -36,7 +38,8 @@ struct BodyCase {
   /// "case.toml:27: body 'upper': body[2].mesh", where the mesh is named (for mesh errors:
   /// Gmsh syntax errors, meshes without physical groups); empty for a BodyCase built by hand.
   std::string mesh_context;
-  /// contact_boundary, then every dirichlet and traction boundary, in file order. When empty
+  /// contact_boundary (or the body's boundaries in [[interface]] tables), then every dirichlet
+  /// and traction boundary, in file order. When empty
   /// (a BodyCase built by hand), load_body checks the names in `definition` instead.
   std::vector<BoundaryReference> boundary_references;
 };
@@ -77,16 +80,29 @@ struct SolverOptions {
   double pairing_tolerance = 1e-6;  // relative to the shortest contact edge
 };
 
+/// One [[interface]] table (or the one interface of a two-body case without them).
+struct InterfaceCase {
+  InterfaceDefinition definition;  // bodies (indices into CaseDefinition::bodies), boundaries
+  std::string context;             // "case.toml:41: interface[2]" for messages
+};
+
+/// The most bodies a case may have.
+inline constexpr std::size_t maximum_body_count = 256;
+
 struct CaseDefinition {
   std::filesystem::path file;
   std::string title;
-  std::array<BodyCase, 2> bodies;
+  /// Two or more bodies, in file order; body alpha's definition.contact_boundaries are the
+  /// boundaries its interfaces name, in interface order, each once.
+  std::vector<BodyCase> bodies;
+  /// The contact interfaces, at least one; every body is in at least one.
+  std::vector<InterfaceCase> interfaces;
   std::optional<std::string> gap_expression;
   std::map<std::string, double> gap_constants;
   std::string gap_context;  // "case.toml:12: gap.expression", the GapFunction context
   SolverOptions solver;
   CouplingOptions coupling;
-  ContactOptions contact;  // [contact]: node-to-node or mortar
+  ContactOptions contact;  // [contact]: node-to-node or mortar (interfaces may override it)
   /// The command-line overrides applied to the file, in order, as given ("KEY=VALUE", see
   /// case_file_overrides.hpp); empty when the file is read as it is.
   std::vector<std::string> overrides;
@@ -100,6 +116,11 @@ struct CaseDefinition {
 /// The acceleration options with the per-body relaxations resolved (relaxation1/2, else
 /// relaxation).
 AccelerationOptions effective_acceleration(const CouplingOptions& options);
+
+/// The interfaces of `definition` as the contact graph's coupling takes them.
+std::vector<InterfaceDefinition> interface_definitions(const CaseDefinition& definition);
+/// The body names, in body order.
+std::vector<std::string> body_names(const CaseDefinition& definition);
 
 /// `message` about the case in `case_file`, prefixed with the file's path unless it already
 /// names it (errors raised after reading: a body left with a rigid motion, unmatched contact

@@ -167,7 +167,7 @@ std::string format_number(double value) {
 }
 
 BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
-                        const std::filesystem::path& directory) {
+                        const std::filesystem::path& directory, ContactBoundaryKey contact_key) {
   // The name goes into every later message, so it is looked at before the keys are checked.
   const auto name_node = (*entry.table)["name"].value<std::string>();
   CaseContext context = file;
@@ -183,9 +183,14 @@ BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
   body.context = file.file + ": body '" + definition.name + "'";
   read_mesh(table, directory, body);
   const PlaneModel model = read_model(table);
-  // One contact boundary per body in the case file (for now): a one-element list.
-  definition.contact_boundaries = {
-      read_boundary_name(table, "contact_boundary", body.boundary_references)};
+  if (contact_key == ContactBoundaryKey::required) {
+    definition.contact_boundaries = {
+        read_boundary_name(table, "contact_boundary", body.boundary_references)};
+  } else if (table.contains("contact_boundary")) {
+    table.fail("contact_boundary",
+               "the case has [[interface]] tables: give the contact boundaries there "
+               "(interface.boundaries)");
+  }
   definition.body_force = table.optional_vector("body_force").value_or(Eigen::Vector2d::Zero());
   definition.material = read_material(table, model);
   for (const TableEntry& item : table.array_of_tables("dirichlet")) {

@@ -8,11 +8,15 @@
 
 namespace robin {
 
+/// Whether a [[body]] table names its contact boundary: required in a case of two bodies
+/// without [[interface]] tables, refused in a case with them (the interfaces name boundaries).
+enum class ContactBoundaryKey { required, refused };
+
 /// Reads and checks the [[body]] table `entry` (keys, types, ranges, material, mesh file
 /// existence and options). Relative mesh paths are resolved against `directory`.
 /// `file` carries the case file label (its body part is ignored). Throws InputError.
 BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
-                        const std::filesystem::path& directory);
+                        const std::filesystem::path& directory, ContactBoundaryKey contact_key);
 
 /// Formats a number for messages (up to 12 significant digits).
 std::string format_number(double value);

@@ -187,6 +187,19 @@ std::optional<std::string> CheckedTable::optional_choice(
   return value;
 }
 
+std::array<std::string, 2> CheckedTable::string_pair(std::string_view key) const {
+  const toml::node& node = required(key);
+  const auto* array = node.as_array();
+  if (array == nullptr || array->size() != 2) fail(key, "expected an array of two strings");
+  std::array<std::string, 2> pair;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto value = array->get(i)->value<std::string>();
+    if (!value || value->empty()) fail(key, "expected an array of two non-empty strings");
+    pair[i] = *value;
+  }
+  return pair;
+}
+
 std::optional<Eigen::Vector2d> CheckedTable::optional_vector(std::string_view key) const {
   const toml::node* node = table_.get(key);
   if (node == nullptr) return std::nullopt;

@@ -10,6 +10,7 @@
 
 #include <toml++/toml.h>
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -73,6 +74,8 @@ class CheckedTable {
                                              const std::vector<std::string>& choices) const;
   /// [a, b] of two numbers.
   std::optional<Eigen::Vector2d> optional_vector(std::string_view key) const;
+  /// ["a", "b"] of two non-empty strings (required).
+  std::array<std::string, 2> string_pair(std::string_view key) const;
   /// [[a, b, c], [d, e, f], [g, h, i]] of numbers, by rows.
   std::optional<Eigen::Matrix3d> optional_matrix(std::string_view key) const;
   /// A table whose keys are free names and whose values are numbers.

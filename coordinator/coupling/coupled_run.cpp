@@ -6,9 +6,11 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "coupling/checkpoint_encoding.hpp"
+#include "coupling/interface_outputs.hpp"
 #include "coupling/iteration_checkpoint.hpp"
 #include "coupling/local_problem.hpp"
 
@@ -25,6 +27,21 @@ PortTimings difference(const PortTimings& later, const PortTimings& earlier) {
   return {later.compute_seconds - earlier.compute_seconds,
           later.round_trip_seconds - earlier.round_trip_seconds,
           later.bytes_sent - earlier.bytes_sent, later.bytes_received - earlier.bytes_received};
+}
+
+std::vector<PortTimings> differences(const std::vector<PortTimings>& later,
+                                     const std::vector<PortTimings>& earlier) {
+  std::vector<PortTimings> result;
+  for (std::size_t alpha = 0; alpha < later.size(); ++alpha) {
+    result.push_back(difference(later[alpha], earlier.at(alpha)));
+  }
+  return result;
+}
+
+/// "both bodies" or "the 4 bodies", for progress lines.
+std::string every_body(const RecoverablePorts& ports) {
+  return ports.body_count() == 2 ? "both bodies"
+                                 : "the " + std::to_string(ports.body_count()) + " bodies";
 }
 
 /// A server's refusal of a body's setup, with the place in the case file it is about: a body
@@ -68,31 +85,39 @@ std::string message_of(const std::exception_ptr& failure) {
   }
 }
 
-/// Calls `request(port, alpha)` on both ports concurrently and returns both results. After both
-/// have finished, a failure of one body is rethrown as it is; failures of both bodies become
-/// one PortError carrying both messages (each names its server, body and step).
+/// Calls `request(port, alpha)` on every port concurrently and returns the results in port
+/// order. After all have finished, a failure of one body is rethrown as it is; failures of
+/// several bodies become one PortError carrying every message (each names its server, body and
+/// step).
 template <typename Request>
-auto on_both_ports(const std::array<SubdomainPort*, 2>& ports, Request request) {
-  auto second = std::async(std::launch::async, [&] { return request(*ports[1], 1); });
-  std::array<std::exception_ptr, 2> failures;
-  decltype(request(*ports[0], 0)) first{}, other{};
-  try {
-    first = request(*ports[0], 0);
-  } catch (...) {
-    failures[0] = std::current_exception();
+auto on_every_port(const std::vector<SubdomainPort*>& ports, Request request) {
+  using Result = decltype(request(*ports[0], 0));
+  std::vector<std::future<Result>> others;
+  for (std::size_t alpha = 1; alpha < ports.size(); ++alpha) {
+    others.push_back(std::async(std::launch::async, [&, alpha] {
+      return request(*ports[alpha], static_cast<int>(alpha));
+    }));
   }
-  try {
-    other = second.get();
-  } catch (...) {
-    failures[1] = std::current_exception();
+  std::vector<Result> results(ports.size());
+  std::vector<std::exception_ptr> failures(ports.size());
+  for (std::size_t alpha = 0; alpha < ports.size(); ++alpha) {
+    try {
+      results[alpha] = alpha == 0 ? request(*ports[0], 0) : others[alpha - 1].get();
+    } catch (...) {
+      failures[alpha] = std::current_exception();
+    }
   }
-  if (failures[0] && failures[1]) {
-    throw PortError(message_of(failures[0]) + "\n  and " + message_of(failures[1]));
-  }
+  std::vector<std::exception_ptr> failed;
   for (const std::exception_ptr& failure : failures) {
-    if (failure) std::rethrow_exception(failure);
+    if (failure) failed.push_back(failure);
   }
-  return std::array<decltype(first), 2>{std::move(first), std::move(other)};
+  if (failed.size() == 1) std::rethrow_exception(failed.front());
+  if (failed.size() > 1) {
+    std::string message = message_of(failed.front());
+    for (std::size_t k = 1; k < failed.size(); ++k) message += "\n  and " + message_of(failed[k]);
+    throw PortError(message);
+  }
+  return results;
 }
 
 /// The displacement of the output node nearest to `point` (node ids are opaque to the
@@ -114,24 +139,13 @@ Eigen::Vector2d displacement_near(const BodyOutput& output, const Eigen::Vector2
 
 /// The excluded pairs in the final state, scaled by the included pairs' gaps and traces.
 ExcludedPairClearance excluded_clearance(const CoupledRunResult& result) {
-  const RobinResult& iteration = result.iteration;
-  double scale = 0.0;
-  for (const BodyInterfaceState& body : iteration.state.bodies) {
-    if (body.normal_trace.size() > 0) {
-      scale = std::max(scale, body.normal_trace.cwiseAbs().maxCoeff());
-    }
-  }
-  if (result.pairing.size() > 0)
-    scale = std::max(scale, result.pairing.gaps().cwiseAbs().maxCoeff());
-  const auto displacement_of = [&](int body, const ContactPair& pair) {
-    return displacement_near(result.outputs[body], body == 0 ? pair.position : pair.position2);
+  const auto displacement_of = [&](int body, const ContactPair& pair, int side) {
+    return displacement_near(result.outputs.at(static_cast<std::size_t>(body)),
+                             side == 0 ? pair.position : pair.position2);
   };
-  return excluded_pair_clearance(result.pairing, displacement_of, scale);
+  return graph_excluded_clearance(result.coupling, result.iteration.state, displacement_of);
 }
 
-/// The load steps of a case with [loading] on ports whose contact is assigned (see
-/// run_coupled_case). Fills result.steps and, from the last step computed, result.iteration,
-/// outputs and iteration_port_timings; result.excluded_clearance is the worst over the steps.
 /// The start of load step `factor` from the fixed points of the steps before it: the linear
 /// extrapolation x_p + (t - t_p) / (t_p - t_q) (x_p - x_q) through the last two, (t_q, x_q) and
 /// (t_p, x_p), or x_p alone when there is one or the factors coincide. In a fixed active set the
@@ -150,17 +164,19 @@ Eigen::VectorXd predicted_start(const std::vector<std::pair<double, Eigen::Vecto
 /// fixed point at load factor 0: with no load and no prescribed displacement u = 0, so for
 /// "robin", "robin-constant" and "dirichlet-neumann" H(x) = d when no gap is negative.
 bool start_is_the_unloaded_fixed_point(const CouplingOptions& options,
-                                       const ContactPairing& pairing) {
+                                       const CouplingProblem& problem) {
   const bool obstacle_scheme = options.algorithm == "robin" ||
                                options.algorithm == "robin-constant" ||
                                options.algorithm == "dirichlet-neumann";
-  return obstacle_scheme && options.initial_obstacle == "gap" && pairing.size() > 0 &&
-         pairing.gaps().minCoeff() >= 0.0;
+  return obstacle_scheme && options.initial_obstacle == "gap" && problem.gaps.size() > 0 &&
+         problem.gaps.minCoeff() >= 0.0;
 }
 
-/// The timings of both bodies' ports (the replaced ones included).
-std::array<PortTimings, 2> port_timings(const RecoverablePorts& ports) {
-  return {ports.timings(0), ports.timings(1)};
+/// The timings of every body's ports (the replaced ones included).
+std::vector<PortTimings> port_timings(const RecoverablePorts& ports) {
+  std::vector<PortTimings> timings;
+  for (int alpha = 0; alpha < ports.body_count(); ++alpha) timings.push_back(ports.timings(alpha));
+  return timings;
 }
 
 /// The iteration on the recoverable ports: after a lost server, it continues from its last
@@ -168,7 +184,7 @@ std::array<PortTimings, 2> port_timings(const RecoverablePorts& ports) {
 /// contact warm start to where the iteration found it (the load steps before it) and is called
 /// before every attempt after a lost server, and before the first when `behind`. The iteration's
 /// last checkpoint goes to `last` when it is not null.
-RobinResult recoverable_iteration(RecoverablePorts& ports, const ContactPairing& pairing,
+RobinResult recoverable_iteration(RecoverablePorts& ports, const CouplingProblem& problem,
                                   const CouplingOptions& options,
                                   const Eigen::VectorXd* initial_iterate,
                                   const IterationCheckpoint* resume,
@@ -198,41 +214,40 @@ RobinResult recoverable_iteration(RecoverablePorts& ports, const ContactPairing&
       }
     }
     loop.resume = start;
-    return run_robin_iteration(ports.port(0), ports.port(1), pairing, options, initial_iterate,
-                               loop, observer.iteration);
+    return run_robin_iteration(ports.ports(), problem, options, initial_iterate, loop,
+                               observer.iteration);
   });
   if (last != nullptr) *last = std::move(latest);
   return result;
 }
 
-/// Both bodies' fields for the iteration's contact forces.
-std::array<BodyOutput, 2> collect_fields(RecoverablePorts& ports, const RobinResult& iteration) {
+/// Every body's fields for the iteration's contact forces.
+std::vector<BodyOutput> collect_fields(RecoverablePorts& ports, const RobinResult& iteration) {
   return ports.run([&] {
-    return on_both_ports(ports.ports(), [&](SubdomainPort& port, int alpha) {
+    return on_every_port(ports.ports(), [&](SubdomainPort& port, int alpha) {
       return port.fields(iteration.state.bodies[static_cast<std::size_t>(alpha)].contact_force);
     });
   });
 }
 
 /// Only the contact solves of the iterations at `iterates` (x_1, x_2, ...) of a run of the
-/// iteration with `options` on `pairing` (the two-body problem of run_robin_iteration), results
-/// discarded: the servers' contact warm start after them is the one that run left
-/// (CouplingScheme::repeat_contact_solves). Throws PortError as the iteration does.
-void repeat_contact_solves(SubdomainPort& body1, SubdomainPort& body2,
-                           const ContactPairing& pairing, const CouplingOptions& options,
+/// iteration with `options` on `problem`, results discarded: the servers' contact warm start
+/// after them is the one that run left (CouplingScheme::repeat_contact_solves). Throws PortError
+/// as the iteration does.
+void repeat_contact_solves(const std::vector<SubdomainPort*>& ports,
+                           const CouplingProblem& problem, const CouplingOptions& options,
                            const std::vector<Eigen::VectorXd>& iterates) {
   if (iterates.empty()) return;
-  const std::unique_ptr<CouplingScheme> scheme =
-      make_coupling_scheme(options, {&body1, &body2}, two_body_problem(pairing));
+  const std::unique_ptr<CouplingScheme> scheme = make_coupling_scheme(options, ports, problem);
   for (std::size_t index = 0; index < iterates.size(); ++index) {
     scheme->repeat_contact_solves(iterates[index], static_cast<int>(index) + 1);
   }
 }
 
-/// Sets the load factor of both bodies (and of their replacements).
+/// Sets the load factor of every body (and of their replacements).
 void set_load_factor(RecoverablePorts& ports, double factor) {
   ports.run([&] {
-    on_both_ports(ports.ports(), [&](SubdomainPort& port, int) {
+    on_every_port(ports.ports(), [&](SubdomainPort& port, int) {
       port.set_load_factor(factor);
       return 0;
     });
@@ -288,7 +303,7 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
                                  " load steps before (the servers' warm start)");
       for (const auto& [earlier, iterates] : solved) {
         set_load_factor(ports, earlier);
-        repeat_contact_solves(ports.port(0), ports.port(1), result.pairing, options, iterates);
+        repeat_contact_solves(ports.ports(), result.coupling.problem, options, iterates);
       }
       set_load_factor(ports, factor);
     };
@@ -307,22 +322,22 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
           << (step.warm_started ? ", starting from the previous steps" : "")
           << (done_before ? " (completed before the checkpoint: collecting its fields)" : "");
     report_stage(observer, stage.str());
-    const std::array<PortTimings, 2> before = port_timings(ports);
+    const std::vector<PortTimings> before = port_timings(ports);
     set_load_factor(ports, step.factor);
-    const std::array<PortTimings, 2> before_iteration = port_timings(ports);
+    const std::vector<PortTimings> before_iteration = port_timings(ports);
     const Eigen::VectorXd start =
         step.warm_started ? predicted_start(points, step.factor) : Eigen::VectorXd();
     const auto iteration_start = Clock::now();
     std::optional<IterationCheckpoint> last;
     if (done_before) {
-      step.iteration = recoverable_iteration(ports, result.pairing, options, nullptr, resume, {},
-                                             observer, {}, false, &last);
+      step.iteration = recoverable_iteration(ports, result.coupling.problem, options, nullptr,
+                                             resume, {}, observer, {}, false, &last);
     } else {
       // a loop resumed after it stopped makes no request: the servers stay behind
       const bool stopped = resume != nullptr && resume->stopped;
       behind = behind || result.recoveries.size() != recoveries;
       step.iteration = recoverable_iteration(
-          ports, result.pairing, options, step.warm_started ? &start : nullptr, resume,
+          ports, result.coupling.problem, options, step.warm_started ? &start : nullptr, resume,
           continuation.checkpoint, observer,
           solved.empty() ? std::function<void()>() : catch_up(step.factor), behind && !stopped,
           &last);
@@ -330,11 +345,8 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
       recoveries = result.recoveries.size();
     }
     result.profile.iterations_seconds += seconds_since(iteration_start);
-    for (int alpha = 0; alpha < 2; ++alpha) {
-      result.iteration_port_timings[alpha] =
-          difference(ports.timings(alpha), before_iteration[alpha]);
-    }
-    report_stage(observer, "collecting the fields of both bodies (load step " +
+    result.iteration_port_timings = differences(port_timings(ports), before_iteration);
+    report_stage(observer, "collecting the fields of " + every_body(ports) + " (load step " +
                                std::to_string(step.step) + ")");
     const auto fields_start = Clock::now();
     step.outputs = collect_fields(ports, step.iteration);
@@ -342,15 +354,13 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
     result.iteration = step.iteration;
     result.outputs = step.outputs;
     step.excluded_clearance = excluded_clearance(result);
-    for (int alpha = 0; alpha < 2; ++alpha) {
-      step.port_timings[alpha] = difference(ports.timings(alpha), before[alpha]);
-    }
+    step.port_timings = differences(port_timings(ports), before);
     step.seconds = done_before ? resumed[k].seconds : seconds_since(step_start);
     if (result.steps.empty() || step.excluded_clearance.relative_penetration >
                                     result.excluded_clearance.relative_penetration) {
       result.excluded_clearance = step.excluded_clearance;
     }
-    if (points.empty() && start_is_the_unloaded_fixed_point(options, result.pairing)) {
+    if (points.empty() && start_is_the_unloaded_fixed_point(options, result.coupling.problem)) {
       points.emplace_back(0.0, step.iteration.initial_iterate);
     }
     points.emplace_back(step.factor, step.iteration.restart_iterate);
@@ -371,34 +381,69 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
   }
 }
 
-/// Sets both bodies up (each once, also across recoveries) and returns their interfaces.
-std::array<InterfaceDescription, 2> set_up_bodies(RecoverablePorts& ports,
-                                                  const CaseDefinition& loaded) {
+/// Sets every body up (each once, also across recoveries) and returns their interfaces.
+std::vector<InterfaceDescription> set_up_bodies(RecoverablePorts& ports,
+                                                const CaseDefinition& loaded) {
   ports.run([&] {
-    on_both_ports(ports.ports(), [&](SubdomainPort& port, int alpha) {
+    on_every_port(ports.ports(), [&](SubdomainPort& port, int alpha) {
       if (ports.interface(alpha)) return 0;
+      const BodyCase& body = loaded.bodies[static_cast<std::size_t>(alpha)];
       try {
-        ports.interface(alpha) = port.setup(loaded.bodies[alpha], loaded.solver);
+        ports.interface(alpha) = port.setup(body, loaded.solver);
       } catch (const PortError& error) {
-        throw PortError(in_body_case(loaded.bodies[alpha], error.what()));
+        throw PortError(in_body_case(body, error.what()));
       }
       return 0;
     });
   });
-  return {*ports.interface(0), *ports.interface(1)};
+  std::vector<InterfaceDescription> interfaces;
+  for (int alpha = 0; alpha < ports.body_count(); ++alpha) {
+    interfaces.push_back(*ports.interface(alpha));
+  }
+  return interfaces;
+}
+
+/// The contact rows of every interface from the servers' descriptions; errors name the file.
+GraphCoupling couple_interfaces(const CaseDefinition& definition,
+                                const std::vector<InterfaceDescription>& interfaces) {
+  const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
+  return couple_contact_graph(interfaces, body_names(definition),
+                              interface_definitions(definition), gap.get(), definition.contact,
+                              definition.solver.pairing_tolerance);
+}
+
+/// The iteration of a case without [loading], and its fields.
+void run_single_solve(RecoverablePorts& recoverable, const CouplingOptions& options,
+                      const RunObserver& observer, const RunContinuation& continuation,
+                      CoupledRunResult& result) {
+  const std::vector<PortTimings> before = port_timings(recoverable);
+  const auto iteration_start = Clock::now();
+  result.iteration =
+      recoverable_iteration(recoverable, result.coupling.problem, options, nullptr,
+                            continuation.resume, continuation.checkpoint, observer);
+  result.profile.iterations_seconds = seconds_since(iteration_start);
+  result.iteration_port_timings = differences(port_timings(recoverable), before);
+  report_stage(observer, "collecting the fields of " + every_body(recoverable));
+  const auto fields_start = Clock::now();
+  result.outputs = collect_fields(recoverable, result.iteration);
+  result.profile.fields_seconds = seconds_since(fields_start);
+  result.excluded_clearance = excluded_clearance(result);
 }
 
 }  // namespace
 
 CoupledRunResult run_coupled_case(const CaseDefinition& definition,
-                                  const std::array<SubdomainPort*, 2>& ports,
+                                  const std::vector<SubdomainPort*>& ports,
                                   const CouplingOptions& options, const RunObserver& observer,
                                   const RunContinuation& continuation) {
   const auto start = Clock::now();
   CoupledRunResult result;
   result.profile.launch_seconds = seconds_launched();
   result.options = options;
-  report_stage(observer, "reading and meshing both bodies");
+  const std::string bodies = definition.bodies.size() == 2
+                                 ? std::string("both bodies")
+                                 : "the " + std::to_string(definition.bodies.size()) + " bodies";
+  report_stage(observer, "reading and meshing " + bodies);
   CaseDefinition loaded = definition;
   load_meshes(loaded);
   result.meshing_seconds = seconds_since(start);
@@ -408,56 +453,48 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                  result.recoveries.push_back(text);
                                  report_warning(observer, text);
                                });
-  report_stage(observer, "setting up both bodies (assembly, factorization)");
+  report_stage(observer, "setting up " + bodies + " (assembly, factorization)");
   const auto setup_start = Clock::now();
   result.interfaces = set_up_bodies(recoverable, loaded);
   result.profile.setup_seconds = seconds_since(setup_start);
-  const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
-  const std::string& name1 = definition.bodies[0].definition.name;
-  const std::string& name2 = definition.bodies[1].definition.name;
   const auto coupling_start = Clock::now();
-  result.pairing =
-      discretize_contact(result.interfaces[0], name1, result.interfaces[1], name2, gap.get(),
-                         definition.contact, definition.solver.pairing_tolerance);
+  result.coupling = couple_interfaces(definition, result.interfaces);
   result.coupling_seconds = seconds_since(coupling_start);
   result.profile.contact_coupling_seconds = result.coupling_seconds;
-  report_stage(observer, describe_contact(result.pairing, name1, name2));
-  for (const std::string& line : result.pairing.excluded) report_warning(observer, line);
-  if (const std::string overlap = overlap_warning(result.pairing); !overlap.empty())
-    report_warning(observer, overlap);
+  for (const std::string& line : describe_interfaces(result.coupling, body_names(definition)))
+    report_stage(observer, line);
+  for (const std::string& line : excluded_pair_lines(result.coupling)) report_warning(observer, line);
+  for (const std::string& line : overlap_warnings(result.coupling)) report_warning(observer, line);
   const auto assignment_start = Clock::now();
   recoverable.run([&] {
-    for (int alpha = 0; alpha < 2; ++alpha)
-      recoverable.port(alpha).assign_contact(result.pairing.assignment(alpha));
+    for (int alpha = 0; alpha < recoverable.body_count(); ++alpha) {
+      recoverable.port(alpha).assign_contact(
+          result.coupling.operators[static_cast<std::size_t>(alpha)]);
+    }
   });
-  recoverable.contact_assigned(result.pairing);
+  recoverable.contact_assigned(result.coupling.operators);
   result.profile.contact_assignment_seconds = seconds_since(assignment_start);
   result.setup_seconds = seconds_since(start);
 
   if (definition.loading.stepped()) {
     run_load_steps(definition.loading, recoverable, options, observer, continuation, result);
   } else {
-    const std::array<PortTimings, 2> before = port_timings(recoverable);
-    const auto iteration_start = Clock::now();
-    result.iteration =
-        recoverable_iteration(recoverable, result.pairing, options, nullptr, continuation.resume,
-                              continuation.checkpoint, observer);
-    result.profile.iterations_seconds = seconds_since(iteration_start);
-    for (int alpha = 0; alpha < 2; ++alpha) {
-      result.iteration_port_timings[alpha] = difference(recoverable.timings(alpha), before[alpha]);
-    }
-    report_stage(observer, "collecting the fields of both bodies");
-    const auto fields_start = Clock::now();
-    result.outputs = collect_fields(recoverable, result.iteration);
-    result.profile.fields_seconds = seconds_since(fields_start);
-    result.excluded_clearance = excluded_clearance(result);
+    run_single_solve(recoverable, options, observer, continuation, result);
   }
   result.port_timings = port_timings(recoverable);
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    result.profile.bodies[alpha] = recoverable.port(alpha).profile();
+  for (int alpha = 0; alpha < recoverable.body_count(); ++alpha) {
+    result.profile.bodies.push_back(recoverable.port(alpha).profile());
   }
   result.total_seconds = seconds_since(start);
   return result;
+}
+
+const ContactPairing& CoupledRunResult::pairing() const {
+  if (coupling.pairings.size() != 1) {
+    throw std::logic_error("CoupledRunResult::pairing: the case has " +
+                           std::to_string(coupling.pairings.size()) + " contact interfaces");
+  }
+  return coupling.pairings.front();
 }
 
 int exit_code(IterationStatus status) {

@@ -1,14 +1,15 @@
 #pragma once
-// A whole coupled run on two ports: setup of both bodies (in parallel), pairing of their
-// interfaces, contact assignment, the Robin iteration, the final fields, and the result files.
+// A whole coupled run on one port per body: setup of every body (in parallel), the coupling of
+// the contact interfaces into constraint rows (contact graph), contact assignment, the Robin
+// iteration, the final fields, and the result files. Two bodies are the graph of one edge.
 // Shared by robin-coordinator (remote ports) and the in-process mode / tests.
 
-#include <array>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "coupling/case_file.hpp"
 #include "coupling/contact_pairing.hpp"
+#include "coupling/graph_coupling.hpp"
 #include "coupling/iteration_checkpoint.hpp"
 #include "coupling/port_recovery.hpp"
 #include "coupling/robin_iteration.hpp"
@@ -23,26 +24,27 @@ struct LoadStepResult {
   double factor = 1.0;        // the load factor of the step
   bool warm_started = false;  // started from the previous steps' fixed points
   RobinResult iteration;
-  std::array<BodyOutput, 2> outputs;
+  std::vector<BodyOutput> outputs;  // body order
   ExcludedPairClearance excluded_clearance;
-  std::array<PortTimings, 2> port_timings;  // the step alone: load factor, iteration, fields
+  std::vector<PortTimings> port_timings;  // the step alone: load factor, iteration, fields
   double seconds = 0.0;                     // wall time of the step
 };
 
 struct CoupledRunResult {
   CouplingOptions options;  // the options the iteration ran with
-  ContactPairing pairing;
+  /// Per interface its rows, per body its operator, and the graph's problem.
+  GraphCoupling coupling;
   RobinResult iteration;
-  std::array<BodyOutput, 2> outputs;
-  std::array<InterfaceDescription, 2> interfaces;
-  std::array<PortTimings, 2> port_timings;            // whole run
-  std::array<PortTimings, 2> iteration_port_timings;  // the iteration alone (no setup, fields)
+  std::vector<BodyOutput> outputs;                     // body order
+  std::vector<InterfaceDescription> interfaces;        // body order: the servers' descriptions
+  std::vector<PortTimings> port_timings;               // whole run
+  std::vector<PortTimings> iteration_port_timings;     // the iteration alone (no setup, fields)
   /// The excluded pairs in the final state (contact_pairing.hpp): a penetration beyond
   /// excluded_pair_penetration_limit means a Dirichlet condition drives the bodies into each
   /// other, which the tools report as an error.
   ExcludedPairClearance excluded_clearance;
   double setup_seconds = 0.0;     // meshing, server setups, contact coupling, assignment
-  double meshing_seconds = 0.0;   // reading and meshing both bodies (coordinator side)
+  double meshing_seconds = 0.0;   // reading and meshing every body (coordinator side)
   double coupling_seconds = 0.0;  // building the contact rows (pairing or mortar)
   double total_seconds = 0.0;
   /// The load steps of a case with [loading], in order, up to the first that did not converge
@@ -54,6 +56,10 @@ struct CoupledRunResult {
   std::vector<std::string> recoveries;
   /// The stages of the run (run_profile.hpp); output_seconds is set by write_coupled_outputs.
   RunProfile profile;
+
+  /// The rows of the only interface of a two-body case. Throws std::logic_error when the case
+  /// has several interfaces.
+  const ContactPairing& pairing() const;
 };
 
 /// Checkpoints, resume and server recovery of a coupled run (docs/outputs.md, "Checkpoint and
@@ -85,10 +91,10 @@ struct RunObserver {
   IterationObserver iteration;
 };
 
-/// Runs the case on the ports (ports[0] gets body 1). `options` replaces the case's
+/// Runs the case on the ports, one per body in body order (ports[0] gets body 1). `options` replaces the case's
 /// [coupling] table (the caller merges command-line overrides). Throws PortError, InputError.
 /// A case with [loading] sets the bodies up and assigns the contact once, then per step sets
-/// the load factor on both ports (SetLoadFactor: the servers keep K's factor and F), runs the
+/// the load factor on every port (SetLoadFactor: the servers keep K's factor and F), runs the
 /// iteration (with loading.warm_start from the previous steps' fixed points: the last one, or
 /// the linear extrapolation through the last two to the step's factor), and collects the
 /// fields; it stops after the first step that does not converge.
@@ -98,7 +104,7 @@ struct RunObserver {
 /// that have not seen the steps before it (a resume, a replaced server) first repeats those
 /// steps' contact solves at their load factors (their contact warm start).
 CoupledRunResult run_coupled_case(const CaseDefinition& definition,
-                                  const std::array<SubdomainPort*, 2>& ports,
+                                  const std::vector<SubdomainPort*>& ports,
                                   const CouplingOptions& options, const RunObserver& observer = {},
                                   const RunContinuation& continuation = {});
 

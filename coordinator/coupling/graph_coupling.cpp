@@ -10,12 +10,13 @@ ContactPairing couple_interface(const std::vector<InterfaceDescription>& bodies,
                                 const std::vector<std::string>& names,
                                 const InterfaceDefinition& interface, std::size_t index,
                                 const GapFunction* gap, const ContactOptions& options,
-                                double pairing_tolerance) {
+                                double pairing_tolerance, bool single) {
   const std::string context = "contact interface " + std::to_string(index + 1) + " (body '" +
                               names.at(static_cast<std::size_t>(interface.body_a)) +
                               "' boundary '" + interface.boundary_a + "' against body '" +
                               names.at(static_cast<std::size_t>(interface.body_b)) +
                               "' boundary '" + interface.boundary_b + "'): ";
+  const ContactOptions& contact = interface.contact ? *interface.contact : options;
   try {
     return discretize_contact(
         restrict_to_boundary(bodies.at(static_cast<std::size_t>(interface.body_a)),
@@ -23,8 +24,9 @@ ContactPairing couple_interface(const std::vector<InterfaceDescription>& bodies,
         names[static_cast<std::size_t>(interface.body_a)],
         restrict_to_boundary(bodies.at(static_cast<std::size_t>(interface.body_b)),
                              interface.boundary_b),
-        names[static_cast<std::size_t>(interface.body_b)], gap, options, pairing_tolerance);
+        names[static_cast<std::size_t>(interface.body_b)], gap, contact, pairing_tolerance);
   } catch (const InputError& error) {
+    if (single) throw;  // two bodies: the messages of discretize_contact, unchanged
     throw InputError(context + error.what());
   }
 }
@@ -47,7 +49,8 @@ GraphCoupling couple_contact_graph(const std::vector<InterfaceDescription>& bodi
                        " must join two different bodies of the " + std::to_string(count));
     }
     coupling.pairings.push_back(
-        couple_interface(bodies, names, interface, k, gap, options, pairing_tolerance));
+        couple_interface(bodies, names, interface, k, gap, options, pairing_tolerance,
+                         interfaces.size() == 1));
     edges.push_back({interface.body_a, interface.body_b,
                      static_cast<Eigen::Index>(coupling.pairings.back().size())});
   }
@@ -74,10 +77,10 @@ GraphCoupling couple_contact_graph(const std::vector<InterfaceDescription>& bodi
   coupling.problem.gaps = concatenate(gaps);
   coupling.problem.weights = concatenate(weights);
   coupling.problem.probe_forces = concatenate(probes);
-  return coupling;
-}
-
   for (const InterfaceDescription& body : bodies) {
     coupling.problem.rigid_modes.push_back(body.rigid_modes);
   }
+  return coupling;
+}
+
 }  // namespace robin

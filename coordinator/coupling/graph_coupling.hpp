@@ -8,18 +8,10 @@
 #include <vector>
 
 #include "coupling/contact_discretization.hpp"
+#include "coupling/contact_interface.hpp"
 #include "coupling/coupling_scheme.hpp"
 
 namespace robin {
-
-/// One contact interface as a case names it: body a's boundary `boundary_a` against body b's
-/// `boundary_b` (body indices 0-based). For pairing and mortar, body a plays body 1's part.
-struct InterfaceDefinition {
-  int body_a = 0;
-  int body_b = 1;
-  std::string boundary_a;
-  std::string boundary_b;
-};
 
 struct GraphCoupling {
   std::vector<ContactPairing> pairings;    // per interface, its rows in global order
@@ -29,7 +21,8 @@ struct GraphCoupling {
 
 /// Discretizes every interface of `interfaces` between the bodies described by `bodies`
 /// (their InterfaceDescriptions, with one surface per contact boundary; `names` for messages).
-/// `gap` may be null. Throws InputError naming the interface, bodies and boundaries (an unknown
+/// `gap` may be null; `options` couples every interface that has no contact options of its own.
+/// With one interface, errors are those of discretize_contact. Throws InputError naming the interface, bodies and boundaries (an unknown
 /// boundary, unmatched nodes, boundaries that do not face each other).
 GraphCoupling couple_contact_graph(const std::vector<InterfaceDescription>& bodies,
                                    const std::vector<std::string>& names,

@@ -1,6 +1,7 @@
 #include "coupling/local_problem.hpp"
 
 #include <chrono>
+#include <stdexcept>
 
 namespace robin {
 namespace {
@@ -27,32 +28,46 @@ LocalProblem prepare_local_problem(const CaseDefinition& definition,
   load_meshes(loaded);
   problem.mesh_seconds = seconds_since(start);
   const auto setup_start = std::chrono::steady_clock::now();
-  for (int alpha = 0; alpha < 2; ++alpha) {
+  for (BodyCase& body_case : loaded.bodies) {
     BodySolverOptions options = definition.solver.body;
     if (observer) {
-      const BodyDefinition& body = loaded.bodies[alpha].definition;
+      const BodyDefinition& body = body_case.definition;
       const long dof_count = 2L * static_cast<long>(body.mesh.node_count());
       options.observer = [observer, name = body.name, dof_count](SetupStage stage) {
         observer(name, stage, dof_count);
       };
     }
-    problem.bodies[alpha] =
-        std::make_unique<BodySolver>(std::move(loaded.bodies[alpha].definition), options);
+    problem.bodies.push_back(
+        std::make_unique<BodySolver>(std::move(body_case.definition), options));
   }
   problem.setup_seconds = seconds_since(setup_start);
   const auto coupling_start = std::chrono::steady_clock::now();
-  const BodySolver& body1 = *problem.bodies[0];
-  const BodySolver& body2 = *problem.bodies[1];
-  problem.pairing = discretize_contact(body1.contact_boundary(), body1.name(),
-                                       body2.contact_boundary(), body2.name(), problem.gap.get(),
-                                       definition.contact, definition.solver.pairing_tolerance);
+  std::vector<InterfaceDescription> descriptions;
+  for (const auto& body : problem.bodies) descriptions.push_back(body->contact_boundary());
+  problem.coupling = couple_contact_graph(descriptions, body_names(definition),
+                                          interface_definitions(definition), problem.gap.get(),
+                                          definition.contact, definition.solver.pairing_tolerance);
   problem.coupling_seconds = seconds_since(coupling_start);
   const auto assignment_start = std::chrono::steady_clock::now();
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    problem.bodies[alpha]->assign_contact(problem.pairing.assignment(alpha));
+  for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
+    problem.bodies[alpha]->assign_contact(problem.coupling.operators[alpha]);
   }
   problem.assignment_seconds = seconds_since(assignment_start);
   return problem;
+}
+
+const ContactPairing& LocalProblem::pairing() const {
+  if (coupling.pairings.size() != 1) {
+    throw std::logic_error("LocalProblem::pairing: the case has " +
+                           std::to_string(coupling.pairings.size()) + " contact interfaces");
+  }
+  return coupling.pairings.front();
+}
+
+std::vector<const BodySolver*> LocalProblem::body_solvers() const {
+  std::vector<const BodySolver*> solvers;
+  for (const auto& body : bodies) solvers.push_back(body.get());
+  return solvers;
 }
 
 }  // namespace robin

@@ -1,9 +1,9 @@
 #pragma once
-// A case built entirely in this process: both bodies read, assembled, factorized, their
-// contact boundaries paired and assigned. Used by robin-monolithic, by the in-process
-// subdomain ports and by tests.
+// A case built entirely in this process: every body read, assembled, factorized, the contact
+// interfaces discretized (node-to-node pairing or mortar rows) and each body assigned its rows
+// in body order (contact_graph.hpp). Used by robin-monolithic, by the in-process subdomain
+// ports and by tests.
 
-#include <array>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -11,6 +11,7 @@
 #include "coupling/case_file.hpp"
 #include "coupling/contact_pairing.hpp"
 #include "coupling/gap_function.hpp"
+#include "coupling/graph_coupling.hpp"
 #include "numerics/body_solver.hpp"
 
 namespace robin {
@@ -18,12 +19,19 @@ namespace robin {
 struct LocalProblem {
   CaseDefinition definition;
   std::unique_ptr<GapFunction> gap;  // null when the case has no [gap]
-  std::array<std::unique_ptr<BodySolver>, 2> bodies;
-  ContactPairing pairing;
-  double mesh_seconds = 0.0;        // reading and meshing both bodies
-  double setup_seconds = 0.0;       // both bodies' assembly and factorization, one after the other
+  std::vector<std::unique_ptr<BodySolver>> bodies;  // body order
+  /// Per interface its rows (pairings), per body its operator, and the graph's problem.
+  GraphCoupling coupling;
+  double mesh_seconds = 0.0;        // reading and meshing every body
+  double setup_seconds = 0.0;       // every body's assembly and factorization, one after another
   double coupling_seconds = 0.0;    // pairing or mortar rows
-  double assignment_seconds = 0.0;  // both bodies' contact assignment (interface operators)
+  double assignment_seconds = 0.0;  // every body's contact assignment (interface operators)
+
+  /// The rows of the only interface of a two-body case. Throws std::logic_error when the case
+  /// has several interfaces.
+  const ContactPairing& pairing() const;
+  /// The bodies as the graph's solvers take them (body order).
+  std::vector<const BodySolver*> body_solvers() const;
 };
 
 /// The case's gap function, or null when it has none.

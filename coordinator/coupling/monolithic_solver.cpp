@@ -225,26 +225,36 @@ MonolithicResult solve_monolithic(const BodySolver& body1, const BodySolver& bod
                           parameters, initial_force);
 }
 
-std::vector<MonolithicStep> solve_monolithic_steps(BodySolver& body1, BodySolver& body2,
-                                                   const ContactPairing& pairing,
+std::vector<MonolithicStep> solve_monolithic_steps(const std::vector<BodySolver*>& bodies,
+                                                   const ContactGraph& graph,
+                                                   const Eigen::VectorXd& gaps,
                                                    const LoadingOptions& loading,
                                                    const MprgpParameters& parameters) {
+  const std::vector<const BodySolver*> solvers(bodies.begin(), bodies.end());
   std::vector<MonolithicStep> steps;
   for (std::size_t k = 0; k < loading.factors.size(); ++k) {
     MonolithicStep step;
     step.step = static_cast<int>(k + 1);
     step.factor = loading.factors[k];
-    body1.set_load_factor(step.factor);
-    body2.set_load_factor(step.factor);
+    for (BodySolver* body : bodies) body->set_load_factor(step.factor);
     const Eigen::VectorXd initial = loading.warm_start && !steps.empty()
                                         ? steps.back().result.contact_force
                                         : Eigen::VectorXd();
-    step.result = solve_monolithic(body1, body2, pairing, parameters, initial);
+    step.result = solve_monolithic(solvers, graph, gaps, parameters, initial);
     const bool converged = step.result.qp.status == QpStatus::converged;
     steps.push_back(std::move(step));
     if (!converged) break;
   }
   return steps;
+}
+
+std::vector<MonolithicStep> solve_monolithic_steps(BodySolver& body1, BodySolver& body2,
+                                                   const ContactPairing& pairing,
+                                                   const LoadingOptions& loading,
+                                                   const MprgpParameters& parameters) {
+  return solve_monolithic_steps({&body1, &body2},
+                                ContactGraph::two_bodies(static_cast<Eigen::Index>(pairing.size())),
+                                pairing.gaps(), loading, parameters);
 }
 
 }  // namespace robin

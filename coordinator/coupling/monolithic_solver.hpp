@@ -79,6 +79,12 @@ std::vector<MonolithicStep> solve_monolithic_steps(BodySolver& body1, BodySolver
                                                    const ContactPairing& pairing,
                                                    const LoadingOptions& loading,
                                                    const MprgpParameters& parameters);
+/// The same on a contact graph (the bodies in body order, each assigned its rows).
+std::vector<MonolithicStep> solve_monolithic_steps(const std::vector<BodySolver*>& bodies,
+                                                   const ContactGraph& graph,
+                                                   const Eigen::VectorXd& gaps,
+                                                   const LoadingOptions& loading,
+                                                   const MprgpParameters& parameters);
 
 /// Residuals of (u1_N, u2_N, lambda1, lambda2) against the gaps d. Displacement scale:
 /// max(max|d|, max|u1_N|, max|u2_N|, displacement_floor, tiny); force scale:

@@ -1,20 +1,23 @@
 #include "coupling/port_recovery.hpp"
 
+#include <algorithm>
 #include <utility>
 
 namespace robin {
 
-RecoverablePorts::RecoverablePorts(const std::array<SubdomainPort*, 2>& ports,
+RecoverablePorts::RecoverablePorts(const std::vector<SubdomainPort*>& ports,
                                    const CaseDefinition& loaded, ServerReplacement replacement,
                                    std::function<void(const std::string&)> report)
     : ports_(ports),
+      replaced_timings_(ports.size()),
       loaded_(loaded),
       replacement_(std::move(replacement)),
-      report_(std::move(report)) {}
+      report_(std::move(report)),
+      interfaces_(ports.size()) {}
 
 PortTimings RecoverablePorts::timings(int body) const {
-  PortTimings sum = replaced_timings_[body];
-  const PortTimings& current = ports_[body]->timings();
+  PortTimings sum = replaced_timings_.at(static_cast<std::size_t>(body));
+  const PortTimings& current = ports_.at(static_cast<std::size_t>(body))->timings();
   sum.compute_seconds += current.compute_seconds;
   sum.round_trip_seconds += current.round_trip_seconds;
   sum.bytes_sent += current.bytes_sent;
@@ -23,23 +26,27 @@ PortTimings RecoverablePorts::timings(int body) const {
 }
 
 void RecoverablePorts::restore_body(int body) {
-  SubdomainPort& port = *ports_[body];
-  const std::string& name = loaded_.bodies[body].definition.name;
+  const auto index = static_cast<std::size_t>(body);
+  SubdomainPort& port = *ports_[index];
+  const std::string& name = loaded_.bodies[index].definition.name;
   if (report_) report_("setting body '" + name + "' up again on " + port.describe());
-  interfaces_[body] = port.setup(loaded_.bodies[body], loaded_.solver);
-  if (pairing_ != nullptr) port.assign_contact(pairing_->assignment(body));
+  interfaces_[index] = port.setup(loaded_.bodies[index], loaded_.solver);
+  if (operators_ != nullptr) port.assign_contact(operators_->at(index));
   if (load_factor_) port.set_load_factor(*load_factor_);
 }
 
 void RecoverablePorts::recover(const PortError& error) {
   std::string failure = error.what();
+  const std::size_t count = ports_.size();
   for (;;) {
-    std::array<bool, 2> lost{false, false};
+    std::vector<bool> lost(count, false);
     if (replacement_) {
-      for (int body = 0; body < 2; ++body) lost[body] = replacement_.lost(body);
+      for (std::size_t body = 0; body < count; ++body) {
+        lost[body] = replacement_.lost(static_cast<int>(body));
+      }
     }
-    if (!lost[0] && !lost[1]) throw PortError(failure);
-    for (int body = 0; body < 2; ++body) {
+    if (std::find(lost.begin(), lost.end(), true) == lost.end()) throw PortError(failure);
+    for (std::size_t body = 0; body < count; ++body) {
       ports_[body]->abandon_request();
       // throws when the server cannot be replaced: the run fails with that message
       if (!lost[body]) continue;
@@ -49,14 +56,14 @@ void RecoverablePorts::recover(const PortError& error) {
       sum.round_trip_seconds += old.round_trip_seconds;
       sum.bytes_sent += old.bytes_sent;
       sum.bytes_received += old.bytes_received;
-      ports_[body] = replacement_.replace(body, failure);
+      ports_[body] = replacement_.replace(static_cast<int>(body), failure);
     }
     try {
-      for (int body = 0; body < 2; ++body) {
+      for (std::size_t body = 0; body < count; ++body) {
         if (lost[body]) {
-          restore_body(body);
-        } else if (pairing_ != nullptr) {
-          ports_[body]->assign_contact(pairing_->assignment(body));
+          restore_body(static_cast<int>(body));
+        } else if (operators_ != nullptr) {
+          ports_[body]->assign_contact(operators_->at(body));
         }
       }
       return;

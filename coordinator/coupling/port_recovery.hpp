@@ -12,7 +12,7 @@
 // start of the iteration; the resumed iteration repeats the contact solves of the iterations
 // before it on both servers, so that it runs as it would have.
 
-#include <array>
+#include <vector>
 #include <functional>
 #include <optional>
 #include <string>
@@ -25,7 +25,7 @@ namespace robin {
 
 /// The caller's hooks for lost servers; both empty: a lost server fails the run.
 struct ServerReplacement {
-  /// Whether the server of body `body` (0 or 1) is gone (its process ended, its connection
+  /// Whether the server of body `body` (0-based) is gone (its process ended, its connection
   /// dropped), after a step on it failed.
   std::function<bool(int body)> lost;
   /// A port to a new (or restarted) server for body `body`, told the failure that lost the old
@@ -39,13 +39,15 @@ class RecoverablePorts {
  public:
   /// `loaded` holds the bodies with their meshes (load_meshes); it must outlive this object.
   /// `report` is told, for people, what was recovered.
-  RecoverablePorts(const std::array<SubdomainPort*, 2>& ports, const CaseDefinition& loaded,
+  /// One port per body of `loaded`, in body order.
+  RecoverablePorts(const std::vector<SubdomainPort*>& ports, const CaseDefinition& loaded,
                    ServerReplacement replacement, std::function<void(const std::string&)> report);
 
-  SubdomainPort& port(int body) { return *ports_[body]; }
+  SubdomainPort& port(int body) { return *ports_.at(static_cast<std::size_t>(body)); }
+  int body_count() const { return static_cast<int>(ports_.size()); }
   /// The timings of body `body`'s ports: the current one's plus those of the ports it replaced.
   PortTimings timings(int body) const;
-  const std::array<SubdomainPort*, 2>& ports() const { return ports_; }
+  const std::vector<SubdomainPort*>& ports() const { return ports_; }
 
   /// Runs `stage()` until it returns: after a PortError with a lost server, recover() and again.
   template <typename Stage>
@@ -60,9 +62,12 @@ class RecoverablePorts {
   }
 
   /// The interface of body `body` once set up (by the setup stage or a recovery).
-  std::optional<InterfaceDescription>& interface(int body) { return interfaces_[body]; }
-  /// Records that the contact is assigned (a replacement server gets the same assignment).
-  void contact_assigned(const ContactPairing& pairing) { pairing_ = &pairing; }
+  std::optional<InterfaceDescription>& interface(int body) {
+    return interfaces_.at(static_cast<std::size_t>(body));
+  }
+  /// Records that the contact is assigned, body alpha `operators[alpha]` (a replacement server
+  /// gets the same assignment); `operators` must outlive this object.
+  void contact_assigned(const std::vector<ContactOperator>& operators) { operators_ = &operators; }
   /// Records the load factor of the bodies (a replacement server gets it too).
   void load_factor_set(double factor) { load_factor_ = factor; }
 
@@ -72,13 +77,13 @@ class RecoverablePorts {
   void recover(const PortError& error);
   void restore_body(int body);
 
-  std::array<SubdomainPort*, 2> ports_;
-  std::array<PortTimings, 2> replaced_timings_;  // summed over the replaced ports
+  std::vector<SubdomainPort*> ports_;
+  std::vector<PortTimings> replaced_timings_;  // summed over the replaced ports
   const CaseDefinition& loaded_;
   ServerReplacement replacement_;
   std::function<void(const std::string&)> report_;
-  std::array<std::optional<InterfaceDescription>, 2> interfaces_;
-  const ContactPairing* pairing_ = nullptr;
+  std::vector<std::optional<InterfaceDescription>> interfaces_;
+  const std::vector<ContactOperator>* operators_ = nullptr;
   std::optional<double> load_factor_;
 };
 

@@ -112,10 +112,10 @@ std::string write_body_vtu(const std::filesystem::path& directory, const BodySol
   return write_body_output(directory, make_body_output(body, contact_force));
 }
 
-void write_solution_pvd(const std::filesystem::path& directory, const std::string& file1,
-                        const std::string& file2) {
+void write_solution_pvd(const std::filesystem::path& directory,
+                        const std::vector<std::string>& files) {
   ensure_directory(directory);
-  write_pvd(directory / "solution.pvd", {file1, file2});
+  write_pvd(directory / "solution.pvd", files);
 }
 
 void write_pvd_series(const std::filesystem::path& path, const std::vector<PvdDataSet>& datasets) {

@@ -52,12 +52,12 @@ void write_contact_csv(const std::filesystem::path& path, const ContactPairing& 
 std::string write_body_vtu(const std::filesystem::path& directory, const BodySolver& body,
                            const Eigen::VectorXd& contact_force);
 
-/// Writes solution.pvd naming both body files.
-void write_solution_pvd(const std::filesystem::path& directory, const std::string& file1,
-                        const std::string& file2);
+/// Writes solution.pvd naming every body's file (part k: body k + 1).
+void write_solution_pvd(const std::filesystem::path& directory,
+                        const std::vector<std::string>& files);
 
 /// One dataset of a ParaView collection: `file` (relative to the .pvd) at `timestep` as part
-/// `part` (the body: 0 for body 1, 1 for body 2).
+/// `part` (the body: 0 for body 1, 1 for body 2, ...).
 struct PvdDataSet {
   double timestep = 0.0;
   int part = 0;

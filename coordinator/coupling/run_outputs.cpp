@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "coupling/history_rows.hpp"
+#include "coupling/interface_outputs.hpp"
 #include "coupling/result_files.hpp"
 #include "coupling/step_outputs.hpp"
 
@@ -55,11 +56,40 @@ nlohmann::json final_residuals_json(const RobinResult& iteration) {
           {"force_error_estimate", accepted->force_error}};
 }
 
+/// The keys of summary.json about the contact (robin-monolithic writes the same): per
+/// interface in "interfaces"; for one interface also at the top level, as always.
+void add_contact_summary(nlohmann::json& summary, const CaseDefinition& definition,
+                         const CoupledRunResult& result) {
+  const GraphCoupling& coupling = result.coupling;
+  const std::vector<std::string> names = body_names(definition);
+  std::size_t rows = 0;
+  std::string discretization;
+  for (const std::string& line : describe_interfaces(coupling, names)) {
+    discretization += (discretization.empty() ? "" : "; ") + line;
+  }
+  std::string overlaps;
+  for (const std::string& line : overlap_warnings(coupling)) {
+    overlaps += (overlaps.empty() ? "" : "; ") + line;
+  }
+  for (const ContactPairing& pairing : coupling.pairings) rows += pairing.size();
+  summary["contact_pairs"] = rows;
+  summary["contact_discretization"] = discretization;
+  summary["excluded_pairs"] = excluded_pair_lines(coupling);
+  summary["excluded_pair_penetration"] = result.excluded_clearance.relative_penetration;
+  summary["initial_overlap"] = overlaps;
+  nlohmann::json interfaces = nlohmann::json::array();
+  if (has_interface_state(coupling, result.iteration.state)) {
+    interfaces =
+        interfaces_json(coupling, interface_definitions(definition), names, result.iteration.state);
+  }
+  summary["contact_force_resultant"] = coupling.pairings.size() == 1 && !interfaces.empty()
+                                           ? interfaces[0]["contact_force_resultant"]
+                                           : nlohmann::json(nullptr);
+  summary["interfaces"] = interfaces;
+}
+
 nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunResult& result) {
   const RobinResult& iteration = result.iteration;
-  const Eigen::VectorXd mean_force =
-      0.5 * (iteration.state.bodies[0].contact_force + iteration.state.bodies[1].contact_force);
-  const Eigen::Vector2d resultant = contact_resultant(result.pairing, mean_force);
   nlohmann::json summary;
   summary["method"] = "robin";
   summary["case"] = definition.file.string();
@@ -79,22 +109,15 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
     summary["final_residuals"] = final_residuals_json(iteration);
     summary["joint_state_residuals"] = residuals_json(iteration.history.back());
   }
-  summary["contact_pairs"] = result.pairing.size();
-  summary["contact_discretization"] = describe_contact(
-      result.pairing, definition.bodies[0].definition.name, definition.bodies[1].definition.name);
-  summary["excluded_pairs"] = result.pairing.excluded;
-  summary["excluded_pair_penetration"] = result.excluded_clearance.relative_penetration;
-  summary["initial_overlap"] = overlap_warning(result.pairing);
-  summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
+  add_contact_summary(summary, definition, result);
   double server_compute = 0.0;
   long iteration_bytes = 0;
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    iteration_bytes += result.iteration_port_timings[alpha].bytes_sent +
-                       result.iteration_port_timings[alpha].bytes_received;
+  for (const PortTimings& timings : result.iteration_port_timings) {
+    iteration_bytes += timings.bytes_sent + timings.bytes_received;
   }
   const double iterations = std::max<double>(1.0, static_cast<double>(iteration.history.size()));
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    const PortTimings& timings = result.port_timings[alpha];
+  for (std::size_t alpha = 0; alpha < result.outputs.size(); ++alpha) {
+    const PortTimings& timings = result.port_timings.at(alpha);
     const BodyOutput& output = result.outputs[alpha];
     summary["bodies"].push_back(
         {{"name", output.body_name},
@@ -129,13 +152,14 @@ void write_coupled_outputs(ResultDirectory& results, const CaseDefinition& defin
                            const CoupledRunResult& result) {
   const auto start = std::chrono::steady_clock::now();
   const std::filesystem::path& directory = results.staging();
-  const std::string file1 = write_body_output(directory, result.outputs[0]);
-  const std::string file2 = write_body_output(directory, result.outputs[1]);
-  write_solution_pvd(directory, file1, file2);
+  std::vector<std::string> files;
+  for (const BodyOutput& output : result.outputs) {
+    files.push_back(write_body_output(directory, output));
+  }
+  write_solution_pvd(directory, files);
   const RobinResult& iteration = result.iteration;
-  const InterfaceState state = two_body_interface_state(iteration.state);
-  if (state.normal_trace1.size() == static_cast<Eigen::Index>(result.pairing.size())) {
-    write_contact_csv(directory / "contact.csv", result.pairing, state);
+  if (has_interface_state(result.coupling, iteration.state)) {
+    write_contact_files(directory, result.coupling, body_names(definition), iteration.state);
   }
   write_history_csv(directory / "history.csv", iteration.history, result.options);
   nlohmann::json summary = make_summary(definition, result);
@@ -146,8 +170,7 @@ void write_coupled_outputs(ResultDirectory& results, const CaseDefinition& defin
   RunProfile profile = result.profile;
   profile.output_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  summary["profile"] = profile_json(
-      profile, {definition.bodies[0].definition.name, definition.bodies[1].definition.name});
+  summary["profile"] = profile_json(profile, body_names(definition));
   results.commit(summary);
 }
 

@@ -44,7 +44,7 @@ nlohmann::json body_profile_json(const BodyProfile& profile, const std::string& 
   return body;
 }
 
-nlohmann::json profile_json(const RunProfile& profile, const std::array<std::string, 2>& names) {
+nlohmann::json profile_json(const RunProfile& profile, const std::vector<std::string>& names) {
   nlohmann::json json = {{"launch", profile.launch_seconds},
                          {"meshing", profile.meshing_seconds},
                          {"setup", profile.setup_seconds},
@@ -54,8 +54,8 @@ nlohmann::json profile_json(const RunProfile& profile, const std::array<std::str
                          {"fields", profile.fields_seconds},
                          {"output", profile.output_seconds}};
   json["bodies"] = nlohmann::json::array();
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    json["bodies"].push_back(body_profile_json(profile.bodies[alpha], names[alpha]));
+  for (std::size_t alpha = 0; alpha < profile.bodies.size(); ++alpha) {
+    json["bodies"].push_back(body_profile_json(profile.bodies[alpha], names.at(alpha)));
   }
   return json;
 }
@@ -84,11 +84,12 @@ nlohmann::json monolithic_profile_json(const LocalProblem& problem, double launc
   profile.contact_assignment_seconds = problem.assignment_seconds;
   profile.iterations_seconds = solve_seconds;
   profile.output_seconds = output_seconds;
-  for (int alpha = 0; alpha < 2; ++alpha) {
-    profile.bodies[alpha] = local_body_profile(*problem.bodies[alpha]);
+  std::vector<std::string> names;
+  for (const auto& body : problem.bodies) {
+    profile.bodies.push_back(local_body_profile(*body));
+    names.push_back(body->name());
   }
-  nlohmann::json json =
-      profile_json(profile, {problem.bodies[0]->name(), problem.bodies[1]->name()});
+  nlohmann::json json = profile_json(profile, names);
   json["fields"] = nullptr;
   return json;
 }

@@ -4,7 +4,7 @@
 // as measured where the body lives. Every time is wall-clock seconds; a stage that was not
 // reported (a server of protocol 2.1 or older) is null.
 
-#include <array>
+#include <vector>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -18,13 +18,13 @@ namespace robin {
 struct RunProfile {
   double launch_seconds = 0.0;              // program start to the run's start (seconds_launched)
   double meshing_seconds = 0.0;             // reading the .msh files or meshing the .geo bodies
-  double setup_seconds = 0.0;               // both bodies' setup requests, in parallel
+  double setup_seconds = 0.0;               // every body's setup request, in parallel
   double contact_coupling_seconds = 0.0;    // pairing or mortar rows
-  double contact_assignment_seconds = 0.0;  // both bodies' AssignContact, one after the other
+  double contact_assignment_seconds = 0.0;  // every body's AssignContact, one after another
   double iterations_seconds = 0.0;          // the iteration (every load step's)
-  double fields_seconds = 0.0;              // collecting both bodies' fields (every load step's)
+  double fields_seconds = 0.0;              // collecting every body's fields (every load step's)
   double output_seconds = 0.0;              // writing the result files but summary.json
-  std::array<BodyProfile, 2> bodies;
+  std::vector<BodyProfile> bodies;          // body order
 };
 
 /// Seconds since this program started (static initialization of the coordinator library):
@@ -33,7 +33,7 @@ struct RunProfile {
 double seconds_launched();
 
 /// The "profile" object of summary.json for a coupled run whose bodies are `names`.
-nlohmann::json profile_json(const RunProfile& profile, const std::array<std::string, 2>& names);
+nlohmann::json profile_json(const RunProfile& profile, const std::vector<std::string>& names);
 
 /// The per-body object of "profile.bodies" for a body of that profile.
 nlohmann::json body_profile_json(const BodyProfile& profile, const std::string& name);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "coupling/history_rows.hpp"
+#include "coupling/interface_outputs.hpp"
 #include "coupling/result_files.hpp"
 #include "numerics/body_output.hpp"
 
@@ -37,37 +38,31 @@ void close_csv(std::ofstream& out, const std::filesystem::path& path) {
   if (!out) throw std::runtime_error("error while writing '" + path.string() + "' (disk full?)");
 }
 
-/// What steps.csv and "load_steps" say about the interface state of one step.
-struct StepInterface {
-  int active_pairs = 0;                                 // pairs with a positive mean contact force
-  double largest_pressure = 0.0;                        // max_i (lambda1_i + lambda2_i) / (2 m_i)
-  Eigen::Vector2d resultant = Eigen::Vector2d::Zero();  // contact_resultant of the mean force
-};
-
-StepInterface step_interface(const ContactPairing& pairing, const Eigen::VectorXd& force1,
-                             const Eigen::VectorXd& force2) {
-  StepInterface summary;
-  if (force1.size() != static_cast<Eigen::Index>(pairing.size()) || force2.size() != force1.size())
-    return summary;
-  const Eigen::VectorXd mean = 0.5 * (force1 + force2);
-  for (std::size_t i = 0; i < pairing.size(); ++i) {
-    const double force = mean[static_cast<Eigen::Index>(i)];
-    if (force > 0.0) ++summary.active_pairs;
-    summary.largest_pressure = std::max(summary.largest_pressure, force / pairing.pairs[i].weight);
+/// What steps.csv and "load_steps" say about the interface state of one step: for one interface
+/// its summary; for several, the active rows summed, the largest pressure over all, and the
+/// resultant of the first interface (each interface's own in summary.json's "interfaces").
+InterfaceSummary step_interface(const GraphCoupling& coupling, const CouplingState& state) {
+  InterfaceSummary total;
+  for (std::size_t k = 0; k < coupling.pairings.size(); ++k) {
+    const InterfaceSummary one = summarize_interface(
+        coupling.pairings[k], interface_state(coupling.problem.graph, state, k));
+    total.active_pairs += one.active_pairs;
+    total.largest_pressure = std::max(total.largest_pressure, one.largest_pressure);
+    if (k == 0) total.resultant = one.resultant;
   }
-  summary.resultant = contact_resultant(pairing, mean);
-  return summary;
+  return total;
 }
 
-/// The PVD series of both bodies over the steps: file k of body b is
+/// The PVD series of every body over the steps: file k of body b is
 /// steps/step_NNN/<file name of body b>.
 void write_series(const std::filesystem::path& directory, const LoadingOptions& loading,
-                  const std::vector<std::array<std::string, 2>>& files) {
+                  const std::vector<std::vector<std::string>>& files) {
   std::vector<PvdDataSet> datasets;
   for (std::size_t k = 0; k < files.size(); ++k) {
-    for (int part = 0; part < 2; ++part) {
+    for (int part = 0; part < static_cast<int>(files[k].size()); ++part) {
       const std::filesystem::path file =
-          step_directory(static_cast<int>(k + 1), loading.factors.size()) / files[k][part];
+          step_directory(static_cast<int>(k + 1), loading.factors.size()) /
+          files[k][static_cast<std::size_t>(part)];
       datasets.push_back({loading.timestep(k), part, file.generic_string()});
     }
   }
@@ -116,9 +111,7 @@ nlohmann::json coupled_steps_json(const CoupledRunResult& result) {
   nlohmann::json steps = nlohmann::json::array();
   for (const LoadStepResult& step : result.steps) {
     const RobinResult& iteration = step.iteration;
-    const StepInterface interface =
-        step_interface(result.pairing, iteration.state.bodies[0].contact_force,
-                       iteration.state.bodies[1].contact_force);
+    const InterfaceSummary interface = step_interface(result.coupling, iteration.state);
     steps.push_back(
         {{"step", step.step},
          {"load_factor", step.factor},
@@ -140,7 +133,8 @@ nlohmann::json coupled_steps_json(const CoupledRunResult& result) {
 void write_coupled_step_outputs(const std::filesystem::path& directory,
                                 const CaseDefinition& definition, const CoupledRunResult& result) {
   const LoadingOptions& loading = definition.loading;
-  std::vector<std::array<std::string, 2>> files;
+  std::vector<std::vector<std::string>> files;
+  const std::vector<std::string> names = body_names(definition);
   const std::filesystem::path table_path = directory / "steps.csv";
   std::ofstream table = open_csv(table_path);
   table << "step,load_factor,status,iterations,qp_iterations,warm_started,final_residual,"
@@ -149,16 +143,15 @@ void write_coupled_step_outputs(const std::filesystem::path& directory,
     const std::filesystem::path step_path =
         directory / step_directory(step.step, loading.factors.size());
     std::filesystem::create_directories(step_path);
-    files.push_back({write_body_output(step_path, step.outputs[0]),
-                     write_body_output(step_path, step.outputs[1])});
-    const RobinResult& iteration = step.iteration;
-    const InterfaceState state = two_body_interface_state(iteration.state);
-    if (state.normal_trace1.size() == static_cast<Eigen::Index>(result.pairing.size())) {
-      write_contact_csv(step_path / "contact.csv", result.pairing, state);
+    files.emplace_back();
+    for (const BodyOutput& output : step.outputs) {
+      files.back().push_back(write_body_output(step_path, output));
     }
-    const StepInterface interface =
-        step_interface(result.pairing, iteration.state.bodies[0].contact_force,
-                       iteration.state.bodies[1].contact_force);
+    const RobinResult& iteration = step.iteration;
+    if (has_interface_state(result.coupling, iteration.state)) {
+      write_contact_files(step_path, result.coupling, names, iteration.state);
+    }
+    const InterfaceSummary interface = step_interface(result.coupling, iteration.state);
     table << step.step << ',' << exact_text(step.factor) << ',' << to_string(iteration.status)
           << ',' << iteration.history.size() << ',' << qp_iterations(iteration) << ','
           << (step.warm_started ? 1 : 0) << ',' << exact_text(iteration.final_largest_residual())
@@ -176,8 +169,8 @@ nlohmann::json monolithic_steps_json(const LocalProblem& problem,
   nlohmann::json entries = nlohmann::json::array();
   for (const MonolithicStep& step : steps) {
     const MonolithicResult& result = step.result;
-    const StepInterface interface =
-        step_interface(problem.pairing, result.contact_force, result.contact_force);
+    const InterfaceSummary interface = step_interface(
+        problem.coupling, monolithic_state(problem.coupling.problem.graph, result));
     entries.push_back(
         {{"step", step.step},
          {"load_factor", step.factor},
@@ -196,26 +189,25 @@ void write_monolithic_step_outputs(const std::filesystem::path& directory,
                                    const LocalProblem& problem,
                                    const std::vector<MonolithicStep>& steps) {
   const LoadingOptions& loading = problem.definition.loading;
-  std::vector<std::array<std::string, 2>> files;
+  std::vector<std::vector<std::string>> files;
   const std::filesystem::path table_path = directory / "steps.csv";
   std::ofstream table = open_csv(table_path);
   table << "step,load_factor,status,iterations,active_pairs,largest_pressure,resultant_x,"
            "resultant_y,seconds\n";
+  const ContactGraph& graph = problem.coupling.problem.graph;
   for (const MonolithicStep& step : steps) {
     const std::filesystem::path step_path =
         directory / step_directory(step.step, loading.factors.size());
     const MonolithicResult& result = step.result;
-    std::array<std::string, 2> names;
-    for (int alpha = 0; alpha < 2; ++alpha) {
+    const CouplingState state = monolithic_state(graph, result);
+    files.emplace_back();
+    for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
       problem.bodies[alpha]->set_load_factor(step.factor);
-      names[alpha] = write_body_vtu(step_path, *problem.bodies[alpha], result.contact_force);
+      files.back().push_back(
+          write_body_vtu(step_path, *problem.bodies[alpha], state.bodies[alpha].contact_force));
     }
-    files.push_back(names);
-    write_contact_csv(step_path / "contact.csv", problem.pairing,
-                      {result.normal_traces[0], result.normal_traces[1], result.contact_force,
-                       result.contact_force});
-    const StepInterface interface =
-        step_interface(problem.pairing, result.contact_force, result.contact_force);
+    write_contact_files(step_path, problem.coupling, body_names(problem.definition), state);
+    const InterfaceSummary interface = step_interface(problem.coupling, state);
     table << step.step << ',' << exact_text(step.factor) << ',' << to_string(result.qp.status)
           << ',' << result.qp.iterations << ',' << interface.active_pairs << ','
           << exact_text(interface.largest_pressure) << ',' << exact_text(interface.resultant.x())

@@ -443,12 +443,18 @@ RunCheckpoint checkpoint_identity(const CaseDefinition& definition,
 }  // namespace
 
 int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
-                    const std::array<std::string, 2>& endpoints,
-                    const std::array<ChannelOptions, 2>& channels, const ServerRestart& restart) {
+                    const std::vector<std::string>& endpoints,
+                    const std::vector<ChannelOptions>& channels, const ServerRestart& restart) {
   auto log = coordinator_logger();
+  const std::size_t body_count = definition.bodies.size();
+  if (endpoints.size() != body_count || (!channels.empty() && channels.size() != body_count)) {
+    log->error("{}: the case has {} bodies but {} servers were given (one per body, in body order)",
+               definition.file.string(), body_count, endpoints.size());
+    return 2;
+  }
   const CouplingOptions options = merged_coupling_options(definition.coupling, settings);
   const std::shared_ptr<ProgressDisplay> display = display_of(settings);
-  display->set_bodies({definition.bodies[0].definition.name, definition.bodies[1].definition.name});
+  display->set_bodies(body_names(definition));
   CaseDefinition observed = definition;  // tells the display as each body's mesh is made
   observed.meshing = meshing_reporter(definition, display, log);
   std::unique_ptr<ResultDirectory> results;
@@ -468,17 +474,18 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     log->warn("the output directory {} also holds files that are not results of a run: {}",
               settings.output_directory.string(), fmt::join(results->leftover_files(), ", "));
   }
-  std::array<std::unique_ptr<RemotePort>, 2> ports;
+  std::vector<std::unique_ptr<RemotePort>> ports(body_count);
   std::vector<std::unique_ptr<RemotePort>> replaced_ports;  // kept until the run ends
   const auto make_port = [&](int alpha, const std::string& endpoint) {
     RemotePortOptions port_options;
     port_options.request_timeout_seconds = options.request_timeout_seconds;
     port_options.setup_timeout_seconds = options.setup_timeout_seconds;
-    port_options.channel = channels[alpha];
+    if (!channels.empty()) port_options.channel = channels[static_cast<std::size_t>(alpha)];
     port_options.heartbeat_timeout_seconds = settings.heartbeat_timeout_seconds;
     port_options.on_status = progress_reporter(log, display);
-    const std::string& body = definition.bodies[alpha].definition.name;
-    ports[alpha] = std::make_unique<RemotePort>(endpoint, body, port_options);
+    const std::string& body = definition.bodies[static_cast<std::size_t>(alpha)].definition.name;
+    ports[static_cast<std::size_t>(alpha)] =
+        std::make_unique<RemotePort>(endpoint, body, port_options);
     log->info("body {} '{}' on server {}", alpha + 1, body, endpoint);
   };
   RunContinuation continuation;
@@ -497,23 +504,24 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
   continuation.step_completed = [&](const LoadStepCheckpoint& step) {
     checkpoint.steps.push_back(step);
   };
-  std::array<int, 2> restarts{0, 0};
+  std::vector<int> restarts(body_count, 0);
   nlohmann::json restart_records = nlohmann::json::array();
   if (restart.lost && restart.restart && settings.max_server_restarts > 0) {
     continuation.replacement.lost = [&](int body) {
-      return restart.lost(body, ports[body]->connection_lost());
+      return restart.lost(body, ports[static_cast<std::size_t>(body)]->connection_lost());
     };
     continuation.replacement.replace = [&](int body, const std::string& failure) {
-      const std::string& name = definition.bodies[body].definition.name;
-      if (restarts[body] >= settings.max_server_restarts) {
+      const auto index = static_cast<std::size_t>(body);
+      const std::string& name = definition.bodies[index].definition.name;
+      if (restarts[index] >= settings.max_server_restarts) {
         throw PortError(
             fmt::format("{}\n  the server of body '{}' was lost again after {} restarts "
                         "(--max-server-restarts {}): the run stops",
-                        failure, name, restarts[body], settings.max_server_restarts));
+                        failure, name, restarts[index], settings.max_server_restarts));
       }
-      ++restarts[body];
+      ++restarts[index];
       log->warn("lost the server of body '{}': {}; replacing it (restart {} of {})", name, failure,
-                restarts[body], settings.max_server_restarts);
+                restarts[index], settings.max_server_restarts);
       std::string endpoint;
       try {
         endpoint = restart.restart(body);
@@ -521,25 +529,29 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
         throw PortError(
             fmt::format("{}\n  the server of body '{}' cannot be replaced (restart "
                         "{} of {}): {}",
-                        failure, name, restarts[body], settings.max_server_restarts, error.what()));
+                        failure, name, restarts[index], settings.max_server_restarts,
+                        error.what()));
       }
       restart_records.push_back({{"body", name},
-                                 {"restart", restarts[body]},
+                                 {"restart", restarts[index]},
                                  {"of", settings.max_server_restarts},
                                  {"endpoint", endpoint},
                                  {"failure", failure}});
       results->add_to_record("server_restarts", restart_records);
-      replaced_ports.push_back(std::move(ports[body]));
+      replaced_ports.push_back(std::move(ports[index]));
       make_port(body, endpoint);
-      return static_cast<SubdomainPort*>(ports[body].get());
+      return static_cast<SubdomainPort*>(ports[index].get());
     };
   }
   int code = 1;
   try {
-    for (int alpha = 0; alpha < 2; ++alpha) make_port(alpha, endpoints[alpha]);
-    const CoupledRunResult result =
-        run_coupled_case(observed, {ports[0].get(), ports[1].get()}, options,
-                         make_observer(log, options, display), continuation);
+    std::vector<SubdomainPort*> run_ports;
+    for (std::size_t alpha = 0; alpha < body_count; ++alpha) {
+      make_port(static_cast<int>(alpha), endpoints[alpha]);
+      run_ports.push_back(ports[alpha].get());
+    }
+    const CoupledRunResult result = run_coupled_case(
+        observed, run_ports, options, make_observer(log, options, display), continuation);
     display->finish();
     write_coupled_outputs(*results, definition, result);
     code = report_outcome(result, settings, *log);

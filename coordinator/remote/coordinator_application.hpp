@@ -110,16 +110,17 @@ std::string progress_line(const IterationRecord& record, const CouplingOptions& 
 /// as the interrupted run left it.
 std::optional<CaseDefinition> load_case(CoordinatorSettings& settings);
 
-/// Runs the case against the servers at `endpoints` (the first gets body 1), writes the result
-/// files into the output directory and returns the exit code (see the file comment). The
-/// servers' runs are always ended. `channels[i]` sets the transport and the waiting hooks of
-/// port i; the iteration also stops between iterations on a stop signal.
+/// Runs the case against the servers at `endpoints`, one per body in body order (the first gets
+/// body 1), writes the result files into the output directory and returns the exit code (see
+/// the file comment). The servers' runs are always ended. `channels[i]` sets the transport and
+/// the waiting hooks of port i (empty: the defaults for every port); the iteration also stops
+/// between iterations on a stop signal.
 /// `restart` replaces lost servers (at most settings.max_server_restarts per body); the run
 /// checkpoints every iteration into the output directory and, with settings.resume,
 /// continues from that checkpoint.
 int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
-                    const std::array<std::string, 2>& endpoints,
-                    const std::array<ChannelOptions, 2>& channels = {},
+                    const std::vector<std::string>& endpoints,
+                    const std::vector<ChannelOptions>& channels = {},
                     const ServerRestart& restart = {});
 
 /// Logs a failure and returns its exit code: 128 + signal once a stop signal was received

@@ -22,15 +22,15 @@ int main(int argc, char** argv) {
   // --check-server ENDPOINT: the protocol conformance checker, with its own options.
   if (robin::requests_server_check(argc, argv)) return robin::server_check_main(argc, argv);
   CLI::App app{
-      "robin-coordinator: Robin domain decomposition of a two-body contact case on two "
-      "robin-subdomain servers"};
+      "robin-coordinator: Robin domain decomposition of a contact case on robin-subdomain "
+      "servers, one per body"};
   robin::CoordinatorSettings settings;
   std::vector<std::string> subdomains;
   robin::add_coordinator_options(app, settings);
   robin::add_version_option(app, "robin-coordinator");
   app.add_option("--subdomain", subdomains,
-                 "endpoint of a robin-subdomain server (e.g. tcp://host:5555); give it twice, "
-                 "the first serves body 1")
+                 "endpoint of a robin-subdomain server (e.g. tcp://host:5555); give it once per "
+                 "body of the case, in body order (the first serves body 1)")
       ->required()
       ->allow_extra_args(false);  // one endpoint per --subdomain; the count is checked below
   robin::CurveClientSettings curve;
@@ -46,9 +46,9 @@ int main(int argc, char** argv) {
                  "(CASE and --subdomain are then not needed; --check-server ENDPOINT --help)")
       ->type_name("ENDPOINT");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
-  if (subdomains.size() != 2) {
-    std::cerr << "robin-coordinator: give exactly two --subdomain ENDPOINT options (the first "
-                 "serves body 1, the second body 2); got "
+  if (subdomains.size() < 2) {
+    std::cerr << "robin-coordinator: give one --subdomain ENDPOINT option per body, at least two "
+                 "(the first serves body 1, the second body 2, ...); got "
               << subdomains.size() << "\nRun with --help for more information.\n";
     return 2;
   }
@@ -71,7 +71,14 @@ int main(int argc, char** argv) {
   }
   const auto definition = robin::load_case(settings);
   if (!definition) return 1;
-  std::array<robin::ChannelOptions, 2> channels;
+  if (definition->bodies.size() != subdomains.size()) {
+    std::cerr << "robin-coordinator: the case " << definition->file.string() << " has "
+              << definition->bodies.size() << " bodies: give one --subdomain ENDPOINT per body, "
+              << "in body order; got " << subdomains.size()
+              << "\nRun with --help for more information.\n";
+    return 2;
+  }
+  std::vector<robin::ChannelOptions> channels(subdomains.size());
   for (std::size_t index = 0; index < channels.size(); ++index) {
     channels[index].on_wait = robin::throw_if_stop_requested;
     channels[index].curve = curve_keys[index];
@@ -85,6 +92,5 @@ int main(int argc, char** argv) {
     robin::await_server(subdomains[body], settings.server_grace_period_seconds, channels[body]);
     return subdomains[body];
   };
-  return robin::run_coordinator(*definition, settings, {subdomains[0], subdomains[1]}, channels,
-                                restart);
+  return robin::run_coordinator(*definition, settings, subdomains, channels, restart);
 }

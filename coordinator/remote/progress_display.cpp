@@ -96,7 +96,8 @@ LiveStatusSink::LiveStatusSink(std::size_t body_count, std::FILE* terminal, std:
 
 void LiveStatusSink::set_line(std::size_t index, const std::string& text) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (finished_ || index >= lines_.size()) return;
+  if (finished_) return;
+  if (index >= lines_.size()) lines_.resize(index + 1);  // a body beyond the first count
   lines_[index] = columns_ > 1 && text.size() >= columns_ ? text.substr(0, columns_ - 1) : text;
   redraw();
 }

@@ -67,7 +67,7 @@ class LiveStatusSink : public spdlog::sinks::base_sink<std::mutex> {
   /// `columns`: the terminal's width (0: unknown); longer status lines are cut to fit, so that
   /// each takes one row and the cursor movements stay right.
   LiveStatusSink(std::size_t body_count, std::FILE* terminal, std::size_t columns = 0);
-  /// Replaces line `index` and redraws (nothing once finished).
+  /// Replaces line `index` (adding lines up to it) and redraws (nothing once finished).
   void set_line(std::size_t index, const std::string& text);
   /// Leaves the status lines as last drawn; later log lines follow below them.
   void finish();

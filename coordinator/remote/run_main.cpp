@@ -1,12 +1,12 @@
 // robin-run CASE --output DIR [options]
-// The one-command launcher: starts two robin-subdomain servers (found next to this executable)
+// The one-command launcher: starts one robin-subdomain server per body (found next to this executable)
 // on tcp://127.0.0.1 with ephemeral ports, logs of the servers in DIR/logs/server-<body>.log,
 // runs the coordinator against them and stops them. SIGINT/SIGTERM stop everything cleanly.
 // --curve encrypts the local connections with CurveZMQ, with keys made for this run only
 // (curve_options.hpp); without it the loopback connections are not encrypted.
 // Servers on other hosts: --server-command "ssh HOST" (or "srun -N1 -n1 ...", "ip netns exec
 // NS") puts words before the server's command line, --server-listen the address it binds, and
-// --server-executable its path there; each is given once for both servers or once per body
+// --server-executable its path there; each is given once for every server or once per body
 // (body order). The prefix must pass the server's standard output through (its "listening on
 // ENDPOINT" line gives the endpoint the coordinator connects to) and forward SIGTERM.
 // A server that dies mid-run is restarted (--max-server-restarts times per body, default 2):
@@ -15,7 +15,6 @@
 
 #include <spdlog/spdlog.h>
 
-#include <array>
 #include <cstdio>
 #include <optional>
 #include <sstream>
@@ -50,10 +49,11 @@ std::string per_body(const std::vector<std::string>& values, int index) {
   return values.size() == 1 ? values[0] : values[static_cast<std::size_t>(index)];
 }
 
-std::array<robin::ServerLaunchOptions, 2> placed(const robin::ServerLaunchOptions& launch,
-                                                 const ServerPlacement& placement) {
-  std::array<robin::ServerLaunchOptions, 2> options{launch, launch};
-  for (int index = 0; index < 2; ++index) {
+std::vector<robin::ServerLaunchOptions> placed(const robin::ServerLaunchOptions& launch,
+                                               const ServerPlacement& placement,
+                                               std::size_t body_count) {
+  std::vector<robin::ServerLaunchOptions> options(body_count, launch);
+  for (int index = 0; index < static_cast<int>(body_count); ++index) {
     options[index].command_prefix = split_words(per_body(placement.commands, index));
     if (const std::string listen = per_body(placement.listens, index); !listen.empty()) {
       options[index].listen = listen;
@@ -84,22 +84,20 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
                    keys->client_keys().server_public_key);
     }
     launch.executable = robin::sibling_executable("robin-subdomain");
-    robin::LocalServers servers(
-        {definition.bodies[0].definition.name, definition.bodies[1].definition.name},
-        placed(launch, placement));
+    robin::LocalServers servers(robin::body_names(definition),
+                                placed(launch, placement, definition.bodies.size()));
     servers.await_listening(robin::throw_if_stop_requested);
     if (keys) keys->remove_files();  // read by the servers; the coordinator's are in memory
-    std::array<robin::ChannelOptions, 2> channels;
-    for (int index = 0; index < 2; ++index) {
+    std::vector<robin::ChannelOptions> channels(servers.size());
+    for (int index = 0; index < static_cast<int>(servers.size()); ++index) {
       robin::SubdomainServer& server = servers.server(index);
       spdlog::info("{} listening on {} (log: {})", server.label(), server.endpoint(),
                    server.log_file().string());
-      channels[index].on_wait = robin::throw_if_stop_requested;
+      robin::ChannelOptions& channel = channels[static_cast<std::size_t>(index)];
+      channel.on_wait = robin::throw_if_stop_requested;
       // the server of the body now: a restart replaces it
-      channels[index].server_failure = [&servers, index] {
-        return servers.server(index).failure();
-      };
-      channels[index].curve = launch.curve_client;
+      channel.server_failure = [&servers, index] { return servers.server(index).failure(); };
+      channel.curve = launch.curve_client;
     }
     robin::ServerRestart restart;
     restart.lost = [&servers](int body, bool connection_lost) {
@@ -125,8 +123,8 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "robin-run: solve a two-body contact case by Robin domain decomposition, with two local "
-      "robin-subdomain servers"};
+      "robin-run: solve a contact case by Robin domain decomposition, with one local "
+      "robin-subdomain server per body"};
   robin::CoordinatorSettings settings;
   settings.tool = "robin-run";
   robin::add_coordinator_options(app, settings);
@@ -138,7 +136,7 @@ int main(int argc, char** argv) {
   ServerPlacement placement;
   app.add_option("--server-command", placement.commands,
                  "words put before each server's command line to start it elsewhere, e.g. "
-                 "\"ssh node1\" or \"srun -N1 -n1\"; once for both or once per body")
+                 "\"ssh node1\" or \"srun -N1 -n1\"; once for every server or once per body")
       ->type_name("WORDS");
   app.add_option("--server-listen", placement.listens,
                  "endpoint each server binds (default tcp://127.0.0.1:*), e.g. "
@@ -149,14 +147,6 @@ int main(int argc, char** argv) {
                  "once or per body")
       ->type_name("PATH");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
-  for (const auto* values : {&placement.commands, &placement.listens, &placement.executables}) {
-    if (values->size() > 2) {
-      std::fprintf(stderr,
-                   "robin-run: --server-command, --server-listen and --server-executable "
-                   "are given once for both servers or twice (body order)\n");
-      return 2;
-    }
-  }
   // --quiet quietens this terminal; the servers' log files keep --log-level.
   settings.display = std::make_shared<robin::ProgressDisplay>(
       robin::progress_output_of_this_process(settings.quiet));
@@ -165,5 +155,15 @@ int main(int argc, char** argv) {
   robin::install_stop_signal_handlers();
   auto definition = robin::load_case(settings);
   if (!definition) return 1;
+  for (const auto* values : {&placement.commands, &placement.listens, &placement.executables}) {
+    if (values->size() > 1 && values->size() != definition->bodies.size()) {
+      std::fprintf(stderr,
+                   "robin-run: --server-command, --server-listen and --server-executable "
+                   "are given once for every server or once per body (the case has %zu bodies, "
+                   "in body order); got %zu\n",
+                   definition->bodies.size(), values->size());
+      return 2;
+    }
+  }
   return run_with_local_servers(*definition, settings, curve, placement);
 }

@@ -3,6 +3,7 @@
 #include <deque>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <system_error>
 #include <thread>
 #include <vector>
@@ -122,15 +123,18 @@ void SubdomainServer::finish_stop() noexcept {
   process_->stop(options_.grace_seconds);
 }
 
-LocalServers::LocalServers(const std::array<std::string, 2>& bodies,
+LocalServers::LocalServers(const std::vector<std::string>& bodies,
                            const ServerLaunchOptions& options)
-    : LocalServers(bodies, std::array<ServerLaunchOptions, 2>{options, options}) {}
+    : LocalServers(bodies, std::vector<ServerLaunchOptions>(bodies.size(), options)) {}
 
-LocalServers::LocalServers(const std::array<std::string, 2>& bodies,
-                           const std::array<ServerLaunchOptions, 2>& options)
+LocalServers::LocalServers(const std::vector<std::string>& bodies,
+                           const std::vector<ServerLaunchOptions>& options)
     : bodies_(bodies), options_(options) {
-  for (int index = 0; index < 2; ++index) {
-    servers_[index] = std::make_unique<SubdomainServer>(bodies[index], options[index]);
+  if (options.size() != bodies.size()) {
+    throw std::invalid_argument("LocalServers: one set of launch options per body");
+  }
+  for (std::size_t index = 0; index < bodies.size(); ++index) {
+    servers_.push_back(std::make_unique<SubdomainServer>(bodies[index], options[index]));
   }
 }
 
@@ -143,18 +147,21 @@ void LocalServers::await_listening(const std::function<void()>& on_wait) {
 }
 
 void LocalServers::restart(int index, const std::function<void()>& on_wait) {
-  servers_[index].reset();  // reaps the exited server (or stops one that still runs)
-  servers_[index] = std::make_unique<SubdomainServer>(bodies_[index], options_[index]);
-  servers_[index]->await_listening(on_wait);
+  const auto body = static_cast<std::size_t>(index);
+  servers_.at(body).reset();  // reaps the exited server (or stops one that still runs)
+  servers_[body] = std::make_unique<SubdomainServer>(bodies_[body], options_[body]);
+  servers_[body]->await_listening(on_wait);
 }
 
-std::array<std::string, 2> LocalServers::endpoints() const {
-  return {servers_[0]->endpoint(), servers_[1]->endpoint()};
+std::vector<std::string> LocalServers::endpoints() const {
+  std::vector<std::string> endpoints;
+  for (const auto& server : servers_) endpoints.push_back(server->endpoint());
+  return endpoints;
 }
 
 void LocalServers::stop() noexcept {
-  // Both Shutdown requests at once: a server busy with a long setup answers neither, and its
-  // deadline should not be waited for twice.
+  // Every Shutdown request at once: a server busy with a long setup answers none, and its
+  // deadline should not be waited for once per server.
   std::vector<std::thread> requests;
   for (auto& server : servers_) {
     if (!server) continue;

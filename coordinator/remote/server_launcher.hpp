@@ -80,29 +80,30 @@ class SubdomainServer {
   bool shutdown_acknowledged_ = false;
 };
 
-/// Starts one server per body and stops both (in parallel) at destruction.
+/// Starts one server per body and stops them all (in parallel) at destruction.
 class LocalServers {
  public:
-  LocalServers(const std::array<std::string, 2>& bodies, const ServerLaunchOptions& options);
+  LocalServers(const std::vector<std::string>& bodies, const ServerLaunchOptions& options);
   /// One set of options per body (e.g. another command prefix and listen address per host).
-  LocalServers(const std::array<std::string, 2>& bodies,
-               const std::array<ServerLaunchOptions, 2>& options);
+  LocalServers(const std::vector<std::string>& bodies,
+               const std::vector<ServerLaunchOptions>& options);
   ~LocalServers();
-  /// Waits until both listen (see SubdomainServer::await_listening).
+  /// Waits until every server listens (see SubdomainServer::await_listening).
   void await_listening(const std::function<void()>& on_wait = {});
-  std::array<std::string, 2> endpoints() const;
-  SubdomainServer& server(int index) { return *servers_[index]; }
+  std::vector<std::string> endpoints() const;
+  std::size_t size() const { return servers_.size(); }
+  SubdomainServer& server(int index) { return *servers_.at(static_cast<std::size_t>(index)); }
   /// Replaces server `index` (which has exited) by a new one started with the same options and
   /// waits until it listens (its log goes on in the same file). Throws as the constructor and
   /// await_listening do.
   void restart(int index, const std::function<void()>& on_wait = {});
-  /// Stops both servers; idempotent.
+  /// Stops every server; idempotent.
   void stop() noexcept;
 
  private:
-  std::array<std::string, 2> bodies_;
-  std::array<ServerLaunchOptions, 2> options_;
-  std::array<std::unique_ptr<SubdomainServer>, 2> servers_;
+  std::vector<std::string> bodies_;
+  std::vector<ServerLaunchOptions> options_;
+  std::vector<std::unique_ptr<SubdomainServer>> servers_;
 };
 
 /// The last `count` lines of a text file ("" when it cannot be read), for error messages.

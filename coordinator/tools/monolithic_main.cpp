@@ -1,5 +1,6 @@
 // robin-monolithic CASE --output DIR [--set KEY=VALUE ...] [--quiet]
-// The single-process reference solver of the whole two-body contact problem (paper (5)).
+// The single-process reference solver of the whole contact problem (paper (5)): two bodies, or N
+// bodies on the contact graph of the case's [[interface]] tables.
 // Exit codes: 0 converged (or --help, --version); 1 bad input or failure (also: a Dirichlet
 // condition drives an excluded contact pair into penetration; the results are written); 2 bad
 // command line; 3 the contact QP did not converge (the results are written); 130 / 143 stopped
@@ -18,6 +19,7 @@
 
 #include "command_line.hpp"
 #include "coupling/case_file_overrides.hpp"
+#include "coupling/interface_outputs.hpp"
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
 #include "coupling/result_directory.hpp"
@@ -35,10 +37,32 @@ namespace {
 using robin::LocalProblem;
 using robin::MonolithicResult;
 
+/// The keys of summary.json about the contact (robin-coordinator writes the same): per
+/// interface in "interfaces"; for one interface also at the top level, as always.
+void add_contact_summary(nlohmann::json& summary, const LocalProblem& problem,
+                         const robin::CouplingState& state) {
+  const robin::GraphCoupling& coupling = problem.coupling;
+  const std::vector<std::string> names = robin::body_names(problem.definition);
+  Eigen::Index rows = 0;
+  for (const robin::ContactPairing& pairing : coupling.pairings) {
+    rows += static_cast<Eigen::Index>(pairing.size());
+  }
+  summary["contact_pairs"] = rows;
+  summary["contact_discretization"] = fmt::format(
+      "{}", fmt::join(robin::describe_interfaces(coupling, names), "; "));
+  summary["excluded_pairs"] = robin::excluded_pair_lines(coupling);
+  summary["initial_overlap"] =
+      fmt::format("{}", fmt::join(robin::overlap_warnings(coupling), "; "));
+  const nlohmann::json interfaces = robin::interfaces_json(
+      coupling, robin::interface_definitions(problem.definition), names, state);
+  summary["contact_force_resultant"] =
+      coupling.pairings.size() == 1 ? interfaces[0]["contact_force_resultant"] : nullptr;
+  summary["interfaces"] = interfaces;
+}
+
 nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult& result,
                             double total_seconds) {
   nlohmann::json summary;
-  const Eigen::Vector2d resultant = robin::contact_resultant(problem.pairing, result.contact_force);
   summary["method"] = "monolithic";
   summary["case"] = problem.definition.file.string();
   summary["overrides"] = problem.definition.overrides;  // --set KEY=VALUE, in order
@@ -50,12 +74,8 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   summary["qp_status"] = robin::to_string(result.qp.status);
   summary["iterations"] = result.qp.iterations;
   summary["operator_applications"] = result.qp.operator_applications;
-  summary["contact_pairs"] = problem.pairing.size();
-  summary["contact_discretization"] = robin::describe_contact(
-      problem.pairing, problem.bodies[0]->name(), problem.bodies[1]->name());
-  summary["excluded_pairs"] = problem.pairing.excluded;
-  summary["initial_overlap"] = robin::overlap_warning(problem.pairing);
-  summary["contact_force_resultant"] = {resultant.x(), resultant.y()};
+  add_contact_summary(summary, problem,
+                      robin::monolithic_state(problem.coupling.problem.graph, result));
   summary["residuals"] = {{"penetration", result.residuals.penetration},
                           {"force_balance", result.residuals.force_balance},
                           {"complementarity", result.residuals.complementarity}};
@@ -83,31 +103,33 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
 /// The excluded pairs in the solution (node ids are this process's mesh node indices).
 robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem,
                                                      const MonolithicResult& result) {
-  const std::array<Eigen::VectorXd, 2> displacements{
-      problem.bodies[0]->displacement(result.contact_force),
-      problem.bodies[1]->displacement(result.contact_force)};
-  const auto displacement_of = [&](int body, const robin::ContactPair& pair) {
-    const Eigen::Index node = body == 0 ? pair.node1 : pair.node2;
-    return Eigen::Vector2d(displacements[body].segment<2>(2 * node));
+  const robin::ContactGraph& graph = problem.coupling.problem.graph;
+  const robin::CouplingState state = robin::monolithic_state(graph, result);
+  std::vector<Eigen::VectorXd> displacements;
+  for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
+    displacements.push_back(problem.bodies[alpha]->displacement(state.bodies[alpha].contact_force));
+  }
+  const auto displacement_of = [&](int body, const robin::ContactPair& pair, int side) {
+    const Eigen::Index node = side == 0 ? pair.node1 : pair.node2;
+    return Eigen::Vector2d(displacements[static_cast<std::size_t>(body)].segment<2>(2 * node));
   };
-  const double scale = std::max({problem.pairing.gaps().cwiseAbs().maxCoeff(),
-                                 result.normal_traces[0].cwiseAbs().maxCoeff(),
-                                 result.normal_traces[1].cwiseAbs().maxCoeff()});
-  return robin::excluded_pair_clearance(problem.pairing, displacement_of, scale);
+  return robin::graph_excluded_clearance(problem.coupling, state, displacement_of);
 }
 
 /// Writes the result files into the directory's staging area (result_directory.hpp); the
 /// caller commits them with summary.json.
 void write_outputs(const std::filesystem::path& directory, const LocalProblem& problem,
                    const MonolithicResult& result) {
-  const std::string file1 =
-      robin::write_body_vtu(directory, *problem.bodies[0], result.contact_force);
-  const std::string file2 =
-      robin::write_body_vtu(directory, *problem.bodies[1], result.contact_force);
-  robin::write_solution_pvd(directory, file1, file2);
-  robin::InterfaceState state{result.normal_traces[0], result.normal_traces[1],
-                              result.contact_force, result.contact_force};
-  robin::write_contact_csv(directory / "contact.csv", problem.pairing, state);
+  const robin::ContactGraph& graph = problem.coupling.problem.graph;
+  const robin::CouplingState state = robin::monolithic_state(graph, result);
+  std::vector<std::string> files;
+  for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
+    files.push_back(
+        robin::write_body_vtu(directory, *problem.bodies[alpha], state.bodies[alpha].contact_force));
+  }
+  robin::write_solution_pvd(directory, files);
+  robin::write_contact_files(directory, problem.coupling, robin::body_names(problem.definition),
+                             state);
 }
 
 int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirectory& results,
@@ -192,7 +214,7 @@ int run(const std::filesystem::path& case_path, const std::vector<std::string>& 
 LocalProblem prepare_with_progress(const robin::CaseDefinition& definition,
                                    const std::shared_ptr<robin::ProgressDisplay>& display) {
   auto log = spdlog::get("monolithic");
-  display->set_bodies({definition.bodies[0].definition.name, definition.bodies[1].definition.name});
+  display->set_bodies(robin::body_names(definition));
   robin::CaseDefinition observed = definition;
   observed.meshing = robin::meshing_reporter(definition, display, log);
   std::map<std::string, std::chrono::steady_clock::time_point> setup_started;
@@ -216,9 +238,10 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
   const double launched = robin::seconds_launched();  // the profile's "launch"
   auto log = spdlog::get("monolithic");
   const std::filesystem::path& case_path = definition.file;
-  log->info("case {}: bodies '{}' and '{}'", case_path.string(),
-            definition.bodies[0].definition.name, definition.bodies[1].definition.name);
-  log->info("reading and meshing both bodies");
+  log->info("case {}: bodies '{}'", case_path.string(),
+            fmt::join(robin::body_names(definition), "', '"));
+  log->info("reading and meshing {}", definition.bodies.size() == 2 ? std::string("both bodies")
+                                                                     : "the bodies");
   const LocalProblem problem = prepare_with_progress(definition, display);
   for (const auto& body : problem.bodies) {
     log->info("body '{}': {} dofs, assembly {:.3f} s, factorization {:.3f} s ({} nonzeros in L)",
@@ -226,18 +249,22 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
               body->timings().ordering_seconds + body->timings().factorization_seconds,
               body->factor_nonzeros());
   }
-  log->info("{}", robin::describe_contact(problem.pairing, problem.bodies[0]->name(),
-                                          problem.bodies[1]->name()));
-  for (const std::string& line : problem.pairing.excluded) log->warn("{}", line);
-  if (const std::string overlap = robin::overlap_warning(problem.pairing); !overlap.empty())
-    log->warn("{}", overlap);
+  const std::vector<std::string> names = robin::body_names(definition);
+  for (const std::string& line : robin::describe_interfaces(problem.coupling, names))
+    log->info("{}", line);
+  for (const std::string& line : robin::excluded_pair_lines(problem.coupling))
+    log->warn("{}", line);
+  for (const std::string& line : robin::overlap_warnings(problem.coupling)) log->warn("{}", line);
   // [loading]: every step at its load factor, the last one reported below (step_outputs.hpp).
+  const robin::CouplingProblem& graph_problem = problem.coupling.problem;
+  std::vector<robin::BodySolver*> bodies;
+  for (const auto& body : problem.bodies) bodies.push_back(body.get());
   const std::vector<robin::MonolithicStep> steps =
-      robin::solve_monolithic_steps(*problem.bodies[0], *problem.bodies[1], problem.pairing,
+      robin::solve_monolithic_steps(bodies, graph_problem.graph, graph_problem.gaps,
                                     definition.loading, definition.solver.qp);
   const MonolithicResult result =
-      steps.empty() ? robin::solve_monolithic(*problem.bodies[0], *problem.bodies[1],
-                                              problem.pairing, definition.solver.qp)
+      steps.empty() ? robin::solve_monolithic(problem.body_solvers(), graph_problem.graph,
+                                              graph_problem.gaps, definition.solver.qp)
                     : steps.back().result;
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -283,7 +310,7 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"robin-monolithic: single-process reference solve of a two-body contact case"};
+  CLI::App app{"robin-monolithic: single-process reference solve of a contact case"};
   std::filesystem::path case_path, output;
   std::string level = "info";
   bool quiet = false;

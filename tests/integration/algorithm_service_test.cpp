@@ -64,7 +64,7 @@ void run_every_variant(const std::string& case_name) {
   const CaseDefinition definition = read_case_file(example(case_name));
   const LocalProblem reference = prepare_local_problem(definition);
   const MonolithicResult monolithic = solve_monolithic(*reference.bodies[0], *reference.bodies[1],
-                                                       reference.pairing, definition.solver.qp);
+                                                       reference.pairing(), definition.solver.qp);
   ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
   const TemporaryDirectory logs("algorithm-service");
   SubdomainServer server1(definition.bodies[0].definition.name, server_options(logs.path()));

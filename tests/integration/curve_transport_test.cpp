@@ -288,7 +288,7 @@ std::vector<std::vector<double>> contact_rows(const std::filesystem::path& path)
 void expect_contact_csv_of_in_process_run(const std::filesystem::path& contact_csv) {
   const CoupledRunResult& reference = in_process_reference();
   const TemporaryDirectory expected("contact-csv-reference");
-  write_contact_csv(expected.path() / "contact.csv", reference.pairing,
+  write_contact_csv(expected.path() / "contact.csv", reference.pairing(),
                     two_body_interface_state(reference.iteration.state));
   const auto rows = contact_rows(contact_csv);
   const auto expected_rows = contact_rows(expected.path() / "contact.csv");

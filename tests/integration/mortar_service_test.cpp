@@ -71,13 +71,13 @@ void expect_python_and_cpp_equal_monolithic(const std::string& case_file) {
   body1.end_run();
   body2.end_run();
   ASSERT_EQ(run.iteration.status, IterationStatus::converged) << run.iteration.message;
-  EXPECT_GE(run.pairing.non_mortar_body, 0);
+  EXPECT_GE(run.pairing().non_mortar_body, 0);
 
   const LocalProblem problem = prepare_local_problem(definition);
   MprgpParameters reference = definition.solver.qp;
   reference.relative_tolerance = 1e-14;
   const MonolithicResult monolithic =
-      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing, reference);
+      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), reference);
   ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
   std::printf("%s, C++ and Python servers: %zu iterations\n", case_file.c_str(),
               run.iteration.history.size());

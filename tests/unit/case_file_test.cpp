@@ -412,7 +412,7 @@ std::vector<ErrorCase> error_cases() {
        "titel",
        1,
        {"case.toml:{line}: unknown key 'titel' (expected one of: title, gap, solver, coupling, "
-        "contact, body, loading, reference)"}},
+        "contact, body, loading, reference, interface)"}},
       {"UnknownSolverKey",
        "interface_operator",
        "interface_operators",

@@ -165,7 +165,7 @@ TEST(JsonFile, IsPrettyPrintedWithTwoSpacesAndRoundTrips) {
 TEST(SolutionPvd, NamesBothBodyFilesInANewDirectory) {
   const TemporaryDirectory directory("result_files");
   const auto output = directory.path() / "run" / "output";
-  write_solution_pvd(output, "upper.vtu", "lower.vtu");
+  write_solution_pvd(output, {"upper.vtu", "lower.vtu"});
   const json document = read_vtk_xml(output / "solution.pvd");
   EXPECT_EQ(document["root"]["type"], "Collection");
   ASSERT_EQ(document["datasets"].size(), 2u);
@@ -180,7 +180,7 @@ TEST(ResultFiles, UncreatableDirectoryGivesAnErrorNamingIt) {
   const auto blocker = directory.path() / "a_file";
   std::ofstream(blocker) << "not a directory\n";
   const auto output = blocker / "output";
-  expect_error_naming([&] { write_solution_pvd(output, "a.vtu", "b.vtu"); }, {output.string()});
+  expect_error_naming([&] { write_solution_pvd(output, {"a.vtu", "b.vtu"}); }, {output.string()});
   expect_error_naming([&] { write_json(output / "summary.json", json::object()); },
                       {output.string()});
   expect_error_naming([&] { write_contact_csv(output / "contact.csv", {}, {}); },

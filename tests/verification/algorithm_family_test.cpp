@@ -26,7 +26,7 @@ double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& 
 
 MonolithicResult monolithic_reference(const CaseDefinition& definition) {
   const LocalProblem reference = prepare_local_problem(definition);
-  return solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing,
+  return solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing(),
                           definition.solver.qp);
 }
 

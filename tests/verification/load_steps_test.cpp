@@ -74,12 +74,12 @@ TEST(LoadSteps, PatchTestPressureIsTheLoadFactorTimesTheExactPressureAtEveryStep
     const double pressure = step.factor * exact_patch_pressure();
     std::printf("patch test step %d (factor %g): %zu iterations, pressure error %.2e\n", step.step,
                 step.factor, step.iteration.history.size(),
-                largest_pressure_error(robin.pairing, step.iteration.state.bodies[0].contact_force,
+                largest_pressure_error(robin.pairing(), step.iteration.state.bodies[0].contact_force,
                                        pressure));
-    EXPECT_LE(largest_pressure_error(robin.pairing, step.iteration.state.bodies[0].contact_force,
+    EXPECT_LE(largest_pressure_error(robin.pairing(), step.iteration.state.bodies[0].contact_force,
                                      pressure),
               1e-8);
-    EXPECT_LE(largest_pressure_error(robin.pairing, step.iteration.state.bodies[1].contact_force,
+    EXPECT_LE(largest_pressure_error(robin.pairing(), step.iteration.state.bodies[1].contact_force,
                                      pressure),
               1e-8);
     EXPECT_EQ(step.warm_started, step.step > 1);
@@ -91,11 +91,11 @@ TEST(LoadSteps, PatchTestPressureIsTheLoadFactorTimesTheExactPressureAtEveryStep
   LocalProblem problem = prepare_local_problem(definition);
   MprgpParameters parameters = definition.solver.qp;
   const std::vector<MonolithicStep> steps = solve_monolithic_steps(
-      *problem.bodies[0], *problem.bodies[1], problem.pairing, definition.loading, parameters);
+      *problem.bodies[0], *problem.bodies[1], problem.pairing(), definition.loading, parameters);
   ASSERT_EQ(steps.size(), 3u);
   for (const MonolithicStep& step : steps) {
     ASSERT_EQ(step.result.qp.status, QpStatus::converged);
-    EXPECT_LE(largest_pressure_error(problem.pairing, step.result.contact_force,
+    EXPECT_LE(largest_pressure_error(problem.pairing(), step.result.contact_force,
                                      step.factor * exact_patch_pressure()),
               1e-10);
   }
@@ -127,9 +127,9 @@ TEST_P(HertzStepsTest, StepsEqualFreshMonolithicSolvesAndWarmStartsSaveIteration
     // A fresh monolithic solve of the case written at this step's load.
     const CaseDefinition fresh = scaled_case(definition, step.factor);
     const LocalProblem problem = prepare_local_problem(fresh);
-    ASSERT_EQ(problem.pairing.size(), robin.pairing.size());
+    ASSERT_EQ(problem.pairing().size(), robin.pairing().size());
     const MonolithicResult reference =
-        solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing, fresh.solver.qp);
+        solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), fresh.solver.qp);
     ASSERT_EQ(reference.qp.status, QpStatus::converged);
     const double scale = reference.contact_force.lpNorm<Eigen::Infinity>();
     ASSERT_GT(scale, 0.0);

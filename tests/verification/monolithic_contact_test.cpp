@@ -41,7 +41,7 @@ Eigen::Vector2d total_reaction(const BodySolver& body, const Eigen::VectorXd& co
 /// Returns the larger of the two imbalances relative to |resultant|.
 double expect_equilibrium(const LocalProblem& problem, const Eigen::VectorXd& force,
                           double tolerance) {
-  const Eigen::Vector2d resultant = contact_resultant(problem.pairing, force);
+  const Eigen::Vector2d resultant = contact_resultant(problem.pairing(), force);
   double worst = 0.0;
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodySolver& body = *problem.bodies[alpha];
@@ -116,9 +116,9 @@ HertzSolve solve_hertz(double depth) {
   }
   HertzSolve solve{prepare_local_problem(definition), {}, 0.0};
   solve.result = solve_monolithic(*solve.problem.bodies[0], *solve.problem.bodies[1],
-                                  solve.problem.pairing, solve.problem.definition.solver.qp);
+                                  solve.problem.pairing(), solve.problem.definition.solver.qp);
   EXPECT_EQ(solve.result.qp.status, QpStatus::converged) << solve.result.qp.message;
-  solve.load = contact_resultant(solve.problem.pairing, solve.result.contact_force).y();
+  solve.load = contact_resultant(solve.problem.pairing(), solve.result.contact_force).y();
   return solve;
 }
 
@@ -170,7 +170,7 @@ TEST(MonolithicContact, HertzHalfWidthAndPeakPressure) {
 
   // Measured half-width: midway between the outermost closed pair and its open neighbour on
   // each side; peak pressure: largest lambda_i / m_i.
-  const auto& pairs = problem.pairing.pairs;
+  const auto& pairs = problem.pairing().pairs;
   int closed = 0;
   double measured_peak = 0.0;
   double outer_closed = 0.0, inner_open = 1e300;
@@ -200,7 +200,7 @@ TEST(MonolithicContact, PartialContactSatisfiesKktAndEquilibrium) {
   const LocalProblem problem =
       prepare_local_problem(read_case_file(example("two_blocks_partial.toml")));
   const MonolithicResult result = solve_monolithic(*problem.bodies[0], *problem.bodies[1],
-                                                   problem.pairing, problem.definition.solver.qp);
+                                                   problem.pairing(), problem.definition.solver.qp);
   ASSERT_EQ(result.qp.status, QpStatus::converged) << result.qp.message;
   int closed = 0;
   for (Eigen::Index i = 0; i < result.contact_force.size(); ++i) {
@@ -213,8 +213,8 @@ TEST(MonolithicContact, PartialContactSatisfiesKktAndEquilibrium) {
   // lambda >= 0 by construction of the dual; the rest of KKT measured independently here.
   EXPECT_GE(result.contact_force.minCoeff(), 0.0);
   const Eigen::VectorXd clearance =
-      problem.pairing.gaps() - result.normal_traces[0] - result.normal_traces[1];
-  const double displacement_scale = problem.pairing.gaps().cwiseAbs().maxCoeff();
+      problem.pairing().gaps() - result.normal_traces[0] - result.normal_traces[1];
+  const double displacement_scale = problem.pairing().gaps().cwiseAbs().maxCoeff();
   const double force_scale = result.contact_force.maxCoeff();
   const double penetration = std::max(0.0, -clearance.minCoeff()) / displacement_scale;
   const double complementarity =
@@ -229,10 +229,10 @@ TEST(MonolithicContact, PartialContactSatisfiesKktAndEquilibrium) {
   // normal trace is the trace of that displacement field.
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodySolver& body = *problem.bodies[alpha];
-    const double imbalance = free_dof_imbalance(body, problem.pairing, alpha, result.contact_force);
+    const double imbalance = free_dof_imbalance(body, problem.pairing(), alpha, result.contact_force);
     const Eigen::VectorXd returned = alpha == 0 ? result.normal_traces[0] : result.normal_traces[1];
     const double trace_error =
-        (normal_trace(problem.pairing, alpha, body.displacement(result.contact_force)) - returned)
+        (normal_trace(problem.pairing(), alpha, body.displacement(result.contact_force)) - returned)
             .cwiseAbs()
             .maxCoeff() /
         displacement_scale;

@@ -44,7 +44,7 @@ double largest_pressure_error(const ContactPairing& pairing, const Eigen::Vector
 MonolithicResult solve_reference(const LocalProblem& problem, double qp_tolerance = 1e-14) {
   MprgpParameters parameters = problem.definition.solver.qp;
   parameters.relative_tolerance = qp_tolerance;
-  return solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing, parameters);
+  return solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), parameters);
 }
 
 class MortarPatchTest : public ::testing::TestWithParam<std::string> {};
@@ -54,11 +54,11 @@ TEST_P(MortarPatchTest, MonolithicPressureIsExactAtEveryMultiplierNode) {
   definition.contact.non_mortar = GetParam();
   const LocalProblem problem = prepare_local_problem(definition);
   const int expected_side = GetParam() == "lower" ? 0 : 1;  // "": the finer side, the upper
-  EXPECT_EQ(problem.pairing.non_mortar_body, expected_side);
-  EXPECT_EQ(problem.pairing.size(), GetParam() == "lower" ? 11u : 15u);
+  EXPECT_EQ(problem.pairing().non_mortar_body, expected_side);
+  EXPECT_EQ(problem.pairing().size(), GetParam() == "lower" ? 11u : 15u);
   const MonolithicResult result = solve_reference(problem);
   ASSERT_EQ(result.qp.status, QpStatus::converged);
-  EXPECT_LE(largest_pressure_error(problem.pairing, result.contact_force, exact_patch_pressure()),
+  EXPECT_LE(largest_pressure_error(problem.pairing(), result.contact_force, exact_patch_pressure()),
             1e-10);
 }
 
@@ -81,7 +81,7 @@ TEST_P(MortarPatchTest, RobinIterationConvergesToTheMonolithicMortarSolution) {
   EXPECT_LE((robin.iteration.state.bodies[1].contact_force - reference.contact_force)
                 .lpNorm<Eigen::Infinity>(),
             1e-8 * scale);
-  EXPECT_LE(largest_pressure_error(robin.pairing, robin.iteration.state.bodies[0].contact_force,
+  EXPECT_LE(largest_pressure_error(robin.pairing(), robin.iteration.state.bodies[0].contact_force,
                                    exact_patch_pressure()),
             1e-8);
 }
@@ -94,10 +94,10 @@ TEST(MortarPatch, ExactOnFinerMeshesToo) {
   CaseDefinition definition = example("non_matching_blocks.toml");
   for (BodyCase& body : definition.bodies) body.mesh_options.size = 0.02;
   const LocalProblem problem = prepare_local_problem(definition);
-  EXPECT_EQ(problem.pairing.size(), 72u);
+  EXPECT_EQ(problem.pairing().size(), 72u);
   const MonolithicResult result = solve_reference(problem);
   ASSERT_EQ(result.qp.status, QpStatus::converged);
-  EXPECT_LE(largest_pressure_error(problem.pairing, result.contact_force, exact_patch_pressure()),
+  EXPECT_LE(largest_pressure_error(problem.pairing(), result.contact_force, exact_patch_pressure()),
             1e-10);
 }
 
@@ -109,7 +109,7 @@ TEST(NodeToSegment, FailsTheContactPatchTestThatMortarPasses) {
   const MonolithicResult result = solve_reference(problem);
   ASSERT_EQ(result.qp.status, QpStatus::converged);
   const double error =
-      largest_pressure_error(problem.pairing, result.contact_force, exact_patch_pressure());
+      largest_pressure_error(problem.pairing(), result.contact_force, exact_patch_pressure());
   std::printf("node-to-segment patch test: largest pressure error %.3e\n", error);
   EXPECT_GT(error, 1e-3);
 }
@@ -120,10 +120,10 @@ TEST(MortarOnMatchingMeshes, GivesTheNodeToNodeAnswer) {
   const LocalProblem node_to_node = prepare_local_problem(definition);
   definition.contact.method = ContactMethod::mortar;
   const LocalProblem mortar = prepare_local_problem(definition);
-  ASSERT_EQ(mortar.pairing.size(), node_to_node.pairing.size());
-  for (std::size_t j = 0; j < mortar.pairing.size(); ++j) {
-    EXPECT_NEAR(mortar.pairing.pairs[j].weight, node_to_node.pairing.pairs[j].weight, 1e-13);
-    EXPECT_NEAR(mortar.pairing.pairs[j].gap, node_to_node.pairing.pairs[j].gap, 1e-13);
+  ASSERT_EQ(mortar.pairing().size(), node_to_node.pairing().size());
+  for (std::size_t j = 0; j < mortar.pairing().size(); ++j) {
+    EXPECT_NEAR(mortar.pairing().pairs[j].weight, node_to_node.pairing().pairs[j].weight, 1e-13);
+    EXPECT_NEAR(mortar.pairing().pairs[j].gap, node_to_node.pairing().pairs[j].gap, 1e-13);
   }
   const MonolithicResult first = solve_reference(node_to_node);
   const MonolithicResult second = solve_reference(mortar);
@@ -133,10 +133,10 @@ TEST(MortarOnMatchingMeshes, GivesTheNodeToNodeAnswer) {
 
 TEST(AutomaticContactMethod, ChoosesMortarForNonMatchingAndNodeToNodeForMatchingMeshes) {
   CaseDefinition matching = example("two_blocks.toml");
-  EXPECT_EQ(prepare_local_problem(matching).pairing.non_mortar_body, -1);
+  EXPECT_EQ(prepare_local_problem(matching).pairing().non_mortar_body, -1);
   CaseDefinition non_matching = example("non_matching_blocks.toml");
   non_matching.contact.method = ContactMethod::automatic;
-  EXPECT_EQ(prepare_local_problem(non_matching).pairing.non_mortar_body, 1);
+  EXPECT_EQ(prepare_local_problem(non_matching).pairing().non_mortar_body, 1);
 }
 
 }  // namespace

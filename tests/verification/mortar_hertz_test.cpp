@@ -64,15 +64,15 @@ HertzFit fit_pressure(const ContactPairing& pairing, const Eigen::VectorXd& forc
 TEST(MortarHertz, HalfWidthAndPeakPressureWithinTwoPercentOfHertz) {
   const CaseDefinition definition = hertz_cylinder(0.05);
   const LocalProblem problem = prepare_local_problem(definition);
-  EXPECT_GE(problem.pairing.non_mortar_body, 0);  // mortar
+  EXPECT_GE(problem.pairing().non_mortar_body, 0);  // mortar
   const MonolithicResult result = solve_monolithic(*problem.bodies[0], *problem.bodies[1],
-                                                   problem.pairing, definition.solver.qp);
+                                                   problem.pairing(), definition.solver.qp);
   ASSERT_EQ(result.qp.status, QpStatus::converged);
-  const double load = std::abs(contact_resultant(problem.pairing, result.contact_force).y());
+  const double load = std::abs(contact_resultant(problem.pairing(), result.contact_force).y());
   const double effective = 1000.0 / (2.0 * (1.0 - 0.3 * 0.3));
   const double hertz_width = std::sqrt(4.0 * load * 1.0 / (pi * effective));
   const double hertz_peak = 2.0 * load / (pi * hertz_width);
-  const HertzFit fit = fit_pressure(problem.pairing, result.contact_force);
+  const HertzFit fit = fit_pressure(problem.pairing(), result.contact_force);
   std::printf("P = %.6g: a = %.6f (Hertz %.6f), p0 = %.5f (Hertz %.5f)\n", load, fit.half_width,
               hertz_width, fit.peak, hertz_peak);
   EXPECT_LE(std::abs(fit.half_width - hertz_width) / hertz_width, 0.02);
@@ -90,7 +90,7 @@ TEST(MortarHertz, RobinIterationConvergesToTheMonolithicMortarSolution) {
   MprgpParameters reference = definition.solver.qp;
   reference.relative_tolerance = 1e-14;
   const MonolithicResult monolithic =
-      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing, reference);
+      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), reference);
   ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
   const double scale = monolithic.contact_force.lpNorm<Eigen::Infinity>();
   EXPECT_LE((robin.iteration.state.bodies[0].contact_force - monolithic.contact_force)

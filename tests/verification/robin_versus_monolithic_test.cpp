@@ -69,10 +69,10 @@ std::size_t expect_matches_monolithic(const CaseDefinition& definition,
   MprgpParameters reference_qp = definition.solver.qp;
   if (reference_qp_tolerance > 0.0) reference_qp.relative_tolerance = reference_qp_tolerance;
   const MonolithicResult monolithic =
-      solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing, reference_qp);
+      solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing(), reference_qp);
   EXPECT_EQ(monolithic.qp.status, QpStatus::converged);
-  EXPECT_EQ(robin.pairing.size(), reference.pairing.size());
-  if (robin.pairing.size() != reference.pairing.size()) return iterations;
+  EXPECT_EQ(robin.pairing().size(), reference.pairing().size());
+  if (robin.pairing().size() != reference.pairing().size()) return iterations;
   const RobinResult& state = robin.iteration;
   EXPECT_LE(relative_difference(state.state.bodies[0].contact_force, monolithic.contact_force),
             1e-7);
