@@ -4,7 +4,7 @@
 # its seed corpus in a scratch directory, and prints a table: harness, inputs executed, crashes
 # (artifacts written), coverage (libFuzzer's final cov: and ft:), corpus size, wall time.
 #
-# Usage: benchmarks/fuzz.sh [harness...]   harnesses: server case_file mesh_data (default all)
+# Usage: benchmarks/fuzz.sh [harness...]   harnesses: server case_file mesh_data mesh_file (default all)
 # Environment: RUNS (inputs per harness, default 1000000), BUILD (build directory, default
 # build-fuzz), SCRATCH (scratch directory, default a new mktemp -d; kept, with each harness's
 # log, corpus and crash artifacts), JOBS (build parallelism, default 2), TIMEOUT (seconds per
@@ -19,11 +19,11 @@ jobs=${JOBS:-2}
 timeout=${TIMEOUT:-10}
 max_restarts=${MAX_RESTARTS:-5}
 harnesses=("$@")
-if [ ${#harnesses[@]} -eq 0 ]; then harnesses=(server case_file mesh_data); fi
+if [ ${#harnesses[@]} -eq 0 ]; then harnesses=(server case_file mesh_data mesh_file); fi
 for harness in "${harnesses[@]}"; do
   case "$harness" in
-    server | case_file | mesh_data) ;;
-    *) echo "fuzz.sh: unknown harness '$harness' (server, case_file, mesh_data)" >&2; exit 2 ;;
+    server | case_file | mesh_data | mesh_file) ;;
+    *) echo "fuzz.sh: unknown harness '$harness' (server, case_file, mesh_data, mesh_file)" >&2; exit 2 ;;
   esac
 done
 scratch=${SCRATCH:-$(mktemp -d "${TMPDIR:-/tmp}/robin-fuzz-run-XXXXXX")}

@@ -25,7 +25,7 @@ case "${1:-}" in
     export CC=clang CXX=clang++
     options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DROBIN_WERROR=ON -DROBIN_FUZZ=ON
              -DROBIN_BUILD_TESTS=OFF -DROBIN_BUILD_BENCHMARKS=OFF)
-    targets=(--target robin-fuzz-server robin-fuzz-case-file robin-fuzz-mesh-data)
+    targets=(--target robin-fuzz-server robin-fuzz-case-file robin-fuzz-mesh-data robin-fuzz-mesh-file)
     ;;
   "") ;;
   *) echo "build.sh: unknown option '$1' (--sanitize, --fuzz)" >&2; exit 2 ;;

@@ -8,9 +8,9 @@
 
 #include "mesh_codec.hpp"
 #include "numerics/errors.hpp"
-#include "numerics/gmsh_reader.hpp"
 #include "numerics/mesh_validity.hpp"
 #include "server/file_access.hpp"
+#include "server/mesh_file_reader.hpp"
 
 namespace robin {
 namespace {
@@ -62,7 +62,7 @@ Mesh decode_body_mesh(const protocol::SetupBody& message, const std::string& con
       resolve_data_file(files.data_directory, message.mesh_path(), field);
   check_data_file_size(path, message.mesh_path(), files.maximum_bytes, field);
   try {
-    Mesh mesh = read_gmsh_mesh(path);
+    Mesh mesh = read_mesh_file_in_child(path);
     check_element_validity(mesh, context + ": SetupBody.mesh_path");
     return mesh;
   } catch (const InputError& error) {

@@ -823,6 +823,26 @@ TEST(SubdomainProcess, MeshFileAboveTheSizeLimitIsRefusedUnread) {
   expect_hello(server.socket, id++);
 }
 
+// A mesh file that crashes Gmsh 4.8 (tests/data/mesh_gmsh_crash_v22.msh: its $Nodes section says
+// 11 nodes and lists 12; `gmsh -0` dies of SIGSEGV on it, found by tests/fuzz/mesh_file_fuzzer)
+// in the data directory: robin-subdomain reads mesh files in a child process, so the request
+// is BAD_INPUT naming the crash and the server goes on: Hello, and square.msh is read as before.
+TEST(SubdomainProcess, MeshFileThatCrashesGmshIsBadInputAndTheServerGoesOn) {
+  const AttackFiles files;
+  std::filesystem::copy_file(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_gmsh_crash_v22.msh",
+                             files.data / "crash.msh");
+  ConnectedServer server({"--data-directory", files.data.string()});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  std::uint64_t id = 1;
+  expect_error(exchange(server.socket, square_path_setup(id++, "crash.msh")), protocol::BAD_INPUT,
+               "body 'square': SetupBody.mesh_path: the mesh reader (Gmsh) crashed on this file "
+               "(signal 11, Segmentation fault): refused");
+  expect_hello(server.socket, id++);
+  EXPECT_TRUE(exchange(server.socket, square_path_setup(id++, "square.msh")).has_interface());
+  ASSERT_TRUE(exchange(server.socket, shutdown(id)).has_acknowledge());
+  EXPECT_EQ(server.process.wait_for_exit(), 0) << server.process.stderr_text();
+}
+
 /// The virtual memory size of process `pid` in bytes (VmSize of /proc/PID/status; 0 if unknown).
 std::uint64_t virtual_memory_bytes(pid_t pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
