@@ -369,12 +369,8 @@ TEST(RemotePort, ServerOfProtocolOneIsRefusedNamingBothVersions) {
     std::cout << message << "\n";
     EXPECT_NE(message.find("server " + server.endpoint()), std::string::npos) << message;
     EXPECT_NE(message.find("step handshake"), std::string::npos) << message;
-    EXPECT_NE(message.find("speaks protocol 1." + std::to_string(protocol::protocol_minor)),
-              std::string::npos)
-        << message;
-    EXPECT_NE(message.find("this coordinator speaks 2." + std::to_string(protocol::protocol_minor)),
-              std::string::npos)
-        << message;
+    EXPECT_NE(message.find("the server speaks protocol 1."), std::string::npos) << message;
+    EXPECT_NE(message.find("this coordinator speaks 2."), std::string::npos) << message;
   }
 }
 
