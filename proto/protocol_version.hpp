@@ -11,6 +11,7 @@ inline constexpr unsigned protocol_major = 2;
 /// reuse the body's factor and F; a coordinator sends it only to servers of minor >= 1) and
 /// StatusRequest (heartbeat and setup progress, capability "status"). 2.2: the stage times of
 /// SetupBody, AssignContact and FieldsRequest in their replies (StageTime), for the profile.
-inline constexpr unsigned protocol_minor = 2;
+/// 2.3: floating bodies, SetupBody.floating and InterfaceDescription.rigid_modes.
+inline constexpr unsigned protocol_minor = 3;
 
 }  // namespace robin::protocol

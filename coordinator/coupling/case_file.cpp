@@ -292,6 +292,12 @@ AccelerationOptions effective_acceleration(const CouplingOptions& options) {
   return acceleration;
 }
 
+BodySolverOptions body_solver_options(const SolverOptions& solver, const BodyCase& body) {
+  BodySolverOptions options = solver.body;
+  if (body.floating) options.rigid_motions = RigidMotions::held_by_contact;
+  return options;
+}
+
 std::vector<InterfaceDefinition> interface_definitions(const CaseDefinition& definition) {
   std::vector<InterfaceDefinition> interfaces;
   for (const InterfaceCase& interface : definition.interfaces) {

@@ -42,6 +42,9 @@ struct BodyCase {
   /// and traction boundary, in file order. When empty
   /// (a BodyCase built by hand), load_body checks the names in `definition` instead.
   std::vector<BoundaryReference> boundary_references;
+  /// [[body]] floating = true: contact alone may hold the body (its supports may leave rigid
+  /// motions free; docs/method.md, "Floating bodies"). false: such a body is an error.
+  bool floating = false;
 };
 
 /// Options of the Robin iteration (coordinator); command-line flags override them.
@@ -85,6 +88,10 @@ struct InterfaceCase {
   InterfaceDefinition definition;  // bodies (indices into CaseDefinition::bodies), boundaries
   std::string context;             // "case.toml:41: interface[2]" for messages
 };
+
+/// The solver options of one body: `solver`'s, with its rigid motions held by contact when the
+/// body is floating (otherwise as `solver` says: refused, unless a caller asked otherwise).
+BodySolverOptions body_solver_options(const SolverOptions& solver, const BodyCase& body);
 
 /// The most bodies a case may have.
 inline constexpr std::size_t maximum_body_count = 256;

@@ -13,7 +13,7 @@ namespace {
 
 const std::vector<std::string> body_keys{"name",       "mesh",      "mesh_size", "element_order",
                                          "recombine",  "model",     "material",  "contact_boundary",
-                                         "body_force", "dirichlet", "traction"};
+                                         "body_force", "dirichlet", "traction", "floating"};
 const std::vector<std::string> material_keys{"young", "poisson", "voigt"};
 const std::vector<std::string> dirichlet_keys{"boundary", "x", "y", "fix"};
 const std::vector<std::string> traction_keys{"boundary", "vector", "pressure"};
@@ -192,6 +192,7 @@ BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
                "(interface.boundaries)");
   }
   definition.body_force = table.optional_vector("body_force").value_or(Eigen::Vector2d::Zero());
+  body.floating = table.optional_boolean("floating").value_or(false);
   definition.material = read_material(table, model);
   for (const TableEntry& item : table.array_of_tables("dirichlet")) {
     const CheckedTable condition(*item.table, item.path, context, dirichlet_keys);

@@ -29,7 +29,7 @@ LocalProblem prepare_local_problem(const CaseDefinition& definition,
   problem.mesh_seconds = seconds_since(start);
   const auto setup_start = std::chrono::steady_clock::now();
   for (BodyCase& body_case : loaded.bodies) {
-    BodySolverOptions options = definition.solver.body;
+    BodySolverOptions options = body_solver_options(definition.solver, body_case);
     if (observer) {
       const BodyDefinition& body = body_case.definition;
       const long dof_count = 2L * static_cast<long>(body.mesh.node_count());

@@ -100,7 +100,8 @@ void write_contact_csv(const std::filesystem::path& path, const ContactPairing& 
 }
 
 std::string write_body_vtu(const std::filesystem::path& directory, const BodySolver& body,
-                           const Eigen::VectorXd& contact_force) {
+                           const Eigen::VectorXd& contact_force,
+                           const Eigen::VectorXd& rigid_amplitudes) {
   const std::filesystem::path path = directory / (body.name() + ".vtu");
   if (contact_force.size() != body.contact_size()) {
     throw std::runtime_error("cannot write '" + path.string() + "': body '" + body.name() +
@@ -109,7 +110,9 @@ std::string write_body_vtu(const std::filesystem::path& directory, const BodySol
                              std::to_string(contact_force.size()) + " entries");
   }
   ensure_directory(directory);
-  return write_body_output(directory, make_body_output(body, contact_force));
+  return write_body_output(directory, rigid_amplitudes.size() > 0
+                                          ? make_body_output(body, contact_force, rigid_amplitudes)
+                                          : make_body_output(body, contact_force));
 }
 
 void write_solution_pvd(const std::filesystem::path& directory,

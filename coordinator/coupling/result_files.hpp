@@ -48,9 +48,12 @@ void write_contact_csv(const std::filesystem::path& path, const ContactPairing& 
 /// numerics/vtu_writer.hpp).
 /// The fields are those of make_body_output (numerics/body_output.hpp), shared with the
 /// remote subdomain path.
+/// A floating body's rigid motion has the amplitudes `rigid_amplitudes` (k values; empty: none,
+/// or those of the body's last contact solve).
 /// Returns the written file name (relative to `directory`).
 std::string write_body_vtu(const std::filesystem::path& directory, const BodySolver& body,
-                           const Eigen::VectorXd& contact_force);
+                           const Eigen::VectorXd& contact_force,
+                           const Eigen::VectorXd& rigid_amplitudes = {});
 
 /// Writes solution.pvd naming every body's file (part k: body k + 1).
 void write_solution_pvd(const std::filesystem::path& directory,

@@ -203,8 +203,11 @@ void write_monolithic_step_outputs(const std::filesystem::path& directory,
     files.emplace_back();
     for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
       problem.bodies[alpha]->set_load_factor(step.factor);
-      files.back().push_back(
-          write_body_vtu(step_path, *problem.bodies[alpha], state.bodies[alpha].contact_force));
+      const Eigen::VectorXd rigid_amplitudes = alpha < result.rigid_amplitudes.size()
+                                                   ? result.rigid_amplitudes[alpha]
+                                                   : Eigen::VectorXd();
+      files.back().push_back(write_body_vtu(step_path, *problem.bodies[alpha],
+                                            state.bodies[alpha].contact_force, rigid_amplitudes));
     }
     write_contact_files(step_path, problem.coupling, body_names(problem.definition), state);
     const InterfaceSummary interface = step_interface(problem.coupling, state);

@@ -171,11 +171,14 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
     const IterationRecord& last = iteration.history.back();
     if (const SequenceResiduals* accepted = iteration.accepted_sequence()) {
       outcome += fmt::format(
-          ": obstacle sequence {} reached {:.1e} < tolerance {:.0e} ({}; body {} takes its "
-          "contact force); final state: penetration {:.1e}, complementarity {:.1e}, obstacle "
-          "change {:.1e}, force error estimate {:.1e}",
+          ": obstacle sequence {} reached {:.1e} < tolerance {:.0e} ({}; {}); final state: "
+          "penetration {:.1e}, complementarity {:.1e}, obstacle change {:.1e}, force error "
+          "estimate {:.1e}",
           iteration.completed_by_sequence, accepted->largest(), options.tolerance,
-          options.stopping + " stopping", 3 - iteration.completed_by_sequence,
+          options.stopping + " stopping",
+          result.outputs.size() == 2
+              ? fmt::format("body {} takes its contact force", 3 - iteration.completed_by_sequence)
+              : std::string("the other bodies take their neighbours' contact forces"),
           accepted->penetration, accepted->complementarity, accepted->obstacle_change,
           accepted->force_error);
     } else {
@@ -207,9 +210,10 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
     round_trip += timings.round_trip_seconds;
   }
   log.info(
-      "wall time {:.3f} s (setup {:.3f} s, iteration {:.3f} s); summed over both servers: "
+      "wall time {:.3f} s (setup {:.3f} s, iteration {:.3f} s); summed over the {} servers: "
       "compute {:.3f} s, request round trips {:.3f} s",
-      result.total_seconds, result.setup_seconds, iteration.wall_seconds, compute, round_trip);
+      result.total_seconds, result.setup_seconds, iteration.wall_seconds,
+      result.port_timings.size(), compute, round_trip);
   log.info("results in {} (open solution.pvd in ParaView)", settings.output_directory.string());
   return code;
 }

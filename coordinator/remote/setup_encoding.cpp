@@ -93,7 +93,7 @@ void encode_material(const Material& material, const std::string& context,
 }
 
 protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
-                                      const SolverOptions& solver) {
+                                      const SolverOptions& solver, bool floating) {
   protocol::SetupBody message;
   message.set_body_name(definition.name);
   *message.mutable_mesh() = encode_mesh(definition.mesh);
@@ -112,6 +112,7 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
     message.add_contact_boundaries(boundary);
   }
   encode_solver(solver, *message.mutable_solver());
+  message.set_floating(floating);
   return message;
 }
 

@@ -13,9 +13,10 @@ namespace robin {
 /// The SetupBody request for `definition` (its mesh loaded): the mesh as MeshData (the server
 /// needs no access to the coordinator's files and runs no script), the plane model, the
 /// material (see encode_material), body force, Dirichlet conditions, tractions, the contact
-/// boundary and the body solver settings of `solver`. `context` names the body for errors.
+/// boundary, the body solver settings of `solver` and whether the body is `floating` (held by
+/// contact alone). `context` names the body for errors.
 protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
-                                      const SolverOptions& solver);
+                                      const SolverOptions& solver, bool floating = false);
 
 /// Writes `material` into `message` exactly (the server rebuilds the same Material bit for bit):
 ///  - an isotropic plane-strain material (the only kind with out_of_plane_poisson != 0) is sent

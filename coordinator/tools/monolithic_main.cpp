@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <string>
@@ -60,6 +61,21 @@ void add_contact_summary(nlohmann::json& summary, const LocalProblem& problem,
   summary["interfaces"] = interfaces;
 }
 
+/// Body `alpha`'s rigid amplitudes in `result` (empty for a body without rigid motions).
+Eigen::VectorXd rigid_amplitudes_of(const MonolithicResult& result, std::size_t alpha) {
+  return alpha < result.rigid_amplitudes.size() ? result.rigid_amplitudes[alpha]
+                                                : Eigen::VectorXd();
+}
+
+/// The sum of body `alpha`'s reactions at its prescribed degrees of freedom in the solution.
+Eigen::Vector2d reaction_resultant(const LocalProblem& problem, const MonolithicResult& result,
+                                   const robin::CouplingState& state, std::size_t alpha) {
+  const robin::BodySolver& body = *problem.bodies[alpha];
+  const Eigen::VectorXd reactions = body.reactions(
+      body.displacement(state.bodies[alpha].contact_force, rigid_amplitudes_of(result, alpha)));
+  return reactions.reshaped(2, reactions.size() / 2).rowwise().sum();
+}
+
 nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult& result,
                             double total_seconds) {
   nlohmann::json summary;
@@ -74,20 +90,24 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   summary["qp_status"] = robin::to_string(result.qp.status);
   summary["iterations"] = result.qp.iterations;
   summary["operator_applications"] = result.qp.operator_applications;
-  add_contact_summary(summary, problem,
-                      robin::monolithic_state(problem.coupling.problem.graph, result));
+  const robin::CouplingState state =
+      robin::monolithic_state(problem.coupling.problem.graph, result);
+  add_contact_summary(summary, problem, state);
   summary["residuals"] = {{"penetration", result.residuals.penetration},
                           {"force_balance", result.residuals.force_balance},
                           {"complementarity", result.residuals.complementarity}};
   double assembly = 0, factorization = 0;
-  for (const auto& body : problem.bodies) {
+  for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
+    const auto& body = problem.bodies[alpha];
+    const Eigen::Vector2d reaction = reaction_resultant(problem, result, state, alpha);
     summary["bodies"].push_back(
         {{"name", body->name()},
          {"dofs", body->free_dof_count()},
          {"nodes", body->mesh().node_count()},
          {"elements", body->mesh().element_count()},
          {"factor_nonzeros", body->factor_nonzeros()},
-         {"applied_force", {body->applied_force().x(), body->applied_force().y()}}});
+         {"applied_force", {body->applied_force().x(), body->applied_force().y()}},
+         {"reaction_resultant", {reaction.x(), reaction.y()}}});
     assembly += body->timings().assembly_seconds;
     factorization += body->timings().ordering_seconds + body->timings().factorization_seconds +
                      body->timings().interface_seconds;
@@ -100,6 +120,20 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   return summary;
 }
 
+/// The index of the mesh node nearest to `point`.
+Eigen::Index nearest_node(const robin::Mesh& mesh, const Eigen::Vector2d& point) {
+  Eigen::Index nearest = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < mesh.nodes.size(); ++k) {
+    const double distance = (mesh.nodes[k] - point).squaredNorm();
+    if (distance < best) {
+      best = distance;
+      nearest = static_cast<Eigen::Index>(k);
+    }
+  }
+  return nearest;
+}
+
 /// The excluded pairs in the solution (node ids are this process's mesh node indices).
 robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem,
                                                      const MonolithicResult& result) {
@@ -107,11 +141,16 @@ robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem
   const robin::CouplingState state = robin::monolithic_state(graph, result);
   std::vector<Eigen::VectorXd> displacements;
   for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
-    displacements.push_back(problem.bodies[alpha]->displacement(state.bodies[alpha].contact_force));
+    displacements.push_back(problem.bodies[alpha]->displacement(state.bodies[alpha].contact_force,
+                                                                rigid_amplitudes_of(result, alpha)));
   }
   const auto displacement_of = [&](int body, const robin::ContactPair& pair, int side) {
-    const Eigen::Index node = side == 0 ? pair.node1 : pair.node2;
-    return Eigen::Vector2d(displacements[static_cast<std::size_t>(body)].segment<2>(2 * node));
+    const auto index = static_cast<std::size_t>(body);
+    Eigen::Index node = side == 0 ? pair.node1 : pair.node2;
+    if (node < 0) {  // the mortar side of a mortar row has no node of its own: the nearest one
+      node = nearest_node(problem.bodies[index]->mesh(), side == 0 ? pair.position : pair.position2);
+    }
+    return Eigen::Vector2d(displacements[index].segment<2>(2 * node));
   };
   return robin::graph_excluded_clearance(problem.coupling, state, displacement_of);
 }
@@ -124,8 +163,9 @@ void write_outputs(const std::filesystem::path& directory, const LocalProblem& p
   const robin::CouplingState state = robin::monolithic_state(graph, result);
   std::vector<std::string> files;
   for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
-    files.push_back(
-        robin::write_body_vtu(directory, *problem.bodies[alpha], state.bodies[alpha].contact_force));
+    files.push_back(robin::write_body_vtu(directory, *problem.bodies[alpha],
+                                          state.bodies[alpha].contact_force,
+                                          rigid_amplitudes_of(result, alpha)));
   }
   robin::write_solution_pvd(directory, files);
   robin::write_contact_files(directory, problem.coupling, robin::body_names(problem.definition),

@@ -288,6 +288,13 @@ class SubdomainProtocol:
         self.run_id = ""                  # (and whichever run the body belonged to)
         self.state = AWAITING_SETUP
         record.body = quoted(request.setup_body.body_name, 64)[1:-1]
+        if request.setup_body.floating:
+            # Since 2.3: a body held by contact alone needs the generalized inverse and the
+            # equality-constrained dual (docs/method.md, "Floating bodies"), which this
+            # reference server does not implement.
+            raise RequestError("UNSUPPORTED", "body '%s' is floating (held by contact alone): "
+                               "this server solves only bodies whose supports remove every "
+                               "rigid motion; run it on robin-subdomain" % record.body)
         mesh_start = time.perf_counter()
         definition, settings = decode_setup_body(request.setup_body, self.protocol,
                                                  self.data_directory)

@@ -435,6 +435,11 @@ class BadBodies(ServerTestCase):
         singular = setup_body()
         singular.ClearField("dirichlet")
         self.refused(singular, code="SINGULAR_BODY")
+        floating = setup_body()
+        floating.ClearField("dirichlet")
+        floating.floating = True  # protocol 2.3: this reference server has no floating bodies
+        self.refused(floating, "body 'lower' is floating (held by contact alone)",
+                     code="UNSUPPORTED")
         self.refused(setup_body(mesh=None), "SetupBody.mesh and SetupBody.mesh_path are both "
                      "empty")
         three = setup_body()

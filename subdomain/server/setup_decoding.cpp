@@ -238,6 +238,8 @@ DecodedSetup decode_setup_body(const protocol::SetupBody& message, const MeshFil
     definition.body_force = decode_vector(message.body_force(), context, "body_force");
   }
   decode_solver(message.solver(), context, setup);
+  setup.body.rigid_motions =
+      message.floating() ? RigidMotions::held_by_contact : RigidMotions::refuse;
   definition.mesh = decode_body_mesh(message, context, files);
   definition.contact_boundaries = decode_contact_boundaries(message, definition.mesh, context);
   for (int k = 0; k < message.dirichlet_size(); ++k) {

@@ -8,10 +8,17 @@
 //    per interface, summary.json's "bodies" and "interfaces";
 //  - mirror symmetry (numbers from outside the code): the row is symmetric about x = 1.5 (equal
 //    outer blocks, mirrored meshes), so both interfaces carry the same contact resultant;
-//  - robin-coordinator with two servers for the three bodies exits 2 naming the count.
+//  - robin-coordinator with two servers for the three bodies exits 2 naming the count;
+//  - the shipped keystone arch (examples/arch.toml: four bodies, the keystone floating, held by
+//    contact alone): robin-run equals robin-monolithic to 1e-8 on every interface, and both
+//    satisfy global equilibrium (the reactions of the supports balance the applied loads, the
+//    contact forces cancelling between the bodies) and the keystone's own (its three
+//    interfaces' forces balance its weight).
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
@@ -128,6 +135,57 @@ TEST(ManyBodiesService, TwoServersForThreeBodiesAreACommandLineError) {
   EXPECT_NE(outcome.errors.find("has 3 bodies: give one --subdomain ENDPOINT per body"),
             std::string::npos)
       << outcome.errors;
+}
+
+Eigen::Vector2d vector_of(const nlohmann::json& pair) {
+  return {pair[0].get<double>(), pair[1].get<double>()};
+}
+
+/// Global equilibrium: the reactions of every body's supports and the applied loads sum to zero;
+/// the keystone's (body 3's) interfaces balance its weight: interfaces 1 and 2 are the
+/// abutments' push on it (body a on body b), interface 3 its push on the platen.
+void expect_arch_equilibrium(const nlohmann::json& summary, const std::string& what) {
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  double scale = 0.0;
+  for (const nlohmann::json& body : summary["bodies"]) {
+    const Eigen::Vector2d reaction = vector_of(body["reaction_resultant"]);
+    total += reaction + vector_of(body["applied_force"]);
+    scale = std::max(scale, reaction.norm());
+  }
+  EXPECT_LE(total.norm(), 1e-8 * scale) << what << ": sum of reactions and loads " << total.transpose();
+  const nlohmann::json& interfaces = summary["interfaces"];
+  ASSERT_EQ(interfaces.size(), 3u);
+  const Eigen::Vector2d weight = vector_of(summary["bodies"][2]["applied_force"]);
+  EXPECT_NEAR(weight.y(), -1.3, 1e-12) << "the keystone's area is 1.3, its body force -1";
+  const Eigen::Vector2d on_keystone = vector_of(interfaces[0]["contact_force_resultant"]) +
+                                      vector_of(interfaces[1]["contact_force_resultant"]) -
+                                      vector_of(interfaces[2]["contact_force_resultant"]);
+  EXPECT_LE((on_keystone + weight).norm(), 1e-8 * on_keystone.norm())
+      << what << ": contact forces on the keystone " << on_keystone.transpose();
+}
+
+TEST(ManyBodiesService, KeystoneArchWithAFloatingBodyEqualsTheMonolithicSolution) {
+  const TemporaryDirectory directory("many-bodies-arch");
+  const std::string arch = testing::example("arch.toml").string();
+  const ProcessOutcome monolithic = run_tool(
+      "robin-monolithic", {arch, "--output", (directory.path() / "monolithic").string()},
+      directory.path(), 300.0);
+  ASSERT_EQ(monolithic.exit, "exited with status 0") << monolithic.errors;
+  const ProcessOutcome run = run_tool(
+      "robin-run", {arch, "--output", (directory.path() / "run").string()}, directory.path(), 600.0);
+  ASSERT_EQ(run.exit, "exited with status 0") << run.errors;
+  for (const std::string file : {"contact_1_abutment_left_keystone.csv",
+                                 "contact_2_abutment_right_keystone.csv",
+                                 "contact_3_keystone_platen.csv"}) {
+    testing::expect_same_table(testing::csv_values(directory.path() / "run" / file),
+                               testing::csv_values(directory.path() / "monolithic" / file), 1e-8,
+                               "arch " + file);
+  }
+  const nlohmann::json run_summary = testing::read_summary(directory.path() / "run");
+  EXPECT_EQ(run_summary["status"], "converged");
+  expect_arch_equilibrium(run_summary, "robin-run");
+  expect_arch_equilibrium(testing::read_summary(directory.path() / "monolithic"),
+                          "robin-monolithic");
 }
 
 }  // namespace

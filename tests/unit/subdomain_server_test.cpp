@@ -1330,6 +1330,24 @@ TEST(SubdomainServer, FloatingBodyIsSingularNamingTheBody) {
   EXPECT_NE(reply.error().message().find("body 'lower'"), std::string::npos);
 }
 
+TEST(SubdomainServer, FloatingBodyIsSetUpWhenTheClientSaysContactHoldsIt) {
+  // protocol 2.3: SetupBody.floating; the body's supports leave one rigid motion (u_x) free
+  SubdomainServer server(quiet_settings());
+  protocol::SetupBody floating = lower_block_setup();
+  floating.mutable_dirichlet(0)->clear_x();
+  floating.set_floating(true);
+  const protocol::Envelope reply = exchange(server, setup_request(1, floating));
+  ASSERT_TRUE(reply.has_interface()) << reply.DebugString();
+  EXPECT_EQ(reply.interface().rigid_modes(), 1u);  // the horizontal translation
+  // the same body with every rigid motion removed reports none
+  SubdomainServer held(quiet_settings());
+  protocol::SetupBody supported = lower_block_setup();
+  supported.set_floating(true);
+  const protocol::Envelope held_reply = exchange(held, setup_request(2, supported));
+  ASSERT_TRUE(held_reply.has_interface()) << held_reply.DebugString();
+  EXPECT_EQ(held_reply.interface().rigid_modes(), 0u);
+}
+
 TEST(SubdomainServer, ShutdownIsAcknowledgedAndRaisesTheFlag) {
   SubdomainServer server(quiet_settings());
   EXPECT_FALSE(server.shutdown_requested());
