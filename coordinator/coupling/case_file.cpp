@@ -301,7 +301,19 @@ BodySolverOptions body_solver_options(const SolverOptions& solver, const BodyCas
 std::vector<InterfaceDefinition> interface_definitions(const CaseDefinition& definition) {
   std::vector<InterfaceDefinition> interfaces;
   for (const InterfaceCase& interface : definition.interfaces) {
-    interfaces.push_back(interface.definition);
+    InterfaceDefinition coupled = interface.definition;
+    ContactOptions contact = coupled.contact.value_or(definition.contact);
+    const bool floating_a = definition.bodies.at(static_cast<std::size_t>(coupled.body_a)).floating;
+    const bool floating_b = definition.bodies.at(static_cast<std::size_t>(coupled.body_b)).floating;
+    if (contact.non_mortar.empty() && floating_a != floating_b) {
+      // A floating body takes the obstacles of its interfaces (docs/method.md, "Floating
+      // bodies"): its rows must be its own nodes, or its dual has more rows than its trace has
+      // degrees of freedom there (a singular F, a contact force that is not unique).
+      const int floating = floating_a ? coupled.body_a : coupled.body_b;
+      contact.non_mortar = definition.bodies[static_cast<std::size_t>(floating)].definition.name;
+      coupled.contact = contact;
+    }
+    interfaces.push_back(std::move(coupled));
   }
   return interfaces;
 }

@@ -124,7 +124,9 @@ struct CaseDefinition {
 /// relaxation).
 AccelerationOptions effective_acceleration(const CouplingOptions& options);
 
-/// The interfaces of `definition` as the contact graph's coupling takes them.
+/// The interfaces of `definition` as the contact graph's coupling takes them. An interface whose
+/// non-mortar side is "auto" between a floating and a supported body gets the floating body as
+/// its non-mortar side.
 std::vector<InterfaceDefinition> interface_definitions(const CaseDefinition& definition);
 /// The body names, in body order.
 std::vector<std::string> body_names(const CaseDefinition& definition);

@@ -13,12 +13,18 @@
 //    contact alone): robin-run equals robin-monolithic to 1e-8 on every interface, and both
 //    satisfy global equilibrium (the reactions of the supports balance the applied loads, the
 //    contact forces cancelling between the bodies) and the keystone's own (its three
-//    interfaces' forces balance its weight).
+//    interfaces' forces balance its weight);
+//  - a stack of three blocks under uniform compression on non-matching meshes, the middle one
+//    floating (tests/data/stack_of_three.toml): the pressure at every multiplier row of both
+//    interfaces is the exact series-spring value, 1e-10 from robin-monolithic and 1e-8 from
+//    robin-run.
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
@@ -36,14 +42,18 @@ using testing::TemporaryDirectory;
 
 const std::filesystem::path data = ROBIN_TEST_DATA;
 
-/// row_of_three.toml copied into `directory` with absolute mesh paths.
-std::filesystem::path row_case(const std::filesystem::path& directory) {
-  const std::string text = std::regex_replace(testing::read_text(data / "row_of_three.toml"),
+/// tests/data/`name` copied into `directory` with absolute mesh paths.
+std::filesystem::path data_case(const std::filesystem::path& directory, const std::string& name) {
+  const std::string text = std::regex_replace(testing::read_text(data / name),
                                               std::regex("mesh = \""), "mesh = \"" +
                                                                            data.string() + "/");
-  const std::filesystem::path path = directory / "row_of_three.toml";
+  const std::filesystem::path path = directory / name;
   std::ofstream(path) << text;
   return path;
+}
+
+std::filesystem::path row_case(const std::filesystem::path& directory) {
+  return data_case(directory, "row_of_three.toml");
 }
 
 const std::vector<std::string> contact_files{"contact_1_left_middle.csv",
@@ -186,6 +196,50 @@ TEST(ManyBodiesService, KeystoneArchWithAFloatingBodyEqualsTheMonolithicSolution
   expect_arch_equilibrium(run_summary, "robin-run");
   expect_arch_equilibrium(testing::read_summary(directory.path() / "monolithic"),
                           "robin-monolithic");
+}
+
+/// The plane-strain constrained modulus E (1 - nu) / ((1 + nu)(1 - 2 nu)), nu = 0.3.
+double constrained_modulus(double young) {
+  return young * 0.7 / (1.3 * 0.4);
+}
+
+/// Every row's pressure in the contact files of `results` within `relative` of `exact`.
+void expect_uniform_pressure(const std::filesystem::path& results, double exact, double relative,
+                             const std::string& what) {
+  for (const std::string file : {"contact_1_bottom_middle.csv", "contact_2_middle_top.csv"}) {
+    const auto columns = testing::read_csv(results / file);
+    ASSERT_TRUE(columns.count("pressure") != 0) << what << " " << file;
+    const std::vector<std::string>& pressures = columns.at("pressure");
+    ASSERT_GE(pressures.size(), 8u) << what << " " << file;
+    double worst = 0.0;
+    for (const std::string& pressure : pressures) {
+      worst = std::max(worst, std::abs(std::stod(pressure) - exact) / exact);
+    }
+    std::cout << what << " " << file << ": " << pressures.size()
+              << " rows, largest relative pressure error " << worst << "\n";
+    EXPECT_LE(worst, relative) << what << " " << file;
+  }
+}
+
+TEST(ManyBodiesService, FloatingBlockInAStackOnNonMatchingMeshesHasTheExactUniformPressure) {
+  const TemporaryDirectory directory("many-bodies-stack");
+  const std::string stack = data_case(directory.path(), "stack_of_three.toml").string();
+  const double exact = 0.01 / (1.0 / constrained_modulus(1000.0) +
+                               1.0 / constrained_modulus(300.0) +
+                               1.0 / constrained_modulus(2000.0));
+  const ProcessOutcome monolithic = run_tool(
+      "robin-monolithic", {stack, "--output", (directory.path() / "monolithic").string()},
+      directory.path(), 300.0);
+  ASSERT_EQ(monolithic.exit, "exited with status 0") << monolithic.errors;
+  expect_uniform_pressure(directory.path() / "monolithic", exact, 1e-10, "robin-monolithic");
+  const ProcessOutcome run = run_tool(
+      "robin-run", {stack, "--output", (directory.path() / "run").string()}, directory.path(),
+      600.0);
+  ASSERT_EQ(run.exit, "exited with status 0") << run.errors;
+  expect_uniform_pressure(directory.path() / "run", exact, 1e-8, "robin-run");
+  const nlohmann::json summary = testing::read_summary(directory.path() / "run");
+  EXPECT_NE(summary["interfaces"][0]["contact_discretization"].get<std::string>().find("mortar"),
+            std::string::npos);
 }
 
 }  // namespace
