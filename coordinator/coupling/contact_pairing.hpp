@@ -85,8 +85,9 @@ void require_constraints_left(const ContactPairing& pairing, const std::string& 
 /// flat and gently curved zones, so that contact.csv reads as a profile): indices into points.
 std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points);
 
-/// "" when every gap d_i >= 0; otherwise one line for the log and summary.json: how many pairs
-/// overlap initially, the largest overlap and where.
+/// "" when every gap d_i >= 0 (up to round-off: -1e-12 of the contact zone's length); otherwise
+/// one line for the log and summary.json: how many pairs overlap initially, the largest overlap
+/// and where.
 std::string overlap_warning(const ContactPairing& pairing);
 
 /// The clearance of the excluded pairs in a solution: the largest penetration

@@ -153,6 +153,16 @@ TEST(ContactPairing, InitialOverlapIsReportedWithTheDeepestPair) {
   EXPECT_NE(warning.find("0.9 at (1, 0)"), std::string::npos) << warning;
   const ContactPairing touching = pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
   EXPECT_EQ(overlap_warning(touching), "");  // d = 0 exactly is contact, not overlap
+  // the round-off of gaps computed from coordinates on an inclined boundary (the zone is 1 long:
+  // 1e-12 of it is the threshold) is not an overlap; 1e-9 is
+  const GapFunction round_off("-2e-16", {}, "test");
+  EXPECT_EQ(overlap_warning(pair_contact_nodes(lower, "lower", upper, "upper", &round_off, 1e-6)),
+            "");
+  const GapFunction small("-1e-9", {}, "test");
+  const std::string small_warning =
+      overlap_warning(pair_contact_nodes(lower, "lower", upper, "upper", &small, 1e-6));
+  EXPECT_NE(small_warning.find("3 of 3 contact pairs overlap"), std::string::npos)
+      << small_warning;
 }
 
 TEST(ContactPairing, ExcludedPairClearanceMeasuresThePenetrationOfPrescribedNodes) {
