@@ -15,8 +15,8 @@ namespace robin {
 
 namespace {
 
-const std::vector<std::string> root_keys{"title",   "gap",  "solver",  "coupling",
-                                         "contact", "body", "loading", "reference", "interface"};
+const std::vector<std::string> root_keys{"title", "gap",     "solver",    "coupling", "contact",
+                                         "body",  "loading", "reference", "interface"};
 const std::vector<std::string> contact_keys{"method", "non_mortar"};
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
@@ -219,7 +219,8 @@ void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
 
 /// The [[body]] tables: exactly two without [[interface]] tables, 2 to maximum_body_count with
 /// them; names unique. Returns the entries (for the lines of later messages).
-std::vector<TableEntry> read_bodies(const CheckedTable& root, const std::filesystem::path& directory,
+std::vector<TableEntry> read_bodies(const CheckedTable& root,
+                                    const std::filesystem::path& directory,
                                     CaseDefinition& definition) {
   const std::vector<TableEntry> entries = root.array_of_tables("body");
   const bool graph = root.contains("interface");
@@ -349,7 +350,7 @@ static CaseDefinition read_case_document(const std::filesystem::path& path,
     table->fail("non_mortar",
                 "'" + definition.contact.non_mortar + "' is not the name of a body (nor \"auto\")");
   }
-  read_interfaces(root, bodies, definition);  // [[interface]]: coupling/case_file_interface.hpp
+  read_interfaces(root, bodies, definition);    // [[interface]]: coupling/case_file_interface.hpp
   definition.reference = read_reference(root);  // after the bodies: their materials give E*
   return definition;
 }

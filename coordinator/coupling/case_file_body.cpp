@@ -13,7 +13,7 @@ namespace {
 
 const std::vector<std::string> body_keys{"name",       "mesh",      "mesh_size", "element_order",
                                          "recombine",  "model",     "material",  "contact_boundary",
-                                         "body_force", "dirichlet", "traction", "floating"};
+                                         "body_force", "dirichlet", "traction",  "floating"};
 const std::vector<std::string> material_keys{"young", "poisson", "voigt"};
 const std::vector<std::string> dirichlet_keys{"boundary", "x", "y", "fix"};
 const std::vector<std::string> traction_keys{"boundary", "vector", "pressure"};

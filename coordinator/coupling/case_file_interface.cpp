@@ -25,8 +25,8 @@ int body_index(const CheckedTable& table, const std::vector<BodyCase>& bodies,
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     if (bodies[k].definition.name == name) return static_cast<int>(k);
   }
-  table.fail("bodies", "'" + name + "' is not the name of a body (the bodies: " +
-                           list_names(bodies) + ")");
+  table.fail("bodies",
+             "'" + name + "' is not the name of a body (the bodies: " + list_names(bodies) + ")");
 }
 
 ContactMethod method_of(const std::string& choice) {
@@ -92,8 +92,9 @@ InterfaceCase read_interface(const TableEntry& entry, const CaseContext& context
   file_only.body.clear();
   const std::string location = file_only.prefix(table.line("boundaries"));
   for (int side = 0; side < 2; ++side) {
-    BodyCase& body = definition.bodies[static_cast<std::size_t>(side == 0 ? interface.body_a
-                                                                          : interface.body_b)];
+    BodyCase& body =
+        definition
+            .bodies[static_cast<std::size_t>(side == 0 ? interface.body_a : interface.body_b)];
     const std::string field = table.field("boundaries") + "[" + std::to_string(side + 1) + "]";
     add_contact_boundary(body, boundaries[static_cast<std::size_t>(side)],
                          {boundaries[static_cast<std::size_t>(side)], field, location}, table);

@@ -234,8 +234,8 @@ std::vector<BodyOutput> collect_fields(RecoverablePorts& ports, const RobinResul
 /// iteration with `options` on `problem`, results discarded: the servers' contact warm start
 /// after them is the one that run left (CouplingScheme::repeat_contact_solves). Throws PortError
 /// as the iteration does.
-void repeat_contact_solves(const std::vector<SubdomainPort*>& ports,
-                           const CouplingProblem& problem, const CouplingOptions& options,
+void repeat_contact_solves(const std::vector<SubdomainPort*>& ports, const CouplingProblem& problem,
+                           const CouplingOptions& options,
                            const std::vector<Eigen::VectorXd>& iterates) {
   if (iterates.empty()) return;
   const std::unique_ptr<CouplingScheme> scheme = make_coupling_scheme(options, ports, problem);
@@ -407,9 +407,8 @@ std::vector<InterfaceDescription> set_up_bodies(RecoverablePorts& ports,
 GraphCoupling couple_interfaces(const CaseDefinition& definition,
                                 const std::vector<InterfaceDescription>& interfaces) {
   const std::unique_ptr<GapFunction> gap = make_gap_function(definition);
-  return couple_contact_graph(interfaces, body_names(definition),
-                              interface_definitions(definition), gap.get(), definition.contact,
-                              definition.solver.pairing_tolerance);
+  return couple_contact_graph(interfaces, body_names(definition), interface_definitions(definition),
+                              gap.get(), definition.contact, definition.solver.pairing_tolerance);
 }
 
 /// The iteration of a case without [loading], and its fields.
@@ -418,9 +417,8 @@ void run_single_solve(RecoverablePorts& recoverable, const CouplingOptions& opti
                       CoupledRunResult& result) {
   const std::vector<PortTimings> before = port_timings(recoverable);
   const auto iteration_start = Clock::now();
-  result.iteration =
-      recoverable_iteration(recoverable, result.coupling.problem, options, nullptr,
-                            continuation.resume, continuation.checkpoint, observer);
+  result.iteration = recoverable_iteration(recoverable, result.coupling.problem, options, nullptr,
+                                           continuation.resume, continuation.checkpoint, observer);
   result.profile.iterations_seconds = seconds_since(iteration_start);
   result.iteration_port_timings = differences(port_timings(recoverable), before);
   report_stage(observer, "collecting the fields of " + every_body(recoverable));
@@ -463,7 +461,8 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
   result.profile.contact_coupling_seconds = result.coupling_seconds;
   for (const std::string& line : describe_interfaces(result.coupling, body_names(definition)))
     report_stage(observer, line);
-  for (const std::string& line : excluded_pair_lines(result.coupling)) report_warning(observer, line);
+  for (const std::string& line : excluded_pair_lines(result.coupling))
+    report_warning(observer, line);
   for (const std::string& line : overlap_warnings(result.coupling)) report_warning(observer, line);
   const auto assignment_start = Clock::now();
   recoverable.run([&] {

@@ -27,7 +27,7 @@ struct LoadStepResult {
   std::vector<BodyOutput> outputs;  // body order
   ExcludedPairClearance excluded_clearance;
   std::vector<PortTimings> port_timings;  // the step alone: load factor, iteration, fields
-  double seconds = 0.0;                     // wall time of the step
+  double seconds = 0.0;                   // wall time of the step
 };
 
 struct CoupledRunResult {
@@ -35,10 +35,10 @@ struct CoupledRunResult {
   /// Per interface its rows, per body its operator, and the graph's problem.
   GraphCoupling coupling;
   RobinResult iteration;
-  std::vector<BodyOutput> outputs;                     // body order
-  std::vector<InterfaceDescription> interfaces;        // body order: the servers' descriptions
-  std::vector<PortTimings> port_timings;               // whole run
-  std::vector<PortTimings> iteration_port_timings;     // the iteration alone (no setup, fields)
+  std::vector<BodyOutput> outputs;                  // body order
+  std::vector<InterfaceDescription> interfaces;     // body order: the servers' descriptions
+  std::vector<PortTimings> port_timings;            // whole run
+  std::vector<PortTimings> iteration_port_timings;  // the iteration alone (no setup, fields)
   /// The excluded pairs in the final state (contact_pairing.hpp): a penetration beyond
   /// excluded_pair_penetration_limit means a Dirichlet condition drives the bodies into each
   /// other, which the tools report as an error.
@@ -91,12 +91,12 @@ struct RunObserver {
   IterationObserver iteration;
 };
 
-/// Runs the case on the ports, one per body in body order (ports[0] gets body 1). `options` replaces the case's
-/// [coupling] table (the caller merges command-line overrides). Throws PortError, InputError.
-/// A case with [loading] sets the bodies up and assigns the contact once, then per step sets
-/// the load factor on every port (SetLoadFactor: the servers keep K's factor and F), runs the
-/// iteration (with loading.warm_start from the previous steps' fixed points: the last one, or
-/// the linear extrapolation through the last two to the step's factor), and collects the
+/// Runs the case on the ports, one per body in body order (ports[0] gets body 1). `options`
+/// replaces the case's [coupling] table (the caller merges command-line overrides). Throws
+/// PortError, InputError. A case with [loading] sets the bodies up and assigns the contact once,
+/// then per step sets the load factor on every port (SetLoadFactor: the servers keep K's factor and
+/// F), runs the iteration (with loading.warm_start from the previous steps' fixed points: the last
+/// one, or the linear extrapolation through the last two to the step's factor), and collects the
 /// fields; it stops after the first step that does not converge.
 /// With `continuation`, the iteration is checkpointed and may resume, and a lost server is
 /// replaced: its body set up again and the stage it was lost in repeated, the iteration from

@@ -48,9 +48,8 @@ GraphCoupling couple_contact_graph(const std::vector<InterfaceDescription>& bodi
       throw InputError("contact interface " + std::to_string(k + 1) +
                        " must join two different bodies of the " + std::to_string(count));
     }
-    coupling.pairings.push_back(
-        couple_interface(bodies, names, interface, k, gap, options, pairing_tolerance,
-                         interfaces.size() == 1));
+    coupling.pairings.push_back(couple_interface(bodies, names, interface, k, gap, options,
+                                                 pairing_tolerance, interfaces.size() == 1));
     edges.push_back({interface.body_a, interface.body_b,
                      static_cast<Eigen::Index>(coupling.pairings.back().size())});
   }

@@ -22,8 +22,9 @@ struct GraphCoupling {
 /// Discretizes every interface of `interfaces` between the bodies described by `bodies`
 /// (their InterfaceDescriptions, with one surface per contact boundary; `names` for messages).
 /// `gap` may be null; `options` couples every interface that has no contact options of its own.
-/// With one interface, errors are those of discretize_contact. Throws InputError naming the interface, bodies and boundaries (an unknown
-/// boundary, unmatched nodes, boundaries that do not face each other).
+/// With one interface, errors are those of discretize_contact. Throws InputError naming the
+/// interface, bodies and boundaries (an unknown boundary, unmatched nodes, boundaries that do not
+/// face each other).
 GraphCoupling couple_contact_graph(const std::vector<InterfaceDescription>& bodies,
                                    const std::vector<std::string>& names,
                                    const std::vector<InterfaceDefinition>& interfaces,

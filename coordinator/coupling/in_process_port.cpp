@@ -18,7 +18,8 @@ InterfaceDescription InProcessPort::setup(const BodyCase& body_case, const Solve
     throw PortError(describe() + ": body '" + name_ + "' has no mesh (load_meshes first)");
   }
   const auto start = std::chrono::steady_clock::now();
-  body_ = std::make_unique<BodySolver>(body_case.definition, body_solver_options(solver, body_case));
+  body_ =
+      std::make_unique<BodySolver>(body_case.definition, body_solver_options(solver, body_case));
   const BodyTimings& timings = body_->timings();
   timings_.compute_seconds += timings.setup_seconds();
   profile_ = BodyProfile{};

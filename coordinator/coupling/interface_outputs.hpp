@@ -9,6 +9,7 @@
 // rows, excluded pairs, contact force resultant and file.
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>

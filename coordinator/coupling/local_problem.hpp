@@ -18,7 +18,7 @@ namespace robin {
 
 struct LocalProblem {
   CaseDefinition definition;
-  std::unique_ptr<GapFunction> gap;  // null when the case has no [gap]
+  std::unique_ptr<GapFunction> gap;                 // null when the case has no [gap]
   std::vector<std::unique_ptr<BodySolver>> bodies;  // body order
   /// Per interface its rows (pairings), per body its operator, and the graph's problem.
   GraphCoupling coupling;

@@ -12,10 +12,10 @@
 // start of the iteration; the resumed iteration repeats the contact solves of the iterations
 // before it on both servers, so that it runs as it would have.
 
-#include <vector>
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "coupling/case_file.hpp"
 #include "coupling/contact_pairing.hpp"

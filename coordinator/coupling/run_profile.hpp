@@ -4,9 +4,9 @@
 // as measured where the body lives. Every time is wall-clock seconds; a stage that was not
 // reported (a server of protocol 2.1 or older) is null.
 
-#include <vector>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"

@@ -169,8 +169,8 @@ nlohmann::json monolithic_steps_json(const LocalProblem& problem,
   nlohmann::json entries = nlohmann::json::array();
   for (const MonolithicStep& step : steps) {
     const MonolithicResult& result = step.result;
-    const InterfaceSummary interface = step_interface(
-        problem.coupling, monolithic_state(problem.coupling.problem.graph, result));
+    const InterfaceSummary interface =
+        step_interface(problem.coupling, monolithic_state(problem.coupling.problem.graph, result));
     entries.push_back(
         {{"step", step.step},
          {"load_factor", step.factor},

@@ -530,11 +530,10 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
       try {
         endpoint = restart.restart(body);
       } catch (const std::exception& error) {
-        throw PortError(
-            fmt::format("{}\n  the server of body '{}' cannot be replaced (restart "
-                        "{} of {}): {}",
-                        failure, name, restarts[index], settings.max_server_restarts,
-                        error.what()));
+        throw PortError(fmt::format(
+            "{}\n  the server of body '{}' cannot be replaced (restart "
+            "{} of {}): {}",
+            failure, name, restarts[index], settings.max_server_restarts, error.what()));
       }
       restart_records.push_back({{"body", name},
                                  {"restart", restarts[index]},

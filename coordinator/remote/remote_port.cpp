@@ -217,7 +217,8 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   if (server_name_.empty()) handshake();
   const auto encoding_start = Clock::now();
   Envelope request;
-  *request.mutable_setup_body() = encode_setup_body(body.definition, body.context, solver, body.floating);
+  *request.mutable_setup_body() =
+      encode_setup_body(body.definition, body.context, solver, body.floating);
   const double encoding_seconds = seconds_since(encoding_start);
   const auto sent = Clock::now();
   const Envelope reply =

@@ -1,7 +1,8 @@
 // robin-run CASE --output DIR [options]
-// The one-command launcher: starts one robin-subdomain server per body (found next to this executable)
-// on tcp://127.0.0.1 with ephemeral ports, logs of the servers in DIR/logs/server-<body>.log,
-// runs the coordinator against them and stops them. SIGINT/SIGTERM stop everything cleanly.
+// The one-command launcher: starts one robin-subdomain server per body (found next to this
+// executable) on tcp://127.0.0.1 with ephemeral ports, logs of the servers in
+// DIR/logs/server-<body>.log, runs the coordinator against them and stops them. SIGINT/SIGTERM stop
+// everything cleanly.
 // --curve encrypts the local connections with CurveZMQ, with keys made for this run only
 // (curve_options.hpp); without it the loopback connections are not encrypted.
 // Servers on other hosts: --server-command "ssh HOST" (or "srun -N1 -n1 ...", "ip netns exec

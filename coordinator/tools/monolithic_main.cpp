@@ -49,8 +49,8 @@ void add_contact_summary(nlohmann::json& summary, const LocalProblem& problem,
     rows += static_cast<Eigen::Index>(pairing.size());
   }
   summary["contact_pairs"] = rows;
-  summary["contact_discretization"] = fmt::format(
-      "{}", fmt::join(robin::describe_interfaces(coupling, names), "; "));
+  summary["contact_discretization"] =
+      fmt::format("{}", fmt::join(robin::describe_interfaces(coupling, names), "; "));
   summary["excluded_pairs"] = robin::excluded_pair_lines(coupling);
   summary["initial_overlap"] =
       fmt::format("{}", fmt::join(robin::overlap_warnings(coupling), "; "));
@@ -141,14 +141,15 @@ robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem
   const robin::CouplingState state = robin::monolithic_state(graph, result);
   std::vector<Eigen::VectorXd> displacements;
   for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
-    displacements.push_back(problem.bodies[alpha]->displacement(state.bodies[alpha].contact_force,
-                                                                rigid_amplitudes_of(result, alpha)));
+    displacements.push_back(problem.bodies[alpha]->displacement(
+        state.bodies[alpha].contact_force, rigid_amplitudes_of(result, alpha)));
   }
   const auto displacement_of = [&](int body, const robin::ContactPair& pair, int side) {
     const auto index = static_cast<std::size_t>(body);
     Eigen::Index node = side == 0 ? pair.node1 : pair.node2;
     if (node < 0) {  // the mortar side of a mortar row has no node of its own: the nearest one
-      node = nearest_node(problem.bodies[index]->mesh(), side == 0 ? pair.position : pair.position2);
+      node =
+          nearest_node(problem.bodies[index]->mesh(), side == 0 ? pair.position : pair.position2);
     }
     return Eigen::Vector2d(displacements[index].segment<2>(2 * node));
   };
@@ -280,8 +281,8 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
   const std::filesystem::path& case_path = definition.file;
   log->info("case {}: bodies '{}'", case_path.string(),
             fmt::join(robin::body_names(definition), "', '"));
-  log->info("reading and meshing {}", definition.bodies.size() == 2 ? std::string("both bodies")
-                                                                     : "the bodies");
+  log->info("reading and meshing {}",
+            definition.bodies.size() == 2 ? std::string("both bodies") : "the bodies");
   const LocalProblem problem = prepare_with_progress(definition, display);
   for (const auto& body : problem.bodies) {
     log->info("body '{}': {} dofs, assembly {:.3f} s, factorization {:.3f} s ({} nonzeros in L)",
@@ -299,9 +300,8 @@ int solve_and_write(const robin::CaseDefinition& definition, robin::ResultDirect
   const robin::CouplingProblem& graph_problem = problem.coupling.problem;
   std::vector<robin::BodySolver*> bodies;
   for (const auto& body : problem.bodies) bodies.push_back(body.get());
-  const std::vector<robin::MonolithicStep> steps =
-      robin::solve_monolithic_steps(bodies, graph_problem.graph, graph_problem.gaps,
-                                    definition.loading, definition.solver.qp);
+  const std::vector<robin::MonolithicStep> steps = robin::solve_monolithic_steps(
+      bodies, graph_problem.graph, graph_problem.gaps, definition.loading, definition.solver.qp);
   const MonolithicResult result =
       steps.empty() ? robin::solve_monolithic(problem.body_solvers(), graph_problem.graph,
                                               graph_problem.gaps, definition.solver.qp)

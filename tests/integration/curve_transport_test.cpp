@@ -34,10 +34,10 @@ namespace robin {
 namespace {
 
 using testing::example;
+using testing::expect_same_interface_state;
 using testing::run_tool;
 using testing::server_options;
 using testing::TemporaryDirectory;
-using testing::expect_same_interface_state;
 using testing::vectors_close;
 
 /// examples/two_blocks.toml with both meshes loaded (SubdomainPort::setup sends the mesh).

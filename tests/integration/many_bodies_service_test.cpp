@@ -44,9 +44,8 @@ const std::filesystem::path data = ROBIN_TEST_DATA;
 
 /// tests/data/`name` copied into `directory` with absolute mesh paths.
 std::filesystem::path data_case(const std::filesystem::path& directory, const std::string& name) {
-  const std::string text = std::regex_replace(testing::read_text(data / name),
-                                              std::regex("mesh = \""), "mesh = \"" +
-                                                                           data.string() + "/");
+  const std::string text = std::regex_replace(
+      testing::read_text(data / name), std::regex("mesh = \""), "mesh = \"" + data.string() + "/");
   const std::filesystem::path path = directory / name;
   std::ofstream(path) << text;
   return path;
@@ -63,11 +62,10 @@ const std::vector<std::string> contact_files{"contact_1_left_middle.csv",
 const std::filesystem::path& monolithic_results() {
   static const TemporaryDirectory directory("many-bodies-monolithic");
   static const bool solved = [] {
-    const ProcessOutcome outcome =
-        run_tool("robin-monolithic",
-                 {row_case(directory.path()).string(), "--output",
-                  (directory.path() / "out").string()},
-                 directory.path(), 120.0);
+    const ProcessOutcome outcome = run_tool(
+        "robin-monolithic",
+        {row_case(directory.path()).string(), "--output", (directory.path() / "out").string()},
+        directory.path(), 120.0);
     EXPECT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
     return true;
   }();
@@ -87,9 +85,9 @@ void expect_equal_to_monolithic(const std::filesystem::path& results, const std:
 TEST(ManyBodiesService, RobinRunEqualsTheMonolithicContactGraphSolution) {
   const TemporaryDirectory directory("many-bodies-run");
   const std::filesystem::path output = directory.path() / "out";
-  const ProcessOutcome outcome = run_tool(
-      "robin-run", {row_case(directory.path()).string(), "--output", output.string()},
-      directory.path(), 300.0);
+  const ProcessOutcome outcome =
+      run_tool("robin-run", {row_case(directory.path()).string(), "--output", output.string()},
+               directory.path(), 300.0);
   ASSERT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
   expect_equal_to_monolithic(output, "robin-run");
   EXPECT_FALSE(std::filesystem::exists(output / "contact.csv"));  // one file per interface
@@ -128,8 +126,7 @@ TEST(ManyBodiesService, RobinCoordinatorAgainstThreeServersEqualsTheMonolithicSo
   for (const std::string& endpoint : servers.endpoints()) {
     arguments.insert(arguments.end(), {"--subdomain", endpoint});
   }
-  const ProcessOutcome outcome =
-      run_tool("robin-coordinator", arguments, directory.path(), 300.0);
+  const ProcessOutcome outcome = run_tool("robin-coordinator", arguments, directory.path(), 300.0);
   ASSERT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
   expect_equal_to_monolithic(directory.path() / "out", "robin-coordinator");
 }
@@ -162,7 +159,8 @@ void expect_arch_equilibrium(const nlohmann::json& summary, const std::string& w
     total += reaction + vector_of(body["applied_force"]);
     scale = std::max(scale, reaction.norm());
   }
-  EXPECT_LE(total.norm(), 1e-8 * scale) << what << ": sum of reactions and loads " << total.transpose();
+  EXPECT_LE(total.norm(), 1e-8 * scale)
+      << what << ": sum of reactions and loads " << total.transpose();
   const nlohmann::json& interfaces = summary["interfaces"];
   ASSERT_EQ(interfaces.size(), 3u);
   const Eigen::Vector2d weight = vector_of(summary["bodies"][2]["applied_force"]);
@@ -177,16 +175,17 @@ void expect_arch_equilibrium(const nlohmann::json& summary, const std::string& w
 TEST(ManyBodiesService, KeystoneArchWithAFloatingBodyEqualsTheMonolithicSolution) {
   const TemporaryDirectory directory("many-bodies-arch");
   const std::string arch = testing::example("arch.toml").string();
-  const ProcessOutcome monolithic = run_tool(
-      "robin-monolithic", {arch, "--output", (directory.path() / "monolithic").string()},
-      directory.path(), 300.0);
+  const ProcessOutcome monolithic =
+      run_tool("robin-monolithic", {arch, "--output", (directory.path() / "monolithic").string()},
+               directory.path(), 300.0);
   ASSERT_EQ(monolithic.exit, "exited with status 0") << monolithic.errors;
-  const ProcessOutcome run = run_tool(
-      "robin-run", {arch, "--output", (directory.path() / "run").string()}, directory.path(), 600.0);
+  const ProcessOutcome run =
+      run_tool("robin-run", {arch, "--output", (directory.path() / "run").string()},
+               directory.path(), 600.0);
   ASSERT_EQ(run.exit, "exited with status 0") << run.errors;
-  for (const std::string file : {"contact_1_abutment_left_keystone.csv",
-                                 "contact_2_abutment_right_keystone.csv",
-                                 "contact_3_keystone_platen.csv"}) {
+  for (const std::string file :
+       {"contact_1_abutment_left_keystone.csv", "contact_2_abutment_right_keystone.csv",
+        "contact_3_keystone_platen.csv"}) {
     testing::expect_same_table(testing::csv_values(directory.path() / "run" / file),
                                testing::csv_values(directory.path() / "monolithic" / file), 1e-8,
                                "arch " + file);
@@ -224,17 +223,17 @@ void expect_uniform_pressure(const std::filesystem::path& results, double exact,
 TEST(ManyBodiesService, FloatingBlockInAStackOnNonMatchingMeshesHasTheExactUniformPressure) {
   const TemporaryDirectory directory("many-bodies-stack");
   const std::string stack = data_case(directory.path(), "stack_of_three.toml").string();
-  const double exact = 0.01 / (1.0 / constrained_modulus(1000.0) +
-                               1.0 / constrained_modulus(300.0) +
-                               1.0 / constrained_modulus(2000.0));
-  const ProcessOutcome monolithic = run_tool(
-      "robin-monolithic", {stack, "--output", (directory.path() / "monolithic").string()},
-      directory.path(), 300.0);
+  const double exact =
+      0.01 / (1.0 / constrained_modulus(1000.0) + 1.0 / constrained_modulus(300.0) +
+              1.0 / constrained_modulus(2000.0));
+  const ProcessOutcome monolithic =
+      run_tool("robin-monolithic", {stack, "--output", (directory.path() / "monolithic").string()},
+               directory.path(), 300.0);
   ASSERT_EQ(monolithic.exit, "exited with status 0") << monolithic.errors;
   expect_uniform_pressure(directory.path() / "monolithic", exact, 1e-10, "robin-monolithic");
-  const ProcessOutcome run = run_tool(
-      "robin-run", {stack, "--output", (directory.path() / "run").string()}, directory.path(),
-      600.0);
+  const ProcessOutcome run =
+      run_tool("robin-run", {stack, "--output", (directory.path() / "run").string()},
+               directory.path(), 600.0);
   ASSERT_EQ(run.exit, "exited with status 0") << run.errors;
   expect_uniform_pressure(directory.path() / "run", exact, 1e-8, "robin-run");
   const nlohmann::json summary = testing::read_summary(directory.path() / "run");

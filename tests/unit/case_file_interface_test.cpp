@@ -115,7 +115,8 @@ class CaseFileInterfaceError : public ::testing::TestWithParam<InterfaceError> {
 
 TEST_P(CaseFileInterfaceError, MessageNamesTheFieldAndTheProblem) {
   const InterfaceError& error = GetParam();
-  const std::string message = read_error(write_case(replaced(three_bodies(), error.from, error.to)));
+  const std::string message =
+      read_error(write_case(replaced(three_bodies(), error.from, error.to)));
   ASSERT_FALSE(message.empty());
   for (const std::string& fragment : error.fragments) {
     EXPECT_NE(message.find(fragment), std::string::npos)
@@ -159,15 +160,15 @@ INSTANTIATE_TEST_SUITE_P(
                        "method = \"node-to-node\"",
                        "non_mortar = \"left\"",
                        {"interface[2].non_mortar: 'left' is not one of the interface's bodies"}},
-        InterfaceError{"UnknownKey",
-                       "method = \"node-to-node\"",
-                       "gap = 0.1",
-                       {"unknown key 'interface[2].gap'", "bodies, boundaries, method, non_mortar"}}),
+        InterfaceError{
+            "UnknownKey",
+            "method = \"node-to-node\"",
+            "gap = 0.1",
+            {"unknown key 'interface[2].gap'", "bodies, boundaries, method, non_mortar"}}),
     [](const ::testing::TestParamInfo<InterfaceError>& info) { return info.param.name; });
 
 TEST(CaseFileInterfaces, MoreThanTwoBodiesWithoutInterfacesSaysWhatIsMissing) {
-  const std::string text = body("left", "left") + body("middle", "middle") +
-                           body("right", "right");
+  const std::string text = body("left", "left") + body("middle", "middle") + body("right", "right");
   const std::string message = read_error(write_case(
       std::regex_replace(text, std::regex("model = "), "contact_boundary = \"left\"\nmodel = ")));
   EXPECT_NE(message.find("expected exactly two [[body]] tables, found 3 (a case of more bodies "
@@ -177,9 +178,8 @@ TEST(CaseFileInterfaces, MoreThanTwoBodiesWithoutInterfacesSaysWhatIsMissing) {
 }
 
 TEST(CaseFileInterfaces, AnUnknownInterfaceBoundaryIsNamedWhenTheMeshIsRead) {
-  CaseDefinition definition =
-      read_case_file(write_case(replaced(three_bodies(), "boundaries = [\"right\", \"left\"]",
-                                         "boundaries = [\"right\", \"side\"]")));
+  CaseDefinition definition = read_case_file(write_case(replaced(
+      three_bodies(), "boundaries = [\"right\", \"left\"]", "boundaries = [\"right\", \"side\"]")));
   try {
     load_meshes(definition);
     FAIL() << "no InputError";

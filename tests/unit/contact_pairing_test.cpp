@@ -161,8 +161,7 @@ TEST(ContactPairing, InitialOverlapIsReportedWithTheDeepestPair) {
   const GapFunction small("-1e-9", {}, "test");
   const std::string small_warning =
       overlap_warning(pair_contact_nodes(lower, "lower", upper, "upper", &small, 1e-6));
-  EXPECT_NE(small_warning.find("3 of 3 contact pairs overlap"), std::string::npos)
-      << small_warning;
+  EXPECT_NE(small_warning.find("3 of 3 contact pairs overlap"), std::string::npos) << small_warning;
 }
 
 TEST(ContactPairing, ExcludedPairClearanceMeasuresThePenetrationOfPrescribedNodes) {

@@ -74,8 +74,8 @@ TEST(LoadSteps, PatchTestPressureIsTheLoadFactorTimesTheExactPressureAtEveryStep
     const double pressure = step.factor * exact_patch_pressure();
     std::printf("patch test step %d (factor %g): %zu iterations, pressure error %.2e\n", step.step,
                 step.factor, step.iteration.history.size(),
-                largest_pressure_error(robin.pairing(), step.iteration.state.bodies[0].contact_force,
-                                       pressure));
+                largest_pressure_error(robin.pairing(),
+                                       step.iteration.state.bodies[0].contact_force, pressure));
     EXPECT_LE(largest_pressure_error(robin.pairing(), step.iteration.state.bodies[0].contact_force,
                                      pressure),
               1e-8);
@@ -128,8 +128,8 @@ TEST_P(HertzStepsTest, StepsEqualFreshMonolithicSolvesAndWarmStartsSaveIteration
     const CaseDefinition fresh = scaled_case(definition, step.factor);
     const LocalProblem problem = prepare_local_problem(fresh);
     ASSERT_EQ(problem.pairing().size(), robin.pairing().size());
-    const MonolithicResult reference =
-        solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), fresh.solver.qp);
+    const MonolithicResult reference = solve_monolithic(*problem.bodies[0], *problem.bodies[1],
+                                                        problem.pairing(), fresh.solver.qp);
     ASSERT_EQ(reference.qp.status, QpStatus::converged);
     const double scale = reference.contact_force.lpNorm<Eigen::Infinity>();
     ASSERT_GT(scale, 0.0);

@@ -229,7 +229,8 @@ TEST(MonolithicContact, PartialContactSatisfiesKktAndEquilibrium) {
   // normal trace is the trace of that displacement field.
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodySolver& body = *problem.bodies[alpha];
-    const double imbalance = free_dof_imbalance(body, problem.pairing(), alpha, result.contact_force);
+    const double imbalance =
+        free_dof_imbalance(body, problem.pairing(), alpha, result.contact_force);
     const Eigen::VectorXd returned = alpha == 0 ? result.normal_traces[0] : result.normal_traces[1];
     const double trace_error =
         (normal_trace(problem.pairing(), alpha, body.displacement(result.contact_force)) - returned)

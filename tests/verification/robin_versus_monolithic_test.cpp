@@ -68,8 +68,8 @@ std::size_t expect_matches_monolithic(const CaseDefinition& definition,
   const LocalProblem reference = prepare_local_problem(definition);
   MprgpParameters reference_qp = definition.solver.qp;
   if (reference_qp_tolerance > 0.0) reference_qp.relative_tolerance = reference_qp_tolerance;
-  const MonolithicResult monolithic =
-      solve_monolithic(*reference.bodies[0], *reference.bodies[1], reference.pairing(), reference_qp);
+  const MonolithicResult monolithic = solve_monolithic(*reference.bodies[0], *reference.bodies[1],
+                                                       reference.pairing(), reference_qp);
   EXPECT_EQ(monolithic.qp.status, QpStatus::converged);
   EXPECT_EQ(robin.pairing().size(), reference.pairing().size());
   if (robin.pairing().size() != reference.pairing().size()) return iterations;
