@@ -450,22 +450,7 @@ ContactSolveResult BodySolver::solve_contact(const Eigen::VectorXd& obstacle,
   scaled.solution_scaled_tolerance = true;  // resolve lambda relative to itself, not to |e - g|
   const MprgpResult qp = solve_mprgp(*compliance_, right_hand_side, lower, warm_start_, scaled);
 
-  ContactSolveResult result;
-  result.contact_force = qp.solution;
-  result.normal_trace = obstacle - qp.gradient;
-  result.status = qp.status;
-  result.iterations = qp.iterations;
-  result.operator_applications = qp.operator_applications;
-  result.projected_gradient_norm = qp.projected_gradient_norm;
-  result.message = qp.message;
-  result.active.resize(contact_size());
-  for (int i = 0; i < contact_size(); ++i) {
-    const double clearance = obstacle[i] - result.normal_trace[i];
-    result.active[i] = result.contact_force[i] > 0.0;
-    result.penetration = std::max(result.penetration, -clearance);
-    result.complementarity =
-        std::max(result.complementarity, std::abs(result.contact_force[i] * clearance));
-  }
+  ContactSolveResult result = contact_solve_result(qp, obstacle);
   if (qp.status == QpStatus::converged) warm_start_ = qp.solution;
   result.seconds = seconds_since(start);
   return result;

@@ -40,6 +40,8 @@
 // and e(t) = t e, by linearity; K, its factor and F do not depend on t and are kept.
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -100,6 +102,30 @@ struct ContactSolveResult {
   double seconds = 0.0;
   std::string message;
 };
+
+/// The result of a contact solve from its dual QP's result `qp` (MprgpResult, SmalbeResult) at
+/// `obstacle` g: lambda = the solution, u_N = g - gradient (the gradient of the dual is g - u_N),
+/// the active rows (lambda > 0), the largest penetration and |lambda (g - u_N)|.
+template <typename QpResult>
+ContactSolveResult contact_solve_result(const QpResult& qp, const Eigen::VectorXd& obstacle) {
+  ContactSolveResult result;
+  result.contact_force = qp.solution;
+  result.normal_trace = obstacle - qp.gradient;
+  result.status = qp.status;
+  result.iterations = qp.iterations;
+  result.operator_applications = qp.operator_applications;
+  result.projected_gradient_norm = qp.projected_gradient_norm;
+  result.message = qp.message;
+  result.active.resize(static_cast<std::size_t>(obstacle.size()));
+  for (Eigen::Index i = 0; i < obstacle.size(); ++i) {
+    const double clearance = obstacle[i] - result.normal_trace[i];
+    result.active[static_cast<std::size_t>(i)] = result.contact_force[i] > 0.0;
+    result.penetration = std::max(result.penetration, -clearance);
+    result.complementarity =
+        std::max(result.complementarity, std::abs(result.contact_force[i] * clearance));
+  }
+  return result;
+}
 
 /// Wall time of the setup stages (numerics/setup_progress.hpp), in seconds. For a body set up
 /// anew; after replace_loads(): assembly is the load vector's, ordering 0 and factorization the

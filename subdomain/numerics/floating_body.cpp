@@ -113,23 +113,8 @@ ContactSolveResult BodySolver::solve_floating_contact(const Eigen::VectorXd& obs
   const SmalbeResult qp =
       solve_smalbe(*compliance_, right_hand_side, lower, rigid_trace_.transpose(), rigid_load(),
                    warm_start_, warm_multiplier_, smalbe);
-  ContactSolveResult result;
-  result.contact_force = qp.solution;
   // u_N = g - (F l - (e - g) + G'mu) = e - F l + B R alpha with alpha = -mu
-  result.normal_trace = obstacle - qp.gradient;
-  result.status = qp.status;
-  result.iterations = qp.iterations;
-  result.operator_applications = qp.operator_applications;
-  result.projected_gradient_norm = qp.projected_gradient_norm;
-  result.message = qp.message;
-  result.active.resize(contact_size());
-  for (int i = 0; i < contact_size(); ++i) {
-    const double clearance = obstacle[i] - result.normal_trace[i];
-    result.active[i] = result.contact_force[i] > 0.0;
-    result.penetration = std::max(result.penetration, -clearance);
-    result.complementarity =
-        std::max(result.complementarity, std::abs(result.contact_force[i] * clearance));
-  }
+  ContactSolveResult result = contact_solve_result(qp, obstacle);
   if (qp.status == QpStatus::converged) {
     warm_start_ = qp.solution;
     warm_multiplier_ = qp.multiplier;
