@@ -21,12 +21,16 @@ protocol::CellType to_protocol(ElementType type) {
       return protocol::TRIANGLE6;
     case ElementType::quadrilateral4:
       return protocol::QUADRILATERAL4;
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+    case ElementType::hexahedron8:
+      break;
   }
   return protocol::CELL_TYPE_UNSPECIFIED;
 }
 
-protocol::CellType to_protocol(EdgeType type) {
-  return type == EdgeType::line3 ? protocol::LINE3 : protocol::LINE2;
+protocol::CellType to_protocol(FacetType type) {
+  return type == FacetType::line3 ? protocol::LINE3 : protocol::LINE2;
 }
 
 std::optional<ElementType> element_type(protocol::CellType type) {
@@ -42,9 +46,9 @@ std::optional<ElementType> element_type(protocol::CellType type) {
   }
 }
 
-std::optional<EdgeType> edge_type(protocol::CellType type) {
-  if (type == protocol::LINE2) return EdgeType::line2;
-  if (type == protocol::LINE3) return EdgeType::line3;
+std::optional<FacetType> edge_type(protocol::CellType type) {
+  if (type == protocol::LINE2) return FacetType::line2;
+  if (type == protocol::LINE3) return FacetType::line3;
   return std::nullopt;
 }
 
@@ -162,13 +166,13 @@ void decode_boundaries(const protocol::MeshData& data, const MeshErrors& errors,
     if (mesh.boundaries.count(boundary.name()) != 0) {
       errors.fail(field + ".name", "'" + boundary.name() + "' names two boundaries");
     }
-    const std::optional<EdgeType> type = edge_type(boundary.segments().type());
+    const std::optional<FacetType> type = edge_type(boundary.segments().type());
     if (!type) {
       errors.fail(field + ".segments.type",
                   "is " + cell_type_name(boundary.segments().type()) + ": expected LINE2 or LINE3");
     }
     mesh.boundaries[boundary.name()] =
-        BoundaryGroup{*type, decode_connectivity(boundary.segments(), nodes_per_edge(*type),
+        BoundaryGroup{*type, decode_connectivity(boundary.segments(), nodes_per_facet(*type),
                                                  mesh.node_count(), errors, field + ".segments")};
   }
 }

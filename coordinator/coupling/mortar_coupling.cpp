@@ -33,8 +33,8 @@ struct Side {
   std::string name;
   int body = 0;  // 0 or 1
 
-  EdgeType segment_type() const { return surface ? surface->segment_type : EdgeType::line2; }
-  int nodes_per_segment() const { return nodes_per_edge(segment_type()); }
+  FacetType segment_type() const { return surface ? surface->segment_type : FacetType::line2; }
+  int nodes_per_segment() const { return nodes_per_facet(segment_type()); }
   int segment_count() const {
     return surface ? static_cast<int>(surface->segments.size()) / nodes_per_segment() : 0;
   }

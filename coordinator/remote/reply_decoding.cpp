@@ -99,12 +99,12 @@ std::map<std::string, BoundaryGroup> decode_boundaries(const protocol::FieldsRep
                            "') has segments that are not LINE2 or LINE3");
     }
     BoundaryGroup group;
-    group.type = type == protocol::LINE3 ? EdgeType::line3 : EdgeType::line2;
+    group.type = type == protocol::LINE3 ? FacetType::line3 : FacetType::line2;
     const auto& connectivity = boundary.segments().connectivity();
-    if (connectivity.size() % nodes_per_edge(group.type) != 0) {
+    if (connectivity.size() % nodes_per_facet(group.type) != 0) {
       throw MalformedReply(
           what + " ('" + boundary.name() + "') has " + std::to_string(connectivity.size()) +
-          " segment nodes, not a multiple of " + std::to_string(nodes_per_edge(group.type)));
+          " segment nodes, not a multiple of " + std::to_string(nodes_per_facet(group.type)));
     }
     for (const std::uint32_t node : connectivity) {
       if (static_cast<long>(node) >= node_count) {
@@ -189,7 +189,7 @@ ContactSurfaceDescription decode_surface(const protocol::InterfaceDescription& m
   }
   ContactSurfaceDescription decoded;
   decoded.boundary = surface.boundary();
-  decoded.segment_type = nodes_per_segment == 3 ? EdgeType::line3 : EdgeType::line2;
+  decoded.segment_type = nodes_per_segment == 3 ? FacetType::line3 : FacetType::line2;
   decoded.segments.assign(surface.segments().begin(), surface.segments().end());
   return decoded;
 }

@@ -109,9 +109,9 @@ Eigen::VectorXd assemble_external_load(const BodyDefinition& body) {
 std::vector<int> oriented_segments(const Mesh& mesh, const BoundaryGroup& group,
                                    const std::vector<int>& nodes) {
   const NodeElementMap adjacency(mesh);
-  const int count = nodes_per_edge(group.type);
+  const int count = nodes_per_facet(group.type);
   std::vector<int> segments;
-  for (std::size_t e = 0; e < group.edge_count(); ++e) {
+  for (std::size_t e = 0; e < group.facet_count(); ++e) {
     // Without adjacency the normal is the tangent turned clockwise (body on the left).
     const Eigen::Vector2d left = EdgeGeometry(mesh, group, e).evaluate(0.0).outward_normal;
     const Eigen::Vector2d outward =

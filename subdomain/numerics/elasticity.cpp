@@ -21,6 +21,10 @@ int stiffness_degree(ElementType type) {
       return 2;
     case ElementType::quadrilateral4:
       return 3;
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+    case ElementType::hexahedron8:
+      break;
   }
   throw std::invalid_argument("stiffness_degree: unknown element type");
 }
@@ -30,8 +34,8 @@ int stiffness_degree(ElementType type) {
 int load_degree(ElementType type) {
   return type == ElementType::triangle6 ? 6 : 4;
 }
-int edge_load_degree(EdgeType type) {
-  return type == EdgeType::line3 ? 6 : 4;
+int edge_load_degree(FacetType type) {
+  return type == FacetType::line3 ? 6 : 4;
 }
 
 /// Strain-displacement matrix B (3 x 2n): strain (e_xx, e_yy, 2 e_xy) = B u_e, with
@@ -134,9 +138,9 @@ Eigen::VectorXd assemble_boundary_traction(const Mesh& mesh, const BoundaryGroup
                                            const TractionField& traction) {
   Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * mesh.node_count());
   const NodeElementMap adjacency(mesh);
-  const int count = nodes_per_edge(group.type);
+  const int count = nodes_per_facet(group.type);
   const std::vector<QuadraturePoint> rule = edge_quadrature(edge_load_degree(group.type));
-  for (std::size_t e = 0; e < group.edge_count(); ++e) {
+  for (std::size_t e = 0; e < group.facet_count(); ++e) {
     const EdgeGeometry edge(mesh, group, e, adjacency);
     for (const QuadraturePoint& point : rule) {
       const EdgePoint at = edge.evaluate(point.reference.x());
@@ -153,9 +157,9 @@ Eigen::VectorXd assemble_boundary_traction(const Mesh& mesh, const BoundaryGroup
 
 Eigen::VectorXd boundary_weights(const Mesh& mesh, const BoundaryGroup& group) {
   Eigen::VectorXd weights = Eigen::VectorXd::Zero(mesh.node_count());
-  const int count = nodes_per_edge(group.type);
+  const int count = nodes_per_facet(group.type);
   const std::vector<QuadraturePoint> rule = edge_quadrature(edge_load_degree(group.type));
-  for (std::size_t e = 0; e < group.edge_count(); ++e) {
+  for (std::size_t e = 0; e < group.facet_count(); ++e) {
     const EdgeGeometry edge(mesh, group, e);
     for (const QuadraturePoint& point : rule) {
       const EdgePoint at = edge.evaluate(point.reference.x());
@@ -173,10 +177,10 @@ std::vector<Eigen::Vector2d> boundary_normal_sums(const Mesh& mesh, const Bounda
                                                   bool edges_have_body_on_left) {
   std::optional<NodeElementMap> adjacency;
   if (!edges_have_body_on_left) adjacency.emplace(mesh);
-  const int count = nodes_per_edge(group.type);
+  const int count = nodes_per_facet(group.type);
   const std::vector<double> node_references = edge_reference_nodes(group.type);
   std::vector<Eigen::Vector2d> sums(mesh.node_count(), Eigen::Vector2d::Zero());
-  for (std::size_t e = 0; e < group.edge_count(); ++e) {
+  for (std::size_t e = 0; e < group.facet_count(); ++e) {
     const EdgeGeometry edge =
         adjacency ? EdgeGeometry(mesh, group, e, *adjacency) : EdgeGeometry(mesh, group, e);
     const double length = edge.length();

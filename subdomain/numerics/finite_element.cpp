@@ -169,14 +169,18 @@ void shape_functions(ElementType type, const Eigen::Vector2d& reference, Eigen::
       }
       return;
     }
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+    case ElementType::hexahedron8:
+      break;
   }
   throw std::invalid_argument("shape_functions: unknown element type");
 }
 
-void edge_shape_functions(EdgeType type, double reference, Eigen::VectorXd& values,
+void edge_shape_functions(FacetType type, double reference, Eigen::VectorXd& values,
                           Eigen::VectorXd& reference_derivatives) {
   const double t = reference;
-  if (type == EdgeType::line2) {
+  if (type == FacetType::line2) {
     values.resize(2);
     reference_derivatives.resize(2);
     values << 0.5 * (1.0 - t), 0.5 * (1.0 + t);
@@ -198,6 +202,10 @@ std::vector<Eigen::Vector2d> reference_nodes(ElementType type) {
       return {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {0.5, 0.0}, {0.5, 0.5}, {0.0, 0.5}};
     case ElementType::quadrilateral4:
       return {{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}};
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+    case ElementType::hexahedron8:
+      break;
   }
   throw std::invalid_argument("reference_nodes: unknown element type");
 }
@@ -207,8 +215,8 @@ Eigen::Vector2d reference_centroid(ElementType type) {
   return Eigen::Vector2d(1.0 / 3.0, 1.0 / 3.0);
 }
 
-std::vector<double> edge_reference_nodes(EdgeType type) {
-  if (type == EdgeType::line2) return {-1.0, 1.0};
+std::vector<double> edge_reference_nodes(FacetType type) {
+  if (type == FacetType::line2) return {-1.0, 1.0};
   return {-1.0, 1.0, 0.0};
 }
 
@@ -278,7 +286,7 @@ std::optional<NodeElementMap::ElementIndex> NodeElementMap::element_with(int fir
 
 EdgeGeometry::EdgeGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t edge)
     : type_(group.type) {
-  const int count = nodes_per_edge(type_);
+  const int count = nodes_per_facet(type_);
   coordinates_.resize(count, 2);
   for (int i = 0; i < count; ++i) {
     coordinates_.row(i) = mesh.nodes[group.connectivity[edge * count + i]].transpose();
@@ -293,7 +301,7 @@ EdgeGeometry::EdgeGeometry(const Mesh& mesh, const BoundaryGroup& group, std::si
 EdgeGeometry::EdgeGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t edge,
                            const NodeElementMap& adjacency)
     : EdgeGeometry(mesh, group, edge) {
-  const int count = nodes_per_edge(type_);
+  const int count = nodes_per_facet(type_);
   const int first = group.connectivity[edge * count];
   const int second = group.connectivity[edge * count + 1];
   const std::optional<NodeElementMap::ElementIndex> element = adjacency.element_with(first, second);

@@ -27,7 +27,7 @@ void shape_functions(ElementType type, const Eigen::Vector2d& reference, Eigen::
 /// 1D Gauss rule on [-1, 1] exact to `degree` (the point is reference.x(), reference.y() = 0)
 /// and edge shape functions in Gmsh order.
 std::vector<QuadraturePoint> edge_quadrature(int degree);
-void edge_shape_functions(EdgeType type, double reference, Eigen::VectorXd& values,
+void edge_shape_functions(FacetType type, double reference, Eigen::VectorXd& values,
                           Eigen::VectorXd& reference_derivatives);
 
 /// Reference coordinates of the nodes of an element of `type`, in node order.
@@ -37,7 +37,7 @@ std::vector<Eigen::Vector2d> reference_nodes(ElementType type);
 Eigen::Vector2d reference_centroid(ElementType type);
 
 /// Reference coordinate in [-1, 1] of each node of an edge of `type`, in node order.
-std::vector<double> edge_reference_nodes(EdgeType type);
+std::vector<double> edge_reference_nodes(FacetType type);
 
 /// Shape functions of an element at one point, with physical gradients dN/dx (n x 2),
 /// the mapped position x and the Jacobian determinant det(dx/dxi).
@@ -102,7 +102,7 @@ class EdgeGeometry {
   double length() const;
 
  private:
-  EdgeType type_;
+  FacetType type_;
   Eigen::MatrixX2d coordinates_;
   double orientation_ = 1.0;  // +1 or -1: flips the clockwise-turned tangent outward
 };

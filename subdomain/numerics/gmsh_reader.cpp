@@ -167,7 +167,7 @@ struct GmshAreaBlock {
 /// Area elements and boundary edges with Gmsh node tags, before compaction.
 struct GmshElements {
   std::map<ElementType, GmshAreaBlock> areas;
-  std::map<std::string, std::pair<EdgeType, std::vector<std::size_t>>> edges;
+  std::map<std::string, std::pair<FacetType, std::vector<std::size_t>>> edges;
 };
 
 std::set<int> surfaces_to_read() {
@@ -235,7 +235,7 @@ void read_boundary_edges(const ErrorSource& source, GmshElements& elements) {
           throw source.error("boundary '" + name + "': unsupported 1D element " +
                              gmsh_element_name(types[k]) + "; use 2-node or 3-node lines");
         }
-        const EdgeType type = types[k] == 1 ? EdgeType::line2 : EdgeType::line3;
+        const FacetType type = types[k] == 1 ? FacetType::line2 : FacetType::line3;
         auto [entry, inserted] = elements.edges.try_emplace(name, type, std::vector<std::size_t>{});
         if (entry->second.first != type) {
           throw source.error("boundary '" + name + "' mixes 2-node and 3-node lines");

@@ -14,10 +14,10 @@ namespace robin {
 struct ContactSurfaceDescription {
   std::string boundary;  // its name (a BodyDefinition::contact_boundaries entry)
   /// The boundary's segments as positions into InterfaceDescription::node_ids,
-  /// nodes_per_edge(segment_type) per segment (endpoints, then the midpoint), each oriented
+  /// nodes_per_facet(segment_type) per segment (endpoints, then the midpoint), each oriented
   /// with the body on its left: the outward normal is the direction from the first to the
   /// second endpoint turned clockwise.
-  EdgeType segment_type = EdgeType::line2;
+  FacetType segment_type = FacetType::line2;
   std::vector<int> segments;
   /// The boundary's own nodes as positions into InterfaceDescription::node_ids, ascending (the
   /// distinct entries of `segments`), with their normals and weights from this boundary's

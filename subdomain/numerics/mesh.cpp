@@ -15,18 +15,72 @@ int nodes_per_element(ElementType type) {
       return 6;
     case ElementType::quadrilateral4:
       return 4;
+    case ElementType::tetrahedron4:
+      return 4;
+    case ElementType::tetrahedron10:
+      return 10;
+    case ElementType::hexahedron8:
+      return 8;
   }
   throw std::invalid_argument("nodes_per_element: unknown element type");
 }
 
-int nodes_per_edge(EdgeType type) {
+int nodes_per_facet(FacetType type) {
   switch (type) {
-    case EdgeType::line2:
+    case FacetType::line2:
       return 2;
-    case EdgeType::line3:
+    case FacetType::line3:
+      return 3;
+    case FacetType::triangle3:
+      return 3;
+    case FacetType::triangle6:
+      return 6;
+    case FacetType::quadrilateral4:
+      return 4;
+  }
+  throw std::invalid_argument("nodes_per_facet: unknown facet type");
+}
+
+int element_dimension(ElementType type) {
+  switch (type) {
+    case ElementType::triangle3:
+    case ElementType::triangle6:
+    case ElementType::quadrilateral4:
+      return 2;
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+    case ElementType::hexahedron8:
       return 3;
   }
-  throw std::invalid_argument("nodes_per_edge: unknown edge type");
+  throw std::invalid_argument("element_dimension: unknown element type");
+}
+
+int facet_dimension(FacetType type) {
+  switch (type) {
+    case FacetType::line2:
+    case FacetType::line3:
+      return 1;
+    case FacetType::triangle3:
+    case FacetType::triangle6:
+    case FacetType::quadrilateral4:
+      return 2;
+  }
+  throw std::invalid_argument("facet_dimension: unknown facet type");
+}
+
+ElementType face_parametrization(FacetType type) {
+  switch (type) {
+    case FacetType::triangle3:
+      return ElementType::triangle3;
+    case FacetType::triangle6:
+      return ElementType::triangle6;
+    case FacetType::quadrilateral4:
+      return ElementType::quadrilateral4;
+    case FacetType::line2:
+    case FacetType::line3:
+      break;
+  }
+  throw std::invalid_argument("face_parametrization: an edge is not a face");
 }
 
 std::string to_string(ElementType type) {
@@ -37,8 +91,30 @@ std::string to_string(ElementType type) {
       return "triangle6";
     case ElementType::quadrilateral4:
       return "quadrilateral4";
+    case ElementType::tetrahedron4:
+      return "tetrahedron4";
+    case ElementType::tetrahedron10:
+      return "tetrahedron10";
+    case ElementType::hexahedron8:
+      return "hexahedron8";
   }
   throw std::invalid_argument("to_string: unknown element type");
+}
+
+std::string to_string(FacetType type) {
+  switch (type) {
+    case FacetType::line2:
+      return "line2";
+    case FacetType::line3:
+      return "line3";
+    case FacetType::triangle3:
+      return "triangle3";
+    case FacetType::triangle6:
+      return "triangle6";
+    case FacetType::quadrilateral4:
+      return "quadrilateral4";
+  }
+  throw std::invalid_argument("to_string: unknown facet type");
 }
 
 std::string ElementBlock::element_label(std::size_t element) const {

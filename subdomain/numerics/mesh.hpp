@@ -1,6 +1,8 @@
 #pragma once
-// A 2D finite-element mesh: nodes, area elements in blocks of one type, and
-// named boundary groups (Gmsh physical curves) made of line elements.
+// A finite-element mesh of a body in two or three dimensions: nodes, elements of the body's
+// dimension (areas in 2D, volumes in 3D) in blocks of one type, and named boundary groups
+// (Gmsh physical curves in 2D, physical surfaces in 3D) made of facets, the elements of one
+// dimension less: edges in 2D, faces in 3D.
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -14,16 +16,32 @@ enum class ElementType {
   triangle3,       // linear triangle (P1)
   triangle6,       // quadratic triangle (P2), Gmsh node order
   quadrilateral4,  // bilinear quadrilateral (Q1), counter-clockwise
+  tetrahedron4,    // linear tetrahedron (P1), Gmsh node order
+  tetrahedron10,   // quadratic tetrahedron (P2), Gmsh node order
+  hexahedron8,     // trilinear hexahedron (Q1), Gmsh node order
 };
 
-enum class EdgeType {
-  line2,  // linear edge, endpoints
-  line3,  // quadratic edge: two endpoints then the midpoint (Gmsh order)
+/// The boundary elements: edges of 2D bodies, faces of 3D bodies.
+enum class FacetType {
+  line2,           // linear edge, endpoints
+  line3,           // quadratic edge: two endpoints then the midpoint (Gmsh order)
+  triangle3,       // linear triangular face
+  triangle6,       // quadratic triangular face, Gmsh node order
+  quadrilateral4,  // bilinear quadrilateral face
 };
 
 int nodes_per_element(ElementType type);
-int nodes_per_edge(EdgeType type);
+int nodes_per_facet(FacetType type);
+/// 2 for the area elements, 3 for the volume elements.
+int element_dimension(ElementType type);
+/// 1 for edges, 2 for faces.
+int facet_dimension(FacetType type);
+/// The element type whose reference element and shape functions a face uses (a triangle3 face
+/// is parametrized like a triangle3 element); InputError-free: throws std::invalid_argument
+/// for an edge type.
+ElementType face_parametrization(FacetType type);
 std::string to_string(ElementType type);
+std::string to_string(FacetType type);
 
 /// Elements of one type; connectivity is flat, nodes_per_element(type) entries per element,
 /// as zero-based indices into Mesh::nodes.
@@ -37,11 +55,11 @@ struct ElementBlock {
   std::size_t element_count() const { return connectivity.size() / nodes_per_element(type); }
 };
 
-/// A named boundary (a Gmsh physical curve): its line elements.
+/// A named boundary (a Gmsh physical curve in 2D, a physical surface in 3D): its facets.
 struct BoundaryGroup {
-  EdgeType type = EdgeType::line2;
-  std::vector<int> connectivity;  // nodes_per_edge(type) entries per edge
-  std::size_t edge_count() const { return connectivity.size() / nodes_per_edge(type); }
+  FacetType type = FacetType::line2;
+  std::vector<int> connectivity;  // nodes_per_facet(type) entries per facet
+  std::size_t facet_count() const { return connectivity.size() / nodes_per_facet(type); }
   /// Distinct node indices of the group, sorted ascending.
   std::vector<int> nodes() const;
 };

@@ -41,7 +41,7 @@ void add_cell(ElementBlock& block, const Grid& grid, int i, int j) {
 BoundaryGroup make_side(const Grid& grid, int step, int column, int row, int column_step,
                         int row_step, int count) {
   BoundaryGroup group;
-  group.type = step == 2 ? EdgeType::line3 : EdgeType::line2;
+  group.type = step == 2 ? FacetType::line3 : FacetType::line2;
   for (int k = 0; k < count; ++k) {
     const int c = column + k * step * column_step;
     const int r = row + k * step * row_step;

@@ -130,7 +130,7 @@ void check_mesh(const Mesh& mesh, bool boundary_cells, const std::filesystem::pa
   }
   if (!boundary_cells) return;
   for (const auto& [name, group] : mesh.boundaries) {
-    check_connectivity(group.connectivity, nodes_per_edge(group.type), "boundary '" + name + "'",
+    check_connectivity(group.connectivity, nodes_per_facet(group.type), "boundary '" + name + "'",
                        mesh, path);
   }
 }
@@ -196,8 +196,8 @@ std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
   }
   std::vector<std::int64_t> adjacent;
   for (const auto& [name, group] : mesh.boundaries) {
-    const auto nodes = static_cast<std::size_t>(nodes_per_edge(group.type));
-    for (std::size_t k = 0; k < group.edge_count(); ++k) {
+    const auto nodes = static_cast<std::size_t>(nodes_per_facet(group.type));
+    for (std::size_t k = 0; k < group.facet_count(); ++k) {
       const auto found = element_of_side.find(
           edge_key(group.connectivity[k * nodes], group.connectivity[k * nodes + 1]));
       adjacent.push_back(found == element_of_side.end() ? -1 : found->second);
@@ -228,7 +228,7 @@ std::vector<DataArray> geometry_arrays(const Mesh& mesh, bool boundary_cells) {
   }
   if (boundary_cells) {
     for (const auto& [name, group] : mesh.boundaries) {
-      add_cells(group.connectivity, nodes_per_edge(group.type), vtk_cell_type(group.type));
+      add_cells(group.connectivity, nodes_per_facet(group.type), vtk_cell_type(group.type));
     }
   }
   std::vector<DataArray> arrays;
@@ -365,16 +365,28 @@ int vtk_cell_type(ElementType type) {
       return 22;
     case ElementType::quadrilateral4:
       return 9;
+    case ElementType::tetrahedron4:
+      return 10;
+    case ElementType::tetrahedron10:
+      return 24;
+    case ElementType::hexahedron8:
+      return 12;
   }
   throw std::invalid_argument("vtk_cell_type: unknown element type");
 }
 
-int vtk_cell_type(EdgeType type) {
+int vtk_cell_type(FacetType type) {
   switch (type) {
-    case EdgeType::line2:
+    case FacetType::line2:
       return 3;
-    case EdgeType::line3:
+    case FacetType::line3:
       return 21;
+    case FacetType::triangle3:
+      return 5;
+    case FacetType::triangle6:
+      return 22;
+    case FacetType::quadrilateral4:
+      return 9;
   }
   throw std::invalid_argument("vtk_cell_type: unknown edge type");
 }
@@ -395,7 +407,7 @@ void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
   if (options.boundary_cells) {
     for (const auto& [name, group] : mesh.boundaries) {
       boundary_names.push_back(name);
-      boundary_id.insert(boundary_id.end(), group.edge_count(),
+      boundary_id.insert(boundary_id.end(), group.facet_count(),
                          static_cast<std::int32_t>(boundary_names.size()));
     }
   }

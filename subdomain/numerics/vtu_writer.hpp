@@ -65,7 +65,7 @@ struct VtuOptions {
 int vtk_cell_type(ElementType type);
 
 /// The VTK cell type number of an edge type (3 or 21).
-int vtk_cell_type(EdgeType type);
+int vtk_cell_type(FacetType type);
 
 /// Writes the mesh (z = 0) with point and cell fields as described above. Cell fields follow
 /// the element order of mesh.blocks (one value set per area element). The parent directory must

@@ -77,7 +77,7 @@ class MeshDecoder {
     for (std::size_t k = 0; k < counts[1]; ++k) {
       const std::string name = text();
       BoundaryGroup& group = mesh.boundaries[name];
-      group.type = static_cast<EdgeType>(single<int>());
+      group.type = static_cast<FacetType>(single<int>());
       group.connectivity = vector<int>();
     }
     return mesh;

@@ -34,7 +34,7 @@ void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
     protocol::NamedBoundary& boundary = *message.add_boundaries();
     boundary.set_name(name);
     protocol::CellBlock& segments = *boundary.mutable_segments();
-    segments.set_type(group.type == EdgeType::line3 ? protocol::LINE3 : protocol::LINE2);
+    segments.set_type(group.type == FacetType::line3 ? protocol::LINE3 : protocol::LINE2);
     segments.mutable_connectivity()->Assign(group.connectivity.begin(), group.connectivity.end());
   }
 }
@@ -58,7 +58,7 @@ void encode_interface(const std::string& body_name, const InterfaceDescription& 
   for (const ContactSurfaceDescription& contact_surface : interface.surfaces) {
     protocol::ContactSurface& surface = *message.add_surfaces();
     surface.set_boundary(contact_surface.boundary);
-    surface.set_segment_type(contact_surface.segment_type == EdgeType::line3 ? protocol::LINE3
+    surface.set_segment_type(contact_surface.segment_type == FacetType::line3 ? protocol::LINE3
                                                                              : protocol::LINE2);
     surface.mutable_segments()->Assign(contact_surface.segments.begin(),
                                        contact_surface.segments.end());

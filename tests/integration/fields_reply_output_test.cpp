@@ -57,7 +57,7 @@ TEST(FieldsReplyOutput, BoundariesAndTheStressTensorArriveUnchanged) {
   for (const auto& [name, group] : sent.mesh.boundaries) {
     ASSERT_EQ(received.mesh.boundaries.count(name), 1u) << name;
     const BoundaryGroup& arrived = received.mesh.boundaries.at(name);
-    EXPECT_EQ(arrived.type, EdgeType::line3) << name;  // P2 triangles have 3-node edges
+    EXPECT_EQ(arrived.type, FacetType::line3) << name;  // P2 triangles have 3-node edges
     EXPECT_EQ(arrived.connectivity, group.connectivity) << name;
   }
   {

@@ -975,8 +975,8 @@ TEST(LoadBody, ReadsTheMeshWithTheCaseOptions) {
     EXPECT_EQ(block.type, ElementType::triangle6);
   }
   const BoundaryGroup& contact = upper.mesh.boundaries.at("contact");
-  EXPECT_EQ(contact.type, EdgeType::line3);
-  EXPECT_EQ(contact.edge_count(), 4u);
+  EXPECT_EQ(contact.type, FacetType::line3);
+  EXPECT_EQ(contact.facet_count(), 4u);
   for (int node : contact.nodes()) EXPECT_NEAR(upper.mesh.nodes[node].y(), 0.0, 1e-12);
   for (const Eigen::Vector2d& node : upper.mesh.nodes) {
     EXPECT_GE(node.x(), -1e-12);

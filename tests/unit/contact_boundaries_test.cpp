@@ -155,7 +155,7 @@ TEST(ContactBoundaries, TopAndBottomGiveTheUnionWithTheBoundariesWeightsAndNorma
     for (std::size_t k = 0; k < 2; ++k) {
       const ContactSurfaceDescription& surface = interface.surfaces[k];
       EXPECT_EQ(surface.boundary, k == 0 ? "top" : "bottom");
-      EXPECT_EQ(surface.segment_type, order == 1 ? EdgeType::line2 : EdgeType::line3);
+      EXPECT_EQ(surface.segment_type, order == 1 ? FacetType::line2 : FacetType::line3);
       const int count = order + 1;
       ASSERT_EQ(surface.segments.size(), 8u * static_cast<std::size_t>(count));
       ASSERT_EQ(surface.positions.size(), per_side);

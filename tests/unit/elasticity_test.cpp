@@ -101,7 +101,7 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, ShapeFunctions,
                          });
 
 TEST(EdgeShapeFunctions, KroneckerAndDerivatives) {
-  for (const EdgeType type : {EdgeType::line2, EdgeType::line3}) {
+  for (const FacetType type : {FacetType::line2, FacetType::line3}) {
     const std::vector<double> nodes = edge_reference_nodes(type);
     Eigen::VectorXd values, derivatives, plus, minus;
     for (std::size_t k = 0; k < nodes.size(); ++k) {
@@ -124,7 +124,7 @@ Mesh unit_triangle() {
   mesh.nodes = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
   mesh.node_tags = {1, 2, 3};
   mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
-  mesh.boundaries["bottom"] = {EdgeType::line2, {0, 1}};
+  mesh.boundaries["bottom"] = {FacetType::line2, {0, 1}};
   return mesh;
 }
 
@@ -300,7 +300,7 @@ TEST(Normals, CornerOfTwoSidesInOneGroupAveragesByLength) {
   mesh.nodes = {{0.0, 0.0}, {2.0, 0.0}, {2.0, 1.0}};
   mesh.node_tags = {1, 2, 3};
   mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
-  mesh.boundaries["corner"] = {EdgeType::line2, {0, 1, 1, 2}};
+  mesh.boundaries["corner"] = {FacetType::line2, {0, 1, 1, 2}};
   const std::vector<Eigen::Vector2d> normals = boundary_node_normals(mesh, mesh.boundary("corner"));
   ASSERT_EQ(normals.size(), 3u);
   EXPECT_NEAR((normals[0] - Eigen::Vector2d(0.0, -1.0)).norm(), 0.0, 1e-15);
@@ -316,7 +316,7 @@ TEST(Errors, InvertedElementAndDetachedEdgeAreInputErrors) {
   Mesh detached = unit_triangle();
   detached.nodes.push_back({5.0, 5.0});
   detached.node_tags.push_back(4);
-  detached.boundaries["far"] = {EdgeType::line2, {2, 3}};
+  detached.boundaries["far"] = {FacetType::line2, {2, 3}};
   try {
     boundary_node_normals(detached, detached.boundary("far"));
     FAIL() << "no InputError";

@@ -50,9 +50,9 @@ double checked_area(const Mesh& mesh) {
 
 /// Sum of the chord lengths of a group's edges (exact for straight boundaries).
 double boundary_length(const Mesh& mesh, const BoundaryGroup& group) {
-  const int count = nodes_per_edge(group.type);
+  const int count = nodes_per_facet(group.type);
   double length = 0.0;
-  for (std::size_t e = 0; e < group.edge_count(); ++e) {
+  for (std::size_t e = 0; e < group.facet_count(); ++e) {
     length +=
         (mesh.nodes[group.connectivity[e * count + 1]] - mesh.nodes[group.connectivity[e * count]])
             .norm();
@@ -120,7 +120,7 @@ TEST(MeshReader, ReadsMsh22WithTagsCoordinatesAndBoundaries) {
   }
   // The bottom side y = 0 holds nodes at x = 0 and x = 1 (the square's corners).
   const BoundaryGroup& bottom = mesh.boundary("bottom");
-  EXPECT_EQ(bottom.type, EdgeType::line2);
+  EXPECT_EQ(bottom.type, FacetType::line2);
   for (const int node : bottom.nodes()) EXPECT_EQ(mesh.nodes[node].y(), 0.0);
 }
 
@@ -214,8 +214,8 @@ TEST(MeshReader, SecondOrderGivesTriangle6WithGmshMidpointOrder) {
     }
   }
   const BoundaryGroup& boundary = mesh.boundary("boundary");
-  ASSERT_EQ(boundary.type, EdgeType::line3);
-  for (std::size_t e = 0; e < boundary.edge_count(); ++e) {
+  ASSERT_EQ(boundary.type, FacetType::line3);
+  for (std::size_t e = 0; e < boundary.facet_count(); ++e) {
     const int* nodes = &boundary.connectivity[3 * e];
     const Eigen::Vector2d expected = 0.5 * (mesh.nodes[nodes[0]] + mesh.nodes[nodes[1]]);
     EXPECT_NEAR((mesh.nodes[nodes[2]] - expected).norm(), 0.0, 1e-12);

@@ -323,8 +323,8 @@ TEST(VtuWriter, CellTypeNumbersAreVtks) {
   EXPECT_EQ(vtk_cell_type(ElementType::triangle3), 5);
   EXPECT_EQ(vtk_cell_type(ElementType::triangle6), 22);
   EXPECT_EQ(vtk_cell_type(ElementType::quadrilateral4), 9);
-  EXPECT_EQ(vtk_cell_type(EdgeType::line2), 3);
-  EXPECT_EQ(vtk_cell_type(EdgeType::line3), 21);
+  EXPECT_EQ(vtk_cell_type(FacetType::line2), 3);
+  EXPECT_EQ(vtk_cell_type(FacetType::line3), 21);
 }
 
 /// A P2 mesh of [0,4]x[0,3] (4 x 3 cells, 2 triangle6 each) with its line3 boundaries,
