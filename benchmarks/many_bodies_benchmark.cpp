@@ -53,9 +53,9 @@ robin::BodyDefinition block(const std::filesystem::path& mesh, int index, int co
   body.mesh = robin::read_gmsh_mesh(mesh, {h, 1, false});
   body.material =
       robin::make_isotropic_material(1000.0, 0.3, robin::PlaneModel::plane_strain, body.name);
-  body.dirichlet.push_back({"bottom", 0.0, 0.0});
-  if (index == 0) body.tractions.push_back({"left", true, Eigen::Vector2d::Zero(), 1.0});
-  if (index == count - 1) body.dirichlet.push_back({"right", 0.0, std::nullopt});
+  body.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
+  if (index == 0) body.tractions.push_back({"left", true, Eigen::Vector3d::Zero(), 1.0});
+  if (index == count - 1) body.dirichlet.push_back({"right", 0.0, std::nullopt, std::nullopt});
   if (index > 0) body.contact_boundaries.push_back("left");
   if (index < count - 1) body.contact_boundaries.push_back("right");
   return body;

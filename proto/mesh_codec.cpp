@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 
 #include "numerics/errors.hpp"
@@ -22,34 +23,74 @@ protocol::CellType to_protocol(ElementType type) {
     case ElementType::quadrilateral4:
       return protocol::QUADRILATERAL4;
     case ElementType::tetrahedron4:
+      return protocol::TETRAHEDRON4;
     case ElementType::tetrahedron10:
+      return protocol::TETRAHEDRON10;
     case ElementType::hexahedron8:
-      break;
+      return protocol::HEXAHEDRON8;
   }
   return protocol::CELL_TYPE_UNSPECIFIED;
 }
 
 protocol::CellType to_protocol(FacetType type) {
-  return type == FacetType::line3 ? protocol::LINE3 : protocol::LINE2;
+  switch (type) {
+    case FacetType::line2:
+      return protocol::LINE2;
+    case FacetType::line3:
+      return protocol::LINE3;
+    case FacetType::triangle3:
+      return protocol::TRIANGLE3;
+    case FacetType::triangle6:
+      return protocol::TRIANGLE6;
+    case FacetType::quadrilateral4:
+      return protocol::QUADRILATERAL4;
+  }
+  return protocol::CELL_TYPE_UNSPECIFIED;
 }
 
-std::optional<ElementType> element_type(protocol::CellType type) {
+/// The domain cell types of a mesh of `dimension` (2 or 3).
+std::optional<ElementType> element_type(protocol::CellType type, unsigned dimension) {
+  if (dimension == 2) {
+    switch (type) {
+      case protocol::TRIANGLE3:
+        return ElementType::triangle3;
+      case protocol::TRIANGLE6:
+        return ElementType::triangle6;
+      case protocol::QUADRILATERAL4:
+        return ElementType::quadrilateral4;
+      default:
+        return std::nullopt;
+    }
+  }
   switch (type) {
-    case protocol::TRIANGLE3:
-      return ElementType::triangle3;
-    case protocol::TRIANGLE6:
-      return ElementType::triangle6;
-    case protocol::QUADRILATERAL4:
-      return ElementType::quadrilateral4;
+    case protocol::TETRAHEDRON4:
+      return ElementType::tetrahedron4;
+    case protocol::TETRAHEDRON10:
+      return ElementType::tetrahedron10;
+    case protocol::HEXAHEDRON8:
+      return ElementType::hexahedron8;
     default:
       return std::nullopt;
   }
 }
 
-std::optional<FacetType> edge_type(protocol::CellType type) {
-  if (type == protocol::LINE2) return FacetType::line2;
-  if (type == protocol::LINE3) return FacetType::line3;
-  return std::nullopt;
+/// The boundary cell (facet) types of a mesh of `dimension`: edges in 2D, faces in 3D.
+std::optional<FacetType> facet_type(protocol::CellType type, unsigned dimension) {
+  if (dimension == 2) {
+    if (type == protocol::LINE2) return FacetType::line2;
+    if (type == protocol::LINE3) return FacetType::line3;
+    return std::nullopt;
+  }
+  switch (type) {
+    case protocol::TRIANGLE3:
+      return FacetType::triangle3;
+    case protocol::TRIANGLE6:
+      return FacetType::triangle6;
+    case protocol::QUADRILATERAL4:
+      return FacetType::quadrilateral4;
+    default:
+      return std::nullopt;
+  }
 }
 
 /// Builds "<context>: SetupBody.mesh.<field> <problem> (mesh '<source>')" errors.
@@ -99,16 +140,21 @@ std::vector<std::size_t> decode_cell_tags(const protocol::CellBlock& block, std:
 }
 
 void decode_nodes(const protocol::MeshData& data, const MeshErrors& errors, Mesh& mesh) {
-  if (data.dimension() != 2) {
+  if (data.dimension() != 2 && data.dimension() != 3) {
     errors.fail("dimension", "is " + std::to_string(data.dimension()) +
-                                 ": robin-subdomain solves plane (2) problems");
+                                 ": robin-subdomain solves plane (2) and solid (3) problems");
   }
+  const int dimension = static_cast<int>(data.dimension());
+  mesh.dimension = dimension;
   const auto& coordinates = data.coordinates();
-  if (coordinates.empty() || coordinates.size() % 2 != 0) {
+  if (coordinates.empty() || coordinates.size() % dimension != 0) {
     errors.fail("coordinates", "has " + std::to_string(coordinates.size()) +
-                                   " values, expected a positive multiple of 2 (x, y per node)");
+                                   " values, expected a positive multiple of " +
+                                   std::to_string(dimension) +
+                                   (dimension == 2 ? " (x, y per node)" : " (x, y, z per node)"));
   }
-  const std::size_t node_count = static_cast<std::size_t>(coordinates.size()) / 2;
+  const std::size_t node_count =
+      static_cast<std::size_t>(coordinates.size()) / static_cast<std::size_t>(dimension);
   if (data.node_tags_size() != 0 && static_cast<std::size_t>(data.node_tags_size()) != node_count) {
     errors.fail("node_tags", "has " + std::to_string(data.node_tags_size()) + " tags for " +
                                  std::to_string(node_count) + " nodes (give one per node or none)");
@@ -116,13 +162,16 @@ void decode_nodes(const protocol::MeshData& data, const MeshErrors& errors, Mesh
   mesh.nodes.resize(node_count);
   mesh.node_tags.resize(node_count);
   for (std::size_t node = 0; node < node_count; ++node) {
-    const double x = coordinates[static_cast<int>(2 * node)];
-    const double y = coordinates[static_cast<int>(2 * node + 1)];
-    if (!std::isfinite(x) || !std::isfinite(y)) {
-      errors.fail("coordinates[" + std::to_string(2 * node) + "]",
+    const std::size_t first = static_cast<std::size_t>(dimension) * node;
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // z = 0 in 2D
+    for (int component = 0; component < dimension; ++component) {
+      point[component] = coordinates[static_cast<int>(first) + component];
+    }
+    if (!point.allFinite()) {
+      errors.fail("coordinates[" + std::to_string(first) + "]",
                   "(node " + std::to_string(node) + ") is not a finite number");
     }
-    mesh.nodes[node] = {x, y};
+    mesh.nodes[node] = point;
     mesh.node_tags[node] =
         data.node_tags_size() == 0 ? node + 1 : data.node_tags(static_cast<int>(node));
   }
@@ -133,10 +182,14 @@ void decode_cells(const protocol::MeshData& data, const MeshErrors& errors, Mesh
   for (int b = 0; b < data.cells_size(); ++b) {
     const protocol::CellBlock& block = data.cells(b);
     const std::string field = "cells[" + std::to_string(b) + "]";
-    const std::optional<ElementType> type = element_type(block.type());
+    const std::optional<ElementType> type = element_type(block.type(), data.dimension());
     if (!type) {
-      errors.fail(field + ".type", "is " + cell_type_name(block.type()) +
-                                       ": expected TRIANGLE3, TRIANGLE6 or QUADRILATERAL4");
+      errors.fail(
+          field + ".type",
+          "is " + cell_type_name(block.type()) +
+              (data.dimension() == 2
+                   ? ": expected TRIANGLE3, TRIANGLE6 or QUADRILATERAL4"
+                   : ": expected TETRAHEDRON4, TETRAHEDRON10 or HEXAHEDRON8 (dimension 3)"));
     }
     ElementBlock decoded;
     decoded.type = *type;
@@ -166,10 +219,13 @@ void decode_boundaries(const protocol::MeshData& data, const MeshErrors& errors,
     if (mesh.boundaries.count(boundary.name()) != 0) {
       errors.fail(field + ".name", "'" + boundary.name() + "' names two boundaries");
     }
-    const std::optional<FacetType> type = edge_type(boundary.segments().type());
+    const std::optional<FacetType> type = facet_type(boundary.segments().type(), data.dimension());
     if (!type) {
       errors.fail(field + ".segments.type",
-                  "is " + cell_type_name(boundary.segments().type()) + ": expected LINE2 or LINE3");
+                  "is " + cell_type_name(boundary.segments().type()) +
+                      (data.dimension() == 2
+                           ? ": expected LINE2 or LINE3"
+                           : ": expected TRIANGLE3, TRIANGLE6 or QUADRILATERAL4 (dimension 3)"));
     }
     mesh.boundaries[boundary.name()] =
         BoundaryGroup{*type, decode_connectivity(boundary.segments(), nodes_per_facet(*type),
@@ -196,11 +252,12 @@ void check_nodes_used(const Mesh& mesh, const MeshErrors& errors) {
 
 protocol::MeshData encode_mesh(const Mesh& mesh) {
   protocol::MeshData data;
-  data.set_dimension(2);
-  data.mutable_coordinates()->Reserve(static_cast<int>(2 * mesh.node_count()));
-  for (const Eigen::Vector2d& node : mesh.nodes) {
-    data.add_coordinates(node.x());
-    data.add_coordinates(node.y());
+  data.set_dimension(static_cast<std::uint32_t>(mesh.dimension));
+  data.mutable_coordinates()->Reserve(mesh.dof_count());
+  for (const Eigen::Vector3d& node : mesh.nodes) {
+    for (int component = 0; component < mesh.dimension; ++component) {
+      data.add_coordinates(node[component]);
+    }
   }
   data.mutable_node_tags()->Assign(mesh.node_tags.begin(), mesh.node_tags.end());
   for (const ElementBlock& block : mesh.blocks) {

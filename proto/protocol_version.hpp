@@ -11,7 +11,11 @@ inline constexpr unsigned protocol_major = 2;
 /// reuse the body's factor and F; a coordinator sends it only to servers of minor >= 1) and
 /// StatusRequest (heartbeat and setup progress, capability "status"). 2.2: the stage times of
 /// SetupBody, AssignContact and FieldsRequest in their replies (StageTime), for the profile.
-/// 2.3: floating bodies, SetupBody.floating and InterfaceDescription.rigid_modes.
-inline constexpr unsigned protocol_minor = 3;
+/// 2.3: floating bodies, SetupBody.floating and InterfaceDescription.rigid_modes. 2.4:
+/// three-dimensional (solid) bodies: MeshData.dimension 3 with tetrahedra and hexahedra (CellType
+/// TETRAHEDRON4, TETRAHEDRON10, HEXAHEDRON8) and triangular or quadrilateral boundary faces, 6x6
+/// Voigt materials, 3 components per node in every vector, Dirichlet.z, FieldsReply.dimension; a
+/// plane body's messages are those of 2.3.
+inline constexpr unsigned protocol_minor = 4;
 
 }  // namespace robin::protocol

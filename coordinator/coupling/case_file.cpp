@@ -397,6 +397,15 @@ InputError mesh_error(const std::vector<BodyCase*>& bodies, const InputError& er
   return error;
 }
 
+/// The case format describes plane bodies (2-component vectors, 3 x 3 Voigt matrices, a plane
+/// model): a three-dimensional mesh is refused until it describes solid ones.
+void require_plane_mesh(const BodyCase& body, const Mesh& mesh) {
+  if (mesh.dimension == 2) return;
+  throw InputError(mesh_context(body) +
+                   ": three-dimensional bodies: a solid (3D) mesh in a case file is not "
+                   "supported yet (the case format describes plane bodies)");
+}
+
 }  // namespace
 
 BodyDefinition load_body(const BodyCase& body) {
@@ -406,6 +415,7 @@ BodyDefinition load_body(const BodyCase& body) {
   } catch (const InputError& error) {
     throw InputError(mesh_context(body) + ": " + error.what());
   }
+  require_plane_mesh(body, definition.mesh);
   check_boundary_names(body, definition);
   return definition;
 }
@@ -425,6 +435,7 @@ void load_meshes(CaseDefinition& definition) {
   }
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     bodies[k]->definition.mesh = std::move(meshes[k]);
+    require_plane_mesh(*bodies[k], bodies[k]->definition.mesh);
     check_boundary_names(*bodies[k], bodies[k]->definition);
   }
 }

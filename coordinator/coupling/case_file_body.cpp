@@ -146,7 +146,7 @@ TractionCondition read_traction(const CheckedTable& table,
   if (vector && pressure) table.fail("pressure", "give either vector or pressure, not both");
   if (!vector && !pressure) table.fail("", "give either vector = [tx, ty] or pressure = p");
   condition.is_pressure = pressure.has_value();
-  if (vector) condition.vector = *vector;
+  if (vector) condition.vector << *vector, 0.0;  // a plane body's traction (z = 0)
   if (pressure) condition.pressure = *pressure;
   return condition;
 }
@@ -191,7 +191,9 @@ BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
                "the case has [[interface]] tables: give the contact boundaries there "
                "(interface.boundaries)");
   }
-  definition.body_force = table.optional_vector("body_force").value_or(Eigen::Vector2d::Zero());
+  const Eigen::Vector2d body_force =
+      table.optional_vector("body_force").value_or(Eigen::Vector2d::Zero());
+  definition.body_force << body_force, 0.0;  // a plane body's (z = 0)
   body.floating = table.optional_boolean("floating").value_or(false);
   definition.material = read_material(table, model);
   for (const TableEntry& item : table.array_of_tables("dirichlet")) {

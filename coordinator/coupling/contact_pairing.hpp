@@ -28,11 +28,11 @@ namespace robin {
 struct ContactPair {
   int node1 = -1;  // mesh node index in body 1 (node-to-node; mortar: the non-mortar node or -1)
   int node2 = -1;  // mesh node index in body 2 (node-to-node; mortar: the non-mortar node or -1)
-  Eigen::Vector2d position = Eigen::Vector2d::Zero();   // body-1 node
-  Eigen::Vector2d position2 = Eigen::Vector2d::Zero();  // body-2 node
-  Eigen::Vector2d normal = Eigen::Vector2d::Zero();     // n1 (unit, outward from body 1)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();   // body-1 node (z = 0 in 2D)
+  Eigen::Vector3d position2 = Eigen::Vector3d::Zero();  // body-2 node
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();     // n1 (unit, outward from body 1)
   double gap = 0.0;                                     // d_i (length)
-  double weight = 0.0;                                  // m_i (length)
+  double weight = 0.0;                                  // m_i (length in 2D, area in 3D)
 };
 
 struct ContactPairing {
@@ -46,6 +46,8 @@ struct ContactPairing {
   /// nodes face no part of the other body (no constraint). -1 and 0 for node-to-node pairing.
   int non_mortar_body = -1;
   int uncovered = 0;
+  /// The bodies' dimension (2 or 3): how many coordinates the messages give.
+  int dimension = 2;
 
   std::size_t size() const { return pairs.size(); }
   /// The constraint operator of body 0 or 1: `operators` when set, otherwise the node-to-node
@@ -71,9 +73,11 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
                                   const InterfaceDescription& body2, const std::string& name2,
                                   const GapFunction* gap, double relative_tolerance);
 
-/// True when the prescribed components of a contact node (x_fixed, y_fixed) fix its
-/// displacement along `normal`: its normal displacement is data, not a contact unknown.
-bool normal_is_prescribed(bool x_fixed, bool y_fixed, const Eigen::Vector2d& normal);
+/// True when the prescribed components of a contact node (`fixed`: u_x, u_y, u_z, as in
+/// InterfaceDescription::fixed) fix its displacement along `normal`: some component is
+/// prescribed and every component of `normal` (up to 1e-12) is along a prescribed one. Its
+/// normal displacement is then data, not a contact unknown.
+bool normal_is_prescribed(const std::array<bool, 3>& fixed, const Eigen::Vector3d& normal);
 
 /// Throws InputError "<method> of bodies 'a' and 'b': all N <rows> have their normal
 /// displacement prescribed ..." when every constraint of `pairing` was excluded.
@@ -83,7 +87,9 @@ void require_constraints_left(const ContactPairing& pairing, const std::string& 
 
 /// The order of `points` along the principal direction of their spread (a curve parameter for
 /// flat and gently curved zones, so that contact.csv reads as a profile): indices into points.
-std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector2d>& points);
+/// Points all at z = 0 (every 2D zone) are ordered in the plane, others by the principal
+/// direction of their spread in space.
+std::vector<std::size_t> order_along_zone(const std::vector<Eigen::Vector3d>& points);
 
 /// "" when every gap d_i >= 0 (up to round-off: -1e-12 of the contact zone's length); otherwise
 /// one line for the log and summary.json: how many pairs overlap initially, the largest overlap
@@ -99,7 +105,7 @@ struct ExcludedPairClearance {
   double relative_penetration = 0.0;  // 0 when no excluded pair penetrates
   std::string description;            // the worst pair, "" when none penetrates
 };
-using PairDisplacement = std::function<Eigen::Vector2d(int body_index, const ContactPair& pair)>;
+using PairDisplacement = std::function<Eigen::Vector3d(int body_index, const ContactPair& pair)>;
 ExcludedPairClearance excluded_pair_clearance(const ContactPairing& pairing,
                                               const PairDisplacement& displacement_of,
                                               double included_scale);

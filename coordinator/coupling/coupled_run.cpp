@@ -122,19 +122,25 @@ auto on_every_port(const std::vector<SubdomainPort*>& ports, Request request) {
 
 /// The displacement of the output node nearest to `point` (node ids are opaque to the
 /// coordinator, positions are not); zero when the fields carry no displacement.
-Eigen::Vector2d displacement_near(const BodyOutput& output, const Eigen::Vector2d& point) {
+Eigen::Vector3d displacement_near(const BodyOutput& output, const Eigen::Vector3d& point) {
+  const int dimension = output.mesh.dimension;
   const OutputField* displacement = nullptr;
   for (const OutputField& field : output.point_fields) {
-    if (field.name == "displacement" && field.components == 2) displacement = &field;
+    if (field.name == "displacement" && field.components == dimension) displacement = &field;
   }
-  if (displacement == nullptr || output.mesh.nodes.empty()) return Eigen::Vector2d::Zero();
+  if (displacement == nullptr || output.mesh.nodes.empty()) return Eigen::Vector3d::Zero();
   std::size_t nearest = 0;
   for (std::size_t k = 1; k < output.mesh.nodes.size(); ++k) {
     if ((output.mesh.nodes[k] - point).squaredNorm() <
         (output.mesh.nodes[nearest] - point).squaredNorm())
       nearest = k;
   }
-  return {displacement->values[2 * nearest], displacement->values[2 * nearest + 1]};
+  Eigen::Vector3d value = Eigen::Vector3d::Zero();
+  const std::size_t first = static_cast<std::size_t>(dimension) * nearest;
+  for (int component = 0; component < dimension; ++component) {
+    value[component] = displacement->values[first + static_cast<std::size_t>(component)];
+  }
+  return value;
 }
 
 /// The excluded pairs in the final state, scaled by the included pairs' gaps and traces.

@@ -483,19 +483,37 @@ Eigen::VectorXd short_wavelength_forces(const ContactPairing& pairing) {
   Eigen::VectorXd forces = pairing.weights();
   if (size < 2) return forces;
   // Principal direction t of the pair positions; the pairs ranked by t . x alternate in sign.
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const ContactPair& pair : pairing.pairs) mean += pair.position / static_cast<double>(size);
-  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-  for (const ContactPair& pair : pairing.pairs) {
-    scatter += (pair.position - mean) * (pair.position - mean).transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
-  const Eigen::Vector2d direction = eigen.eigenvectors().col(1);  // largest eigenvalue
+  // Plane bodies rank in the plane (x, y), solid bodies in space.
   std::vector<std::size_t> order(size);
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return direction.dot(pairing.pairs[a].position) < direction.dot(pairing.pairs[b].position);
-  });
+  if (pairing.dimension == 3) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const ContactPair& pair : pairing.pairs) mean += pair.position / static_cast<double>(size);
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const ContactPair& pair : pairing.pairs) {
+      scatter += (pair.position - mean) * (pair.position - mean).transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    const Eigen::Vector3d direction = eigen.eigenvectors().col(2);  // largest eigenvalue
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return direction.dot(pairing.pairs[a].position) < direction.dot(pairing.pairs[b].position);
+    });
+  } else {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const ContactPair& pair : pairing.pairs) {
+      mean += pair.position.head<2>() / static_cast<double>(size);
+    }
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (const ContactPair& pair : pairing.pairs) {
+      scatter += (pair.position.head<2>() - mean) * (pair.position.head<2>() - mean).transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+    const Eigen::Vector2d direction = eigen.eigenvectors().col(1);  // largest eigenvalue
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return direction.dot(pairing.pairs[a].position.head<2>()) <
+             direction.dot(pairing.pairs[b].position.head<2>());
+    });
+  }
   for (std::size_t rank = 1; rank < size; rank += 2) {
     forces[static_cast<Eigen::Index>(order[rank])] *= -1.0;
   }

@@ -63,16 +63,17 @@ nlohmann::json interfaces_json(const GraphCoupling& coupling,
     const std::string& name_a = names.at(static_cast<std::size_t>(interface.body_a));
     const std::string& name_b = names.at(static_cast<std::size_t>(interface.body_b));
     const InterfaceSummary summary = summarize_interface(pairing, interface_state(graph, state, k));
-    entries.push_back({{"bodies", {name_a, name_b}},
-                       {"boundaries", {interface.boundary_a, interface.boundary_b}},
-                       {"contact_discretization", describe_contact(pairing, name_a, name_b)},
-                       {"contact_pairs", pairing.size()},
-                       {"active_pairs", summary.active_pairs},
-                       {"largest_pressure", summary.largest_pressure},
-                       {"excluded_pairs", pairing.excluded},
-                       {"initial_overlap", overlap_warning(pairing)},
-                       {"contact_force_resultant", {summary.resultant.x(), summary.resultant.y()}},
-                       {"file", contact_file_name(graph, names, k)}});
+    entries.push_back(
+        {{"bodies", {name_a, name_b}},
+         {"boundaries", {interface.boundary_a, interface.boundary_b}},
+         {"contact_discretization", describe_contact(pairing, name_a, name_b)},
+         {"contact_pairs", pairing.size()},
+         {"active_pairs", summary.active_pairs},
+         {"largest_pressure", summary.largest_pressure},
+         {"excluded_pairs", pairing.excluded},
+         {"initial_overlap", overlap_warning(pairing)},
+         {"contact_force_resultant", vector_json(summary.resultant, pairing.dimension)},
+         {"file", contact_file_name(graph, names, k)}});
   }
   return entries;
 }

@@ -25,7 +25,7 @@ namespace robin {
 struct InterfaceSummary {
   int active_pairs = 0;                                 // rows with a positive mean contact force
   double largest_pressure = 0.0;                        // max_i (lambda1_i + lambda2_i) / (2 m_i)
-  Eigen::Vector2d resultant = Eigen::Vector2d::Zero();  // contact_resultant of the mean force
+  Eigen::Vector3d resultant = Eigen::Vector3d::Zero();  // contact_resultant of the mean force
 };
 
 InterfaceSummary summarize_interface(const ContactPairing& pairing, const InterfaceState& state);
@@ -67,7 +67,7 @@ CouplingState monolithic_state(const ContactGraph& graph, const MonolithicResult
 /// `displacement_of(body, pair, side)` the displacement of body `body`'s node of `pair` on
 /// side `side` (0: the interface's body a, 1: body b).
 using GraphPairDisplacement =
-    std::function<Eigen::Vector2d(int body, const ContactPair& pair, int side)>;
+    std::function<Eigen::Vector3d(int body, const ContactPair& pair, int side)>;
 ExcludedPairClearance graph_excluded_clearance(const GraphCoupling& coupling,
                                                const CouplingState& state,
                                                const GraphPairDisplacement& displacement_of);

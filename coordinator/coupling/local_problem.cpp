@@ -32,7 +32,7 @@ LocalProblem prepare_local_problem(const CaseDefinition& definition,
     BodySolverOptions options = body_solver_options(definition.solver, body_case);
     if (observer) {
       const BodyDefinition& body = body_case.definition;
-      const long dof_count = 2L * static_cast<long>(body.mesh.node_count());
+      const long dof_count = static_cast<long>(body.mesh.dof_count());
       options.observer = [observer, name = body.name, dof_count](SetupStage stage) {
         observer(name, stage, dof_count);
       };

@@ -15,10 +15,35 @@
 namespace robin {
 namespace {
 
+/// The point (x, y) of a 2D body's point (x, y, 0): the mortar integration is of plane bodies.
+Eigen::Vector2d in_plane(const Eigen::Vector3d& point) {
+  return point.head<2>();
+}
+
+/// A box tree corner from a plane point: the point itself, or embedded at z = 0 when the tree
+/// takes points in space.
+using Corner = Box::first_type;
+Corner corner(const Eigen::Vector2d& point) {
+  if constexpr (Corner::RowsAtCompileTime == 2) {
+    return point;
+  } else {
+    return Corner(point.x(), point.y(), 0.0);
+  }
+}
+
+/// Throws InputError when `description` is of a three-dimensional body.
+void require_plane(const InterfaceDescription& description, const std::string& name) {
+  if (description.dimension == 2) return;
+  throw InputError("mortar coupling: body '" + name +
+                   "': three-dimensional bodies: mortar coupling is not supported yet (use "
+                   "[contact] method = \"node-to-node\" on matching meshes)");
+}
+
 /// One contact boundary: its interface description (of that one boundary) seen as segments.
 struct Side {
   Side(const InterfaceDescription& description, std::string body_name, int body_index)
       : interface(&description), name(std::move(body_name)), body(body_index) {
+    require_plane(description, name);
     if (description.surfaces.size() > 1) {
       throw InputError("mortar coupling: body '" + name + "' has " +
                        std::to_string(description.surfaces.size()) +
@@ -33,17 +58,20 @@ struct Side {
   std::string name;
   int body = 0;  // 0 or 1
 
-  FacetType segment_type() const { return surface ? surface->segment_type : FacetType::line2; }
+  FacetType segment_type() const { return surface ? surface->facet_type : FacetType::line2; }
   int nodes_per_segment() const { return nodes_per_facet(segment_type()); }
   int segment_count() const {
-    return surface ? static_cast<int>(surface->segments.size()) / nodes_per_segment() : 0;
+    return surface ? static_cast<int>(surface->facets.size()) / nodes_per_segment() : 0;
   }
   /// Position (into node_ids) of local node `local` of `segment`.
   int node(int segment, int local) const {
-    return surface->segments[static_cast<std::size_t>(segment * nodes_per_segment() + local)];
+    return surface->facets[static_cast<std::size_t>(segment * nodes_per_segment() + local)];
   }
-  const Eigen::Vector2d& coordinates(int position) const {
-    return interface->coordinates[static_cast<std::size_t>(position)];
+  Eigen::Vector2d coordinates(int position) const {
+    return in_plane(interface->coordinates[static_cast<std::size_t>(position)]);
+  }
+  Eigen::Vector2d normal(int position) const {
+    return in_plane(interface->normals[static_cast<std::size_t>(position)]);
   }
 };
 
@@ -69,7 +97,7 @@ SegmentPoint evaluate(const Side& side, int segment, double reference) {
 Eigen::Vector2d normal_field(const Side& side, int segment, const Eigen::VectorXd& values) {
   Eigen::Vector2d normal = Eigen::Vector2d::Zero();
   for (int a = 0; a < side.nodes_per_segment(); ++a) {
-    normal += values[a] * side.interface->normals[static_cast<std::size_t>(side.node(segment, a))];
+    normal += values[a] * side.normal(side.node(segment, a));
   }
   return normal.normalized();
 }
@@ -152,7 +180,7 @@ Box segment_box(const Side& side, int segment) {
     low = low.cwiseMin(side.coordinates(side.node(segment, a)));
     high = high.cwiseMax(side.coordinates(side.node(segment, a)));
   }
-  return {low, high};
+  return {corner(low), corner(high)};
 }
 
 BoxTree segment_tree(const Side& side) {
@@ -194,8 +222,8 @@ struct SearchRange {
         const double length = segment_length(*side, segment);
         slack = std::max(slack, length);
         const auto [box_low, box_high] = segment_box(*side, segment);
-        low = low.cwiseMin(box_low);
-        high = high.cwiseMax(box_high);
+        low = low.cwiseMin(box_low.head<2>());
+        high = high.cwiseMax(box_high.head<2>());
       }
     }
     reach = std::max(4.0 * slack, 0.05 * (high - low).norm());
@@ -213,7 +241,7 @@ struct SearchRange {
       }
     }
     const Eigen::Vector2d margin(slack, slack);
-    return {low - margin, high + margin};
+    return {corner(low - margin), corner(high + margin)};
   }
 };
 
@@ -290,7 +318,7 @@ Coupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction*
     for (int a = 0; a < nonmortar.nodes_per_segment(); ++a) {
       const int position = nonmortar.node(segment, a);
       points.push_back(nonmortar.coordinates(position));
-      normals.push_back(nonmortar.interface->normals[static_cast<std::size_t>(position)]);
+      normals.push_back(nonmortar.normal(position));
     }
     for (const int other : tree.near(range.box(points, normals))) {
       if (!facing(nonmortar, segment, mortar, other)) {
@@ -311,8 +339,8 @@ Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction*
   const SearchRange range(nonmortar, mortar);
   const BoxTree tree = segment_tree(mortar);
   for (std::size_t j = 0; j < coupling.rows.size(); ++j) {
-    const Eigen::Vector2d& point = nonmortar.interface->coordinates[j];
-    const Eigen::Vector2d& normal = nonmortar.interface->normals[j];
+    const Eigen::Vector2d point = nonmortar.coordinates(static_cast<int>(j));
+    const Eigen::Vector2d normal = nonmortar.normal(static_cast<int>(j));
     double best = std::numeric_limits<double>::infinity();
     for (const int other : tree.near(range.box({point}, {normal}))) {
       const double eta = project_along(mortar, other, point, normal);
@@ -337,9 +365,8 @@ Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction*
 
 /// normal_is_prescribed (coupling/contact_pairing.hpp) of the node at `position`.
 bool prescribed_along(const InterfaceDescription& side, int position,
-                      const Eigen::Vector2d& normal) {
-  return normal_is_prescribed(side.x_fixed[static_cast<std::size_t>(position)],
-                              side.y_fixed[static_cast<std::size_t>(position)], normal);
+                      const Eigen::Vector3d& normal) {
+  return normal_is_prescribed(side.fixed[static_cast<std::size_t>(position)], normal);
 }
 
 /// Appends `coefficients` (by position of `side`) times `normal` to the row under
@@ -360,7 +387,7 @@ void add_entries(ContactOperator& contact, const Side& side, const std::map<int,
 }
 
 std::string describe(const Side& side, int position) {
-  const Eigen::Vector2d& point = side.coordinates(position);
+  const Eigen::Vector2d point = side.coordinates(position);
   return "body '" + side.name + "' contact node (tag " +
          std::to_string(side.interface->node_tags[static_cast<std::size_t>(position)]) + ") at (" +
          std::to_string(point.x()) + ", " + std::to_string(point.y()) + ")";
@@ -379,7 +406,7 @@ ContactPair constraint_of(const Side& nonmortar, const Coupling& coupling, int p
   pair.normal = (nonmortar.body == 0 ? 1.0 : -1.0) *
                 nonmortar.interface->normals[static_cast<std::size_t>(position)];
   // Both at the non-mortar node: where the constraint is (contact.csv, clearance checks).
-  pair.position = nonmortar.coordinates(position);
+  pair.position = nonmortar.interface->coordinates[static_cast<std::size_t>(position)];
   pair.position2 = pair.position;
   pair.weight = complete ? integrals.dual_nonmortar.at(position) : integrals.covered;
   pair.gap = (complete ? integrals.dual_gap : integrals.standard_gap) / pair.weight;
@@ -393,7 +420,7 @@ ContactPair constraint_of(const Side& nonmortar, const Coupling& coupling, int p
 void write_rows(const Side& nonmortar, const Side& mortar, const Coupling& coupling, int position,
                 double weight, ContactPairing& pairing) {
   const RowIntegrals& integrals = coupling.rows[static_cast<std::size_t>(position)];
-  const Eigen::Vector2d& normal = nonmortar.interface->normals[static_cast<std::size_t>(position)];
+  const Eigen::Vector2d normal = nonmortar.normal(position);
   ContactOperator& own = pairing.operators[static_cast<std::size_t>(nonmortar.body)];
   ContactOperator& other = pairing.operators[static_cast<std::size_t>(mortar.body)];
   if (completely_covered(nonmortar, coupling, position)) {
@@ -413,11 +440,11 @@ void write_rows(const Side& nonmortar, const Side& mortar, const Coupling& coupl
 ContactPairing assemble_rows(const Side& nonmortar, const Side& mortar, const Coupling& coupling) {
   ContactPairing pairing;
   std::vector<int> constrained;
-  std::vector<Eigen::Vector2d> points;
+  std::vector<Eigen::Vector3d> points;
   for (std::size_t j = 0; j < coupling.rows.size(); ++j) {
     const int position = static_cast<int>(j);
     if (!(coupling.rows[j].covered > 1e-3 * nonmortar.interface->weights[j])) continue;
-    const Eigen::Vector2d& normal = nonmortar.interface->normals[j];
+    const Eigen::Vector3d& normal = nonmortar.interface->normals[j];
     if (prescribed_along(*nonmortar.interface, position, normal)) {
       pairing.excluded.push_back(describe(nonmortar, position) +
                                  ": normal displacement prescribed by a Dirichlet condition; "
@@ -426,7 +453,7 @@ ContactPairing assemble_rows(const Side& nonmortar, const Side& mortar, const Co
       continue;
     }
     constrained.push_back(position);
-    points.push_back(nonmortar.coordinates(position));
+    points.push_back(nonmortar.interface->coordinates[j]);
   }
   for (const std::size_t k : order_along_zone(points)) {
     const ContactPair pair = constraint_of(nonmortar, coupling, constrained[k]);

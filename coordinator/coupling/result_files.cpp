@@ -81,7 +81,10 @@ void write_contact_csv(const std::filesystem::path& path, const ContactPairing& 
   check_size(state.contact_force2, pairing.size(), "contact_force2", context);
   ensure_directory(path.parent_path());
   std::ofstream out = open_for_writing(path);
-  out << "pair,x,y,nx,ny,gap0,un1,un2,lambda1,lambda2,pressure\n";
+  // Plane bodies: x, y, nx, ny; solid bodies add z and nz.
+  const bool solid = pairing.dimension == 3;
+  out << (solid ? "pair,x,y,z,nx,ny,nz,gap0,un1,un2,lambda1,lambda2,pressure\n"
+                : "pair,x,y,nx,ny,gap0,un1,un2,lambda1,lambda2,pressure\n");
   for (std::size_t i = 0; i < pairing.size(); ++i) {
     const ContactPair& pair = pairing.pairs[i];
     const auto k = static_cast<Eigen::Index>(i);
@@ -93,6 +96,15 @@ void write_contact_csv(const std::filesystem::path& path, const ContactPairing& 
         pair.position.x(),      pair.position.y(),      pair.normal.x(), pair.normal.y(), pair.gap,
         state.normal_trace1[k], state.normal_trace2[k], lambda1,         lambda2,         pressure};
     out << i;
+    if (solid) {
+      for (double value : {pair.position.x(), pair.position.y(), pair.position.z(), pair.normal.x(),
+                           pair.normal.y(), pair.normal.z()}) {
+        out << ',' << exact_text(value);
+      }
+      for (std::size_t c = 4; c < row.size(); ++c) out << ',' << exact_text(row[c]);
+      out << '\n';
+      continue;
+    }
     for (double value : row) out << ',' << exact_text(value);
     out << '\n';
   }
@@ -167,10 +179,15 @@ void write_json(const std::filesystem::path& path, const nlohmann::json& documen
   finish_writing(out, path);
 }
 
-Eigen::Vector2d contact_resultant(const ContactPairing& pairing, const Eigen::VectorXd& force) {
+nlohmann::json vector_json(const Eigen::Vector3d& vector, int dimension) {
+  if (dimension == 3) return {vector.x(), vector.y(), vector.z()};
+  return {vector.x(), vector.y()};
+}
+
+Eigen::Vector3d contact_resultant(const ContactPairing& pairing, const Eigen::VectorXd& force) {
   check_size(force, pairing.size(), "the contact force", "contact_resultant");
   // R = sum_i lambda_i n1_i: lambda_i pushes body 2 along n1_i (from body 1 towards body 2)
-  Eigen::Vector2d resultant = Eigen::Vector2d::Zero();
+  Eigen::Vector3d resultant = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < pairing.size(); ++i) {
     resultant += force[static_cast<Eigen::Index>(i)] * pairing.pairs[i].normal;
   }

@@ -33,8 +33,9 @@ InterfaceState interface_state(const ContactGraph& graph, const CouplingState& s
 /// The same for two bodies and one interface (body order = pair order).
 InterfaceState two_body_interface_state(const CouplingState& state);
 
-/// Header line "pair,x,y,nx,ny,gap0,un1,un2,lambda1,lambda2,pressure", then one row per pair
-/// (pair = zero-based index). Throws std::runtime_error when a state vector is not of the
+/// Header line "pair,x,y,nx,ny,gap0,un1,un2,lambda1,lambda2,pressure" ("pair,x,y,z,nx,ny,nz,
+/// gap0,..." for solid bodies, pairing.dimension = 3), then one row per pair (pair = zero-based
+/// index). Throws std::runtime_error when a state vector is not of the
 /// pairing's size.
 void write_contact_csv(const std::filesystem::path& path, const ContactPairing& pairing,
                        const InterfaceState& state);
@@ -74,9 +75,12 @@ void write_pvd_series(const std::filesystem::path& path, const std::vector<PvdDa
 /// Pretty-printed JSON (2-space indent) followed by a newline.
 void write_json(const std::filesystem::path& path, const nlohmann::json& document);
 
+/// A vector for summary.json: [x, y] for plane bodies (dimension 2), [x, y, z] for solid ones.
+nlohmann::json vector_json(const Eigen::Vector3d& vector, int dimension);
+
 /// Contact force resultant sum_i lambda_i n1_i acting on body 2 (= minus that on body 1):
 /// lambda is compressive and n1 points from body 1 towards body 2. Throws std::runtime_error
 /// when force is not of the pairing's size.
-Eigen::Vector2d contact_resultant(const ContactPairing& pairing, const Eigen::VectorXd& force);
+Eigen::Vector3d contact_resultant(const ContactPairing& pairing, const Eigen::VectorXd& force);
 
 }  // namespace robin

@@ -126,8 +126,8 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
          {"round_trip_seconds", timings.round_trip_seconds},
          {"bytes_sent", timings.bytes_sent},
          {"bytes_received", timings.bytes_received},
-         {"reaction_resultant", {output.reaction_resultant.x(), output.reaction_resultant.y()}},
-         {"applied_force", {output.applied_force.x(), output.applied_force.y()}}});
+         {"reaction_resultant", vector_json(output.reaction_resultant, output.mesh.dimension)},
+         {"applied_force", vector_json(output.applied_force, output.mesh.dimension)}});
     server_compute += timings.compute_seconds;
   }
   summary["bytes_per_iteration"] = static_cast<double>(iteration_bytes) / iterations;

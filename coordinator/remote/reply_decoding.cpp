@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include "numerics/errors.hpp"
 #include "numerics/interface_description.hpp"
@@ -47,10 +49,44 @@ void expect_compressive(const Eigen::VectorXd& force) {
   }
 }
 
-std::vector<Eigen::Vector2d> to_points(const google::protobuf::RepeatedField<double>& values) {
-  std::vector<Eigen::Vector2d> points(values.size() / 2);
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = {values[2 * i], values[2 * i + 1]};
+/// `dimension` values per point (z = 0 in 2D).
+std::vector<Eigen::Vector3d> to_points(const google::protobuf::RepeatedField<double>& values,
+                                       int dimension) {
+  std::vector<Eigen::Vector3d> points(static_cast<std::size_t>(values.size() / dimension),
+                                      Eigen::Vector3d::Zero());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (int component = 0; component < dimension; ++component) {
+      points[i][component] = values[static_cast<int>(i) * dimension + component];
+    }
+  }
   return points;
+}
+
+/// FieldsReply.dimension: 2 or 3, and 2 when absent (0: a server older than 2.4).
+int checked_dimension(std::uint32_t dimension, const std::string& what) {
+  if (dimension == 0) return 2;
+  if (dimension != 2 && dimension != 3) {
+    throw MalformedReply(what + " is " + std::to_string(dimension) + ", expected 2 or 3");
+  }
+  return static_cast<int>(dimension);
+}
+
+/// The facet (boundary cell) type of a mesh of `dimension`: LINE2, LINE3 in 2D; TRIANGLE3,
+/// TRIANGLE6, QUADRILATERAL4 in 3D; nullopt otherwise.
+std::optional<FacetType> facet_type_of(protocol::CellType type, int dimension) {
+  if (dimension == 2) {
+    if (type == protocol::LINE2) return FacetType::line2;
+    if (type == protocol::LINE3) return FacetType::line3;
+    return std::nullopt;
+  }
+  if (type == protocol::TRIANGLE3) return FacetType::triangle3;
+  if (type == protocol::TRIANGLE6) return FacetType::triangle6;
+  if (type == protocol::QUADRILATERAL4) return FacetType::quadrilateral4;
+  return std::nullopt;
+}
+
+std::string facet_type_names(int dimension) {
+  return dimension == 2 ? "LINE2 or LINE3" : "TRIANGLE3, TRIANGLE6 or QUADRILATERAL4";
 }
 
 QpStatus to_qp_status(protocol::SolveStatus status) {
@@ -82,10 +118,11 @@ OutputField decode_field(const protocol::Field& message, long count, const std::
   return field;
 }
 
-/// The named boundaries of the output mesh: names unique and non-empty, LINE2 or LINE3 segments,
-/// node indices checked against the nodes.
+/// The named boundaries of the output mesh: names unique and non-empty, LINE2 or LINE3 segments
+/// (2D) or TRIANGLE3, TRIANGLE6 or QUADRILATERAL4 faces (3D), node indices checked against the
+/// nodes.
 std::map<std::string, BoundaryGroup> decode_boundaries(const protocol::FieldsReply& message,
-                                                       long node_count) {
+                                                       long node_count, int dimension) {
   std::map<std::string, BoundaryGroup> boundaries;
   for (int g = 0; g < message.boundaries_size(); ++g) {
     const protocol::NamedBoundary& boundary = message.boundaries(g);
@@ -93,13 +130,13 @@ std::map<std::string, BoundaryGroup> decode_boundaries(const protocol::FieldsRep
     if (boundary.name().empty() || boundaries.count(boundary.name()) != 0) {
       throw MalformedReply(what + " has an empty or repeated name '" + boundary.name() + "'");
     }
-    const protocol::CellType type = boundary.segments().type();
-    if (type != protocol::LINE2 && type != protocol::LINE3) {
-      throw MalformedReply(what + " ('" + boundary.name() +
-                           "') has segments that are not LINE2 or LINE3");
+    const std::optional<FacetType> type = facet_type_of(boundary.segments().type(), dimension);
+    if (!type) {
+      throw MalformedReply(what + " ('" + boundary.name() + "') has segments that are not " +
+                           facet_type_names(dimension));
     }
     BoundaryGroup group;
-    group.type = type == protocol::LINE3 ? FacetType::line3 : FacetType::line2;
+    group.type = *type;
     const auto& connectivity = boundary.segments().connectivity();
     if (connectivity.size() % nodes_per_facet(group.type) != 0) {
       throw MalformedReply(
@@ -119,13 +156,19 @@ std::map<std::string, BoundaryGroup> decode_boundaries(const protocol::FieldsRep
 }
 
 /// Element blocks from cell types, offsets and connectivity; indices checked against the nodes.
-std::vector<ElementBlock> decode_blocks(const protocol::FieldsReply& message, long node_count) {
+std::vector<ElementBlock> decode_blocks(const protocol::FieldsReply& message, long node_count,
+                                        int dimension) {
   const long block_count = message.cell_types_size();
   expect_size(message.cell_offsets(), block_count + 1, "cell_offsets");
   std::vector<ElementBlock> blocks;
   for (long b = 0; b < block_count; ++b) {
     ElementBlock block;
     block.type = element_type_of_vtk_cell(message.cell_types(b));
+    if (element_dimension(block.type) != dimension) {
+      throw MalformedReply("element block " + std::to_string(b) + " has VTK cell type " +
+                           std::to_string(message.cell_types(b)) + ", not a cell of dimension " +
+                           std::to_string(dimension));
+    }
     const auto begin = message.cell_offsets(b), end = message.cell_offsets(b + 1);
     const auto per_element = static_cast<std::uint64_t>(nodes_per_element(block.type));
     if (begin > end || end > static_cast<std::uint64_t>(message.connectivity_size()) ||
@@ -140,16 +183,22 @@ std::vector<ElementBlock> decode_blocks(const protocol::FieldsReply& message, lo
       }
       block.connectivity.push_back(static_cast<int>(node));
     }
+    if (block.type == ElementType::tetrahedron10) {
+      // VTK's node order to Gmsh's (the mesh's): the midpoints of edges 1-3 and 2-3 swap.
+      for (std::size_t k = 0; k + 10 <= block.connectivity.size(); k += 10) {
+        std::swap(block.connectivity[k + 8], block.connectivity[k + 9]);
+      }
+    }
     blocks.push_back(std::move(block));
   }
   return blocks;
 }
 
-Eigen::Vector2d decode_resultant(const google::protobuf::RepeatedField<double>& values,
-                                 const std::string& what) {
-  if (values.empty()) return Eigen::Vector2d::Zero();
-  expect_size(values, 2, what);
-  return {values[0], values[1]};
+Eigen::Vector3d decode_resultant(const google::protobuf::RepeatedField<double>& values,
+                                 int dimension, const std::string& what) {
+  if (values.empty()) return Eigen::Vector3d::Zero();
+  expect_size(values, dimension, what);
+  return to_points(values, dimension).front();
 }
 
 }  // namespace
@@ -162,21 +211,29 @@ ElementType element_type_of_vtk_cell(unsigned cell_type) {
       return ElementType::triangle6;
     case 9:
       return ElementType::quadrilateral4;
+    case 10:
+      return ElementType::tetrahedron4;
+    case 24:
+      return ElementType::tetrahedron10;
+    case 12:
+      return ElementType::hexahedron8;
     default:
       throw MalformedReply("unknown VTK cell type " + std::to_string(cell_type) +
-                           " (expected 5, 22 or 9)");
+                           " (expected 5, 22 or 9; 10, 24 or 12 in 3D)");
   }
 }
 
 /// One contact surface: its segments (positions into node_ids, checked in range), and its own
 /// nodes with their normals and weights (fill_surface_nodes).
-ContactSurfaceDescription decode_surface(const protocol::InterfaceDescription& message, int k) {
+ContactSurfaceDescription decode_surface(const protocol::InterfaceDescription& message, int k,
+                                         int dimension) {
   const protocol::ContactSurface& surface = message.surfaces(k);
   const std::string field = "surfaces[" + std::to_string(k) + "]";
-  const int nodes_per_segment = surface.segment_type() == protocol::LINE3 ? 3 : 2;
-  if (surface.segment_type() != protocol::LINE2 && surface.segment_type() != protocol::LINE3) {
-    throw MalformedReply(field + ".segment_type is not LINE2 or LINE3");
+  const std::optional<FacetType> type = facet_type_of(surface.segment_type(), dimension);
+  if (!type) {
+    throw MalformedReply(field + ".segment_type is not " + facet_type_names(dimension));
   }
+  const int nodes_per_segment = nodes_per_facet(*type);
   if (surface.segments_size() % nodes_per_segment != 0) {
     throw MalformedReply(field + ".segments has " + std::to_string(surface.segments_size()) +
                          " entries, not a multiple of " + std::to_string(nodes_per_segment));
@@ -189,8 +246,8 @@ ContactSurfaceDescription decode_surface(const protocol::InterfaceDescription& m
   }
   ContactSurfaceDescription decoded;
   decoded.boundary = surface.boundary();
-  decoded.segment_type = nodes_per_segment == 3 ? FacetType::line3 : FacetType::line2;
-  decoded.segments.assign(surface.segments().begin(), surface.segments().end());
+  decoded.facet_type = *type;
+  decoded.facets.assign(surface.segments().begin(), surface.segments().end());
   return decoded;
 }
 
@@ -201,7 +258,7 @@ void decode_surfaces(const protocol::InterfaceDescription& message,
     throw MalformedReply("surfaces is empty, expected one per contact boundary");
   }
   for (int k = 0; k < message.surfaces_size(); ++k) {
-    interface.surfaces.push_back(decode_surface(message, k));
+    interface.surfaces.push_back(decode_surface(message, k, interface.dimension));
     for (int j = 0; j < k; ++j) {
       if (interface.surfaces[static_cast<std::size_t>(j)].boundary ==
           interface.surfaces.back().boundary) {
@@ -221,32 +278,40 @@ void decode_surfaces(const protocol::InterfaceDescription& message,
 
 InterfaceDescription decode_interface(const protocol::InterfaceDescription& message) {
   const long count = message.node_ids_size();
-  if (message.dimension() != 2) {
-    throw MalformedReply("dimension is " + std::to_string(message.dimension()) + ", expected 2");
+  if (message.dimension() != 2 && message.dimension() != 3) {
+    throw MalformedReply("dimension is " + std::to_string(message.dimension()) +
+                         ", expected 2 (or 3: a solid body)");
   }
+  const int dimension = static_cast<int>(message.dimension());
   expect_size(message.node_tags(), count, "node_tags");
-  expect_size(message.coordinates(), 2 * count, "coordinates");
-  expect_size(message.normals(), 2 * count, "normals");
+  expect_size(message.coordinates(), dimension * count, "coordinates");
+  expect_size(message.normals(), dimension * count, "normals");
   expect_size(message.weights(), count, "weights");
-  expect_size(message.fixed(), 2 * count, "fixed");
+  expect_size(message.fixed(), dimension * count, "fixed");
   expect_finite(message.coordinates(), "coordinates");
   expect_finite(message.normals(), "normals");
   expect_finite(message.weights(), "weights");
   InterfaceDescription interface;
+  interface.dimension = dimension;
   interface.node_ids.assign(message.node_ids().begin(), message.node_ids().end());
   interface.node_tags.assign(message.node_tags().begin(), message.node_tags().end());
-  interface.coordinates = to_points(message.coordinates());
-  interface.normals = to_points(message.normals());
+  interface.coordinates = to_points(message.coordinates(), dimension);
+  interface.normals = to_points(message.normals(), dimension);
   interface.weights.assign(message.weights().begin(), message.weights().end());
+  interface.fixed.assign(static_cast<std::size_t>(count), {false, false, false});
   for (long i = 0; i < count; ++i) {
-    interface.x_fixed.push_back(message.fixed(static_cast<int>(2 * i)));
-    interface.y_fixed.push_back(message.fixed(static_cast<int>(2 * i + 1)));
+    for (int component = 0; component < dimension; ++component) {
+      interface.fixed[static_cast<std::size_t>(i)][static_cast<std::size_t>(component)] =
+          message.fixed(static_cast<int>(dimension * i + component));
+    }
   }
   decode_surfaces(message, interface);
   interface.dof_count = static_cast<int>(message.dof_count());
-  if (message.rigid_modes() > 3) {
-    throw MalformedReply("rigid_modes is " + std::to_string(message.rigid_modes()) +
-                         ", at most 3 in two dimensions");
+  const unsigned most_rigid_modes = dimension == 2 ? 3 : 6;
+  if (message.rigid_modes() > most_rigid_modes) {
+    throw MalformedReply(
+        "rigid_modes is " + std::to_string(message.rigid_modes()) +
+        (dimension == 2 ? ", at most 3 in two dimensions" : ", at most 6 in three dimensions"));
   }
   interface.rigid_modes = static_cast<int>(message.rigid_modes());
   return interface;
@@ -296,13 +361,15 @@ CorrectionSolveResult decode_neumann_result(const protocol::NeumannSolveResult& 
 BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string& body_name) {
   BodyOutput output;
   output.body_name = body_name;
-  const long node_count = message.node_coordinates_size() / 2;
-  expect_size(message.node_coordinates(), 2 * node_count, "node_coordinates");
-  output.mesh.nodes = to_points(message.node_coordinates());
+  const int dimension = checked_dimension(message.dimension(), "dimension");
+  output.mesh.dimension = dimension;
+  const long node_count = message.node_coordinates_size() / dimension;
+  expect_size(message.node_coordinates(), dimension * node_count, "node_coordinates");
+  output.mesh.nodes = to_points(message.node_coordinates(), dimension);
   if (message.node_tags_size() != 0) expect_size(message.node_tags(), node_count, "node_tags");
   output.mesh.node_tags.assign(message.node_tags().begin(), message.node_tags().end());
-  output.mesh.blocks = decode_blocks(message, node_count);
-  output.mesh.boundaries = decode_boundaries(message, node_count);
+  output.mesh.blocks = decode_blocks(message, node_count, dimension);
+  output.mesh.boundaries = decode_boundaries(message, node_count, dimension);
   const long element_count = static_cast<long>(output.mesh.element_count());
   for (const protocol::Field& field : message.point_fields()) {
     output.point_fields.push_back(decode_field(field, node_count, "point"));
@@ -310,8 +377,9 @@ BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string
   for (const protocol::Field& field : message.cell_fields()) {
     output.cell_fields.push_back(decode_field(field, element_count, "cell"));
   }
-  output.reaction_resultant = decode_resultant(message.reaction_resultant(), "reaction_resultant");
-  output.applied_force = decode_resultant(message.applied_force(), "applied_force");
+  output.reaction_resultant =
+      decode_resultant(message.reaction_resultant(), dimension, "reaction_resultant");
+  output.applied_force = decode_resultant(message.applied_force(), dimension, "applied_force");
   return output;
 }
 

@@ -18,7 +18,8 @@ class MalformedReply : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The body's contact boundaries. Node ids, coordinates, normals, weights and fixed flags must
+/// The body's contact boundaries, of dimension 2 or 3 (`dimension` coordinates, normals and
+/// fixed flags per node). Node ids, coordinates, normals, weights and fixed flags must
 /// describe the same number of nodes; one surface per contact boundary (at least one, names
 /// distinct), its segments' positions in range. Each surface's own nodes, normals and weights
 /// are filled in (fill_surface_nodes), so restrict_to_boundary() works on the result.
@@ -37,13 +38,15 @@ CorrectionSolveResult decode_correction_result(const protocol::CorrectionResult&
 CorrectionSolveResult decode_neumann_result(const protocol::NeumannSolveResult& message,
                                             long contact_size);
 
-/// The body's mesh (nodes, tags, element blocks from the VTK cell types 5, 22, 9, and the named
-/// boundaries when the reply has them) and fields. A 6-component stress field gets the component
-/// names XX, YY, ZZ, XY, YZ, XZ, a 3-component one (older servers) xx, yy, xy. Throws
-/// MalformedReply for a size, index, cell type or boundary name that does not fit.
+/// The body's mesh (FieldsReply.dimension, 2 when absent; nodes, tags, element blocks from the
+/// VTK cell types 5, 22, 9 in 2D and 10, 24, 12 in 3D, the quadratic tetrahedra's nodes back in
+/// Gmsh's order, and the named boundaries when the reply has them) and fields. A 6-component stress
+/// field gets the component names XX, YY, ZZ, XY, YZ, XZ, a 3-component one (older servers) xx, yy,
+/// xy. Throws MalformedReply for a size, index, cell type or boundary name that does not fit.
 BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string& body_name);
 
-/// The element type of a VTK cell type number (5, 22 or 9); throws MalformedReply otherwise.
+/// The element type of a VTK cell type number (5, 22 or 9; 10, 24 or 12 for the solid elements);
+/// throws MalformedReply otherwise.
 ElementType element_type_of_vtk_cell(unsigned cell_type);
 
 }  // namespace robin

@@ -15,7 +15,7 @@ namespace {
 /// Young's modulus E for which make_isotropic_material(E, nu, plane strain) yields `stiffness`
 /// exactly, searched a few ulps around the closed form E = C_00 (1 + nu)(1 - 2 nu) / (1 - nu);
 /// nullopt when no such E exists (C is not isotropic with this nu).
-std::optional<double> exact_young_modulus(const Eigen::Matrix3d& stiffness, double nu) {
+std::optional<double> exact_young_modulus(const Eigen::MatrixXd& stiffness, double nu) {
   const double closed_form = stiffness(0, 0) * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu);
   if (!(closed_form > 0.0) || !std::isfinite(closed_form)) return std::nullopt;
   double below = closed_form, above = closed_form;
@@ -37,16 +37,19 @@ void encode_dirichlet(const DirichletCondition& condition, protocol::Dirichlet& 
   message.set_boundary(condition.boundary);
   if (condition.x) message.set_x(*condition.x);
   if (condition.y) message.set_y(*condition.y);
+  if (condition.z) message.set_z(*condition.z);
 }
 
-void encode_traction(const TractionCondition& condition, protocol::Traction& message) {
+void encode_traction(const TractionCondition& condition, int dimension,
+                     protocol::Traction& message) {
   message.set_boundary(condition.boundary);
   message.set_is_pressure(condition.is_pressure);
   if (condition.is_pressure) {
     message.set_pressure(condition.pressure);
   } else {
-    message.add_vector(condition.vector.x());
-    message.add_vector(condition.vector.y());
+    for (int component = 0; component < dimension; ++component) {
+      message.add_vector(condition.vector[component]);
+    }
   }
 }
 
@@ -87,8 +90,11 @@ void encode_material(const Material& material, const std::string& context,
     message.set_poisson_ratio(nu);
     return;
   }
-  for (int row = 0; row < 3; ++row) {
-    for (int column = 0; column < 3; ++column) message.add_voigt(material.stiffness(row, column));
+  const int size = material.voigt_size();  // 3 (plane) or 6 (solid: always sent as `voigt`)
+  for (int row = 0; row < size; ++row) {
+    for (int column = 0; column < size; ++column) {
+      message.add_voigt(material.stiffness(row, column));
+    }
   }
 }
 
@@ -97,16 +103,26 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
   protocol::SetupBody message;
   message.set_body_name(definition.name);
   *message.mutable_mesh() = encode_mesh(definition.mesh);
-  message.set_model(definition.material.model == PlaneModel::plane_strain ? protocol::PLANE_STRAIN
-                                                                          : protocol::PLANE_STRESS);
+  const int dimension = definition.mesh.dimension;
+  if (definition.material.dimension() != dimension) {
+    throw InputError(context + ": material: a " +
+                     (definition.material.dimension() == 3 ? "solid (6x6)" : "plane (3x3)") +
+                     " material for a " + (dimension == 3 ? "solid" : "plane") + " mesh");
+  }
+  if (dimension == 2) {  // a solid body has no plane model (left unspecified)
+    message.set_model(definition.material.model == PlaneModel::plane_strain
+                          ? protocol::PLANE_STRAIN
+                          : protocol::PLANE_STRESS);
+  }
   encode_material(definition.material, context, message);
-  message.add_body_force(definition.body_force.x());
-  message.add_body_force(definition.body_force.y());
+  for (int component = 0; component < dimension; ++component) {
+    message.add_body_force(definition.body_force[component]);
+  }
   for (const DirichletCondition& condition : definition.dirichlet) {
     encode_dirichlet(condition, *message.add_dirichlet());
   }
   for (const TractionCondition& condition : definition.tractions) {
-    encode_traction(condition, *message.add_traction());
+    encode_traction(condition, dimension, *message.add_traction());
   }
   for (const std::string& boundary : definition.contact_boundaries) {
     message.add_contact_boundaries(boundary);

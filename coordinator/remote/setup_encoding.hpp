@@ -11,10 +11,10 @@
 namespace robin {
 
 /// The SetupBody request for `definition` (its mesh loaded): the mesh as MeshData (the server
-/// needs no access to the coordinator's files and runs no script), the plane model, the
-/// material (see encode_material), body force, Dirichlet conditions, tractions, the contact
-/// boundary, the body solver settings of `solver` and whether the body is `floating` (held by
-/// contact alone). `context` names the body for errors.
+/// needs no access to the coordinator's files and runs no script; `dimension` 2 or 3), the
+/// plane model (plane bodies only), the material (see encode_material), body force, Dirichlet
+/// conditions, tractions, the contact boundary, the body solver settings of `solver` and whether
+/// the body is `floating` (held by contact alone). `context` names the body for errors.
 protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
                                       const SolverOptions& solver, bool floating = false);
 
@@ -24,7 +24,8 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
 ///    stress s_zz = nu (s_xx + s_yy) (von Mises) from the isotropic constants; nu is
 ///    out_of_plane_poisson and E is chosen so that the server's C equals ours to the last bit;
 ///  - every other material (plane stress, or a general Voigt matrix) is sent as the row-major
-///    3x3 `voigt` matrix C, which is exact: for those s_zz is zero on both sides.
+///    3x3 `voigt` matrix C, which is exact: for those s_zz is zero on both sides;
+///  - a solid material (6x6, three-dimensional bodies) is sent as its row-major 6x6 `voigt`.
 /// `context` names the body for the InputError thrown when a hand-built Material cannot be
 /// expressed in the protocol (s_zz factor without an isotropic C).
 void encode_material(const Material& material, const std::string& context,

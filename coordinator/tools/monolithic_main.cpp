@@ -68,12 +68,16 @@ Eigen::VectorXd rigid_amplitudes_of(const MonolithicResult& result, std::size_t 
 }
 
 /// The sum of body `alpha`'s reactions at its prescribed degrees of freedom in the solution.
-Eigen::Vector2d reaction_resultant(const LocalProblem& problem, const MonolithicResult& result,
+Eigen::Vector3d reaction_resultant(const LocalProblem& problem, const MonolithicResult& result,
                                    const robin::CouplingState& state, std::size_t alpha) {
   const robin::BodySolver& body = *problem.bodies[alpha];
   const Eigen::VectorXd reactions = body.reactions(
       body.displacement(state.bodies[alpha].contact_force, rigid_amplitudes_of(result, alpha)));
-  return reactions.reshaped(2, reactions.size() / 2).rowwise().sum();
+  const int dimension = body.mesh().dimension;
+  Eigen::Vector3d resultant = Eigen::Vector3d::Zero();
+  resultant.head(dimension) =
+      reactions.reshaped(dimension, reactions.size() / dimension).rowwise().sum();
+  return resultant;
 }
 
 nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult& result,
@@ -99,15 +103,16 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
   double assembly = 0, factorization = 0;
   for (std::size_t alpha = 0; alpha < problem.bodies.size(); ++alpha) {
     const auto& body = problem.bodies[alpha];
-    const Eigen::Vector2d reaction = reaction_resultant(problem, result, state, alpha);
+    const Eigen::Vector3d reaction = reaction_resultant(problem, result, state, alpha);
+    const int dimension = body->mesh().dimension;
     summary["bodies"].push_back(
         {{"name", body->name()},
          {"dofs", body->free_dof_count()},
          {"nodes", body->mesh().node_count()},
          {"elements", body->mesh().element_count()},
          {"factor_nonzeros", body->factor_nonzeros()},
-         {"applied_force", {body->applied_force().x(), body->applied_force().y()}},
-         {"reaction_resultant", {reaction.x(), reaction.y()}}});
+         {"applied_force", robin::vector_json(body->applied_force(), dimension)},
+         {"reaction_resultant", robin::vector_json(reaction, dimension)}});
     assembly += body->timings().assembly_seconds;
     factorization += body->timings().ordering_seconds + body->timings().factorization_seconds +
                      body->timings().interface_seconds;
@@ -121,7 +126,7 @@ nlohmann::json make_summary(const LocalProblem& problem, const MonolithicResult&
 }
 
 /// The index of the mesh node nearest to `point`.
-Eigen::Index nearest_node(const robin::Mesh& mesh, const Eigen::Vector2d& point) {
+Eigen::Index nearest_node(const robin::Mesh& mesh, const Eigen::Vector3d& point) {
   Eigen::Index nearest = 0;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < mesh.nodes.size(); ++k) {
@@ -151,7 +156,10 @@ robin::ExcludedPairClearance excluded_pair_clearance(const LocalProblem& problem
       node =
           nearest_node(problem.bodies[index]->mesh(), side == 0 ? pair.position : pair.position2);
     }
-    return Eigen::Vector2d(displacements[index].segment<2>(2 * node));
+    const int dimension = problem.bodies[index]->mesh().dimension;
+    Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
+    displacement.head(dimension) = displacements[index].segment(dimension * node, dimension);
+    return displacement;
   };
   return robin::graph_excluded_clearance(problem.coupling, state, displacement_of);
 }

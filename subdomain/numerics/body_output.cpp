@@ -15,37 +15,42 @@ std::vector<double> to_values(const double* data, Eigen::Index size) {
   return std::vector<double>(data, data + size);
 }
 
-/// |(B' lambda) at node k| / m_k at the nodes of the contact boundary (force per unit length),
-/// zero elsewhere; m_k is the node's boundary weight. For node-to-node rows this is lambda_i / m_i.
+/// |(B' lambda) at node k| / m_k at the nodes of the contact boundary (force per unit length in
+/// 2D, area in 3D), zero elsewhere; m_k is the node's boundary weight. For node-to-node rows
+/// this is lambda_i / m_i.
 std::vector<double> nodal_contact_pressure(const BodySolver& body,
                                            const Eigen::VectorXd& contact_force_field) {
+  const int dimension = body.mesh().dimension;
   std::vector<double> pressure(body.mesh().node_count(), 0.0);
   for (std::size_t node = 0; node < pressure.size(); ++node) {
     const double weight = body.boundary_weights()[static_cast<Eigen::Index>(node)];
-    if (weight > 0) pressure[node] = contact_force_field.segment<2>(2 * node).norm() / weight;
+    if (weight > 0) {
+      pressure[node] =
+          contact_force_field.segment(dimension * static_cast<Eigen::Index>(node), dimension)
+              .norm() /
+          weight;
+    }
   }
   return pressure;
 }
 
-/// Symmetric stress tensors in ParaView's order (XX, YY, ZZ, XY, YZ, XZ), from in-plane stresses
-/// (s_xx, s_yy, s_xy) per column: s_zz = out_of_plane_stress(material, s) (nu (s_xx + s_yy) for
-/// an isotropic plane-strain material, 0 in plane stress and for a Voigt material), and
-/// s_yz = s_xz = 0 (plane problem).
-std::vector<double> stress_tensors(const Material& material, const Eigen::Matrix3Xd& stresses) {
+/// Symmetric stress tensors in ParaView's order (XX, YY, ZZ, XY, YZ, XZ) from Voigt stresses per
+/// column (numerics/material.hpp, stress_tensor: a plane problem has s_yz = s_xz = 0 and its
+/// out-of-plane s_zz).
+std::vector<double> stress_tensors(const Material& material, const Eigen::MatrixXd& stresses) {
   std::vector<double> values;
   values.reserve(6 * static_cast<std::size_t>(stresses.cols()));
   for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
-    const Eigen::Vector3d stress = stresses.col(k);
-    values.insert(values.end(), {stress(0), stress(1), out_of_plane_stress(material, stress),
-                                 stress(2), 0.0, 0.0});
+    const StressTensor tensor = stress_tensor(material, Eigen::VectorXd(stresses.col(k)));
+    values.insert(values.end(), tensor.data(), tensor.data() + 6);
   }
   return values;
 }
 
-Eigen::Vector2d resultant(const Eigen::VectorXd& nodal_vectors) {
-  Eigen::Vector2d total = Eigen::Vector2d::Zero();
-  for (Eigen::Index node = 0; node < nodal_vectors.size() / 2; ++node) {
-    total += nodal_vectors.segment<2>(2 * node);
+Eigen::Vector3d resultant(const Eigen::VectorXd& nodal_vectors, int dimension) {
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  for (Eigen::Index node = 0; node < nodal_vectors.size() / dimension; ++node) {
+    total.head(dimension) += nodal_vectors.segment(dimension * node, dimension);
   }
   return total;
 }
@@ -74,21 +79,22 @@ BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& conta
   const Eigen::VectorXd reaction = body.reactions(displacement);
   const Eigen::VectorXd force_field = body.contact_force_field(contact_force);
 
+  const int dimension = body.mesh().dimension;
   BodyOutput output;
   output.body_name = body.name();
   output.mesh = body.mesh();
   output.point_fields = {
-      {"displacement", 2, to_values(displacement.data(), displacement.size())},
+      {"displacement", dimension, to_values(displacement.data(), displacement.size())},
       {"stress", 6, stress_tensors(material, stress.nodal_stress), stress_tensor_components()},
       {"von_mises", 1, to_values(stress.nodal_von_mises.data(), stress.nodal_von_mises.size())},
       {"contact_pressure", 1, nodal_contact_pressure(body, force_field)},
-      {"contact_force", 2, to_values(force_field.data(), force_field.size())},
-      {"reaction", 2, to_values(reaction.data(), reaction.size())}};
+      {"contact_force", dimension, to_values(force_field.data(), force_field.size())},
+      {"reaction", dimension, to_values(reaction.data(), reaction.size())}};
   output.cell_fields = {
       {"stress", 6, stress_tensors(material, stress.element_stress), stress_tensor_components()},
       {"von_mises", 1,
        to_values(stress.element_von_mises.data(), stress.element_von_mises.size())}};
-  output.reaction_resultant = resultant(reaction);
+  output.reaction_resultant = resultant(reaction, dimension);
   output.applied_force = body.applied_force();
   return output;
 }

@@ -13,20 +13,20 @@ namespace robin {
 struct BodyOutput {
   std::string body_name;
   Mesh mesh;
-  /// displacement (2), stress (6: XX, YY, ZZ, XY, YZ, XZ; nodal average), von_mises,
-  /// contact_pressure (|B' lambda| / m_k at contact boundary nodes, 0 elsewhere), contact_force
-  /// (2: -B' lambda), reaction (2)
+  /// displacement (d = mesh.dimension components), stress (6: XX, YY, ZZ, XY, YZ, XZ; nodal
+  /// average), von_mises, contact_pressure (|B' lambda| / m_k at contact boundary nodes, 0
+  /// elsewhere), contact_force (d: -B' lambda), reaction (d)
   std::vector<OutputField> point_fields;
   /// stress (6, at element centroids), von_mises
   std::vector<OutputField> cell_fields;
-  Eigen::Vector2d reaction_resultant = Eigen::Vector2d::Zero();  // sum of reactions
-  Eigen::Vector2d applied_force = Eigen::Vector2d::Zero();       // body forces + tractions
+  Eigen::Vector3d reaction_resultant = Eigen::Vector3d::Zero();  // sum of reactions (z = 0 in 2D)
+  Eigen::Vector3d applied_force = Eigen::Vector3d::Zero();       // body forces + tractions
 };
 
 /// The stress field's component names in ParaView's symmetric-tensor order: XX, YY, ZZ, XY, YZ,
-/// XZ. The stress of a plane problem has YZ = XZ = 0 and ZZ = out_of_plane_stress(material,
-/// (XX, YY, XY)): nu (XX + YY) for an isotropic plane-strain material, 0 in plane stress and for
-/// a Voigt material (numerics/material.hpp); von_mises is of the same three-dimensional tensor.
+/// XZ. The stress of a plane problem has YZ = XZ = 0 and ZZ = nu (XX + YY) for an isotropic
+/// plane-strain material, 0 in plane stress and for a Voigt material (stress_tensor,
+/// numerics/material.hpp); von_mises is of the same three-dimensional tensor.
 const std::vector<std::string>& stress_tensor_components();
 
 /// Fields of `body` under contact forces lambda (constraint order of its assignment); a floating

@@ -1,6 +1,7 @@
 #include "numerics/body_solver.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <set>
@@ -60,22 +61,32 @@ Eigen::MatrixXd assemble_dense_compliance(const SparseMatrix& trace,
 /// Prescribed value of every dof from the Dirichlet conditions. Two conditions that give the
 /// same dof different values are an error.
 std::vector<std::optional<double>> prescribed_dofs(const BodyDefinition& body) {
-  std::vector<std::optional<double>> prescribed(2 * body.mesh.node_count());
+  const int dimension = body.mesh.dimension;
+  std::vector<std::optional<double>> prescribed(static_cast<std::size_t>(body.mesh.dof_count()));
   std::vector<std::string> source(prescribed.size());
   auto prescribe = [&](int dof, double value, const std::string& boundary) {
     if (prescribed[dof] && std::abs(*prescribed[dof] - value) > 1e-14 * (1 + std::abs(value))) {
+      static const char* const component_names[] = {" (u_x)", " (u_y)", " (u_z)"};
       throw InputError("body '" + body.name + "': Dirichlet conditions on '" + source[dof] +
                        "' and '" + boundary + "' prescribe different values to node tag " +
-                       std::to_string(body.mesh.node_tags[dof / 2]) +
-                       (dof % 2 == 0 ? " (u_x)" : " (u_y)"));
+                       std::to_string(body.mesh.node_tags[dof / dimension]) +
+                       component_names[dof % dimension]);
     }
     prescribed[dof] = value;
     source[dof] = boundary;
   };
   for (const DirichletCondition& condition : body.dirichlet) {
+    if (condition.z && dimension == 2) {
+      throw InputError("body '" + body.name + "': the Dirichlet condition on '" +
+                       condition.boundary + "' prescribes u_z, but the body is two-dimensional");
+    }
+    const std::optional<double> values[] = {condition.x, condition.y, condition.z};
     for (int node : body.mesh.boundary(condition.boundary).nodes()) {
-      if (condition.x) prescribe(2 * node, *condition.x, condition.boundary);
-      if (condition.y) prescribe(2 * node + 1, *condition.y, condition.boundary);
+      for (int component = 0; component < dimension; ++component) {
+        if (values[component]) {
+          prescribe(dimension * node + component, *values[component], condition.boundary);
+        }
+      }
     }
   }
   return prescribed;
@@ -83,48 +94,78 @@ std::vector<std::optional<double>> prescribed_dofs(const BodyDefinition& body) {
 
 Eigen::VectorXd assemble_external_load(const BodyDefinition& body) {
   const Mesh& mesh = body.mesh;
-  const Eigen::Vector2d body_force = body.body_force;
-  Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(mesh.node_count()));
+  const Eigen::Vector3d body_force = body.body_force;
+  Eigen::VectorXd load = Eigen::VectorXd::Zero(mesh.dof_count());
   if (body_force.squaredNorm() > 0) {
-    load += assemble_body_force(mesh, [body_force](const Eigen::Vector2d&) { return body_force; });
+    load += assemble_body_force(mesh, [body_force](const Eigen::Vector3d&) { return body_force; });
   }
   for (const TractionCondition& traction : body.tractions) {
     const BoundaryGroup& group = mesh.boundary(traction.boundary);
     if (traction.is_pressure) {
       const double pressure = traction.pressure;
       load += assemble_boundary_traction(
-          mesh, group, [pressure](const Eigen::Vector2d&, const Eigen::Vector2d& normal) {
-            return Eigen::Vector2d(-pressure * normal);  // compression positive
+          mesh, group, [pressure](const Eigen::Vector3d&, const Eigen::Vector3d& normal) {
+            return Eigen::Vector3d(-pressure * normal);  // compression positive
           });
     } else {
-      const Eigen::Vector2d vector = traction.vector;
+      const Eigen::Vector3d vector = traction.vector;
       load += assemble_boundary_traction(
-          mesh, group, [vector](const Eigen::Vector2d&, const Eigen::Vector2d&) { return vector; });
+          mesh, group, [vector](const Eigen::Vector3d&, const Eigen::Vector3d&) { return vector; });
     }
   }
   return load;
 }
 
-/// The edges of `group` as positions into `nodes` (sorted), each with the body on its left.
-std::vector<int> oriented_segments(const Mesh& mesh, const BoundaryGroup& group,
-                                   const std::vector<int>& nodes) {
+/// The reference coordinates of the centre of a facet of `type`.
+Eigen::Vector3d group_facet_centre(FacetType type) {
+  if (facet_dimension(type) == 1) return Eigen::Vector3d::Zero();
+  return reference_centroid(face_parametrization(type));
+}
+
+/// Reverses the orientation of the facet whose nodes start at `nodes` (Gmsh order): an edge's
+/// endpoints swap; a face's corners run the other way round (0, 2, 1 / 0, 3, 2, 1), with a
+/// triangle6's midside nodes following their edges (3, 4, 5 -> 5, 4, 3).
+void reverse_facet(FacetType type, int* nodes) {
+  switch (type) {
+    case FacetType::line2:
+    case FacetType::line3:
+      std::swap(nodes[0], nodes[1]);
+      return;
+    case FacetType::triangle3:
+      std::swap(nodes[1], nodes[2]);
+      return;
+    case FacetType::triangle6:
+      std::swap(nodes[1], nodes[2]);
+      std::swap(nodes[3], nodes[5]);
+      return;
+    case FacetType::quadrilateral4:
+      std::swap(nodes[1], nodes[3]);
+      return;
+  }
+}
+
+/// The facets of `group` as positions into `nodes` (sorted), each oriented outward (an edge with
+/// the body on its left, a face with its right-hand normal out of the body).
+std::vector<int> oriented_facets(const Mesh& mesh, const BoundaryGroup& group,
+                                 const std::vector<int>& nodes) {
   const NodeElementMap adjacency(mesh);
   const int count = nodes_per_facet(group.type);
-  std::vector<int> segments;
+  const Eigen::Vector3d centre = group_facet_centre(group.type);
+  std::vector<int> facets;
   for (std::size_t e = 0; e < group.facet_count(); ++e) {
-    // Without adjacency the normal is the tangent turned clockwise (body on the left).
-    const Eigen::Vector2d left = EdgeGeometry(mesh, group, e).evaluate(0.0).outward_normal;
-    const Eigen::Vector2d outward =
-        EdgeGeometry(mesh, group, e, adjacency).evaluate(0.0).outward_normal;
-    const std::size_t first = segments.size();
+    // Without adjacency the normal is the facet's own orientation.
+    const Eigen::Vector3d own = FacetGeometry(mesh, group, e).evaluate(centre).outward_normal;
+    const Eigen::Vector3d outward =
+        FacetGeometry(mesh, group, e, adjacency).evaluate(centre).outward_normal;
+    const std::size_t first = facets.size();
     for (int i = 0; i < count; ++i) {
       const int node = group.connectivity[e * count + i];
-      segments.push_back(
+      facets.push_back(
           static_cast<int>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
     }
-    if (left.dot(outward) < 0.0) std::swap(segments[first], segments[first + 1]);
+    if (own.dot(outward) < 0.0) reverse_facet(group.type, &facets[first]);
   }
-  return segments;
+  return facets;
 }
 
 /// Whether two meshes have the same nodes, elements and boundary groups (bit for bit).
@@ -189,7 +230,7 @@ void BodySolver::assemble() {
     throw InputError("body '" + name() + "': the mesh has no elements");
   }
   check_contact_boundaries();
-  const long dof_count = 2L * static_cast<long>(mesh.node_count());
+  const long dof_count = long{mesh.dimension} * static_cast<long>(mesh.node_count());
   if (options_.maximum_dofs > 0 && dof_count > options_.maximum_dofs) {
     throw ResourceLimitError("body '" + name() + "': " + std::to_string(dof_count) +
                              " degrees of freedom, above this server's limit of " +
@@ -238,11 +279,14 @@ std::vector<int> BodySolver::trailing_unknowns() const {
   std::vector<int> unknowns;
   if (!options_.contact_unknowns_last) return unknowns;
   for (int node : contact_nodes()) {
-    for (int dof : {2 * node, 2 * node + 1}) {
+    const int dimension = definition_.mesh.dimension;
+    for (int dof = dimension * node; dof < dimension * (node + 1); ++dof) {
       if (!dofs_->is_prescribed(dof)) unknowns.push_back(dofs_->free_index(dof));
     }
   }
-  if (static_cast<long>(unknowns.size()) > 2L * options_.dense_limit) unknowns.clear();
+  if (static_cast<long>(unknowns.size()) > long{definition_.mesh.dimension} * options_.dense_limit) {
+    unknowns.clear();
+  }
   return unknowns;
 }
 
@@ -274,6 +318,7 @@ std::vector<int> BodySolver::contact_nodes() const {
 InterfaceDescription BodySolver::contact_boundary() const {
   const Mesh& mesh = definition_.mesh;
   InterfaceDescription interface;
+  interface.dimension = mesh.dimension;
   interface.dof_count = dofs_->free_count();
   interface.rigid_modes = rigid_mode_count();
   interface.node_ids = contact_nodes();
@@ -282,20 +327,23 @@ InterfaceDescription BodySolver::contact_boundary() const {
     interface.node_tags.push_back(mesh.node_tags[node]);
     interface.coordinates.push_back(mesh.nodes[node]);
     interface.weights.push_back(weights[node]);
-    interface.x_fixed.push_back(dofs_->is_prescribed(2 * node));
-    interface.y_fixed.push_back(dofs_->is_prescribed(2 * node + 1));
+    std::array<bool, 3> fixed = {false, false, false};
+    for (int component = 0; component < mesh.dimension; ++component) {
+      fixed[component] = dofs_->is_prescribed(mesh.dimension * node + component);
+    }
+    interface.fixed.push_back(fixed);
   }
   // Per boundary its own normals and weights; the union's normal at a node is the normalized
-  // sum of every boundary's length-weighted normals there (numerics/interface_description.hpp).
-  std::vector<Eigen::Vector2d> sums;
+  // sum of every boundary's measure-weighted normals there (numerics/interface_description.hpp).
+  std::vector<Eigen::Vector3d> sums;
   for (const std::string& boundary : definition_.contact_boundaries) {
     const BoundaryGroup& group = mesh.boundary(boundary);
     ContactSurfaceDescription surface;
     surface.boundary = boundary;
-    surface.segment_type = group.type;
-    surface.segments = oriented_segments(mesh, group, interface.node_ids);
+    surface.facet_type = group.type;
+    surface.facets = oriented_facets(mesh, group, interface.node_ids);
     const std::vector<int> nodes = group.nodes();
-    const std::vector<Eigen::Vector2d> group_sums = boundary_normal_sums(mesh, group);
+    const std::vector<Eigen::Vector3d> group_sums = boundary_normal_sums(mesh, group);
     surface.normals =
         unit_normals(mesh, group_sums, nodes, "boundary " + mesh.boundary_label(group));
     const Eigen::VectorXd group_weights = robin::boundary_weights(mesh, group);
@@ -327,14 +375,16 @@ InterfaceDescription BodySolver::contact_boundary() const {
 void BodySolver::assign_contact(const ContactOperator& contact) {
   const auto start = std::chrono::steady_clock::now();
   report(SetupStage::interface_operator);
-  check_contact_operator(contact, contact_nodes(), "body '" + name() + "'");
+  check_contact_operator(contact, contact_nodes(), definition_.mesh.dimension,
+                         "body '" + name() + "'");
   const bool keep_compliance = compliance_ != nullptr && contact == contact_;
   if (!keep_compliance) {
     const int row_count = contact.row_count();
+    const int dimension = definition_.mesh.dimension;
     std::vector<Eigen::Triplet<double>> triplets;
     for (int row = 0; row < row_count; ++row) {
       for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
-        const int dof = 2 * contact.nodes[k] + contact.components[k];
+        const int dof = dimension * contact.nodes[k] + contact.components[k];
         if (!dofs_->is_prescribed(dof)) {
           triplets.emplace_back(row, dofs_->free_index(dof), contact.values[k]);
         }
@@ -354,10 +404,11 @@ void BodySolver::assign_contact(const ContactOperator& contact) {
 
 void BodySolver::update_free_trace() {
   const ContactOperator& contact = contact_;
+  const int dimension = definition_.mesh.dimension;
   prescribed_trace_ = Eigen::VectorXd::Zero(contact.row_count());
   for (int row = 0; row < contact.row_count(); ++row) {
     for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
-      const int dof = 2 * contact.nodes[k] + contact.components[k];
+      const int dof = dimension * contact.nodes[k] + contact.components[k];
       if (dofs_->is_prescribed(dof)) {
         prescribed_trace_[row] += contact.values[k] * dofs_->prescribed_values()[dof];
       }
@@ -518,10 +569,11 @@ Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& displacement) const
   return reaction;
 }
 
-Eigen::Vector2d BodySolver::applied_force() const {
-  Eigen::Vector2d total = Eigen::Vector2d::Zero();
-  for (Eigen::Index node = 0; node < full_load_.size() / 2; ++node) {
-    total += full_load_.segment<2>(2 * node);
+Eigen::Vector3d BodySolver::applied_force() const {
+  const int dimension = definition_.mesh.dimension;
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  for (Eigen::Index node = 0; node < full_load_.size() / dimension; ++node) {
+    total.head(dimension) += full_load_.segment(dimension * node, dimension);
   }
   return load_factor_ * total;
 }
@@ -530,7 +582,7 @@ Eigen::VectorXd BodySolver::contact_force_field(const Eigen::VectorXd& contact_f
   Eigen::VectorXd field = Eigen::VectorXd::Zero(dofs_->total_count());
   for (int row = 0; row < contact_size(); ++row) {
     for (std::size_t k = contact_.row_offsets[row]; k < contact_.row_offsets[row + 1]; ++k) {
-      field[2 * contact_.nodes[k] + contact_.components[k]] -=
+      field[definition_.mesh.dimension * contact_.nodes[k] + contact_.components[k]] -=
           contact_.values[k] * contact_force[row];
     }
   }

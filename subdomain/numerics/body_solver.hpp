@@ -76,10 +76,10 @@ struct BodySolverOptions {
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
   int dense_limit = 3000;
   /// Eliminate the free dofs of the contact boundaries last in the Cholesky factor (when there
-  /// are at most 2 dense_limit of them), so a dense F comes from the factor's trailing block in
+  /// are at most dimension x dense_limit of them), so a dense F comes from the factor's trailing block in
   /// O(m^2 n_c) instead of n_c solves with the whole factor (see numerics/cholesky.hpp).
   bool contact_unknowns_last = true;
-  /// Limits checked before the work starts (0 = none): the body's degrees of freedom (2 per
+  /// Limits checked before the work starts (0 = none): the body's degrees of freedom (2 or 3 per
   /// node, before assembly) and the memory of its Cholesky factor (from the symbolic
   /// analysis, before the numerical factorization). ResourceLimitError otherwise.
   long maximum_dofs = 0;
@@ -227,7 +227,7 @@ class BodySolver {
   /// correction solve (one product with F). Throws SingularBodyError for a floating body.
   Eigen::VectorXd solve_neumann(const Eigen::VectorXd& contact_force) const;
 
-  /// Full displacement (2 per node, prescribed values included) under contact forces lambda:
+  /// Full displacement (mesh.dimension per node, prescribed values included) under contact forces lambda:
   /// u_f = K^+ (t f - B' lambda) + R alpha, alpha the rigid amplitudes of the last contact solve
   /// (none without rigid motions).
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force) const;
@@ -236,12 +236,13 @@ class BodySolver {
                                const Eigen::VectorXd& rigid_amplitudes) const;
   /// Reaction forces K u - f at prescribed dofs (zero at free dofs), full size.
   Eigen::VectorXd reactions(const Eigen::VectorXd& displacement) const;
-  /// Total applied external force (body force + tractions), (F_x, F_y).
-  Eigen::Vector2d applied_force() const;
+  /// Total applied external force (body force + tractions), (F_x, F_y, F_z) (F_z = 0 in 2D).
+  Eigen::Vector3d applied_force() const;
   /// Contact force field as nodal vectors, full size: -B' lambda (force acting on this body).
   Eigen::VectorXd contact_force_field(const Eigen::VectorXd& contact_force) const;
   /// Boundary weight of every mesh node on the contact boundaries (zero elsewhere): the integral
-  /// of its shape function over the contact boundaries (length; summed over the boundaries).
+  /// of its shape function over the contact boundaries (length in 2D, area in 3D; summed over the
+  /// boundaries).
   const Eigen::VectorXd& boundary_weights() const { return boundary_weights_; }
 
  private:

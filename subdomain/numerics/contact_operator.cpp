@@ -27,12 +27,14 @@ bool operator==(const ContactOperator& left, const ContactOperator& right) {
 }
 
 ContactOperator node_to_node_operator(const std::vector<int>& nodes,
-                                      const std::vector<Eigen::Vector2d>& normals,
+                                      const std::vector<Eigen::Vector3d>& normals,
                                       const std::vector<double>& weights) {
   ContactOperator contact;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     contact.add_entry(nodes[i], 0, normals[i].x());
     contact.add_entry(nodes[i], 1, normals[i].y());
+    // Plane bodies' normals have z = 0: their rows keep the two entries x, y.
+    if (normals[i].z() != 0.0) contact.add_entry(nodes[i], 2, normals[i].z());
     contact.finish_row(weights[i]);
   }
   return contact;
@@ -63,7 +65,7 @@ void check_offsets(const ContactOperator& contact, const std::string& context) {
 }
 
 void check_row(const ContactOperator& contact, int row, const std::vector<int>& contact_nodes,
-               const std::string& context) {
+               int dimension, const std::string& context) {
   std::vector<std::pair<int, int>> seen;
   for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
     std::string entry = std::to_string(k);
@@ -75,9 +77,11 @@ void check_row(const ContactOperator& contact, int row, const std::vector<int>& 
           context + ": AssignContact.node_ids" + entry + " = " + std::to_string(node) +
           " is not a node of the contact boundary (see InterfaceDescription.node_ids)");
     }
-    if (contact.components[k] != 0 && contact.components[k] != 1) {
+    if (contact.components[k] < 0 || contact.components[k] >= dimension) {
       throw InputError(context + ": AssignContact.components" + entry + " = " +
-                       std::to_string(contact.components[k]) + ", expected 0 (x) or 1 (y)");
+                       std::to_string(contact.components[k]) +
+                       (dimension == 3 ? ", expected 0 (x), 1 (y) or 2 (z)"
+                                       : ", expected 0 (x) or 1 (y)"));
     }
     if (!std::isfinite(contact.values[k])) {
       throw InputError(context + ": AssignContact.values" + entry + " is not a finite number");
@@ -102,7 +106,7 @@ void check_row(const ContactOperator& contact, int row, const std::vector<int>& 
 }  // namespace
 
 void check_contact_operator(const ContactOperator& contact, const std::vector<int>& contact_nodes,
-                            const std::string& context) {
+                            int dimension, const std::string& context) {
   if (contact.nodes.size() != contact.values.size() ||
       contact.components.size() != contact.values.size()) {
     throw InputError(context + ": AssignContact has " + std::to_string(contact.nodes.size()) +
@@ -117,7 +121,7 @@ void check_contact_operator(const ContactOperator& contact, const std::vector<in
                      std::to_string(contact.row_count()) + " constraints");
   }
   for (int row = 0; row < contact.row_count(); ++row)
-    check_row(contact, row, contact_nodes, context);
+    check_row(contact, row, contact_nodes, dimension, context);
 }
 
 }  // namespace robin

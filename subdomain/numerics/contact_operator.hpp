@@ -18,7 +18,7 @@ namespace robin {
 struct ContactOperator {
   std::vector<std::size_t> row_offsets{0};
   std::vector<int> nodes;       // mesh node index of each entry
-  std::vector<int> components;  // 0 (x) or 1 (y) of each entry
+  std::vector<int> components;  // 0 (x), 1 (y) or 2 (z, solid bodies) of each entry
   std::vector<double> values;   // coefficient of each entry (dimensionless)
   std::vector<double> weights;  // m_j of each row (length)
 
@@ -38,15 +38,15 @@ inline bool operator!=(const ContactOperator& left, const ContactOperator& right
 
 /// One row per node: (B u)_i = u(nodes[i]) . normals[i], weight weights[i].
 ContactOperator node_to_node_operator(const std::vector<int>& nodes,
-                                      const std::vector<Eigen::Vector2d>& normals,
+                                      const std::vector<Eigen::Vector3d>& normals,
                                       const std::vector<double>& weights);
 
 /// Checks the structure of `contact` against the body's contact nodes (sorted ascending):
 /// offsets start at 0, do not decrease and end at the entry count; no empty row; every node a
-/// contact node; components 0 or 1; finite values; distinct (node, component) pairs in a row;
+/// contact node; components 0 .. dimension - 1; finite values; distinct (node, component) pairs in a row;
 /// one finite weight m_j > 0 per row. Throws InputError "<context>: <field> ..." naming the
 /// first problem (the field names are those of the protocol's AssignContact).
 void check_contact_operator(const ContactOperator& contact, const std::vector<int>& contact_nodes,
-                            const std::string& context);
+                            int dimension, const std::string& context);
 
 }  // namespace robin

@@ -1,6 +1,7 @@
 #include "numerics/dof_map.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <Eigen/QR>
 #include <stdexcept>
 #include <utility>
@@ -72,69 +73,84 @@ Eigen::VectorXd DofMap::restrict(const Eigen::VectorXd& full) const {
   return free_values;
 }
 
+int rigid_mode_count(int dimension) { return dimension == 3 ? 6 : 3; }
+
+Eigen::VectorXd rigid_mode_row(const Mesh& mesh, int dof, const Eigen::Vector3d& centre,
+                               double scale) {
+  const int dimension = mesh.dimension;
+  const int component = dof % dimension;
+  const Eigen::Vector3d relative = (mesh.nodes[dof / dimension] - centre) / scale;
+  Eigen::VectorXd row = Eigen::VectorXd::Zero(rigid_mode_count(dimension));
+  row(component) = 1.0;
+  if (dimension == 2) {
+    row(2) = component == 0 ? -relative.y() : relative.x();
+    return row;
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    row(3 + axis) = Eigen::Vector3d::Unit(axis).cross(relative)(component);
+  }
+  return row;
+}
+
 namespace {
 
 /// The mesh's centre and the largest distance of a node from it (1 for a single point).
-std::pair<Eigen::Vector2d, double> centre_and_scale(const Mesh& mesh) {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& node : mesh.nodes) centre += node;
+std::pair<Eigen::Vector3d, double> centre_and_scale(const Mesh& mesh) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& node : mesh.nodes) centre += node;
   centre /= static_cast<double>(mesh.node_count());
   double scale = 0.0;
-  for (const Eigen::Vector2d& node : mesh.nodes) scale = std::max(scale, (node - centre).norm());
+  for (const Eigen::Vector3d& node : mesh.nodes) scale = std::max(scale, (node - centre).norm());
   if (scale == 0.0) scale = 1.0;
   return {centre, scale};
 }
 
-/// Row `dof` of the rigid modes (1, 0), (0, 1), (-(y - yc), x - xc) / scale.
-Eigen::Vector3d rigid_mode_row(const Mesh& mesh, int dof, const Eigen::Vector2d& centre,
-                               double scale) {
-  const Eigen::Vector2d relative = (mesh.nodes[dof / 2] - centre) / scale;
-  return dof % 2 == 0 ? Eigen::Vector3d(1.0, 0.0, -relative.y())
-                      : Eigen::Vector3d(0.0, 1.0, relative.x());
-}
+int mode_count(const Mesh& mesh) { return rigid_mode_count(mesh.dimension); }
 
 /// Eigen decomposition of the Gram matrix Q_p'Q_p of the rigid modes on the prescribed dofs
 /// (eigenvalues ascending).
-Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> prescribed_gram(const Mesh& mesh,
+Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> prescribed_gram(const Mesh& mesh,
                                                                const DofMap& dofs) {
-  if (dofs.total_count() != static_cast<int>(2 * mesh.node_count())) {
-    throw std::invalid_argument("rigid motions: dof count is not 2 x nodes");
+  if (dofs.total_count() != mesh.dof_count()) {
+    throw std::invalid_argument("rigid motions: dof count is not dimension x nodes");
   }
   const auto [centre, scale] = centre_and_scale(mesh);
-  Eigen::Matrix3d gram = Eigen::Matrix3d::Zero();
+  const int count = mode_count(mesh);
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(count, count);
   for (int dof = 0; dof < dofs.total_count(); ++dof) {
     if (!dofs.is_prescribed(dof)) continue;
-    const Eigen::Vector3d row = rigid_mode_row(mesh, dof, centre, scale);
+    const Eigen::VectorXd row = rigid_mode_row(mesh, dof, centre, scale);
     gram += row * row.transpose();
   }
-  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(gram);
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gram);
 }
 
 /// Whether eigenvalue `index` of the Gram matrix is zero relative to the largest.
-bool is_free_motion(const Eigen::Vector3d& eigenvalues, int index) {
-  return !(eigenvalues(2) > 0.0 && eigenvalues(index) > 1e-10 * eigenvalues(2));
+bool is_free_motion(const Eigen::VectorXd& eigenvalues, int index) {
+  const double largest = eigenvalues(eigenvalues.size() - 1);
+  return !(largest > 0.0 && eigenvalues(index) > 1e-10 * largest);
 }
 
 }  // namespace
 
 bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs) {
-  if (dofs.total_count() != static_cast<int>(2 * mesh.node_count())) {
-    throw std::invalid_argument("removes_rigid_motions: dof count is not 2 x nodes");
+  if (dofs.total_count() != mesh.dof_count()) {
+    throw std::invalid_argument("removes_rigid_motions: dof count is not dimension x nodes");
   }
   if (mesh.node_count() == 0) return false;
-  // Rank 3 when the smallest eigenvalue is not negligible relative to the largest.
+  // Full rank when the smallest eigenvalue is not negligible relative to the largest.
   return !is_free_motion(prescribed_gram(mesh, dofs).eigenvalues(), 0);
 }
 
 Eigen::MatrixXd rigid_body_modes(const Mesh& mesh, const DofMap& dofs) {
   if (mesh.node_count() == 0) return Eigen::MatrixXd(dofs.free_count(), 0);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> gram = prescribed_gram(mesh, dofs);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram = prescribed_gram(mesh, dofs);
   std::vector<int> free_motions;
-  for (int index = 0; index < 3; ++index) {
+  for (int index = 0; index < mode_count(mesh); ++index) {
     if (is_free_motion(gram.eigenvalues(), index)) free_motions.push_back(index);
   }
   const int count = static_cast<int>(free_motions.size());
-  Eigen::MatrixXd coefficients(3, count);  // c: the null space of Q_p
+  Eigen::MatrixXd coefficients(mode_count(mesh), count);  // c: the null space of Q_p
   for (int k = 0; k < count; ++k) coefficients.col(k) = gram.eigenvectors().col(free_motions[k]);
   const auto [centre, scale] = centre_and_scale(mesh);
   Eigen::MatrixXd modes(dofs.free_count(), count);  // Q_f c

@@ -1,5 +1,5 @@
 #pragma once
-// Splits the 2n degrees of freedom of a body into free and prescribed ones
+// Splits the d n degrees of freedom of a body (d = mesh.dimension) into free and prescribed ones
 // (Dirichlet conditions) and reduces K u = f to the free block:
 //   K_ff u_f = f_f - K_fp u_p.
 
@@ -39,16 +39,27 @@ class DofMap {
   int free_count_ = 0;
 };
 
-/// True when the prescribed dofs remove every rigid motion (two translations and the
-/// rotation) of the mesh: the 3 rigid modes restricted to the prescribed dofs have rank 3.
+/// m, the number of rigid motions of a body: 3 in 2D, 6 in 3D.
+int rigid_mode_count(int dimension);
+
+/// Row `dof` (d node + c) of the m rigid modes of `mesh` about `centre`: the translations e_c,
+/// then the rotations w x (x - centre) / scale with w = e_z in 2D (the row (-(y - yc), x - xc)
+/// / scale) and w = e_x, e_y, e_z in 3D.
+Eigen::VectorXd rigid_mode_row(const Mesh& mesh, int dof, const Eigen::Vector3d& centre,
+                               double scale = 1.0);
+
+/// True when the prescribed dofs remove every rigid motion of the mesh (in 2D two translations
+/// and one rotation, in 3D three of each): the m rigid modes (m = 3 or 6) restricted to the
+/// prescribed dofs have rank m.
 bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs);
 
-/// The rigid motions the prescribed dofs leave free, on the free dofs: R (free x k, k <= 3) with
-/// orthonormal columns spanning { r = Q c : (Q c)_p = 0 on every prescribed dof p }, Q the rigid
-/// modes (1, 0), (0, 1), (-(y - yc), x - xc) / s of the mesh (centred and scaled, so the test
-/// does not depend on position and size). c runs over the null space of Q_p'Q_p (3 x 3; its
-/// eigenvalues below 1e-10 times the largest, the test of removes_rigid_motions, count as zero),
-/// so k = 3 - rank(Q_p) and k = 0 exactly when removes_rigid_motions() holds. Since K Q = 0 on
+/// The rigid motions the prescribed dofs leave free, on the free dofs: R (free x k, k <= m) with
+/// orthonormal columns spanning { r = Q c : (Q c)_p = 0 on every prescribed dof p }, Q the m
+/// rigid modes of the mesh: the translations e_c and the rotations w x (x - xc) / s for w = e_z
+/// (2D) or w = e_x, e_y, e_z (3D), centred and scaled so the test does not depend on position
+/// and size. c runs over the null space of Q_p'Q_p (m x m; its eigenvalues below 1e-10 times the
+/// largest, the test of removes_rigid_motions, count as zero), so k = m - rank(Q_p) and k = 0
+/// exactly when removes_rigid_motions() holds. Since K Q = 0 on
 /// the whole mesh and R vanishes on the prescribed dofs, K_ff R = 0: R spans the kernel of the
 /// reduced stiffness (a connected mesh has no other).
 Eigen::MatrixXd rigid_body_modes(const Mesh& mesh, const DofMap& dofs);

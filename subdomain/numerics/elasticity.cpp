@@ -1,5 +1,6 @@
 #include "numerics/elasticity.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
 #include <optional>
@@ -22,9 +23,11 @@ int stiffness_degree(ElementType type) {
     case ElementType::quadrilateral4:
       return 3;
     case ElementType::tetrahedron4:
+      return 1;
     case ElementType::tetrahedron10:
+      return 2;
     case ElementType::hexahedron8:
-      break;
+      return 3;  // the standard 2 x 2 x 2 rule
   }
   throw std::invalid_argument("stiffness_degree: unknown element type");
 }
@@ -32,47 +35,88 @@ int stiffness_degree(ElementType type) {
 /// Degree for loads N_i b(x) with a smooth b: two more than the shape functions' degree
 /// squared, so that the load error stays below the discretization error.
 int load_degree(ElementType type) {
-  return type == ElementType::triangle6 ? 6 : 4;
+  return type == ElementType::triangle6 || type == ElementType::tetrahedron10 ? 6 : 4;
 }
-int edge_load_degree(FacetType type) {
-  return type == FacetType::line3 ? 6 : 4;
+int facet_load_degree(FacetType type) {
+  return type == FacetType::line3 || type == FacetType::triangle6 ? 6 : 4;
 }
 
-/// Strain-displacement matrix B (3 x 2n): strain (e_xx, e_yy, 2 e_xy) = B u_e, with
-/// u_e = (u_x0, u_y0, u_x1, ...).
+/// Strain-displacement matrix B (Voigt size x d n) with u_e = (u_x0, u_y0, [u_z0,] u_x1, ...):
+/// in 2D strain (e_xx, e_yy, 2 e_xy) = B u_e, in 3D (e_xx, e_yy, e_zz, 2 e_yz, 2 e_xz, 2 e_xy).
 Eigen::MatrixXd strain_displacement(const Eigen::MatrixXd& gradients) {
   const Eigen::Index count = gradients.rows();
-  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(3, 2 * count);
+  const Eigen::Index dimension = gradients.cols();
+  if (dimension == 2) {
+    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(3, 2 * count);
+    for (Eigen::Index i = 0; i < count; ++i) {
+      b(0, 2 * i) = gradients(i, 0);
+      b(1, 2 * i + 1) = gradients(i, 1);
+      b(2, 2 * i) = gradients(i, 1);
+      b(2, 2 * i + 1) = gradients(i, 0);
+    }
+    return b;
+  }
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(6, 3 * count);
   for (Eigen::Index i = 0; i < count; ++i) {
-    b(0, 2 * i) = gradients(i, 0);
-    b(1, 2 * i + 1) = gradients(i, 1);
-    b(2, 2 * i) = gradients(i, 1);
-    b(2, 2 * i + 1) = gradients(i, 0);
+    const double dx = gradients(i, 0), dy = gradients(i, 1), dz = gradients(i, 2);
+    b(0, 3 * i) = dx;
+    b(1, 3 * i + 1) = dy;
+    b(2, 3 * i + 2) = dz;
+    b(3, 3 * i + 1) = dz;  // 2 e_yz = du_y/dz + du_z/dy
+    b(3, 3 * i + 2) = dy;
+    b(4, 3 * i) = dz;  // 2 e_xz = du_x/dz + du_z/dx
+    b(4, 3 * i + 2) = dx;
+    b(5, 3 * i) = dy;  // 2 e_xy = du_x/dy + du_y/dx
+    b(5, 3 * i + 1) = dx;
   }
   return b;
 }
 
-Eigen::VectorXd element_displacement(const ElementBlock& block, std::size_t element,
-                                     const Eigen::VectorXd& displacement) {
+Eigen::VectorXd element_displacement(const Mesh& mesh, const ElementBlock& block,
+                                     std::size_t element, const Eigen::VectorXd& displacement) {
   const int count = nodes_per_element(block.type);
-  Eigen::VectorXd local(2 * count);
+  const int dimension = mesh.dimension;
+  Eigen::VectorXd local(dimension * count);
   for (int i = 0; i < count; ++i) {
     const int node = block.connectivity[element * count + i];
-    local.segment<2>(2 * i) = displacement.segment<2>(2 * node);
+    local.segment(dimension * i, dimension) = displacement.segment(dimension * node, dimension);
   }
   return local;
 }
 
 void check_displacement_size(const Mesh& mesh, const Eigen::VectorXd& displacement,
                              const char* caller) {
-  if (displacement.size() != static_cast<Eigen::Index>(2 * mesh.node_count())) {
-    throw std::invalid_argument(std::string(caller) + ": displacement size is not 2 x nodes");
+  if (displacement.size() != static_cast<Eigen::Index>(mesh.dof_count())) {
+    throw std::invalid_argument(std::string(caller) +
+                                ": displacement size is not dimension x nodes");
   }
 }
 
-Eigen::MatrixXd element_stiffness(const ElementGeometry& geometry, const Eigen::Matrix3d& c) {
+/// Throws InputError when the material's Voigt size is not that of the mesh's dimension.
+void check_material_dimension(const Mesh& mesh, const Material& material) {
+  if (material.dimension() != mesh.dimension) {
+    throw InputError("a " + std::to_string(material.dimension()) + "D material (" +
+                     std::to_string(material.voigt_size()) + " x " +
+                     std::to_string(material.voigt_size()) + " Voigt stiffness) on the " +
+                     std::to_string(mesh.dimension) + "D mesh" +
+                     (mesh.source.empty() ? std::string() : " '" + mesh.source + "'") +
+                     ": give a material of the mesh's dimension");
+  }
+}
+
+/// Adds value * e_component at node `node` of a load vector of d-component nodes.
+void add_nodal(Eigen::VectorXd& load, int dimension, int node, const Eigen::Vector3d& value) {
+  load.segment(dimension * node, dimension) += value.head(dimension);
+}
+
+/// K_e = sum over the rule of B^T C B |J| w, with C of fixed size (3 x 3 or 6 x 6: the products
+/// then have a fixed evaluation order, whatever the dimension).
+template <int VoigtSize>
+Eigen::MatrixXd element_stiffness(const ElementGeometry& geometry,
+                                  const Eigen::Matrix<double, VoigtSize, VoigtSize>& c) {
   const int count = geometry.node_count();
-  Eigen::MatrixXd stiffness = Eigen::MatrixXd::Zero(2 * count, 2 * count);
+  const int size = element_dimension(geometry.type()) * count;
+  Eigen::MatrixXd stiffness = Eigen::MatrixXd::Zero(size, size);
   for (const QuadraturePoint& point :
        element_quadrature(geometry.type(), stiffness_degree(geometry.type()))) {
     const ElementPoint at = geometry.evaluate(point.reference);
@@ -83,13 +127,20 @@ Eigen::MatrixXd element_stiffness(const ElementGeometry& geometry, const Eigen::
   return stiffness;
 }
 
+Eigen::MatrixXd element_stiffness(const ElementGeometry& geometry, const Eigen::MatrixXd& c) {
+  if (c.rows() == 3) return element_stiffness<3>(geometry, Eigen::Matrix3d(c));
+  return element_stiffness<6>(geometry, Eigen::Matrix<double, 6, 6>(c));
+}
+
 }  // namespace
 
 SparseMatrix assemble_stiffness(const Mesh& mesh, const Material& material) {
+  check_material_dimension(mesh, material);
+  const int dimension = mesh.dimension;
   std::vector<Eigen::Triplet<double>> triplets;
   std::size_t reserve = 0;
   for (const ElementBlock& block : mesh.blocks) {
-    const std::size_t size = 2 * nodes_per_element(block.type);
+    const std::size_t size = dimension * nodes_per_element(block.type);
     reserve += block.element_count() * size * size;
   }
   triplets.reserve(reserve);
@@ -99,21 +150,22 @@ SparseMatrix assemble_stiffness(const Mesh& mesh, const Material& material) {
     for (std::size_t e = 0; e < block.element_count(); ++e) {
       const Eigen::MatrixXd local = element_stiffness({mesh, b, e}, material.stiffness);
       const int* nodes = &block.connectivity[e * count];
-      for (int i = 0; i < 2 * count; ++i) {
-        for (int j = 0; j < 2 * count; ++j) {
-          triplets.emplace_back(2 * nodes[i / 2] + i % 2, 2 * nodes[j / 2] + j % 2, local(i, j));
+      for (int i = 0; i < dimension * count; ++i) {
+        for (int j = 0; j < dimension * count; ++j) {
+          triplets.emplace_back(dimension * nodes[i / dimension] + i % dimension,
+                                dimension * nodes[j / dimension] + j % dimension, local(i, j));
         }
       }
     }
   }
-  const int size = static_cast<int>(2 * mesh.node_count());
+  const int size = mesh.dof_count();
   SparseMatrix stiffness(size, size);
   stiffness.setFromTriplets(triplets.begin(), triplets.end());
   return stiffness;
 }
 
 Eigen::VectorXd assemble_body_force(const Mesh& mesh, const VectorField& body_force) {
-  Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * mesh.node_count());
+  Eigen::VectorXd load = Eigen::VectorXd::Zero(mesh.dof_count());
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
     const ElementBlock& block = mesh.blocks[b];
     const int count = nodes_per_element(block.type);
@@ -124,9 +176,9 @@ Eigen::VectorXd assemble_body_force(const Mesh& mesh, const VectorField& body_fo
       for (const QuadraturePoint& point : rule) {
         const ElementPoint at = geometry.evaluate(point.reference);
         // f_i += N_i b(x) |J| w
-        const Eigen::Vector2d force = body_force(at.position) * (at.jacobian * point.weight);
+        const Eigen::Vector3d force = body_force(at.position) * (at.jacobian * point.weight);
         for (int i = 0; i < count; ++i) {
-          load.segment<2>(2 * block.connectivity[e * count + i]) += at.values(i) * force;
+          add_nodal(load, mesh.dimension, block.connectivity[e * count + i], at.values(i) * force);
         }
       }
     }
@@ -136,67 +188,90 @@ Eigen::VectorXd assemble_body_force(const Mesh& mesh, const VectorField& body_fo
 
 Eigen::VectorXd assemble_boundary_traction(const Mesh& mesh, const BoundaryGroup& group,
                                            const TractionField& traction) {
-  Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * mesh.node_count());
+  Eigen::VectorXd load = Eigen::VectorXd::Zero(mesh.dof_count());
   const NodeElementMap adjacency(mesh);
   const int count = nodes_per_facet(group.type);
-  const std::vector<QuadraturePoint> rule = edge_quadrature(edge_load_degree(group.type));
+  const std::vector<QuadraturePoint> rule = facet_quadrature(group.type, facet_load_degree(group.type));
   for (std::size_t e = 0; e < group.facet_count(); ++e) {
-    const EdgeGeometry edge(mesh, group, e, adjacency);
+    const FacetGeometry facet(mesh, group, e, adjacency);
     for (const QuadraturePoint& point : rule) {
-      const EdgePoint at = edge.evaluate(point.reference.x());
-      // f_i += N_i t(x, n) |dx/dt| w
-      const Eigen::Vector2d force =
-          traction(at.position, at.outward_normal) * (at.length_element * point.weight);
+      const FacetPoint at = facet.evaluate(point.reference);
+      // f_i += N_i t(x, n) |dx/dxi| w
+      const Eigen::Vector3d force =
+          traction(at.position, at.outward_normal) * (at.measure_element * point.weight);
       for (int i = 0; i < count; ++i) {
-        load.segment<2>(2 * group.connectivity[e * count + i]) += at.values(i) * force;
+        add_nodal(load, mesh.dimension, group.connectivity[e * count + i], at.values(i) * force);
       }
     }
   }
   return load;
 }
 
+namespace {
+
+/// Weights of a 6-node triangle's nodes from its four linear sub-triangles (corner, midside,
+/// midside and the middle one of the three midside nodes): a third of each sub-triangle's area
+/// to each of its corners. Positive, summing to the face's area (for a flat face).
+void add_subtriangle_weights(const Mesh& mesh, const int* nodes, Eigen::VectorXd& weights) {
+  constexpr int subtriangles[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
+  for (const auto& corners : subtriangles) {
+    const Eigen::Vector3d& a = mesh.nodes[nodes[corners[0]]];
+    const double area =
+        0.5 * (mesh.nodes[nodes[corners[1]]] - a).cross(mesh.nodes[nodes[corners[2]]] - a).norm();
+    for (const int corner : corners) weights(nodes[corner]) += area / 3.0;
+  }
+}
+
+}  // namespace
+
 Eigen::VectorXd boundary_weights(const Mesh& mesh, const BoundaryGroup& group) {
   Eigen::VectorXd weights = Eigen::VectorXd::Zero(mesh.node_count());
   const int count = nodes_per_facet(group.type);
-  const std::vector<QuadraturePoint> rule = edge_quadrature(edge_load_degree(group.type));
+  if (group.type == FacetType::triangle6) {
+    for (std::size_t e = 0; e < group.facet_count(); ++e) {
+      add_subtriangle_weights(mesh, &group.connectivity[e * count], weights);
+    }
+    return weights;
+  }
+  const std::vector<QuadraturePoint> rule = facet_quadrature(group.type, facet_load_degree(group.type));
   for (std::size_t e = 0; e < group.facet_count(); ++e) {
-    const EdgeGeometry edge(mesh, group, e);
+    const FacetGeometry facet(mesh, group, e);
     for (const QuadraturePoint& point : rule) {
-      const EdgePoint at = edge.evaluate(point.reference.x());
-      // m_i += N_i |dx/dt| w
+      const FacetPoint at = facet.evaluate(point.reference);
+      // m_i += N_i |dx/dxi| w
       for (int i = 0; i < count; ++i) {
         weights(group.connectivity[e * count + i]) +=
-            at.values(i) * at.length_element * point.weight;
+            at.values(i) * at.measure_element * point.weight;
       }
     }
   }
   return weights;
 }
 
-std::vector<Eigen::Vector2d> boundary_normal_sums(const Mesh& mesh, const BoundaryGroup& group,
-                                                  bool edges_have_body_on_left) {
+std::vector<Eigen::Vector3d> boundary_normal_sums(const Mesh& mesh, const BoundaryGroup& group,
+                                                  bool facets_oriented_outward) {
   std::optional<NodeElementMap> adjacency;
-  if (!edges_have_body_on_left) adjacency.emplace(mesh);
+  if (!facets_oriented_outward) adjacency.emplace(mesh);
   const int count = nodes_per_facet(group.type);
-  const std::vector<double> node_references = edge_reference_nodes(group.type);
-  std::vector<Eigen::Vector2d> sums(mesh.node_count(), Eigen::Vector2d::Zero());
+  const std::vector<Eigen::Vector3d> node_references = facet_reference_nodes(group.type);
+  std::vector<Eigen::Vector3d> sums(mesh.node_count(), Eigen::Vector3d::Zero());
   for (std::size_t e = 0; e < group.facet_count(); ++e) {
-    const EdgeGeometry edge =
-        adjacency ? EdgeGeometry(mesh, group, e, *adjacency) : EdgeGeometry(mesh, group, e);
-    const double length = edge.length();
+    const FacetGeometry facet =
+        adjacency ? FacetGeometry(mesh, group, e, *adjacency) : FacetGeometry(mesh, group, e);
+    const double measure = facet.measure();
     for (int i = 0; i < count; ++i) {
-      // Each node receives its edges' outward normals (taken at the node) times their lengths.
+      // Each node receives its facets' outward normals (taken at the node) times their measures.
       sums[group.connectivity[e * count + i]] +=
-          length * edge.evaluate(node_references[i]).outward_normal;
+          measure * facet.evaluate(node_references[i]).outward_normal;
     }
   }
   return sums;
 }
 
-std::vector<Eigen::Vector2d> unit_normals(const Mesh& mesh,
-                                          const std::vector<Eigen::Vector2d>& sums,
+std::vector<Eigen::Vector3d> unit_normals(const Mesh& mesh,
+                                          const std::vector<Eigen::Vector3d>& sums,
                                           const std::vector<int>& nodes, const std::string& what) {
-  std::vector<Eigen::Vector2d> normals;
+  std::vector<Eigen::Vector3d> normals;
   normals.reserve(nodes.size());
   for (const int node : nodes) {
     const double norm = sums[node].norm();
@@ -209,7 +284,7 @@ std::vector<Eigen::Vector2d> unit_normals(const Mesh& mesh,
   return normals;
 }
 
-std::vector<Eigen::Vector2d> boundary_node_normals(const Mesh& mesh, const BoundaryGroup& group) {
+std::vector<Eigen::Vector3d> boundary_node_normals(const Mesh& mesh, const BoundaryGroup& group) {
   return unit_normals(mesh, boundary_normal_sums(mesh, group), group.nodes(),
                       "boundary " + mesh.boundary_label(group));
 }
@@ -217,19 +292,22 @@ std::vector<Eigen::Vector2d> boundary_node_normals(const Mesh& mesh, const Bound
 StressField recover_stress(const Mesh& mesh, const Material& material,
                            const Eigen::VectorXd& displacement) {
   check_displacement_size(mesh, displacement, "recover_stress");
+  check_material_dimension(mesh, material);
+  const int voigt_size = material.voigt_size();
   StressField field;
-  field.element_stress.resize(3, static_cast<Eigen::Index>(mesh.element_count()));
-  field.nodal_stress = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(mesh.node_count()));
+  field.element_stress.resize(voigt_size, static_cast<Eigen::Index>(mesh.element_count()));
+  field.nodal_stress =
+      Eigen::MatrixXd::Zero(voigt_size, static_cast<Eigen::Index>(mesh.node_count()));
   Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
   Eigen::Index flat = 0;
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
     const ElementBlock& block = mesh.blocks[b];
-    const std::vector<Eigen::Vector2d> node_references = reference_nodes(block.type);
+    const std::vector<Eigen::Vector3d> node_references = reference_nodes(block.type);
     for (std::size_t e = 0; e < block.element_count(); ++e, ++flat) {
       const ElementGeometry geometry(mesh, b, e);
-      const Eigen::VectorXd local = element_displacement(block, e, displacement);
+      const Eigen::VectorXd local = element_displacement(mesh, block, e, displacement);
       // s = C B u_e
-      const auto stress_at = [&](const Eigen::Vector2d& reference) -> Eigen::Vector3d {
+      const auto stress_at = [&](const Eigen::Vector3d& reference) -> Eigen::VectorXd {
         return material.stiffness *
                (strain_displacement(geometry.evaluate(reference).gradients) * local);
       };
@@ -244,10 +322,10 @@ StressField recover_stress(const Mesh& mesh, const Material& material,
   for (Eigen::Index node = 0; node < touching.size(); ++node) {
     if (touching(node) > 0.0) field.nodal_stress.col(node) /= touching(node);
   }
-  const auto von_mises_of = [&](const Eigen::Matrix3Xd& stresses) {
+  const auto von_mises_of = [&](const Eigen::MatrixXd& stresses) {
     Eigen::VectorXd values(stresses.cols());
     for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
-      values(k) = von_mises(material, stresses.col(k));
+      values(k) = von_mises(material, Eigen::VectorXd(stresses.col(k)));
     }
     return values;
   };
@@ -266,11 +344,14 @@ double l2_displacement_error(const Mesh& mesh, const Eigen::VectorXd& displaceme
     const std::vector<QuadraturePoint> rule = element_quadrature(block.type, 6);
     for (std::size_t e = 0; e < block.element_count(); ++e) {
       const ElementGeometry geometry(mesh, b, e);
-      const Eigen::VectorXd local = element_displacement(block, e, displacement);
+      const Eigen::VectorXd local = element_displacement(mesh, block, e, displacement);
+      const int dimension = mesh.dimension;
       for (const QuadraturePoint& point : rule) {
         const ElementPoint at = geometry.evaluate(point.reference);
-        Eigen::Vector2d approximate = Eigen::Vector2d::Zero();
-        for (int i = 0; i < count; ++i) approximate += at.values(i) * local.segment<2>(2 * i);
+        Eigen::Vector3d approximate = Eigen::Vector3d::Zero();
+        for (int i = 0; i < count; ++i) {
+          approximate.head(dimension) += at.values(i) * local.segment(dimension * i, dimension);
+        }
         // ||u_h - u||^2 += |u_h(x) - u(x)|^2 |J| w
         sum += (approximate - exact(at.position)).squaredNorm() * at.jacobian * point.weight;
       }

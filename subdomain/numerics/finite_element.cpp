@@ -1,5 +1,6 @@
 #include "numerics/finite_element.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -35,23 +36,23 @@ std::vector<QuadraturePoint> gauss_legendre(int point_count) {
       x -= step;
       if (std::abs(step) < 1e-16) break;
     }
-    rule[i] = {Eigen::Vector2d(x, 0.0), 2.0 / ((1.0 - x * x) * derivative * derivative)};
+    rule[i] = {Eigen::Vector3d(x, 0.0, 0.0), 2.0 / ((1.0 - x * x) * derivative * derivative)};
   }
   return rule;
 }
 
 void add_triangle_orbit(std::vector<QuadraturePoint>& rule, double a, double weight) {
   // Orbit of (a, a, 1 - 2a) in barycentric coordinates.
-  rule.push_back({Eigen::Vector2d(a, a), weight});
-  rule.push_back({Eigen::Vector2d(1.0 - 2.0 * a, a), weight});
-  rule.push_back({Eigen::Vector2d(a, 1.0 - 2.0 * a), weight});
+  rule.push_back({Eigen::Vector3d(a, a, 0.0), weight});
+  rule.push_back({Eigen::Vector3d(1.0 - 2.0 * a, a, 0.0), weight});
+  rule.push_back({Eigen::Vector3d(a, 1.0 - 2.0 * a, 0.0), weight});
 }
 
 void add_triangle_orbit(std::vector<QuadraturePoint>& rule, double a, double b, double weight) {
   // Orbit of (a, b, 1 - a - b) in barycentric coordinates: its 6 permutations.
   const double c = 1.0 - a - b;
   for (const auto& [r, s] : {std::pair{a, b}, {b, a}, {b, c}, {c, b}, {a, c}, {c, a}}) {
-    rule.push_back({Eigen::Vector2d(r, s), weight});
+    rule.push_back({Eigen::Vector3d(r, s, 0.0), weight});
   }
 }
 
@@ -65,7 +66,7 @@ std::vector<QuadraturePoint> collapsed_triangle_rule(int degree) {
       const double u = 0.5 * (along_u.reference.x() + 1.0);
       const double v = 0.5 * (along_v.reference.x() + 1.0);
       const double weight = 0.25 * along_u.weight * along_v.weight * (1.0 - v);
-      rule.push_back({Eigen::Vector2d(u * (1.0 - v), v), weight});
+      rule.push_back({Eigen::Vector3d(u * (1.0 - v), v, 0.0), weight});
     }
   }
   return rule;
@@ -76,7 +77,7 @@ std::vector<QuadraturePoint> collapsed_triangle_rule(int degree) {
 std::vector<QuadraturePoint> triangle_quadrature(int degree) {
   std::vector<QuadraturePoint> rule;
   if (degree <= 1) {
-    rule.push_back({Eigen::Vector2d(1.0 / 3.0, 1.0 / 3.0), 0.5});
+    rule.push_back({Eigen::Vector3d(1.0 / 3.0, 1.0 / 3.0, 0.0), 0.5});
   } else if (degree == 2) {
     add_triangle_orbit(rule, 1.0 / 6.0, 1.0 / 6.0);
   } else if (degree == 3) {
@@ -86,7 +87,7 @@ std::vector<QuadraturePoint> triangle_quadrature(int degree) {
     add_triangle_orbit(rule, 0.09157621350977078, 0.054975871827661);
   } else if (degree == 5) {
     const double root = std::sqrt(15.0);
-    rule.push_back({Eigen::Vector2d(1.0 / 3.0, 1.0 / 3.0), 9.0 / 80.0});
+    rule.push_back({Eigen::Vector3d(1.0 / 3.0, 1.0 / 3.0, 0.0), 9.0 / 80.0});
     add_triangle_orbit(rule, (6.0 + root) / 21.0, (155.0 + root) / 2400.0);
     add_triangle_orbit(rule, (6.0 - root) / 21.0, (155.0 - root) / 2400.0);
   } else if (degree == 6) {
@@ -104,8 +105,59 @@ std::vector<QuadraturePoint> quadrilateral_quadrature(int degree) {
   std::vector<QuadraturePoint> rule;
   for (const QuadraturePoint& along_eta : line) {
     for (const QuadraturePoint& along_xi : line) {
-      rule.push_back({Eigen::Vector2d(along_xi.reference.x(), along_eta.reference.x()),
+      rule.push_back({Eigen::Vector3d(along_xi.reference.x(), along_eta.reference.x(), 0.0),
                       along_xi.weight * along_eta.weight});
+    }
+  }
+  return rule;
+}
+
+/// Collapsed (Stroud conical) Gauss rule on the tetrahedron for any degree: x = u (1 - v)(1 - w),
+/// y = v (1 - w), z = w on the unit cube, Jacobian (1 - v)(1 - w)^2; positive weights.
+std::vector<QuadraturePoint> collapsed_tetrahedron_rule(int degree) {
+  const std::vector<QuadraturePoint> line = gauss_legendre(degree / 2 + 2);
+  std::vector<QuadraturePoint> rule;
+  for (const QuadraturePoint& along_u : line) {
+    for (const QuadraturePoint& along_v : line) {
+      for (const QuadraturePoint& along_w : line) {
+        const double u = 0.5 * (along_u.reference.x() + 1.0);
+        const double v = 0.5 * (along_v.reference.x() + 1.0);
+        const double w = 0.5 * (along_w.reference.x() + 1.0);
+        const double weight = 0.125 * along_u.weight * along_v.weight * along_w.weight *
+                              (1.0 - v) * (1.0 - w) * (1.0 - w);
+        rule.push_back({Eigen::Vector3d(u * (1.0 - v) * (1.0 - w), v * (1.0 - w), w), weight});
+      }
+    }
+  }
+  return rule;
+}
+
+/// The centroid rule (degree 1), the symmetric 4-point rule (degree 2), the collapsed rule
+/// above; the weights sum to the reference volume 1/6.
+std::vector<QuadraturePoint> tetrahedron_quadrature(int degree) {
+  if (degree <= 1) return {{Eigen::Vector3d(0.25, 0.25, 0.25), 1.0 / 6.0}};
+  if (degree == 2) {
+    // Orbit of (a, a, a, b) in barycentric coordinates, a = (5 - sqrt 5) / 20, b = 1 - 3a.
+    const double a = (5.0 - std::sqrt(5.0)) / 20.0;
+    const double b = 1.0 - 3.0 * a;
+    return {{Eigen::Vector3d(a, a, a), 1.0 / 24.0},
+            {Eigen::Vector3d(b, a, a), 1.0 / 24.0},
+            {Eigen::Vector3d(a, b, a), 1.0 / 24.0},
+            {Eigen::Vector3d(a, a, b), 1.0 / 24.0}};
+  }
+  return collapsed_tetrahedron_rule(degree);
+}
+
+std::vector<QuadraturePoint> hexahedron_quadrature(int degree) {
+  const std::vector<QuadraturePoint> line = gauss_legendre(degree / 2 + 1);
+  std::vector<QuadraturePoint> rule;
+  for (const QuadraturePoint& along_zeta : line) {
+    for (const QuadraturePoint& along_eta : line) {
+      for (const QuadraturePoint& along_xi : line) {
+        rule.push_back({Eigen::Vector3d(along_xi.reference.x(), along_eta.reference.x(),
+                                        along_zeta.reference.x()),
+                        along_xi.weight * along_eta.weight * along_zeta.weight});
+      }
     }
   }
   return rule;
@@ -115,12 +167,55 @@ void check_degree(int degree) {
   if (degree < 0) throw std::invalid_argument("quadrature degree must be >= 0");
 }
 
+/// The local corners of the six edges of a tetrahedron10, in the order of its midside nodes 4..9
+/// (Gmsh: 01, 12, 20, 30, 32, 31).
+constexpr int tetrahedron_edges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};
+
+/// Quadratic tetrahedron: barycentric L0 = 1 - r - s - t, L1 = r, L2 = s, L3 = t; corners
+/// L_i (2 L_i - 1), the midside node of edge ij 4 L_i L_j.
+void quadratic_tetrahedron_functions(const Eigen::Vector3d& reference, Eigen::VectorXd& values,
+                                     Eigen::MatrixXd& reference_gradients) {
+  const Eigen::Vector4d barycentric(1.0 - reference.sum(), reference.x(), reference.y(),
+                                    reference.z());
+  Eigen::Matrix<double, 4, 3> barycentric_gradients;
+  barycentric_gradients << -1.0, -1.0, -1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0;
+  values.resize(10);
+  reference_gradients.resize(10, 3);
+  for (int i = 0; i < 4; ++i) {
+    values(i) = barycentric(i) * (2.0 * barycentric(i) - 1.0);
+    reference_gradients.row(i) = (4.0 * barycentric(i) - 1.0) * barycentric_gradients.row(i);
+  }
+  for (int edge = 0; edge < 6; ++edge) {
+    const int a = tetrahedron_edges[edge][0];
+    const int b = tetrahedron_edges[edge][1];
+    values(4 + edge) = 4.0 * barycentric(a) * barycentric(b);
+    reference_gradients.row(4 + edge) = 4.0 * (barycentric(b) * barycentric_gradients.row(a) +
+                                               barycentric(a) * barycentric_gradients.row(b));
+  }
+}
+
 }  // namespace
 
 std::vector<QuadraturePoint> element_quadrature(ElementType type, int degree) {
   check_degree(degree);
-  if (type == ElementType::quadrilateral4) return quadrilateral_quadrature(degree);
-  return triangle_quadrature(degree);
+  switch (type) {
+    case ElementType::triangle3:
+    case ElementType::triangle6:
+      return triangle_quadrature(degree);
+    case ElementType::quadrilateral4:
+      return quadrilateral_quadrature(degree);
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+      return tetrahedron_quadrature(degree);
+    case ElementType::hexahedron8:
+      return hexahedron_quadrature(degree);
+  }
+  throw std::invalid_argument("element_quadrature: unknown element type");
+}
+
+std::vector<QuadraturePoint> facet_quadrature(FacetType type, int degree) {
+  if (facet_dimension(type) == 1) return edge_quadrature(degree);
+  return element_quadrature(face_parametrization(type), degree);
 }
 
 std::vector<QuadraturePoint> edge_quadrature(int degree) {
@@ -128,10 +223,11 @@ std::vector<QuadraturePoint> edge_quadrature(int degree) {
   return gauss_legendre(degree / 2 + 1);
 }
 
-void shape_functions(ElementType type, const Eigen::Vector2d& reference, Eigen::VectorXd& values,
+void shape_functions(ElementType type, const Eigen::Vector3d& reference, Eigen::VectorXd& values,
                      Eigen::MatrixXd& reference_gradients) {
   const double r = reference.x();
   const double s = reference.y();
+  const double t = reference.z();
   switch (type) {
     case ElementType::triangle3:
       values.resize(3);
@@ -159,7 +255,7 @@ void shape_functions(ElementType type, const Eigen::Vector2d& reference, Eigen::
       // N_i = (1 + xi_i xi)(1 + eta_i eta) / 4 with corners (-1,-1), (1,-1), (1,1), (-1,1).
       values.resize(4);
       reference_gradients.resize(4, 2);
-      const std::vector<Eigen::Vector2d> corners = reference_nodes(type);
+      const std::vector<Eigen::Vector3d> corners = reference_nodes(type);
       for (int i = 0; i < 4; ++i) {
         const double along_xi = 1.0 + corners[i].x() * r;
         const double along_eta = 1.0 + corners[i].y() * s;
@@ -170,9 +266,30 @@ void shape_functions(ElementType type, const Eigen::Vector2d& reference, Eigen::
       return;
     }
     case ElementType::tetrahedron4:
+      values.resize(4);
+      reference_gradients.resize(4, 3);
+      values << 1.0 - r - s - t, r, s, t;
+      reference_gradients << -1.0, -1.0, -1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0;
+      return;
     case ElementType::tetrahedron10:
-    case ElementType::hexahedron8:
-      break;
+      quadratic_tetrahedron_functions(reference, values, reference_gradients);
+      return;
+    case ElementType::hexahedron8: {
+      // N_i = (1 + xi_i xi)(1 + eta_i eta)(1 + zeta_i zeta) / 8 at the corners of [-1, 1]^3.
+      values.resize(8);
+      reference_gradients.resize(8, 3);
+      const std::vector<Eigen::Vector3d> corners = reference_nodes(type);
+      for (int i = 0; i < 8; ++i) {
+        const double along_xi = 1.0 + corners[i].x() * r;
+        const double along_eta = 1.0 + corners[i].y() * s;
+        const double along_zeta = 1.0 + corners[i].z() * t;
+        values(i) = 0.125 * along_xi * along_eta * along_zeta;
+        reference_gradients(i, 0) = 0.125 * corners[i].x() * along_eta * along_zeta;
+        reference_gradients(i, 1) = 0.125 * corners[i].y() * along_xi * along_zeta;
+        reference_gradients(i, 2) = 0.125 * corners[i].z() * along_xi * along_eta;
+      }
+      return;
+    }
   }
   throw std::invalid_argument("shape_functions: unknown element type");
 }
@@ -194,25 +311,76 @@ void edge_shape_functions(FacetType type, double reference, Eigen::VectorXd& val
   reference_derivatives << t - 0.5, t + 0.5, -2.0 * t;
 }
 
-std::vector<Eigen::Vector2d> reference_nodes(ElementType type) {
+std::vector<Eigen::Vector3d> reference_nodes(ElementType type) {
   switch (type) {
     case ElementType::triangle3:
-      return {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
+      return {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
     case ElementType::triangle6:
-      return {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {0.5, 0.0}, {0.5, 0.5}, {0.0, 0.5}};
+      return {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0},
+              {0.5, 0.0, 0.0}, {0.5, 0.5, 0.0}, {0.0, 0.5, 0.0}};
     case ElementType::quadrilateral4:
-      return {{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}};
+      return {{-1.0, -1.0, 0.0}, {1.0, -1.0, 0.0}, {1.0, 1.0, 0.0}, {-1.0, 1.0, 0.0}};
     case ElementType::tetrahedron4:
-    case ElementType::tetrahedron10:
+      return {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    case ElementType::tetrahedron10: {
+      std::vector<Eigen::Vector3d> nodes = reference_nodes(ElementType::tetrahedron4);
+      for (const auto& [a, b] : tetrahedron_edges) nodes.push_back(0.5 * (nodes[a] + nodes[b]));
+      return nodes;
+    }
     case ElementType::hexahedron8:
-      break;
+      return {{-1.0, -1.0, -1.0}, {1.0, -1.0, -1.0}, {1.0, 1.0, -1.0}, {-1.0, 1.0, -1.0},
+              {-1.0, -1.0, 1.0},  {1.0, -1.0, 1.0},  {1.0, 1.0, 1.0},  {-1.0, 1.0, 1.0}};
   }
   throw std::invalid_argument("reference_nodes: unknown element type");
 }
 
-Eigen::Vector2d reference_centroid(ElementType type) {
-  if (type == ElementType::quadrilateral4) return Eigen::Vector2d::Zero();
-  return Eigen::Vector2d(1.0 / 3.0, 1.0 / 3.0);
+Eigen::Vector3d reference_centroid(ElementType type) {
+  switch (type) {
+    case ElementType::triangle3:
+    case ElementType::triangle6:
+      return Eigen::Vector3d(1.0 / 3.0, 1.0 / 3.0, 0.0);
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+      return Eigen::Vector3d(0.25, 0.25, 0.25);
+    case ElementType::quadrilateral4:
+    case ElementType::hexahedron8:
+      return Eigen::Vector3d::Zero();
+  }
+  throw std::invalid_argument("reference_centroid: unknown element type");
+}
+
+void facet_shape_functions(FacetType type, const Eigen::Vector3d& reference,
+                           Eigen::VectorXd& values, Eigen::MatrixXd& reference_gradients) {
+  if (facet_dimension(type) == 2) {
+    shape_functions(face_parametrization(type), reference, values, reference_gradients);
+    return;
+  }
+  Eigen::VectorXd derivatives;
+  edge_shape_functions(type, reference.x(), values, derivatives);
+  reference_gradients = derivatives;
+}
+
+std::vector<Eigen::Vector3d> facet_reference_nodes(FacetType type) {
+  if (facet_dimension(type) == 2) return reference_nodes(face_parametrization(type));
+  std::vector<Eigen::Vector3d> nodes;
+  for (const double t : edge_reference_nodes(type)) nodes.emplace_back(t, 0.0, 0.0);
+  return nodes;
+}
+
+std::vector<std::vector<int>> element_facet_corners(ElementType type) {
+  switch (type) {
+    case ElementType::triangle3:
+    case ElementType::triangle6:
+      return {{0, 1}, {1, 2}, {2, 0}};
+    case ElementType::quadrilateral4:
+      return {{0, 1}, {1, 2}, {2, 3}, {3, 0}};
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+      return {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    case ElementType::hexahedron8:
+      return {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+  }
+  throw std::invalid_argument("element_facet_corners: unknown element type");
 }
 
 std::vector<double> edge_reference_nodes(FacetType type) {
@@ -237,28 +405,43 @@ std::string describe_element(const Mesh& mesh, ElementType type, const int* node
 ElementGeometry::ElementGeometry(const Mesh& mesh, std::size_t block, std::size_t element)
     : mesh_(&mesh), type_(mesh.blocks[block].type) {
   const int count = nodes_per_element(type_);
+  const int dimension = element_dimension(type_);
   nodes_ = &mesh.blocks[block].connectivity[element * count];
-  coordinates_.resize(count, 2);
-  for (int i = 0; i < count; ++i) coordinates_.row(i) = mesh.nodes[nodes_[i]].transpose();
+  coordinates_.resize(count, dimension);
+  for (int i = 0; i < count; ++i) {
+    coordinates_.row(i) = mesh.nodes[nodes_[i]].head(dimension).transpose();
+  }
 }
 
-ElementPoint ElementGeometry::evaluate(const Eigen::Vector2d& reference) const {
+ElementPoint ElementGeometry::evaluate(const Eigen::Vector3d& reference) const {
   ElementPoint point;
   Eigen::MatrixXd reference_gradients;
   shape_functions(type_, reference, point.values, reference_gradients);
-  // J_ij = dx_i / dxi_j = sum_k x_k,i dN_k / dxi_j
-  const Eigen::Matrix2d jacobian = coordinates_.transpose() * reference_gradients;
-  point.jacobian = jacobian.determinant();
+  // J_ij = dx_i / dxi_j = sum_k x_k,i dN_k / dxi_j; fixed-size 2 x 2 or 3 x 3 (closed-form
+  // determinant and inverse).
+  const Eigen::MatrixXd jacobian = coordinates_.transpose() * reference_gradients;
+  Eigen::MatrixXd inverse;
+  if (jacobian.rows() == 2) {
+    const Eigen::Matrix2d fixed = jacobian;
+    point.jacobian = fixed.determinant();
+    inverse = fixed.inverse();
+  } else {
+    const Eigen::Matrix3d fixed = jacobian;
+    point.jacobian = fixed.determinant();
+    inverse = fixed.inverse();
+  }
   if (!(point.jacobian > 0.0)) {
     std::ostringstream text;
     text << describe_element(*mesh_, type_, nodes_) << " has a non-positive Jacobian "
-         << point.jacobian << " at reference point (" << reference.x() << ", " << reference.y()
-         << "): the element is degenerate or tangled; fix the mesh";
+         << point.jacobian << " at reference point (" << reference.x() << ", " << reference.y();
+    if (jacobian.rows() == 3) text << ", " << reference.z();
+    text << "): the element is degenerate or tangled; fix the mesh";
     throw InputError(text.str());
   }
   // dN/dx = dN/dxi J^-1
-  point.gradients = reference_gradients * jacobian.inverse();
-  point.position = coordinates_.transpose() * point.values;
+  point.gradients = reference_gradients * inverse;
+  point.position.setZero();
+  point.position.head(jacobian.rows()) = coordinates_.transpose() * point.values;
   return point;
 }
 
@@ -273,74 +456,138 @@ NodeElementMap::NodeElementMap(const Mesh& mesh) : mesh_(&mesh), elements_(mesh.
   }
 }
 
-std::optional<NodeElementMap::ElementIndex> NodeElementMap::element_with(int first_node,
-                                                                         int second_node) const {
-  for (const ElementIndex& candidate : elements_[first_node]) {
+std::optional<NodeElementMap::ElementIndex> NodeElementMap::element_with(
+    const std::vector<int>& nodes) const {
+  if (nodes.empty()) return std::nullopt;
+  for (const ElementIndex& candidate : elements_[nodes.front()]) {
     const ElementBlock& block = mesh_->blocks[candidate.first];
     const int count = nodes_per_element(block.type);
     const auto begin = block.connectivity.begin() + candidate.second * count;
-    if (std::find(begin, begin + count, second_node) != begin + count) return candidate;
+    const auto contains = [&](int node) { return std::find(begin, begin + count, node) != begin + count; };
+    if (std::all_of(nodes.begin() + 1, nodes.end(), contains)) return candidate;
   }
   return std::nullopt;
 }
 
-EdgeGeometry::EdgeGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t edge)
+namespace {
+
+/// The corner count of a facet (its linear shape): 2 for edges, 3 for triangles, 4 for
+/// quadrilaterals.
+int facet_corner_count(FacetType type) {
+  switch (type) {
+    case FacetType::line2:
+    case FacetType::line3:
+      return 2;
+    case FacetType::triangle3:
+    case FacetType::triangle6:
+      return 3;
+    case FacetType::quadrilateral4:
+      return 4;
+  }
+  throw std::invalid_argument("facet_corner_count: unknown facet type");
+}
+
+/// The facet's own (not yet oriented) normal direction and measure element from the columns of
+/// dx/dxi: an edge's tangent turned clockwise, a face's dx/dr x dx/ds.
+Eigen::Vector3d facet_normal_direction(const Eigen::MatrixXd& derivatives) {
+  if (derivatives.cols() == 1) {
+    return Eigen::Vector3d(derivatives(1, 0), -derivatives(0, 0), 0.0);
+  }
+  return Eigen::Vector3d(derivatives.col(0)).cross(Eigen::Vector3d(derivatives.col(1)));
+}
+
+/// The reference coordinates of a facet's centre.
+Eigen::Vector3d facet_centre(FacetType type) {
+  if (facet_dimension(type) == 1) return Eigen::Vector3d::Zero();
+  return reference_centroid(face_parametrization(type));
+}
+
+std::string facet_label(const Mesh& mesh, const BoundaryGroup& group, std::size_t facet) {
+  const int count = nodes_per_facet(group.type);
+  std::string tags;
+  for (int i = 0; i < facet_corner_count(group.type); ++i) {
+    tags += (i == 0 ? "" : ", ") +
+            std::to_string(mesh.node_tags[group.connectivity[facet * count + i]]);
+  }
+  return "boundary " + mesh.boundary_label(group) + ": the " +
+         (facet_dimension(group.type) == 1 ? "edge" : "face") + " with corner node tags (" + tags +
+         ")";
+}
+
+}  // namespace
+
+FacetGeometry::FacetGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t facet)
     : type_(group.type) {
   const int count = nodes_per_facet(type_);
-  coordinates_.resize(count, 2);
+  coordinates_.resize(count, 3);
   for (int i = 0; i < count; ++i) {
-    coordinates_.row(i) = mesh.nodes[group.connectivity[edge * count + i]].transpose();
+    coordinates_.row(i) = mesh.nodes[group.connectivity[facet * count + i]].transpose();
   }
-  if (coordinates_.row(0) == coordinates_.row(1)) {
-    throw InputError("boundary " + mesh.boundary_label(group) + ": an edge at node tag " +
-                     std::to_string(mesh.node_tags[group.connectivity[edge * count]]) +
-                     " has zero length; fix the mesh");
+  const double extent =
+      (coordinates_.colwise().maxCoeff() - coordinates_.colwise().minCoeff()).norm();
+  const double scale = facet_dimension(type_) == 1 ? extent : extent * extent;
+  if (!(evaluate(facet_centre(type_)).measure_element > 1e-14 * scale)) {
+    throw InputError(facet_label(mesh, group, facet) +
+                     (facet_dimension(type_) == 1 ? " has zero length" : " has zero area") +
+                     "; fix the mesh");
   }
 }
 
-EdgeGeometry::EdgeGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t edge,
-                           const NodeElementMap& adjacency)
-    : EdgeGeometry(mesh, group, edge) {
+FacetGeometry::FacetGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t facet,
+                             const NodeElementMap& adjacency)
+    : FacetGeometry(mesh, group, facet) {
   const int count = nodes_per_facet(type_);
-  const int first = group.connectivity[edge * count];
-  const int second = group.connectivity[edge * count + 1];
-  const std::optional<NodeElementMap::ElementIndex> element = adjacency.element_with(first, second);
-  if (!element) {
-    throw InputError("boundary " + mesh.boundary_label(group) + ": the edge from node tag " +
-                     std::to_string(mesh.node_tags[first]) + " to node tag " +
-                     std::to_string(mesh.node_tags[second]) +
-                     " is not a side of any area element, so it has no outward normal");
+  std::vector<int> corners;
+  for (int i = 0; i < facet_corner_count(type_); ++i) {
+    corners.push_back(group.connectivity[facet * count + i]);
   }
-  // Outward: the chord's clockwise-turned tangent points away from the element's centroid.
+  const std::optional<NodeElementMap::ElementIndex> element = adjacency.element_with(corners);
+  if (!element) {
+    throw InputError(facet_label(mesh, group, facet) + " is not a side of any " +
+                     (facet_dimension(type_) == 1 ? "area" : "volume") +
+                     " element, so it has no outward normal");
+  }
+  // Outward: the facet's own normal at its centre points away from the element's centroid.
   const ElementBlock& block = mesh.blocks[element->first];
-  const int corner_count = block.type == ElementType::quadrilateral4 ? 4 : 3;
   const int* nodes = &block.connectivity[element->second * nodes_per_element(block.type)];
-  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
-  for (int i = 0; i < corner_count; ++i) centroid += mesh.nodes[nodes[i]] / corner_count;
-  const Eigen::Vector2d chord = mesh.nodes[second] - mesh.nodes[first];
-  const Eigen::Vector2d middle = 0.5 * (mesh.nodes[first] + mesh.nodes[second]);
-  orientation_ = Eigen::Vector2d(chord.y(), -chord.x()).dot(middle - centroid) >= 0.0 ? 1.0 : -1.0;
+  const std::vector<Eigen::Vector3d> element_corners = reference_nodes(block.type);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  int corner_count = 0;
+  for (std::size_t i = 0; i < element_corners.size(); ++i) {
+    // Corner nodes come first in every supported element; midside nodes are skipped.
+    if (block.type == ElementType::triangle6 && i >= 3) break;
+    if (block.type == ElementType::tetrahedron10 && i >= 4) break;
+    centroid += mesh.nodes[nodes[i]];
+    ++corner_count;
+  }
+  centroid /= corner_count;
+  Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+  for (const int corner : corners) middle += mesh.nodes[corner] / static_cast<double>(corners.size());
+  orientation_ = 1.0;
+  const FacetPoint at_centre = evaluate(facet_centre(type_));
+  orientation_ = at_centre.outward_normal.dot(middle - centroid) >= 0.0 ? 1.0 : -1.0;
 }
 
-EdgePoint EdgeGeometry::evaluate(double reference) const {
-  EdgePoint point;
-  Eigen::VectorXd derivatives;
-  edge_shape_functions(type_, reference, point.values, derivatives);
+FacetPoint FacetGeometry::evaluate(const Eigen::Vector3d& reference) const {
+  FacetPoint point;
+  Eigen::MatrixXd reference_gradients;
+  facet_shape_functions(type_, reference, point.values, reference_gradients);
   point.position = coordinates_.transpose() * point.values;
-  // t = dx/dt; outward normal = orientation (t_y, -t_x) / |t|
-  const Eigen::Vector2d tangent = coordinates_.transpose() * derivatives;
-  point.length_element = tangent.norm();
-  point.outward_normal =
-      orientation_ * Eigen::Vector2d(tangent.y(), -tangent.x()) / point.length_element;
+  // dx/dxi (3 x facet dimension); the normal is orientation (t_y, -t_x, 0) / |t| for an edge,
+  // orientation (x_r x x_s) / |x_r x x_s| for a face.
+  const Eigen::MatrixXd derivatives = coordinates_.transpose() * reference_gradients;
+  const Eigen::Vector3d direction = facet_normal_direction(derivatives);
+  point.measure_element = direction.norm();
+  point.outward_normal = orientation_ * direction / point.measure_element;
   return point;
 }
 
-double EdgeGeometry::length() const {
-  double length = 0.0;
-  for (const QuadraturePoint& point : edge_quadrature(6)) {
-    length += evaluate(point.reference.x()).length_element * point.weight;
+double FacetGeometry::measure() const {
+  double measure = 0.0;
+  for (const QuadraturePoint& point : facet_quadrature(type_, 6)) {
+    measure += evaluate(point.reference).measure_element * point.weight;
   }
-  return length;
+  return measure;
 }
 
 }  // namespace robin

@@ -1,5 +1,6 @@
 #pragma once
-// Isoparametric shape functions and Gauss rules for the supported elements.
+// Isoparametric shape functions and Gauss rules of the supported elements (areas and volumes)
+// and facets (edges and faces).
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -12,43 +13,63 @@
 namespace robin {
 
 struct QuadraturePoint {
-  Eigen::Vector2d reference;  // point in the reference element
-  double weight;              // weight on the reference element
+  /// Point in the reference element (unused trailing coordinates zero: one for edges, two or
+  /// three for faces and elements).
+  Eigen::Vector3d reference;
+  double weight;  // weight on the reference element
 };
 
 /// Gauss rule exact for polynomials of degree `degree` on the reference element
-/// (triangle: (0,0),(1,0),(0,1); quadrilateral: [-1,1]^2).
+/// (triangle: (0,0),(1,0),(0,1); quadrilateral: [-1,1]^2; tetrahedron: (0,0,0),(1,0,0),(0,1,0),
+/// (0,0,1); hexahedron: [-1,1]^3).
 std::vector<QuadraturePoint> element_quadrature(ElementType type, int degree);
 
-/// Shape function values N (n) and reference derivatives dN (n x 2) at `reference`.
-void shape_functions(ElementType type, const Eigen::Vector2d& reference, Eigen::VectorXd& values,
+/// Shape function values N (n) and reference derivatives dN (n x d, d = element_dimension) at
+/// `reference`.
+void shape_functions(ElementType type, const Eigen::Vector3d& reference, Eigen::VectorXd& values,
                      Eigen::MatrixXd& reference_gradients);
 
-/// 1D Gauss rule on [-1, 1] exact to `degree` (the point is reference.x(), reference.y() = 0)
+/// 1D Gauss rule on [-1, 1] exact to `degree` (the point is reference.x(), the rest zero)
 /// and edge shape functions in Gmsh order.
 std::vector<QuadraturePoint> edge_quadrature(int degree);
 void edge_shape_functions(FacetType type, double reference, Eigen::VectorXd& values,
                           Eigen::VectorXd& reference_derivatives);
 
+/// Rule exact to `degree` on a facet's reference element: [-1, 1] for an edge, the face's
+/// parametrization (face_parametrization) for a face.
+std::vector<QuadraturePoint> facet_quadrature(FacetType type, int degree);
+
+/// Facet shape functions N (n) and reference derivatives (n x facet_dimension) at `reference`.
+void facet_shape_functions(FacetType type, const Eigen::Vector3d& reference,
+                           Eigen::VectorXd& values, Eigen::MatrixXd& reference_gradients);
+
 /// Reference coordinates of the nodes of an element of `type`, in node order.
-std::vector<Eigen::Vector2d> reference_nodes(ElementType type);
+std::vector<Eigen::Vector3d> reference_nodes(ElementType type);
 
 /// Reference coordinates of the centroid of the reference element.
-Eigen::Vector2d reference_centroid(ElementType type);
+Eigen::Vector3d reference_centroid(ElementType type);
+
+/// Reference coordinates of the nodes of a facet of `type`, in node order ([-1, 1] for edges).
+std::vector<Eigen::Vector3d> facet_reference_nodes(FacetType type);
 
 /// Reference coordinate in [-1, 1] of each node of an edge of `type`, in node order.
 std::vector<double> edge_reference_nodes(FacetType type);
 
-/// Shape functions of an element at one point, with physical gradients dN/dx (n x 2),
-/// the mapped position x and the Jacobian determinant det(dx/dxi).
+/// The local node numbers of the corners of each facet of the reference element (Gmsh's side
+/// numbering; corners only): the edges of an area element, the faces of a volume element,
+/// each ordered so that its right-hand normal points out of the element.
+std::vector<std::vector<int>> element_facet_corners(ElementType type);
+
+/// Shape functions of an element at one point, with physical gradients dN/dx (n x d, d the
+/// element's dimension), the mapped position x and the Jacobian determinant det(dx/dxi).
 struct ElementPoint {
   Eigen::VectorXd values;
   Eigen::MatrixXd gradients;
-  Eigen::Vector2d position;
+  Eigen::Vector3d position;
   double jacobian = 0.0;
 };
 
-/// Isoparametric map of one area element of a mesh (which must outlive it).
+/// Isoparametric map of one element of a mesh (which must outlive it).
 class ElementGeometry {
  public:
   ElementGeometry(const Mesh& mesh, std::size_t block, std::size_t element);
@@ -57,54 +78,56 @@ class ElementGeometry {
   /// Mesh index of local node `local`.
   int node(int local) const { return nodes_[local]; }
   /// Throws InputError naming the element when det(dx/dxi) <= 0 at `reference`.
-  ElementPoint evaluate(const Eigen::Vector2d& reference) const;
+  ElementPoint evaluate(const Eigen::Vector3d& reference) const;
 
  private:
   const Mesh* mesh_;
   ElementType type_;
   const int* nodes_;
-  Eigen::MatrixX2d coordinates_;  // n x 2 node coordinates
+  Eigen::MatrixXd coordinates_;  // n x d node coordinates
 };
 
-/// The area elements (block, element) that contain each node.
+/// The elements (block, element) that contain each node.
 class NodeElementMap {
  public:
   using ElementIndex = std::pair<std::size_t, std::size_t>;
   explicit NodeElementMap(const Mesh& mesh);
   const std::vector<ElementIndex>& elements_of(int node) const { return elements_[node]; }
-  /// The first area element that contains both nodes, if any.
-  std::optional<ElementIndex> element_with(int first_node, int second_node) const;
+  /// The first element that contains every one of `nodes`, if any.
+  std::optional<ElementIndex> element_with(const std::vector<int>& nodes) const;
 
  private:
   const Mesh* mesh_;
   std::vector<std::vector<ElementIndex>> elements_;
 };
 
-/// Edge shape functions at one point, the mapped position, the unit normal and the
-/// length element |dx/dt|.
-struct EdgePoint {
+/// Facet shape functions at one point, the mapped position, the unit outward normal and the
+/// measure element (|dx/dt| for an edge, |dx/dr x dx/ds| for a face).
+struct FacetPoint {
   Eigen::VectorXd values;
-  Eigen::Vector2d position;
-  Eigen::Vector2d outward_normal;
-  double length_element = 0.0;
+  Eigen::Vector3d position;
+  Eigen::Vector3d outward_normal;
+  double measure_element = 0.0;
 };
 
-/// Isoparametric map of one boundary edge. With a NodeElementMap the normal points out of
-/// the area element that contains the edge's end nodes (InputError when there is none);
-/// without, the normal is the tangent turned clockwise, (t_y, -t_x) / |t|.
-class EdgeGeometry {
+/// Isoparametric map of one facet of a boundary group. With a NodeElementMap the normal points
+/// out of the element that contains the facet's corner nodes (InputError when there is none);
+/// without, it is the facet's own orientation: for an edge the tangent turned clockwise,
+/// (t_y, -t_x) / |t| (the body on the left), for a face the right-hand normal
+/// dx/dr x dx/ds / |dx/dr x dx/ds|.
+class FacetGeometry {
  public:
-  EdgeGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t edge);
-  EdgeGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t edge,
-               const NodeElementMap& adjacency);
-  EdgePoint evaluate(double reference) const;
-  /// Length of the (possibly curved) edge.
-  double length() const;
+  FacetGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t facet);
+  FacetGeometry(const Mesh& mesh, const BoundaryGroup& group, std::size_t facet,
+                const NodeElementMap& adjacency);
+  FacetPoint evaluate(const Eigen::Vector3d& reference) const;
+  /// Length of an edge or area of a face (possibly curved).
+  double measure() const;
 
  private:
   FacetType type_;
-  Eigen::MatrixX2d coordinates_;
-  double orientation_ = 1.0;  // +1 or -1: flips the clockwise-turned tangent outward
+  Eigen::MatrixX3d coordinates_;  // n x 3
+  double orientation_ = 1.0;      // +1 or -1: flips the facet's own normal outward
 };
 
 }  // namespace robin

@@ -28,33 +28,38 @@ std::string format_number(double value) {
   return text.str();
 }
 
-/// "(u_x, u_y, rotation) ~ (a, b, c)" for the rigid motion `motion` (free dofs): its
-/// least-squares coefficients on (1, 0), (0, 1), (-(y - yc), x - xc), scaled so that the
-/// largest in magnitude is 1.
+/// "(u_x, u_y, rotation) ~ (a, b, c)" (3D: u_x, u_y, u_z, rotation x, y, z) for the rigid motion
+/// `motion` (free dofs): its least-squares coefficients on the rigid modes about the centre
+/// (dof_map.hpp, rigid_mode_row), scaled so that the largest in magnitude is 1.
 std::string describe_rigid_motion(const Mesh& mesh, const DofMap& dofs,
                                   const Eigen::VectorXd& motion) {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& node : mesh.nodes) centre += node;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& node : mesh.nodes) centre += node;
   centre /= static_cast<double>(mesh.node_count());
-  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d projection = Eigen::Vector3d::Zero();
+  const int count = rigid_mode_count(mesh.dimension);
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(count, count);
+  Eigen::VectorXd projection = Eigen::VectorXd::Zero(count);
   for (int dof = 0; dof < dofs.total_count(); ++dof) {
     if (dofs.is_prescribed(dof)) continue;
-    const Eigen::Vector2d relative = mesh.nodes[dof / 2] - centre;
-    const Eigen::Vector3d row = dof % 2 == 0 ? Eigen::Vector3d(1.0, 0.0, -relative.y())
-                                             : Eigen::Vector3d(0.0, 1.0, relative.x());
+    const Eigen::VectorXd row = rigid_mode_row(mesh, dof, centre);
     normal += row * row.transpose();
     projection += row * motion[dofs.free_index(dof)];
   }
-  Eigen::Vector3d coefficients = normal.ldlt().solve(projection);
+  Eigen::VectorXd coefficients = normal.ldlt().solve(projection);
   Eigen::Index largest = 0;
   coefficients.cwiseAbs().maxCoeff(&largest);
   coefficients /= coefficients[largest];  // the largest coefficient 1
   for (double& value : coefficients) {
     if (std::abs(value) < 1e-9) value = 0.0;
   }
-  return "(u_x, u_y, rotation) ~ (" + format_number(coefficients[0]) + ", " +
-         format_number(coefficients[1]) + ", " + format_number(coefficients[2]) + ")";
+  const std::string names = mesh.dimension == 3
+                                ? "(u_x, u_y, u_z, rotation x, rotation y, rotation z)"
+                                : "(u_x, u_y, rotation)";
+  std::string values;
+  for (Eigen::Index k = 0; k < coefficients.size(); ++k) {
+    values += (k == 0 ? "" : ", ") + format_number(coefficients[k]);
+  }
+  return names + " ~ (" + values + ")";
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {

@@ -1,12 +1,16 @@
 #pragma once
 // Reads meshes through the Gmsh C++ API. Supported inputs:
 //  - .msh (format 4.1 and 2.2): read as is;
-//  - .geo: meshed on the fly in 2D. When `size` > 0 the Gmsh variable `h` is set
-//    to it before the script is parsed (like `gmsh -setnumber h SIZE`); a .geo
+//  - .geo: meshed on the fly in its dimension. When `size` > 0 the Gmsh variable `h` is
+//    set to it before the script is parsed (like `gmsh -setnumber h SIZE`); a .geo
 //    declares `DefineConstant[ h = 0.1 ];` to use it.
-// Area elements of every 2D physical group are read (triangles, quadratic
-// triangles, quadrilaterals); every 1D physical group becomes a named boundary.
-// Node coordinates must lie in the z = 0 plane.
+// A model with a volume is a solid body (Mesh::dimension 3): the elements of every 3D physical
+// group are read (4- and 10-node tetrahedra, 8-node hexahedra) and every 2D physical group
+// becomes a named boundary of faces (3- and 6-node triangles, 4-node quadrilaterals). A model
+// without volumes is a plane body (dimension 2): the elements of every 2D physical group
+// (triangles, quadratic triangles, quadrilaterals), every 1D physical group a named boundary of
+// lines, and every node in the z = 0 plane. Elements are oriented positively (counter-clockwise
+// in 2D, a positive Jacobian in 3D).
 
 #include <cstddef>
 #include <filesystem>
@@ -25,7 +29,8 @@ struct MeshReadOptions {
 };
 
 /// Reads `path`. Throws InputError naming the file on any problem (missing file,
-/// parse error, no 2D elements, unsupported element type, no physical groups).
+/// parse error, no elements of the body's dimension, unsupported element type, no physical
+/// groups).
 Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
 /// One mesh file to read, with its .geo options.

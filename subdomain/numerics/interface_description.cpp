@@ -26,21 +26,21 @@ const ContactSurfaceDescription& surface_named(const InterfaceDescription& inter
 
 void fill_surface_nodes(const InterfaceDescription& interface, ContactSurfaceDescription& surface) {
   const std::size_t count = interface.node_ids.size();
-  for (const int position : surface.segments) {
+  for (const int position : surface.facets) {
     if (position < 0 || static_cast<std::size_t>(position) >= count) {
-      throw InputError("contact boundary '" + surface.boundary + "': a segment names position " +
+      throw InputError("contact boundary '" + surface.boundary + "': a facet names position " +
                        std::to_string(position) + ", beyond the " + std::to_string(count) +
                        " nodes");
     }
   }
-  surface.positions = surface.segments;
+  surface.positions = surface.facets;
   std::sort(surface.positions.begin(), surface.positions.end());
   surface.positions.erase(std::unique(surface.positions.begin(), surface.positions.end()),
                           surface.positions.end());
   std::vector<bool> on_other_surface(count, false);
   for (const ContactSurfaceDescription& other : interface.surfaces) {
     if (other.boundary == surface.boundary) continue;
-    for (const int position : other.segments) {
+    for (const int position : other.facets) {
       if (position >= 0 && static_cast<std::size_t>(position) < count) {
         on_other_surface[static_cast<std::size_t>(position)] = true;
       }
@@ -57,16 +57,17 @@ void fill_surface_nodes(const InterfaceDescription& interface, ContactSurfaceDes
     surface.weights.push_back(interface.weights[static_cast<std::size_t>(position)]);
   }
   if (shared.empty()) return;
-  // The shared nodes from this surface's segments alone: a mesh of the description's nodes
-  // (positions as node indices) with the surface as its one boundary, body on the left.
+  // The shared nodes from this surface's facets alone: a mesh of the description's nodes
+  // (positions as node indices) with the surface as its one boundary, facets oriented outward.
   Mesh mesh;
+  mesh.dimension = interface.dimension;
   mesh.nodes = interface.coordinates;
   mesh.node_tags = interface.node_tags;
   BoundaryGroup& group = mesh.boundaries[surface.boundary];
-  group.type = surface.segment_type;
-  group.connectivity = surface.segments;
+  group.type = surface.facet_type;
+  group.connectivity = surface.facets;
   const Eigen::VectorXd weights = boundary_weights(mesh, group);
-  const std::vector<Eigen::Vector2d> normals =
+  const std::vector<Eigen::Vector3d> normals =
       unit_normals(mesh, boundary_normal_sums(mesh, group, true), shared,
                    "boundary " + mesh.boundary_label(group));
   for (std::size_t k = 0; k < shared.size(); ++k) {
@@ -87,23 +88,23 @@ InterfaceDescription restrict_to_boundary(const InterfaceDescription& interface,
     fill_surface_nodes(interface, surface);
   }
   InterfaceDescription restricted;
+  restricted.dimension = interface.dimension;
   restricted.dof_count = interface.dof_count;
   for (const int position : surface.positions) {
     const auto p = static_cast<std::size_t>(position);
     restricted.node_ids.push_back(interface.node_ids[p]);
     restricted.node_tags.push_back(interface.node_tags[p]);
     restricted.coordinates.push_back(interface.coordinates[p]);
-    restricted.x_fixed.push_back(interface.x_fixed[p]);
-    restricted.y_fixed.push_back(interface.y_fixed[p]);
+    restricted.fixed.push_back(interface.fixed[p]);
   }
   restricted.normals = surface.normals;
   restricted.weights = surface.weights;
   ContactSurfaceDescription own;
   own.boundary = surface.boundary;
-  own.segment_type = surface.segment_type;
-  own.segments.reserve(surface.segments.size());
-  for (const int position : surface.segments) {
-    own.segments.push_back(static_cast<int>(
+  own.facet_type = surface.facet_type;
+  own.facets.reserve(surface.facets.size());
+  for (const int position : surface.facets) {
+    own.facets.push_back(static_cast<int>(
         std::lower_bound(surface.positions.begin(), surface.positions.end(), position) -
         surface.positions.begin()));
   }

@@ -43,6 +43,7 @@ Material make_isotropic_material(double young, double poisson, PlaneModel model,
   check_isotropic_parameters(young, poisson, context);
   Material material;
   material.model = model;
+  material.stiffness.resize(3, 3);
   const double nu = poisson;
   if (model == PlaneModel::plane_strain) {
     // C = E / ((1 + nu)(1 - 2 nu)) [[1 - nu, nu, 0], [nu, 1 - nu, 0], [0, 0, (1 - 2 nu) / 2]]
@@ -60,8 +61,28 @@ Material make_isotropic_material(double young, double poisson, PlaneModel model,
   return material;
 }
 
-Material make_voigt_material(const Eigen::Matrix3d& stiffness, PlaneModel model,
+Material make_isotropic_solid_material(double young, double poisson, const std::string& context) {
+  check_isotropic_parameters(young, poisson, context);
+  const double lambda = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+  const double mu = young / (2.0 * (1.0 + poisson));
+  Material material;
+  material.stiffness = Eigen::MatrixXd::Zero(6, 6);
+  material.stiffness.topLeftCorner(3, 3).setConstant(lambda);
+  for (int i = 0; i < 3; ++i) {
+    material.stiffness(i, i) += 2.0 * mu;
+    material.stiffness(3 + i, 3 + i) = mu;
+  }
+  return material;
+}
+
+Material make_voigt_material(const Eigen::MatrixXd& stiffness, PlaneModel model,
                              const std::string& context) {
+  if (!((stiffness.rows() == 3 && stiffness.cols() == 3) ||
+        (stiffness.rows() == 6 && stiffness.cols() == 6))) {
+    throw InputError(context + ": the Voigt stiffness matrix is " +
+                     std::to_string(stiffness.rows()) + " x " + std::to_string(stiffness.cols()) +
+                     ": give 3 x 3 (plane) or 6 x 6 (solid)");
+  }
   if (!stiffness.allFinite()) {
     throw InputError(context + ": the Voigt stiffness matrix has non-finite entries");
   }
@@ -72,14 +93,15 @@ Material make_voigt_material(const Eigen::Matrix3d& stiffness, PlaneModel model,
                      ": the Voigt stiffness matrix is not symmetric (largest |C_ij - C_ji| = " +
                      format_number(asymmetry) + "): give C_ij = C_ji");
   }
-  const Eigen::Matrix3d symmetric = 0.5 * (stiffness + stiffness.transpose());
-  const Eigen::Vector3d eigenvalues =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(symmetric, Eigen::EigenvaluesOnly)
+  const Eigen::MatrixXd symmetric = 0.5 * (stiffness + stiffness.transpose());
+  const Eigen::VectorXd eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(symmetric, Eigen::EigenvaluesOnly)
           .eigenvalues();
-  if (eigenvalues(0) <= 1e-12 * eigenvalues(2)) {
+  const double largest = eigenvalues(eigenvalues.size() - 1);
+  if (eigenvalues(0) <= 1e-12 * largest) {
     throw InputError(context +
                      ": the Voigt stiffness matrix is not positive definite (smallest eigenvalue " +
-                     format_number(eigenvalues(0)) + ", largest " + format_number(eigenvalues(2)) +
+                     format_number(eigenvalues(0)) + ", largest " + format_number(largest) +
                      "): the material would not be stable");
   }
   Material material;
@@ -89,22 +111,29 @@ Material make_voigt_material(const Eigen::Matrix3d& stiffness, PlaneModel model,
   return material;
 }
 
-double von_mises(const Eigen::Vector3d& stress, double stress_zz) {
-  // sqrt(((s_xx - s_yy)^2 + (s_yy - s_zz)^2 + (s_zz - s_xx)^2) / 2 + 3 s_xy^2)
-  const double xx = stress(0);
-  const double yy = stress(1);
-  const double xy = stress(2);
-  const double deviatoric = (xx - yy) * (xx - yy) + (yy - stress_zz) * (yy - stress_zz) +
-                            (stress_zz - xx) * (stress_zz - xx);
-  return std::sqrt(0.5 * deviatoric + 3.0 * xy * xy);
+StressTensor stress_tensor(const Material& material, const Eigen::VectorXd& voigt_stress) {
+  StressTensor tensor;
+  if (material.voigt_size() == 6) {
+    // Voigt (xx, yy, zz, yz, xz, xy) to (XX, YY, ZZ, XY, YZ, XZ).
+    tensor << voigt_stress(0), voigt_stress(1), voigt_stress(2), voigt_stress(5), voigt_stress(3),
+        voigt_stress(4);
+    return tensor;
+  }
+  const double zz = material.out_of_plane_poisson * (voigt_stress(0) + voigt_stress(1));
+  tensor << voigt_stress(0), voigt_stress(1), zz, voigt_stress(2), 0.0, 0.0;
+  return tensor;
 }
 
-double out_of_plane_stress(const Material& material, const Eigen::Vector3d& stress) {
-  return material.out_of_plane_poisson * (stress(0) + stress(1));
+double von_mises(const StressTensor& stress) {
+  // sqrt(((s_xx - s_yy)^2 + (s_yy - s_zz)^2 + (s_zz - s_xx)^2) / 2 + 3 (s_xy^2 + s_yz^2 + s_xz^2))
+  const double xx = stress(0), yy = stress(1), zz = stress(2);
+  const double deviatoric = (xx - yy) * (xx - yy) + (yy - zz) * (yy - zz) + (zz - xx) * (zz - xx);
+  const double shear = stress(3) * stress(3) + stress(4) * stress(4) + stress(5) * stress(5);
+  return std::sqrt(0.5 * deviatoric + 3.0 * shear);
 }
 
-double von_mises(const Material& material, const Eigen::Vector3d& stress) {
-  return von_mises(stress, out_of_plane_stress(material, stress));
+double von_mises(const Material& material, const Eigen::VectorXd& voigt_stress) {
+  return von_mises(stress_tensor(material, voigt_stress));
 }
 
 }  // namespace robin

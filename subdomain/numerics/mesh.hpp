@@ -66,12 +66,18 @@ struct BoundaryGroup {
 
 struct Mesh {
   std::string source;  // the file the mesh came from, for messages ("" when unknown)
-  std::vector<Eigen::Vector2d> nodes;
+  /// 2: a plane body (area elements, edges as facets, every node at z = 0); 3: a solid body
+  /// (volume elements, faces as facets). Degree of freedom `dimension * node + component`.
+  int dimension = 2;
+  /// Node positions; the z coordinate is zero in two dimensions.
+  std::vector<Eigen::Vector3d> nodes;
   std::vector<std::size_t> node_tags;  // original (Gmsh) tag of each node, for output
   std::vector<ElementBlock> blocks;
   std::map<std::string, BoundaryGroup> boundaries;
 
   std::size_t node_count() const { return nodes.size(); }
+  /// dimension * node_count(): the body's displacement components.
+  int dof_count() const { return dimension * static_cast<int>(nodes.size()); }
   std::size_t element_count() const;
   /// The boundary group called `name`; throws InputError listing the known names.
   const BoundaryGroup& boundary(const std::string& name) const;

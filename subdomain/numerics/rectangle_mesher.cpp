@@ -66,7 +66,7 @@ Mesh make_rectangle_mesh(double x0, double y0, double x1, double y1, int nx, int
   for (int row = 0; row < grid.rows; ++row) {
     for (int column = 0; column < grid.columns; ++column) {
       mesh.nodes.emplace_back(x0 + (x1 - x0) * column / (grid.columns - 1),
-                              y0 + (y1 - y0) * row / (grid.rows - 1));
+                              y0 + (y1 - y0) * row / (grid.rows - 1), 0.0);
       mesh.node_tags.push_back(mesh.nodes.size());
     }
   }

@@ -2,6 +2,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <charconv>
@@ -13,6 +14,8 @@
 #include <stdexcept>
 #include <unordered_map>
 #include <variant>
+
+#include "numerics/finite_element.hpp"
 
 namespace robin {
 namespace {
@@ -172,38 +175,78 @@ DataArray field_array(const OutputField& field, std::size_t count,
           std::move(values)};
 }
 
-/// Key of the undirected edge between two nodes.
-std::uint64_t edge_key(int first, int second) {
-  const auto low = static_cast<std::uint64_t>(std::min(first, second));
-  const auto high = static_cast<std::uint64_t>(std::max(first, second));
-  return (low << 32) | high;
+/// Key of a facet by its corner nodes, whatever their order: the sorted corners, -1 padded.
+using FacetKey = std::array<int, 4>;
+
+FacetKey facet_key(const int* corners, int count) {
+  FacetKey key = {-1, -1, -1, -1};
+  std::copy(corners, corners + count, key.begin());
+  std::sort(key.begin(), key.begin() + count);
+  return key;
 }
 
-/// For every edge of every boundary (name order), the flat index of an area element that has it
-/// as a side (matched by its two end nodes), -1 when none has.
+struct FacetKeyHash {
+  std::size_t operator()(const FacetKey& key) const {
+    std::uint64_t hash = 1469598103934665603ULL;  // FNV-1a over the four corners
+    for (const int corner : key) {
+      hash ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(corner));
+      hash *= 1099511628211ULL;
+    }
+    return static_cast<std::size_t>(hash);
+  }
+};
+
+/// The corner count of a facet type (2 for edges, 3 or 4 for faces).
+int facet_corners(FacetType type) {
+  switch (type) {
+    case FacetType::line2:
+    case FacetType::line3:
+      return 2;
+    case FacetType::triangle3:
+    case FacetType::triangle6:
+      return 3;
+    case FacetType::quadrilateral4:
+      return 4;
+  }
+  return 2;
+}
+
+/// For every facet of every boundary (name order), the flat index of an element that has it as
+/// a side (matched by its corner nodes), -1 when none has.
 std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
-  std::unordered_map<std::uint64_t, std::int64_t> element_of_side;
+  std::unordered_map<FacetKey, std::int64_t, FacetKeyHash> element_of_side;
   std::int64_t flat = 0;
   for (const ElementBlock& block : mesh.blocks) {
     const int nodes = nodes_per_element(block.type);
-    const int corners = block.type == ElementType::quadrilateral4 ? 4 : 3;
+    const std::vector<std::vector<int>> sides = element_facet_corners(block.type);
     for (std::size_t e = 0; e < block.element_count(); ++e, ++flat) {
       const int* element = block.connectivity.data() + e * static_cast<std::size_t>(nodes);
-      for (int a = 0; a < corners; ++a) {
-        element_of_side.emplace(edge_key(element[a], element[(a + 1) % corners]), flat);
+      for (const std::vector<int>& side : sides) {
+        int corners[4];
+        for (std::size_t a = 0; a < side.size(); ++a) corners[a] = element[side[a]];
+        element_of_side.emplace(facet_key(corners, static_cast<int>(side.size())), flat);
       }
     }
   }
   std::vector<std::int64_t> adjacent;
   for (const auto& [name, group] : mesh.boundaries) {
     const auto nodes = static_cast<std::size_t>(nodes_per_facet(group.type));
+    const int corners = facet_corners(group.type);
     for (std::size_t k = 0; k < group.facet_count(); ++k) {
-      const auto found = element_of_side.find(
-          edge_key(group.connectivity[k * nodes], group.connectivity[k * nodes + 1]));
+      const auto found = element_of_side.find(facet_key(&group.connectivity[k * nodes], corners));
       adjacent.push_back(found == element_of_side.end() ? -1 : found->second);
     }
   }
   return adjacent;
+}
+
+/// An element's nodes in VTK's order: Gmsh's, except the quadratic tetrahedron, whose last two
+/// midside nodes (Gmsh: on edges 3-2 and 3-1) VTK numbers the other way (edges 1-3, 2-3).
+std::vector<int> vtk_node_order(const ElementBlock& block) {
+  if (block.type != ElementType::tetrahedron10) return block.connectivity;
+  std::vector<int> nodes = block.connectivity;
+  for (std::size_t k = 0; k + 10 <= nodes.size(); k += 10) std::swap(nodes[k + 8], nodes[k + 9]);
+  return nodes;
 }
 
 /// Points, connectivity, offsets (end of each cell in connectivity) and types: area elements
@@ -211,8 +254,8 @@ std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
 std::vector<DataArray> geometry_arrays(const Mesh& mesh, bool boundary_cells) {
   std::vector<double> points;
   points.reserve(3 * mesh.node_count());
-  for (const Eigen::Vector2d& node : mesh.nodes)
-    points.insert(points.end(), {node.x(), node.y(), 0.0});
+  for (const Eigen::Vector3d& node : mesh.nodes)
+    points.insert(points.end(), {node.x(), node.y(), node.z()});
   std::vector<std::int64_t> connectivity, offsets;
   std::vector<std::uint8_t> types;
   const auto add_cells = [&](const std::vector<int>& nodes, int per_cell, int type) {
@@ -224,7 +267,7 @@ std::vector<DataArray> geometry_arrays(const Mesh& mesh, bool boundary_cells) {
     }
   };
   for (const ElementBlock& block : mesh.blocks) {
-    add_cells(block.connectivity, nodes_per_element(block.type), vtk_cell_type(block.type));
+    add_cells(vtk_node_order(block), nodes_per_element(block.type), vtk_cell_type(block.type));
   }
   if (boundary_cells) {
     for (const auto& [name, group] : mesh.boundaries) {
@@ -388,7 +431,7 @@ int vtk_cell_type(FacetType type) {
     case FacetType::quadrilateral4:
       return 9;
   }
-  throw std::invalid_argument("vtk_cell_type: unknown edge type");
+  throw std::invalid_argument("vtk_cell_type: unknown facet type");
 }
 
 void write_vtu(const std::filesystem::path& path, const Mesh& mesh,

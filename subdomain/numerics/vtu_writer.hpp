@@ -9,21 +9,25 @@
 // array inline as text instead, each real number as the shortest decimal that reads back to the
 // same double. Either way the values read back are the doubles given here, bit for bit.
 //
-// Points are Float64 with z = 0. Cells are, in this order:
-//  - the area elements, block after block of mesh.blocks, with VTK types
+// Points are Float64 (x, y, z; z = 0 for plane bodies). Cells are, in this order:
+//  - the elements, block after block of mesh.blocks, with VTK types
 //      triangle3      -> VTK_TRIANGLE (5)
 //      triangle6      -> VTK_QUADRATIC_TRIANGLE (22)  (Gmsh order: corners, then the midpoints
 //                        of edges 01, 12, 20, which is VTK's order)
 //      quadrilateral4 -> VTK_QUAD (9)                  (counter-clockwise, as VTK)
-//  - with VtuOptions::boundary_cells, the edges of every named boundary of mesh.boundaries
-//    (in name order), as VTK_LINE (3) or VTK_QUADRATIC_EDGE (21) (Gmsh line3 order: the two
-//    endpoints, then the midpoint, which is VTK's order). An edge in two boundaries is written
-//    twice, once for each.
+//      tetrahedron4   -> VTK_TETRA (10)
+//      tetrahedron10  -> VTK_QUADRATIC_TETRA (24)     (Gmsh's midside nodes 8 (edge 3-2) and 9
+//                        (edge 3-1) are written swapped: VTK's 8 is on edge 1-3, 9 on 2-3)
+//      hexahedron8    -> VTK_HEXAHEDRON (12)           (Gmsh order is VTK's)
+//  - with VtuOptions::boundary_cells, the facets of every named boundary of mesh.boundaries
+//    (in name order): edges as VTK_LINE (3) or VTK_QUADRATIC_EDGE (21) (Gmsh line3 order: the
+//    two endpoints, then the midpoint, which is VTK's order), faces as VTK_TRIANGLE,
+//    VTK_QUADRATIC_TRIANGLE or VTK_QUAD. A facet in two boundaries is written twice.
 // The writer adds the cell field "boundary_id" (Int32): 0 on area elements, k on the edges of
 // the k-th boundary (k = 1, 2, ... in name order), and, when there are boundary cells, the
 // field-data string array "boundary_names" whose entry k - 1 is the name of boundary k.
-// Cell fields are given per area element; on a boundary edge each cell field holds the values
-// of the area element that has that edge as a side (NaN when no element has it).
+// Cell fields are given per element; on a boundary facet each cell field holds the values of the
+// element that has that facet as a side (NaN when no element has it).
 //
 // A field of 2 components is written with 3 components, the third zero, so that ParaView
 // treats it as a vector (Warp By Vector, Glyph); all other component counts are written as is
@@ -57,18 +61,18 @@ enum class VtuEncoding {
 
 struct VtuOptions {
   VtuEncoding encoding = VtuEncoding::binary_zlib;
-  /// Write the edges of mesh.boundaries as line cells (with boundary_id and boundary_names).
+  /// Write the facets of mesh.boundaries as cells (with boundary_id and boundary_names).
   bool boundary_cells = true;
 };
 
-/// The VTK cell type number of an element type (5, 22 or 9).
+/// The VTK cell type number of an element type (5, 22, 9, 10, 24 or 12).
 int vtk_cell_type(ElementType type);
 
-/// The VTK cell type number of an edge type (3 or 21).
+/// The VTK cell type number of a facet type (3, 21, 5, 22 or 9).
 int vtk_cell_type(FacetType type);
 
-/// Writes the mesh (z = 0) with point and cell fields as described above. Cell fields follow
-/// the element order of mesh.blocks (one value set per area element). The parent directory must
+/// Writes the mesh with point and cell fields as described above. Cell fields follow the element
+/// order of mesh.blocks (one value set per element). The parent directory must
 /// exist. Throws std::runtime_error naming the path when it cannot be written, and naming the
 /// path and the field when a field is malformed (empty name, components < 1,
 /// values.size() != components * count) or a connectivity entry is out of range.

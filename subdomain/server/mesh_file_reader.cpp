@@ -16,7 +16,8 @@
 namespace robin {
 namespace {
 
-// The child's message: 'M' and the mesh (the layout of append_mesh), or 'E' and an error text.
+// The child's message: 'M' and the mesh (the layout of encoded_mesh: its dimension, then x, y, z
+// per node whatever the dimension), or 'E' and an error text.
 
 template <typename Value>
 void append_vector(std::string& out, const std::vector<Value>& values) {
@@ -33,10 +34,11 @@ void append_text(std::string& out, const std::string& text) {
 std::string encoded_mesh(const Mesh& mesh) {
   std::string out = "M";
   append_text(out, mesh.source);
-  std::vector<double> coordinates;
-  coordinates.reserve(2 * mesh.nodes.size());
-  for (const Eigen::Vector2d& node : mesh.nodes)
-    coordinates.insert(coordinates.end(), {node.x(), node.y()});
+  append_vector(out, std::vector<int>{mesh.dimension});
+  std::vector<double> coordinates;  // x, y, z per node (z = 0 in 2D)
+  coordinates.reserve(3 * mesh.nodes.size());
+  for (const Eigen::Vector3d& node : mesh.nodes)
+    coordinates.insert(coordinates.end(), {node.x(), node.y(), node.z()});
   append_vector(out, coordinates);
   append_vector(out, mesh.node_tags);
   append_vector(out, std::vector<std::size_t>{mesh.blocks.size(), mesh.boundaries.size()});
@@ -61,9 +63,11 @@ class MeshDecoder {
   Mesh mesh() {
     Mesh mesh;
     mesh.source = text();
+    mesh.dimension = single<int>();
+    if (mesh.dimension != 2 && mesh.dimension != 3) throw std::runtime_error("bad dimension");
     const std::vector<double> coordinates = vector<double>();
-    for (std::size_t k = 0; k + 1 < coordinates.size(); k += 2) {
-      mesh.nodes.emplace_back(coordinates[k], coordinates[k + 1]);
+    for (std::size_t k = 0; k + 2 < coordinates.size(); k += 3) {
+      mesh.nodes.emplace_back(coordinates[k], coordinates[k + 1], coordinates[k + 2]);
     }
     mesh.node_tags = vector<std::size_t>();
     const std::vector<std::size_t> counts = vector<std::size_t>();

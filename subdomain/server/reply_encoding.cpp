@@ -3,9 +3,26 @@
 namespace robin {
 namespace {
 
-void add_vector(const Eigen::Vector2d& vector, google::protobuf::RepeatedField<double>& values) {
-  values.Add(vector.x());
-  values.Add(vector.y());
+/// The first `dimension` components of `vector` (x, y in 2D; x, y, z in 3D).
+void add_vector(const Eigen::Vector3d& vector, int dimension,
+                google::protobuf::RepeatedField<double>& values) {
+  for (int component = 0; component < dimension; ++component) values.Add(vector[component]);
+}
+
+protocol::CellType facet_cell_type(FacetType type) {
+  switch (type) {
+    case FacetType::line2:
+      return protocol::LINE2;
+    case FacetType::line3:
+      return protocol::LINE3;
+    case FacetType::triangle3:
+      return protocol::TRIANGLE3;
+    case FacetType::triangle6:
+      return protocol::TRIANGLE6;
+    case FacetType::quadrilateral4:
+      return protocol::QUADRILATERAL4;
+  }
+  return protocol::CELL_TYPE_UNSPECIFIED;
 }
 
 void add_values(const Eigen::VectorXd& vector, google::protobuf::RepeatedField<double>& values) {
@@ -20,21 +37,32 @@ void encode_field(const OutputField& field, protocol::Field& message) {
 }
 
 void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
-  message.mutable_node_coordinates()->Reserve(2 * static_cast<int>(mesh.node_count()));
-  for (const Eigen::Vector2d& node : mesh.nodes)
-    add_vector(node, *message.mutable_node_coordinates());
+  if (mesh.dimension == 3) message.set_dimension(3);  // absent (2) for a plane body, as in 2.3
+  message.mutable_node_coordinates()->Reserve(mesh.dof_count());
+  for (const Eigen::Vector3d& node : mesh.nodes)
+    add_vector(node, mesh.dimension, *message.mutable_node_coordinates());
   for (std::size_t tag : mesh.node_tags) message.add_node_tags(static_cast<std::int64_t>(tag));
   message.add_cell_offsets(0);
   for (const ElementBlock& block : mesh.blocks) {
     message.add_cell_types(static_cast<std::uint32_t>(vtk_cell_type(block.type)));
+    const std::size_t first = static_cast<std::size_t>(message.connectivity_size());
     for (int node : block.connectivity) message.add_connectivity(node);
+    if (block.type == ElementType::tetrahedron10) {
+      // VTK's quadratic tetrahedron numbers the midpoints of edges 3-2 and 3-1 (Gmsh's 8, 9)
+      // the other way round.
+      auto& connectivity = *message.mutable_connectivity();
+      for (std::size_t k = first; k + 10 <= static_cast<std::size_t>(connectivity.size());
+           k += 10) {
+        connectivity.SwapElements(static_cast<int>(k + 8), static_cast<int>(k + 9));
+      }
+    }
     message.add_cell_offsets(static_cast<std::uint64_t>(message.connectivity_size()));
   }
   for (const auto& [name, group] : mesh.boundaries) {
     protocol::NamedBoundary& boundary = *message.add_boundaries();
     boundary.set_name(name);
     protocol::CellBlock& segments = *boundary.mutable_segments();
-    segments.set_type(group.type == FacetType::line3 ? protocol::LINE3 : protocol::LINE2);
+    segments.set_type(facet_cell_type(group.type));
     segments.mutable_connectivity()->Assign(group.connectivity.begin(), group.connectivity.end());
   }
 }
@@ -44,24 +72,25 @@ void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
 void encode_interface(const std::string& body_name, const InterfaceDescription& interface,
                       protocol::InterfaceDescription& message) {
   message.set_body_name(body_name);
-  message.set_dimension(2);
+  const int dimension = interface.dimension;
+  message.set_dimension(static_cast<std::uint32_t>(dimension));
   message.set_rigid_modes(static_cast<std::uint32_t>(interface.rigid_modes));
   for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
     message.add_node_ids(interface.node_ids[i]);
     message.add_node_tags(static_cast<std::int64_t>(interface.node_tags[i]));
-    add_vector(interface.coordinates[i], *message.mutable_coordinates());
-    add_vector(interface.normals[i], *message.mutable_normals());
+    add_vector(interface.coordinates[i], dimension, *message.mutable_coordinates());
+    add_vector(interface.normals[i], dimension, *message.mutable_normals());
     message.add_weights(interface.weights[i]);
-    message.add_fixed(interface.x_fixed[i]);
-    message.add_fixed(interface.y_fixed[i]);
+    for (int component = 0; component < dimension; ++component) {
+      message.add_fixed(interface.fixed[i][static_cast<std::size_t>(component)]);
+    }
   }
   for (const ContactSurfaceDescription& contact_surface : interface.surfaces) {
     protocol::ContactSurface& surface = *message.add_surfaces();
     surface.set_boundary(contact_surface.boundary);
-    surface.set_segment_type(contact_surface.segment_type == FacetType::line3 ? protocol::LINE3
-                                                                             : protocol::LINE2);
-    surface.mutable_segments()->Assign(contact_surface.segments.begin(),
-                                       contact_surface.segments.end());
+    surface.set_segment_type(facet_cell_type(contact_surface.facet_type));
+    surface.mutable_segments()->Assign(contact_surface.facets.begin(),
+                                       contact_surface.facets.end());
   }
 }
 
@@ -98,8 +127,9 @@ void encode_fields(const BodyOutput& output, protocol::FieldsReply& message) {
   }
   for (const OutputField& field : output.cell_fields)
     encode_field(field, *message.add_cell_fields());
-  add_vector(output.reaction_resultant, *message.mutable_reaction_resultant());
-  add_vector(output.applied_force, *message.mutable_applied_force());
+  add_vector(output.reaction_resultant, output.mesh.dimension,
+             *message.mutable_reaction_resultant());
+  add_vector(output.applied_force, output.mesh.dimension, *message.mutable_applied_force());
 }
 
 Eigen::VectorXd to_vector(const google::protobuf::RepeatedField<double>& values) {

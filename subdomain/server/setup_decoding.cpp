@@ -81,38 +81,53 @@ PlaneModel decode_model(const protocol::SetupBody& message, const std::string& c
   }
 }
 
-Material decode_material(const protocol::SetupBody& message, const std::string& context) {
-  const PlaneModel model = decode_model(message, context);
+/// The material of a body of `dimension` 2 (a plane model must be given; 9 Voigt values) or 3
+/// (the model is ignored; 36 Voigt values, or an isotropic solid).
+Material decode_material(const protocol::SetupBody& message, const std::string& context,
+                         int dimension) {
+  const PlaneModel model =
+      dimension == 2 ? decode_model(message, context) : PlaneModel::plane_strain;
   const std::string material_context = context + ": SetupBody material";
   if (message.voigt_size() == 0) {
+    if (dimension == 3) {
+      return make_isotropic_solid_material(message.young_modulus(), message.poisson_ratio(),
+                                           material_context);
+    }
     return make_isotropic_material(message.young_modulus(), message.poisson_ratio(), model,
                                    material_context);
   }
   if (message.young_modulus() != 0.0 || message.poisson_ratio() != 0.0) {
     fail(context, "voigt", "is given together with young_modulus/poisson_ratio: give one of them");
   }
-  if (message.voigt_size() != 9) {
+  const int size = dimension == 3 ? 6 : 3;
+  if (message.voigt_size() != size * size) {
+    const std::string shape = std::to_string(size) + "x" + std::to_string(size);
     fail(context, "voigt",
-         "has " + std::to_string(message.voigt_size()) + " values, expected 9 (row-major 3x3)");
+         "has " + std::to_string(message.voigt_size()) + " values, expected " +
+             std::to_string(size * size) + " (row-major " + shape +
+             (dimension == 3 ? ", a solid body" : "") + ")");
   }
-  Eigen::Matrix3d stiffness;
-  for (int row = 0; row < 3; ++row) {
-    for (int column = 0; column < 3; ++column)
-      stiffness(row, column) = message.voigt(3 * row + column);
+  Eigen::MatrixXd stiffness(size, size);
+  for (int row = 0; row < size; ++row) {
+    for (int column = 0; column < size; ++column)
+      stiffness(row, column) = message.voigt(size * row + column);
   }
   return make_voigt_material(stiffness, model, material_context);
 }
 
-/// A vector of 2 finite values from a repeated field (`field` names it in messages).
-Eigen::Vector2d decode_vector(const google::protobuf::RepeatedField<double>& values,
+/// A vector of `dimension` finite values from a repeated field (`field` names it in messages);
+/// z = 0 in 2D.
+Eigen::Vector3d decode_vector(const google::protobuf::RepeatedField<double>& values, int dimension,
                               const std::string& context, const std::string& field) {
-  if (values.size() != 2) {
-    fail(context, field, "has " + std::to_string(values.size()) + " values, expected 2 (x, y)");
+  if (values.size() != dimension) {
+    fail(context, field,
+         "has " + std::to_string(values.size()) + " values, expected " +
+             (dimension == 2 ? std::string("2 (x, y)") : std::string("3 (x, y, z)")));
   }
-  if (!std::isfinite(values[0]) || !std::isfinite(values[1])) {
-    fail(context, field, "has a value that is not a finite number");
-  }
-  return {values[0], values[1]};
+  Eigen::Vector3d vector = Eigen::Vector3d::Zero();
+  for (int component = 0; component < dimension; ++component) vector[component] = values[component];
+  if (!vector.allFinite()) fail(context, field, "has a value that is not a finite number");
+  return vector;
 }
 
 /// Checks that `name` is a boundary (physical curve) of `mesh`.
@@ -132,16 +147,22 @@ void check_boundary(const Mesh& mesh, const std::string& name, const std::string
 DirichletCondition decode_dirichlet(const protocol::Dirichlet& message, const Mesh& mesh,
                                     const std::string& context, const std::string& field) {
   check_boundary(mesh, message.boundary(), context, field + ".boundary");
-  if (message.has_z()) fail(context, field + ".z", "is given: a plane problem has no u_z");
-  if (!message.has_x() && !message.has_y()) {
-    fail(context, field, "prescribes neither x nor y: give at least one");
+  if (mesh.dimension == 2) {
+    if (message.has_z()) fail(context, field + ".z", "is given: a plane problem has no u_z");
+    if (!message.has_x() && !message.has_y()) {
+      fail(context, field, "prescribes neither x nor y: give at least one");
+    }
+  } else if (!message.has_x() && !message.has_y() && !message.has_z()) {
+    fail(context, field, "prescribes none of x, y and z: give at least one");
   }
-  DirichletCondition condition{message.boundary(), std::nullopt, std::nullopt};
+  DirichletCondition condition{message.boundary(), std::nullopt, std::nullopt, std::nullopt};
   if (message.has_x()) condition.x = message.x();
   if (message.has_y()) condition.y = message.y();
-  if ((condition.x && !std::isfinite(*condition.x)) ||
-      (condition.y && !std::isfinite(*condition.y))) {
-    fail(context, field, "has a value that is not a finite number");
+  if (message.has_z()) condition.z = message.z();
+  for (const std::optional<double>& value : {condition.x, condition.y, condition.z}) {
+    if (value && !std::isfinite(*value)) {
+      fail(context, field, "has a value that is not a finite number");
+    }
   }
   return condition;
 }
@@ -153,7 +174,7 @@ TractionCondition decode_traction(const protocol::Traction& message, const Mesh&
   condition.boundary = message.boundary();
   condition.is_pressure = message.is_pressure();
   if (!message.is_pressure()) {
-    condition.vector = decode_vector(message.vector(), context, field + ".vector");
+    condition.vector = decode_vector(message.vector(), mesh.dimension, context, field + ".vector");
     return condition;
   }
   if (message.vector_size() != 0) {
@@ -233,14 +254,31 @@ DecodedSetup decode_setup_body(const protocol::SetupBody& message, const MeshFil
   BodyDefinition& definition = setup.definition;
   definition.name = decode_body_name(message.body_name());
   const std::string context = body_context(definition.name);
-  definition.material = decode_material(message, context);
-  if (message.body_force_size() != 0) {
-    definition.body_force = decode_vector(message.body_force(), context, "body_force");
-  }
+  // The material and the body force depend on the body's dimension, which MeshData states
+  // (dimension 3: a solid body) and a mesh file only once read. They are decoded here, before
+  // the mesh (so a plane body's errors come in the order of protocol 2.3), for a body whose
+  // dimension is known or that looks plane, and after the mesh otherwise or when the file's
+  // mesh turns out solid.
+  const bool from_file = !message.has_mesh() && !message.mesh_path().empty();
+  const int stated_dimension = message.has_mesh() && message.mesh().dimension() == 3 ? 3 : 2;
+  const bool looks_solid = message.voigt_size() == 36 || message.body_force_size() == 3 ||
+                           message.model() == protocol::PLANE_MODEL_UNSPECIFIED;
+  const bool decode_early = !from_file || !looks_solid;
+  const auto decode_loads = [&](int dimension) {
+    definition.material = decode_material(message, context, dimension);
+    definition.body_force = Eigen::Vector3d::Zero();
+    if (message.body_force_size() != 0) {
+      definition.body_force = decode_vector(message.body_force(), dimension, context, "body_force");
+    }
+  };
+  if (decode_early) decode_loads(stated_dimension);
   decode_solver(message.solver(), context, setup);
   setup.body.rigid_motions =
       message.floating() ? RigidMotions::held_by_contact : RigidMotions::refuse;
   definition.mesh = decode_body_mesh(message, context, files);
+  if (!decode_early || definition.mesh.dimension != stated_dimension) {
+    decode_loads(definition.mesh.dimension);
+  }
   definition.contact_boundaries = decode_contact_boundaries(message, definition.mesh, context);
   for (int k = 0; k < message.dirichlet_size(); ++k) {
     definition.dirichlet.push_back(decode_dirichlet(message.dirichlet(k), definition.mesh, context,

@@ -34,9 +34,11 @@ struct MeshFiles {
 
 /// Decodes and checks `message`: body name ([A-Za-z0-9_-]+, at most 64), mesh (MeshData,
 /// checked by decode_mesh; or mesh_path, a file under `files.data_directory` of at most
-/// `files.maximum_bytes`, refused when that directory is empty), plane model (must be given),
-/// material (young_modulus/poisson_ratio, or 9 `voigt` values, not both), body force (0 or 2
-/// values), Dirichlet (at least one of x/y) and traction conditions, 1 to
+/// `files.maximum_bytes`, refused when that directory is empty), plane model (must be given for
+/// a plane body, ignored for a solid one), material (young_modulus/poisson_ratio, or 9 `voigt`
+/// values in 2D and 36 in 3D, not both; isotropic solid materials from
+/// make_isotropic_solid_material), body force (0 or `dimension` values), Dirichlet (at least
+/// one of x/y, and z in 3D only) and traction conditions (`dimension` values), 1 to
 /// maximum_contact_boundaries distinct contact boundaries (a repeated one is refused naming its
 /// field, "SetupBody.contact_boundaries[1] repeats 'top'"), and the solver settings (0 or empty =
 /// server default). Every boundary name is checked against the mesh. Throws InputError naming the

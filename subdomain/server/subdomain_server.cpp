@@ -304,7 +304,7 @@ void SubdomainServer::end_request() noexcept {
   progress_.stage.clear();
   progress_.state = state_;
   progress_.body_name = body_ ? body_->name() : std::string();
-  progress_.dof_count = body_ ? 2L * static_cast<long>(body_->mesh().node_count()) : 0;
+  progress_.dof_count = body_ ? static_cast<long>(body_->mesh().dof_count()) : 0;
 }
 
 void SubdomainServer::fill_status(protocol::Envelope& reply) const {
@@ -499,7 +499,7 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   const double mesh_seconds = seconds_since(mesh_start);
   setup.body.maximum_dofs = settings_.maximum_dofs;
   setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;
-  const long dof_count = 2L * static_cast<long>(setup.definition.mesh.node_count());
+  const long dof_count = static_cast<long>(setup.definition.mesh.dof_count());
   setup.body.observer = [this, dof_count](SetupStage stage) { begin_stage(stage, dof_count); };
   const bool reuse = previous && previous->has_same_stiffness(setup.definition, setup.body);
   std::unique_ptr<BodySolver> body;
@@ -543,7 +543,8 @@ void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
   const ContactOperator contact = decoded_operator(request.assign_contact(), body_->name());
   try {
     // Checked before anything changes: a refused assignment keeps the state and the previous B.
-    check_contact_operator(contact, interface_nodes_, "body '" + body_->name() + "'");
+    check_contact_operator(contact, interface_nodes_, body_->mesh().dimension,
+                           "body '" + body_->name() + "'");
   } catch (const InputError& error) {
     throw RequestError(protocol::INVALID_ARGUMENT, error.what());
   }

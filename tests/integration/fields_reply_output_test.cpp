@@ -29,12 +29,12 @@ BodyOutput block_output() {
   definition.name = "block";
   definition.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 4, 2, ElementType::triangle6);
   definition.material = make_isotropic_material(100.0, 0.25, PlaneModel::plane_strain, "test");
-  definition.dirichlet = {{"bottom", 0.0, 0.0}};
+  definition.dirichlet = {{"bottom", 0.0, 0.0, std::nullopt}};
   definition.contact_boundaries = {"top"};
   BodySolver body(definition);
   const InterfaceDescription top = body.contact_boundary();
   body.assign_contact(node_to_node_operator(
-      top.node_ids, std::vector<Eigen::Vector2d>(top.node_ids.size(), Eigen::Vector2d(0, 1)),
+      top.node_ids, std::vector<Eigen::Vector3d>(top.node_ids.size(), Eigen::Vector3d(0, 1, 0.0)),
       top.weights));
   return make_body_output(body, Eigen::VectorXd::Ones(body.contact_size()));
 }

@@ -86,9 +86,9 @@ Eigen::VectorXd displacement_trace(const CaseDefinition& definition, int alpha,
     EXPECT_EQ(assignment.components[first], 0);
     EXPECT_EQ(assignment.components[first + 1], 1);
     const int node = assignment.nodes[first];
-    const Eigen::Vector2d normal(assignment.values[first], assignment.values[first + 1]);
+    const Eigen::Vector3d normal(assignment.values[first], assignment.values[first + 1], 0.0);
     EXPECT_NEAR(normal.norm(), 1.0, 1e-12);
-    trace[i] = displacement.segment<2>(2 * node).dot(normal);
+    trace[i] = displacement.segment<2>(2 * node).dot(normal.head<2>());
   }
   return trace;
 }

@@ -163,7 +163,7 @@ TEST(FieldsDecoding, UnitSquareDecodesToItsMeshAndFields) {
   const BodyOutput output = decode_fields(unit_square_reply(), "square");
   EXPECT_EQ(output.body_name, "square");
   ASSERT_EQ(output.mesh.nodes.size(), 4u);
-  EXPECT_EQ(output.mesh.nodes[2], Eigen::Vector2d(1.0, 1.0));
+  EXPECT_EQ(output.mesh.nodes[2], Eigen::Vector3d(1.0, 1.0, 0.0));
   EXPECT_EQ(output.mesh.node_tags[3], 14u);
   ASSERT_EQ(output.mesh.blocks.size(), 1u);
   EXPECT_EQ(output.mesh.blocks[0].type, ElementType::triangle3);
@@ -172,8 +172,8 @@ TEST(FieldsDecoding, UnitSquareDecodesToItsMeshAndFields) {
   EXPECT_EQ(output.point_fields[0].values[7], 3.5);
   ASSERT_EQ(output.cell_fields.size(), 1u);
   EXPECT_EQ(output.cell_fields[0].component_names, (std::vector<std::string>{"xx", "yy", "xy"}));
-  EXPECT_EQ(output.reaction_resultant, Eigen::Vector2d(1.5, -2.5));
-  EXPECT_EQ(output.applied_force, Eigen::Vector2d::Zero());
+  EXPECT_EQ(output.reaction_resultant, Eigen::Vector3d(1.5, -2.5, 0.0));
+  EXPECT_EQ(output.applied_force, Eigen::Vector3d::Zero());
 }
 
 TEST(FieldsDecoding, InconsistentRepliesAreRefused) {

@@ -36,10 +36,10 @@ namespace robin {
 namespace {
 
 using testing::example;
+using testing::expect_same_interface_state;
 using testing::python_server_options;
 using testing::server_options;
 using testing::TemporaryDirectory;
-using testing::expect_same_interface_state;
 using testing::vectors_close;
 
 constexpr double tolerance = 1e-6;  // relative, two independent implementations
@@ -150,7 +150,7 @@ ContactOperator assignment_by_position(const InterfaceDescription& boundary,
     return boundary.coordinates[a].x() > boundary.coordinates[b].x();
   });
   std::vector<int> nodes;
-  std::vector<Eigen::Vector2d> normals;
+  std::vector<Eigen::Vector3d> normals;
   std::vector<double> weights;
   for (const std::size_t k : order) {
     std::size_t nearest = 0;

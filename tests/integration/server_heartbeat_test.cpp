@@ -43,7 +43,7 @@ BodyCase large_square_body() {
   body.definition.name = "square";
   body.definition.mesh = make_rectangle_mesh(0.0, 0.0, 1.0, 1.0, 240, 240, ElementType::triangle3);
   body.definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
-  body.definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  body.definition.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   body.definition.contact_boundaries = {"top"};
   body.context = "server_heartbeat_test: body 'square'";
   return body;

@@ -245,7 +245,7 @@ BodyDefinition lower_block_definition() {
   definition.name = "lower";
   definition.mesh = lower_mesh();
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
-  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  definition.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   definition.contact_boundaries = {"contact"};
   return definition;
 }
@@ -321,7 +321,7 @@ TEST(SubdomainProcess, IpcEndpointServesAContactSolveEqualToADirectSolve) {
             static_cast<int>(interface.node_ids.size()));
   // Node-to-node rows with the normal (0, 1): entries (node, x) = 0 and (node, y) = 1.
   const ContactOperator assignment = node_to_node_operator(
-      interface.node_ids, std::vector<Eigen::Vector2d>(interface.node_ids.size(), {0.0, 1.0}),
+      interface.node_ids, std::vector<Eigen::Vector3d>(interface.node_ids.size(), {0.0, 1.0, 0.0}),
       interface.weights);
   protocol::Envelope assign = request(2);
   for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
@@ -627,7 +627,7 @@ TEST(SubdomainProcess, MeshPathOutsideTheDataDirectoryIsRefusedUnread) {
   definition.name = "square";
   definition.mesh = read_gmsh_mesh(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_v41.msh");
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
-  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  definition.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   definition.contact_boundaries = {"top"};
   const BodySolver reference(definition);
   const InterfaceDescription expected = reference.contact_boundary();
@@ -931,7 +931,7 @@ TEST(SubdomainProcess, TwoContactBoundariesAreServedAndARepeatedOrUnknownOneIsRe
   }
   EXPECT_NEAR(weight_sum, 3.0, 1e-12);
   for (int k = 0; k < 2; ++k) {
-    const std::vector<int>& segments = expected.surfaces[static_cast<std::size_t>(k)].segments;
+    const std::vector<int>& segments = expected.surfaces[static_cast<std::size_t>(k)].facets;
     EXPECT_EQ(std::vector<int>(message.surfaces(k).segments().begin(),
                                message.surfaces(k).segments().end()),
               segments);
@@ -952,7 +952,7 @@ TEST(SubdomainProcess, TwoContactBoundariesAreServedAndARepeatedOrUnknownOneIsRe
       EXPECT_NEAR((restricted.normals[i] - own.normals[i]).norm(), 0.0, 1e-14);
     }
     ASSERT_EQ(restricted.surfaces.size(), 1u);
-    EXPECT_EQ(restricted.surfaces.front().segments, own.surfaces.front().segments);
+    EXPECT_EQ(restricted.surfaces.front().facets, own.surfaces.front().facets);
   }
 
   expect_error(

@@ -34,11 +34,11 @@ BodyDefinition loaded_block(double lift, const Eigen::Vector2d& body_force,
   body.name = "block";
   body.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 12, 6, ElementType::triangle6);
   body.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "block");
-  body.body_force = body_force;
-  body.dirichlet.push_back({"bottom", 0.0, lift});
+  body.body_force << body_force, 0.0;
+  body.dirichlet.push_back({"bottom", 0.0, lift, std::nullopt});
   TractionCondition condition;
   condition.boundary = "right";
-  condition.vector = traction;
+  condition.vector << traction, 0.0;
   body.tractions.push_back(condition);
   body.contact_boundaries = {"top"};
   return body;
@@ -55,7 +55,7 @@ BodyDefinition second_loads() {
 /// Node-to-node rows on every node of "top" with normal (0, 1), weights 1.
 ContactOperator top_rows(const Mesh& mesh) {
   const std::vector<int> nodes = mesh.boundary("top").nodes();
-  return node_to_node_operator(nodes, std::vector<Eigen::Vector2d>(nodes.size(), {0.0, 1.0}),
+  return node_to_node_operator(nodes, std::vector<Eigen::Vector3d>(nodes.size(), {0.0, 1.0, 0.0}),
                                std::vector<double>(nodes.size(), 1.0));
 }
 
@@ -152,7 +152,7 @@ TEST(BodyReuse, OnlyLoadsNameAndPrescribedValuesMayChange) {
 
   BodyDefinition sliding = first_loads();
   sliding.dirichlet[0].x.reset();  // u_x no longer prescribed on the bottom
-  sliding.dirichlet.push_back({"left", 0.0, std::nullopt});
+  sliding.dirichlet.push_back({"left", 0.0, std::nullopt, std::nullopt});
   EXPECT_FALSE(body.has_same_stiffness(sliding, options));
 
   BodyDefinition other_contact = first_loads();

@@ -49,11 +49,11 @@ BodyDefinition test_body() {
   body.name = "block";
   body.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 12, 6, ElementType::triangle6);
   body.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "block");
-  body.body_force = Eigen::Vector2d(0.0, 40.0);
-  body.dirichlet.push_back({"bottom", 0.0, bottom_lift});
+  body.body_force = Eigen::Vector3d(0.0, 40.0, 0.0);
+  body.dirichlet.push_back({"bottom", 0.0, bottom_lift, std::nullopt});
   TractionCondition traction;
   traction.boundary = "right";
-  traction.vector = Eigen::Vector2d(-4.0, 1.5);
+  traction.vector = Eigen::Vector3d(-4.0, 1.5, 0.0);
   body.tractions.push_back(traction);
   body.contact_boundaries = {"top"};
   return body;
@@ -66,7 +66,7 @@ ContactOperator top_assignment(const Mesh& mesh) {
   const Eigen::VectorXd weights = boundary_weights(mesh, mesh.boundary("top"));
   std::vector<double> node_weights;
   for (int node : nodes) node_weights.push_back(weights[node]);
-  return node_to_node_operator(nodes, std::vector<Eigen::Vector2d>(nodes.size(), {0.0, 1.0}),
+  return node_to_node_operator(nodes, std::vector<Eigen::Vector3d>(nodes.size(), {0.0, 1.0, 0.0}),
                                node_weights);
 }
 
@@ -118,9 +118,9 @@ class ReferenceBody {
     selection_.setFromTriplets(selection.begin(), selection.end());
     const SparseMatrix stiffness = assemble_stiffness(mesh, body.material);
     Eigen::VectorXd load = assemble_body_force(
-        mesh, [&body](const Eigen::Vector2d&) { return Eigen::Vector2d(body.body_force); });
+        mesh, [&body](const Eigen::Vector3d&) { return Eigen::Vector3d(body.body_force); });
     load += assemble_boundary_traction(mesh, mesh.boundary("right"),
-                                       [&body](const Eigen::Vector2d&, const Eigen::Vector2d&) {
+                                       [&body](const Eigen::Vector3d&, const Eigen::Vector3d&) {
                                          return body.tractions[0].vector;
                                        });
     free_load_ = selection_ * (load - stiffness * prescribed_);
@@ -321,7 +321,7 @@ TEST(BodySolver, GeneralOperatorEqualsTheIndependentSolve) {
     if (boundary == "right") {
       // The corner (2, 0) is the first node of "right" in ascending order and is prescribed.
       const int corner = contact.nodes[0];
-      ASSERT_EQ(body.mesh.nodes[corner], Eigen::Vector2d(2.0, 0.0));
+      ASSERT_EQ(body.mesh.nodes[corner], Eigen::Vector3d(2.0, 0.0, 0.0));
     }
     for (const OperatorChoice& choice : operator_choices()) {
       const std::string label = choice.label + " on '" + boundary + "'";
@@ -378,11 +378,11 @@ TEST(BodySolver, NodeToNodeOperatorIsTheNodeNormalTrace) {
   body.contact_boundaries = {"right"};
   std::vector<int> nodes = body.mesh.boundary("right").nodes();
   std::reverse(nodes.begin(), nodes.end());
-  std::vector<Eigen::Vector2d> normals;
+  std::vector<Eigen::Vector3d> normals;
   std::vector<double> weights;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const double angle = 0.1 * static_cast<double>(i) - 0.4;
-    normals.emplace_back(std::cos(angle), std::sin(angle));
+    normals.emplace_back(std::cos(angle), std::sin(angle), 0.0);
     weights.push_back(0.5 + static_cast<double>(i));
   }
   const ContactOperator contact = node_to_node_operator(nodes, normals, weights);
@@ -403,7 +403,7 @@ TEST(BodySolver, NodeToNodeOperatorIsTheNodeNormalTrace) {
   const auto node_normal_trace = [&](const Eigen::VectorXd& full) {
     Eigen::VectorXd trace(static_cast<Eigen::Index>(nodes.size()));
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-      trace[static_cast<Eigen::Index>(i)] = full.segment<2>(2 * nodes[i]).dot(normals[i]);
+      trace[static_cast<Eigen::Index>(i)] = full.segment<2>(2 * nodes[i]).dot(normals[i].head<2>());
     }
     return trace;
   };
@@ -422,7 +422,8 @@ TEST(BodySolver, NodeToNodeOperatorIsTheNodeNormalTrace) {
     // The contact force field of the 1.x code: -lambda_i n_i at node i.
     Eigen::VectorXd expected_field = Eigen::VectorXd::Zero(2 * body.mesh.node_count());
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-      expected_field.segment<2>(2 * nodes[i]) -= force[static_cast<Eigen::Index>(i)] * normals[i];
+      expected_field.segment<2>(2 * nodes[i]) -=
+          force[static_cast<Eigen::Index>(i)] * normals[i].head<2>();
     }
     EXPECT_LE(largest(solver->contact_force_field(force) - expected_field),
               1e-15 * largest(expected_field))

@@ -225,7 +225,7 @@ TEST(CaseFile, FullCaseFirstBody) {
   expect_matrix_near(upper.material.stiffness,
                      isotropic_stiffness(210e3, 0.3, PlaneModel::plane_stress));
   EXPECT_EQ(upper.contact_boundaries, std::vector<std::string>{"contact"});
-  EXPECT_EQ(upper.body_force, Eigen::Vector2d(0.5, -1.5));
+  EXPECT_EQ(upper.body_force, Eigen::Vector3d(0.5, -1.5, 0.0));
   EXPECT_TRUE(upper.mesh.nodes.empty());  // meshes are read by load_body
 
   ASSERT_EQ(upper.dirichlet.size(), 2u);
@@ -239,7 +239,7 @@ TEST(CaseFile, FullCaseFirstBody) {
   ASSERT_EQ(upper.tractions.size(), 2u);
   EXPECT_EQ(upper.tractions[0].boundary, "right");
   EXPECT_FALSE(upper.tractions[0].is_pressure);
-  EXPECT_EQ(upper.tractions[0].vector, Eigen::Vector2d(1.0, -2.0));
+  EXPECT_EQ(upper.tractions[0].vector, Eigen::Vector3d(1.0, -2.0, 0.0));
   EXPECT_EQ(upper.tractions[1].boundary, "left");
   EXPECT_TRUE(upper.tractions[1].is_pressure);
   EXPECT_EQ(upper.tractions[1].pressure, 3.5);
@@ -278,7 +278,7 @@ TEST(CaseFile, FullCaseSecondBody) {
   voigt << 300.0, 100.0, 10.0, 100.0, 200.0, 20.0, 10.0, 20.0, 50.0;
   EXPECT_EQ(lower.material.stiffness, voigt);
   EXPECT_EQ(lower.contact_boundaries, std::vector<std::string>{"contact"});
-  EXPECT_EQ(lower.body_force, Eigen::Vector2d::Zero());
+  EXPECT_EQ(lower.body_force, Eigen::Vector3d::Zero());
   ASSERT_EQ(lower.dirichlet.size(), 1u);
   EXPECT_EQ(lower.dirichlet[0].boundary, "bottom");
   EXPECT_EQ(lower.dirichlet[0].x, 0.0);  // fix = "both"
@@ -310,7 +310,7 @@ TEST(CaseFile, MissingOptionalTablesGiveTheDocumentedDefaults) {
   EXPECT_EQ(upper.mesh_options.size, 0.0);
   EXPECT_EQ(upper.mesh_options.element_order, 1);
   EXPECT_FALSE(upper.mesh_options.recombine);
-  EXPECT_EQ(upper.definition.body_force, Eigen::Vector2d::Zero());
+  EXPECT_EQ(upper.definition.body_force, Eigen::Vector3d::Zero());
   EXPECT_TRUE(upper.definition.dirichlet.empty());
   EXPECT_TRUE(upper.definition.tractions.empty());
   expect_matrix_near(upper.definition.material.stiffness,
@@ -978,7 +978,7 @@ TEST(LoadBody, ReadsTheMeshWithTheCaseOptions) {
   EXPECT_EQ(contact.type, FacetType::line3);
   EXPECT_EQ(contact.facet_count(), 4u);
   for (int node : contact.nodes()) EXPECT_NEAR(upper.mesh.nodes[node].y(), 0.0, 1e-12);
-  for (const Eigen::Vector2d& node : upper.mesh.nodes) {
+  for (const Eigen::Vector3d& node : upper.mesh.nodes) {
     EXPECT_GE(node.x(), -1e-12);
     EXPECT_LE(node.x(), 1.0 + 1e-12);
     EXPECT_GE(node.y(), -1e-12);

@@ -80,7 +80,7 @@ BodyDefinition block(int order, std::vector<std::string> contact_boundaries) {
   body.name = "middle";
   body.mesh = block_mesh(order);
   body.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "middle");
-  body.dirichlet.push_back({"left", 0.0, 0.0});
+  body.dirichlet.push_back({"left", 0.0, 0.0, std::nullopt});
   body.contact_boundaries = std::move(contact_boundaries);
   return body;
 }
@@ -103,8 +103,8 @@ double side_weight(int order, double position, double length) {
 void expect_same_surface(const ContactSurfaceDescription& actual,
                          const ContactSurfaceDescription& expected) {
   EXPECT_EQ(actual.boundary, expected.boundary);
-  EXPECT_EQ(actual.segment_type, expected.segment_type);
-  EXPECT_EQ(actual.segments, expected.segments);
+  EXPECT_EQ(actual.facet_type, expected.facet_type);
+  EXPECT_EQ(actual.facets, expected.facets);
   EXPECT_EQ(actual.positions, expected.positions);
   EXPECT_EQ(actual.normals, expected.normals);
   EXPECT_EQ(actual.weights, expected.weights);
@@ -118,8 +118,7 @@ void expect_same_description(const InterfaceDescription& actual,
   EXPECT_EQ(actual.coordinates, expected.coordinates);
   EXPECT_EQ(actual.normals, expected.normals);
   EXPECT_EQ(actual.weights, expected.weights);
-  EXPECT_EQ(actual.x_fixed, expected.x_fixed);
-  EXPECT_EQ(actual.y_fixed, expected.y_fixed);
+  EXPECT_EQ(actual.fixed, expected.fixed);
   EXPECT_EQ(actual.dof_count, expected.dof_count);
   ASSERT_EQ(actual.surfaces.size(), expected.surfaces.size());
   for (std::size_t k = 0; k < actual.surfaces.size(); ++k) {
@@ -139,14 +138,14 @@ TEST(ContactBoundaries, TopAndBottomGiveTheUnionWithTheBoundariesWeightsAndNorma
               interface.node_ids.size());
     double total = 0.0;
     for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
-      const Eigen::Vector2d& point = interface.coordinates[i];
+      const Eigen::Vector3d& point = interface.coordinates[i];
       const bool top = std::abs(point.y() - 1.0) < 1e-12;
       ASSERT_TRUE(top || std::abs(point.y()) < 1e-12) << point.transpose();
       EXPECT_NEAR(interface.weights[i], side_weight(order, point.x(), 2.0), placement)
           << point.transpose();
       EXPECT_NEAR(interface.normals[i].x(), 0.0, 1e-12);
       EXPECT_NEAR(interface.normals[i].y(), top ? 1.0 : -1.0, 1e-12);
-      EXPECT_EQ(interface.x_fixed[i], std::abs(point.x()) < 1e-12);  // "left" is clamped
+      EXPECT_EQ(interface.fixed[i][0], std::abs(point.x()) < 1e-12);  // "left" is clamped
       total += interface.weights[i];
     }
     EXPECT_NEAR(total, 4.0, 1e-12);  // the two boundaries' total length
@@ -155,14 +154,14 @@ TEST(ContactBoundaries, TopAndBottomGiveTheUnionWithTheBoundariesWeightsAndNorma
     for (std::size_t k = 0; k < 2; ++k) {
       const ContactSurfaceDescription& surface = interface.surfaces[k];
       EXPECT_EQ(surface.boundary, k == 0 ? "top" : "bottom");
-      EXPECT_EQ(surface.segment_type, order == 1 ? FacetType::line2 : FacetType::line3);
+      EXPECT_EQ(surface.facet_type, order == 1 ? FacetType::line2 : FacetType::line3);
       const int count = order + 1;
-      ASSERT_EQ(surface.segments.size(), 8u * static_cast<std::size_t>(count));
+      ASSERT_EQ(surface.facets.size(), 8u * static_cast<std::size_t>(count));
       ASSERT_EQ(surface.positions.size(), per_side);
       double length = 0.0;
       for (std::size_t e = 0; e < 8; ++e) {
-        const Eigen::Vector2d& from = interface.coordinates[surface.segments[e * count]];
-        const Eigen::Vector2d& to = interface.coordinates[surface.segments[e * count + 1]];
+        const Eigen::Vector3d& from = interface.coordinates[surface.facets[e * count]];
+        const Eigen::Vector3d& to = interface.coordinates[surface.facets[e * count + 1]];
         // body on the left: the top is traversed towards -x, the bottom towards +x
         EXPECT_NEAR(to.x() - from.x(), k == 0 ? -segment : segment, placement);
         EXPECT_NEAR(from.y(), k == 0 ? 1.0 : 0.0, 1e-12);
@@ -191,9 +190,9 @@ TEST(ContactBoundaries, ASharedCornerAppearsOnceWithSummedWeightAndAveragedNorma
     double total = 0.0;
     int corners = 0;
     for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
-      const Eigen::Vector2d& point = interface.coordinates[i];
+      const Eigen::Vector3d& point = interface.coordinates[i];
       total += interface.weights[i];
-      if ((point - Eigen::Vector2d(2.0, 1.0)).norm() > 1e-12) continue;
+      if ((point - Eigen::Vector3d(2.0, 1.0, 0.0)).norm() > 1e-12) continue;
       ++corners;
       const double end = order == 1 ? segment / 2 : segment / 6;
       EXPECT_NEAR(interface.weights[i], 2.0 * end, 1e-12);  // an end of both boundaries
@@ -205,8 +204,8 @@ TEST(ContactBoundaries, ASharedCornerAppearsOnceWithSummedWeightAndAveragedNorma
         ASSERT_NE(at, surface.positions.end()) << surface.boundary;
         const auto j = static_cast<std::size_t>(at - surface.positions.begin());
         EXPECT_NEAR(surface.weights[j], end, 1e-12) << surface.boundary;
-        const Eigen::Vector2d outward =
-            surface.boundary == "top" ? Eigen::Vector2d(0.0, 1.0) : Eigen::Vector2d(1.0, 0.0);
+        const Eigen::Vector3d outward = surface.boundary == "top" ? Eigen::Vector3d(0.0, 1.0, 0.0)
+                                                                  : Eigen::Vector3d(1.0, 0.0, 0.0);
         EXPECT_NEAR((surface.normals[j] - outward).norm(), 0.0, 1e-12) << surface.boundary;
       }
     }
@@ -289,7 +288,7 @@ TEST(ContactBoundaries, PerBoundaryValuesAreRecomputedFromTheSegmentsAlone) {
       EXPECT_NEAR(right.weights[i], expected.weights[i], 1e-15);
       EXPECT_NEAR((right.normals[i] - expected.normals[i]).norm(), 0.0, 1e-14);
     }
-    EXPECT_EQ(right.surfaces.front().segments, expected.surfaces.front().segments);
+    EXPECT_EQ(right.surfaces.front().facets, expected.surfaces.front().facets);
   }
 }
 

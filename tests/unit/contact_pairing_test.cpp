@@ -17,11 +17,10 @@ InterfaceDescription flat_interface(const std::vector<double>& xs, double height
   for (std::size_t i = 0; i < xs.size(); ++i) {
     interface.node_ids.push_back(static_cast<int>(i));
     interface.node_tags.push_back(100 + i);
-    interface.coordinates.emplace_back(xs[i], height);
-    interface.normals.emplace_back(0.0, normal_y);
+    interface.coordinates.emplace_back(xs[i], height, 0.0);
+    interface.normals.emplace_back(0.0, normal_y, 0.0);
     interface.weights.push_back(1.0 + static_cast<double>(i));
-    interface.x_fixed.push_back(false);
-    interface.y_fixed.push_back(false);
+    interface.fixed.push_back({false, false, false});
   }
   return interface;
 }
@@ -117,9 +116,9 @@ TEST(ContactPairing, ExtraNodeOnTheSecondBodyIsNamed) {
 TEST(ContactPairing, PairsWithAPrescribedNormalDisplacementAreExcluded) {
   InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
   InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
-  lower.x_fixed[0] = lower.y_fixed[0] = true;  // clamped: normal displacement prescribed
-  upper.y_fixed[2] = true;                     // u_y fixed and the normal is (0, -1)
-  lower.x_fixed[1] = true;                     // only the tangential component: stays in contact
+  lower.fixed[0][0] = lower.fixed[0][1] = true;  // clamped: normal displacement prescribed
+  upper.fixed[2][1] = true;                      // u_y fixed and the normal is (0, -1)
+  lower.fixed[1][0] = true;                      // only the tangential component: stays in contact
   const ContactPairing pairing = pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
   ASSERT_EQ(pairing.size(), 1u);
   EXPECT_DOUBLE_EQ(pairing.pairs[0].position.x(), 0.5);
@@ -131,7 +130,7 @@ TEST(ContactPairing, PairsWithAPrescribedNormalDisplacementAreExcluded) {
 TEST(ContactPairing, ContactBoundaryThatIsAllDirichletIsAnError) {
   InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
   const InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
-  for (std::size_t i = 0; i < 3; ++i) lower.y_fixed[i] = true;
+  for (std::size_t i = 0; i < 3; ++i) lower.fixed[i][1] = true;
   try {
     pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
     FAIL() << "no error";
@@ -168,13 +167,13 @@ TEST(ContactPairing, ExcludedPairClearanceMeasuresThePenetrationOfPrescribedNode
   // Pair at x = 0 excluded (lower node clamped). Lower normal n1 = (0, 1), upper above.
   InterfaceDescription lower = flat_interface({0.0, 0.5, 1.0}, 0.0, 1.0);
   const InterfaceDescription upper = flat_interface({0.0, 0.5, 1.0}, 0.0, -1.0);
-  lower.x_fixed[0] = lower.y_fixed[0] = true;
+  lower.fixed[0][0] = lower.fixed[0][1] = true;
   const ContactPairing pairing = pair_contact_nodes(lower, "lower", upper, "upper", nullptr, 1e-6);
   ASSERT_EQ(pairing.excluded_pairs.size(), 1u);
   // Upper node moved down by 0.01 onto a fixed lower node with d = 0: penetration
   // u1.n1 + u2.n2 - d = 0 + 0.01 - 0; scale: the included traces' 0.02.
   const auto pressed = [](int body, const ContactPair&) {
-    return body == 0 ? Eigen::Vector2d(0.0, 0.0) : Eigen::Vector2d(0.3, -0.01);
+    return body == 0 ? Eigen::Vector3d(0.0, 0.0, 0.0) : Eigen::Vector3d(0.3, -0.01, 0.0);
   };
   const ExcludedPairClearance clearance = excluded_pair_clearance(pairing, pressed, 0.02);
   EXPECT_NEAR(clearance.relative_penetration, 0.01 / 0.02, 1e-15);
@@ -182,7 +181,7 @@ TEST(ContactPairing, ExcludedPairClearanceMeasuresThePenetrationOfPrescribedNode
   EXPECT_NE(clearance.description.find("0.01"), std::string::npos) << clearance.description;
   // Lifted off instead: no penetration.
   const auto lifted = [](int body, const ContactPair&) {
-    return body == 0 ? Eigen::Vector2d(0.0, 0.0) : Eigen::Vector2d(0.0, 0.01);
+    return body == 0 ? Eigen::Vector3d(0.0, 0.0, 0.0) : Eigen::Vector3d(0.0, 0.01, 0.0);
   };
   EXPECT_EQ(excluded_pair_clearance(pairing, lifted, 0.02).relative_penetration, 0.0);
 }

@@ -69,7 +69,7 @@ class ShapeFunctions : public testing::TestWithParam<ElementType> {};
 
 TEST_P(ShapeFunctions, KroneckerPartitionOfUnityAndGradients) {
   const ElementType type = GetParam();
-  const std::vector<Eigen::Vector2d> nodes = reference_nodes(type);
+  const std::vector<Eigen::Vector3d> nodes = reference_nodes(type);
   Eigen::VectorXd values;
   Eigen::MatrixXd gradients;
   for (std::size_t k = 0; k < nodes.size(); ++k) {
@@ -77,7 +77,7 @@ TEST_P(ShapeFunctions, KroneckerPartitionOfUnityAndGradients) {
     for (std::size_t i = 0; i < nodes.size(); ++i)
       EXPECT_NEAR(values(i), i == k ? 1.0 : 0.0, 1e-15);
   }
-  const Eigen::Vector2d point(0.21, 0.37);
+  const Eigen::Vector3d point(0.21, 0.37, 0.0);
   shape_functions(type, point, values, gradients);
   EXPECT_NEAR(values.sum(), 1.0, 1e-15);
   EXPECT_NEAR(gradients.colwise().sum().norm(), 0.0, 1e-14);
@@ -86,7 +86,7 @@ TEST_P(ShapeFunctions, KroneckerPartitionOfUnityAndGradients) {
   for (int direction = 0; direction < 2; ++direction) {
     Eigen::VectorXd plus, minus;
     Eigen::MatrixXd unused;
-    const Eigen::Vector2d offset = step * Eigen::Vector2d::Unit(direction);
+    const Eigen::Vector3d offset = step * Eigen::Vector3d::Unit(direction);
     shape_functions(type, point + offset, plus, unused);
     shape_functions(type, point - offset, minus, unused);
     EXPECT_NEAR(((plus - minus) / (2 * step) - gradients.col(direction)).norm(), 0.0, 1e-8);
@@ -121,7 +121,7 @@ TEST(EdgeShapeFunctions, KroneckerAndDerivatives) {
 /// One unit right triangle (0,0), (1,0), (0,1).
 Mesh unit_triangle() {
   Mesh mesh;
-  mesh.nodes = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
+  mesh.nodes = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
   mesh.node_tags = {1, 2, 3};
   mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
   mesh.boundaries["bottom"] = {FacetType::line2, {0, 1}};
@@ -174,14 +174,14 @@ TEST_P(RectangleMeshes, StiffnessIsSymmetricWithRigidModesInItsKernel) {
 
 TEST_P(RectangleMeshes, ConstantLoadsSumToTheirResultants) {
   // Body force (2, -3) on the 3 x 2 rectangle: resultant 6 (2, -3).
-  const Eigen::VectorXd body =
-      assemble_body_force(mesh_, [](const Eigen::Vector2d&) { return Eigen::Vector2d(2.0, -3.0); });
+  const Eigen::VectorXd body = assemble_body_force(
+      mesh_, [](const Eigen::Vector3d&) { return Eigen::Vector3d(2.0, -3.0, 0.0); });
   EXPECT_NEAR(body(Eigen::seq(0, Eigen::last, 2)).sum(), 12.0, 1e-12);
   EXPECT_NEAR(body(Eigen::seq(1, Eigen::last, 2)).sum(), -18.0, 1e-12);
   // Pressure 5 on the right side (length 2): t = -5 n with n = (1, 0); resultant (-10, 0).
   const Eigen::VectorXd traction = assemble_boundary_traction(
-      mesh_, mesh_.boundary("right"), [](const Eigen::Vector2d&, const Eigen::Vector2d& normal) {
-        return Eigen::Vector2d(-5.0 * normal);
+      mesh_, mesh_.boundary("right"), [](const Eigen::Vector3d&, const Eigen::Vector3d& normal) {
+        return Eigen::Vector3d(-5.0 * normal);
       });
   EXPECT_NEAR(traction(Eigen::seq(0, Eigen::last, 2)).sum(), -10.0, 1e-12);
   EXPECT_NEAR(traction(Eigen::seq(1, Eigen::last, 2)).norm(), 0.0, 1e-12);
@@ -190,10 +190,12 @@ TEST_P(RectangleMeshes, ConstantLoadsSumToTheirResultants) {
 }
 
 TEST_P(RectangleMeshes, NormalsPointOutOfEverySide) {
-  const std::map<std::string, Eigen::Vector2d> outward = {
-      {"bottom", {0.0, -1.0}}, {"right", {1.0, 0.0}}, {"top", {0.0, 1.0}}, {"left", {-1.0, 0.0}}};
+  const std::map<std::string, Eigen::Vector3d> outward = {{"bottom", {0.0, -1.0, 0.0}},
+                                                          {"right", {1.0, 0.0, 0.0}},
+                                                          {"top", {0.0, 1.0, 0.0}},
+                                                          {"left", {-1.0, 0.0, 0.0}}};
   for (const auto& [name, expected] : outward) {
-    for (const Eigen::Vector2d& normal : boundary_node_normals(mesh_, mesh_.boundary(name))) {
+    for (const Eigen::Vector3d& normal : boundary_node_normals(mesh_, mesh_.boundary(name))) {
       EXPECT_NEAR((normal - expected).norm(), 0.0, 1e-15) << name;
     }
   }
@@ -201,12 +203,13 @@ TEST_P(RectangleMeshes, NormalsPointOutOfEverySide) {
 
 TEST_P(RectangleMeshes, LinearFieldGivesExactStressAndZeroError) {
   // u = (0.1 + 0.02 x - 0.01 y, -0.3 + 0.03 x + 0.04 y): strain (0.02, 0.04, 0.02).
-  const auto field = [](const Eigen::Vector2d& x) {
-    return Eigen::Vector2d(0.1 + 0.02 * x.x() - 0.01 * x.y(), -0.3 + 0.03 * x.x() + 0.04 * x.y());
+  const auto field = [](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d(0.1 + 0.02 * x.x() - 0.01 * x.y(), -0.3 + 0.03 * x.x() + 0.04 * x.y(),
+                           0.0);
   };
   Eigen::VectorXd displacement(2 * mesh_.node_count());
   for (std::size_t i = 0; i < mesh_.node_count(); ++i) {
-    displacement.segment<2>(2 * i) = field(mesh_.nodes[i]);
+    displacement.segment<2>(2 * i) = field(mesh_.nodes[i]).head<2>();
   }
   const Eigen::Vector3d exact = material_.stiffness * Eigen::Vector3d(0.02, 0.04, 0.02);
   const StressField stress = recover_stress(mesh_, material_, displacement);
@@ -225,7 +228,7 @@ TEST_P(RectangleMeshes, LinearFieldGivesExactStressAndZeroError) {
   // u_h = 0 against u = (x^2, 0) on [-1, 2] x [0.5, 2.5]: ||u||^2 = (2^5 + 1) / 5 * 2.
   const double error = l2_displacement_error(
       mesh_, Eigen::VectorXd::Zero(displacement.size()),
-      [](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x() * x.x(), 0.0); });
+      [](const Eigen::Vector3d& x) { return Eigen::Vector3d(x.x() * x.x(), 0.0, 0.0); });
   EXPECT_NEAR(error, std::sqrt(33.0 / 5.0 * 2.0), 1e-12);
 }
 
@@ -239,7 +242,7 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, RectangleMeshes,
 TEST(Loads, LinearBodyForceOnTheUnitTriangleByHand) {
   // b = (x, 0): f_i = int N_i x with N = (1 - x - y, x, y): (1/24, 1/12, 1/24).
   const Eigen::VectorXd load = assemble_body_force(
-      unit_triangle(), [](const Eigen::Vector2d& x) { return Eigen::Vector2d(x.x(), 0.0); });
+      unit_triangle(), [](const Eigen::Vector3d& x) { return Eigen::Vector3d(x.x(), 0.0, 0.0); });
   EXPECT_NEAR(load(0), 1.0 / 24.0, 1e-15);
   EXPECT_NEAR(load(2), 1.0 / 12.0, 1e-15);
   EXPECT_NEAR(load(4), 1.0 / 24.0, 1e-15);
@@ -271,20 +274,20 @@ TEST(Normals, ClockwiseGmshTriangleHasOutwardNormalsOnEachSide) {
         read_gmsh_mesh(data_directory / "mesh_clockwise.geo", {.element_order = order});
     const BoundaryGroup& boundary = mesh.boundary("boundary");
     const std::vector<int> nodes = boundary.nodes();
-    const std::vector<Eigen::Vector2d> normals = boundary_node_normals(mesh, boundary);
+    const std::vector<Eigen::Vector3d> normals = boundary_node_normals(mesh, boundary);
     int checked = 0;
     for (std::size_t k = 0; k < nodes.size(); ++k) {
-      const Eigen::Vector2d& x = mesh.nodes[nodes[k]];
-      Eigen::Vector2d expected;
-      if (x.norm() < 1e-12 || (x - Eigen::Vector2d(0, 1.5)).norm() < 1e-12 ||
-          (x - Eigen::Vector2d(2, 0)).norm() < 1e-12) {
+      const Eigen::Vector3d& x = mesh.nodes[nodes[k]];
+      Eigen::Vector3d expected;
+      if (x.norm() < 1e-12 || (x - Eigen::Vector3d(0, 1.5, 0.0)).norm() < 1e-12 ||
+          (x - Eigen::Vector3d(2, 0, 0.0)).norm() < 1e-12) {
         continue;
       } else if (std::abs(x.x()) < 1e-12) {
-        expected = {-1.0, 0.0};
+        expected = {-1.0, 0.0, 0.0};
       } else if (std::abs(x.y()) < 1e-12) {
-        expected = {0.0, -1.0};
+        expected = {0.0, -1.0, 0.0};
       } else {
-        expected = {0.6, 0.8};
+        expected = {0.6, 0.8, 0.0};
       }
       EXPECT_NEAR((normals[k] - expected).norm(), 0.0, 1e-12) << x.transpose();
       ++checked;
@@ -297,15 +300,15 @@ TEST(Normals, CornerOfTwoSidesInOneGroupAveragesByLength) {
   // Group "corner": the bottom edge (0,0)-(2,0) and the right edge (2,0)-(2,1) of one
   // triangle; the shared node gets (2 (0, -1) + 1 (1, 0)) / |...| = (1, -2) / sqrt(5).
   Mesh mesh;
-  mesh.nodes = {{0.0, 0.0}, {2.0, 0.0}, {2.0, 1.0}};
+  mesh.nodes = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {2.0, 1.0, 0.0}};
   mesh.node_tags = {1, 2, 3};
   mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
   mesh.boundaries["corner"] = {FacetType::line2, {0, 1, 1, 2}};
-  const std::vector<Eigen::Vector2d> normals = boundary_node_normals(mesh, mesh.boundary("corner"));
+  const std::vector<Eigen::Vector3d> normals = boundary_node_normals(mesh, mesh.boundary("corner"));
   ASSERT_EQ(normals.size(), 3u);
-  EXPECT_NEAR((normals[0] - Eigen::Vector2d(0.0, -1.0)).norm(), 0.0, 1e-15);
-  EXPECT_NEAR((normals[1] - Eigen::Vector2d(1.0, -2.0) / std::sqrt(5.0)).norm(), 0.0, 1e-15);
-  EXPECT_NEAR((normals[2] - Eigen::Vector2d(1.0, 0.0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((normals[0] - Eigen::Vector3d(0.0, -1.0, 0.0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((normals[1] - Eigen::Vector3d(1.0, -2.0, 0.0) / std::sqrt(5.0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((normals[2] - Eigen::Vector3d(1.0, 0.0, 0.0)).norm(), 0.0, 1e-15);
 }
 
 TEST(Errors, InvertedElementAndDetachedEdgeAreInputErrors) {
@@ -314,7 +317,7 @@ TEST(Errors, InvertedElementAndDetachedEdgeAreInputErrors) {
   const Material material = make_isotropic_material(1.0, 0.3, PlaneModel::plane_strain, "m");
   EXPECT_THROW(assemble_stiffness(mesh, material), InputError);
   Mesh detached = unit_triangle();
-  detached.nodes.push_back({5.0, 5.0});
+  detached.nodes.push_back({5.0, 5.0, 0.0});
   detached.node_tags.push_back(4);
   detached.boundaries["far"] = {FacetType::line2, {2, 3}};
   try {

@@ -21,10 +21,10 @@ BodyDefinition block(bool supported_bottom) {
   body.name = "block";
   body.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 8, 4, ElementType::quadrilateral4);
   body.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "block");
-  body.dirichlet.push_back({"left", 0.0, std::nullopt});
-  body.dirichlet.push_back({"right", 0.0, std::nullopt});
-  if (supported_bottom) body.dirichlet.push_back({"bottom", std::nullopt, 0.0});
-  body.body_force = Eigen::Vector2d(0.0, -3.0);
+  body.dirichlet.push_back({"left", 0.0, std::nullopt, std::nullopt});
+  body.dirichlet.push_back({"right", 0.0, std::nullopt, std::nullopt});
+  if (supported_bottom) body.dirichlet.push_back({"bottom", std::nullopt, 0.0, std::nullopt});
+  body.body_force = Eigen::Vector3d(0.0, -3.0, 0.0);
   body.contact_boundaries.push_back(supported_bottom ? "top" : "bottom");
   return body;
 }
@@ -35,7 +35,7 @@ TEST(FloatingBodySolver, RestingOnARigidObstacleEqualsTheSupportedBody) {
   BodySolver floating(block(false), options);
   ASSERT_EQ(floating.rigid_mode_count(), 1);
   const std::vector<int> nodes = floating.mesh().boundary("bottom").nodes();
-  const std::vector<Eigen::Vector2d> normals(nodes.size(), Eigen::Vector2d(0.0, -1.0));
+  const std::vector<Eigen::Vector3d> normals(nodes.size(), Eigen::Vector3d(0.0, -1.0, 0.0));
   const std::vector<double> weights(nodes.size(), 1.0);
   floating.assign_contact(node_to_node_operator(nodes, normals, weights));
   MprgpParameters parameters;

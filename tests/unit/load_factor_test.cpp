@@ -98,11 +98,11 @@ BodyDefinition loaded_block(double factor) {
   definition.name = "block";
   definition.mesh = mesh;
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
-  definition.dirichlet.push_back({"bottom", 0.002 * factor, 0.01 * factor});
-  definition.body_force = Eigen::Vector2d(0.0, -5.0 * factor);
+  definition.dirichlet.push_back({"bottom", 0.002 * factor, 0.01 * factor, std::nullopt});
+  definition.body_force = Eigen::Vector3d(0.0, -5.0 * factor, 0.0);
   TractionCondition traction;
   traction.boundary = "right";
-  traction.vector = Eigen::Vector2d(1.0 * factor, 2.0 * factor);
+  traction.vector = Eigen::Vector3d(1.0 * factor, 2.0 * factor, 0.0);
   definition.tractions.push_back(traction);
   TractionCondition pressure;
   pressure.boundary = "left";
@@ -121,7 +121,7 @@ TEST(BodySolverLoadFactor, EqualsTheBodyWrittenWithScaledLoads) {
   BodySolver stepped(loaded_block(1.0));
   const InterfaceDescription interface = stepped.contact_boundary();
   const ContactOperator contact = node_to_node_operator(
-      interface.node_ids, std::vector<Eigen::Vector2d>(interface.node_ids.size(), {0.0, 1.0}),
+      interface.node_ids, std::vector<Eigen::Vector3d>(interface.node_ids.size(), {0.0, 1.0, 0.0}),
       interface.weights);
   stepped.assign_contact(contact);
   const Eigen::VectorXd force = Eigen::VectorXd::LinSpaced(stepped.contact_size(), 0.5, 1.5);

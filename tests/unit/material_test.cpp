@@ -94,13 +94,14 @@ TEST(Material, VoigtMatrixMustBeSymmetricPositiveDefinite) {
 
 TEST(Material, VonMisesOfClassicalStates) {
   // Uniaxial tension: sigma; pure shear tau: sqrt(3) tau; hydrostatic: 0.
-  EXPECT_NEAR(von_mises(Eigen::Vector3d(5.0, 0.0, 0.0), 0.0), 5.0, 1e-14);
-  EXPECT_NEAR(von_mises(Eigen::Vector3d(0.0, 0.0, 2.0), 0.0), 2.0 * std::sqrt(3.0), 1e-14);
-  EXPECT_NEAR(von_mises(Eigen::Vector3d(-4.0, -4.0, 0.0), -4.0), 0.0, 1e-14);
+  // (XX, YY, ZZ, XY, YZ, XZ)
+  EXPECT_NEAR(von_mises(StressTensor{5.0, 0.0, 0.0, 0.0, 0.0, 0.0}), 5.0, 1e-14);
+  EXPECT_NEAR(von_mises(StressTensor{0.0, 0.0, 0.0, 2.0, 0.0, 0.0}), 2.0 * std::sqrt(3.0), 1e-14);
+  EXPECT_NEAR(von_mises(StressTensor{-4.0, -4.0, -4.0, 0.0, 0.0, 0.0}), 0.0, 1e-14);
   // Plane strain, nu = 0.3: s = (1, 1, 0) gives s_zz = 0.6 and
   // sqrt(((1 - 1)^2 + (1 - 0.6)^2 + (0.6 - 1)^2) / 2) = 0.4.
   const Material strain = make_isotropic_material(1.0, 0.3, PlaneModel::plane_strain, "m");
-  EXPECT_NEAR(out_of_plane_stress(strain, Eigen::Vector3d(1.0, 1.0, 0.0)), 0.6, 1e-15);
+  EXPECT_NEAR(stress_tensor(strain, Eigen::Vector3d(1.0, 1.0, 0.0))(2), 0.6, 1e-15);
   EXPECT_NEAR(von_mises(strain, Eigen::Vector3d(1.0, 1.0, 0.0)), 0.4, 1e-14);
   // Plane stress: s_zz = 0, equal biaxial stress 1 gives 1.
   const Material stress = make_isotropic_material(1.0, 0.3, PlaneModel::plane_stress, "m");

@@ -28,8 +28,8 @@ double twice_signed_area(const Mesh& mesh, const ElementBlock& block, std::size_
   const int corners = block.type == ElementType::quadrilateral4 ? 4 : 3;
   double sum = 0.0;
   for (int i = 0; i < corners; ++i) {
-    const Eigen::Vector2d& a = mesh.nodes[block.connectivity[e * count + i]];
-    const Eigen::Vector2d& b = mesh.nodes[block.connectivity[e * count + (i + 1) % corners]];
+    const Eigen::Vector3d& a = mesh.nodes[block.connectivity[e * count + i]];
+    const Eigen::Vector3d& b = mesh.nodes[block.connectivity[e * count + (i + 1) % corners]];
     sum += a.x() * b.y() - b.x() * a.y();
   }
   return sum;
@@ -67,19 +67,19 @@ std::set<std::string> boundary_names(const Mesh& mesh) {
 }
 
 /// Node tag -> coordinates from the $Nodes section of a .msh 2.2 file, parsed here.
-std::map<std::size_t, Eigen::Vector2d> nodes_of_msh22(const std::filesystem::path& path) {
+std::map<std::size_t, Eigen::Vector3d> nodes_of_msh22(const std::filesystem::path& path) {
   std::ifstream stream(path);
   std::string line;
   while (std::getline(stream, line) && line != "$Nodes") {
   }
   std::size_t count = 0;
   stream >> count;
-  std::map<std::size_t, Eigen::Vector2d> nodes;
+  std::map<std::size_t, Eigen::Vector3d> nodes;
   for (std::size_t k = 0; k < count; ++k) {
     std::size_t tag = 0;
     double x = 0, y = 0, z = 0;
     stream >> tag >> x >> y >> z;
-    nodes[tag] = {x, y};
+    nodes[tag] = {x, y, 0.0};
   }
   return nodes;
 }
@@ -101,7 +101,7 @@ void expect_unit_square_with_named_sides(const Mesh& mesh) {
   for (const auto& [name, group] : mesh.boundaries) {
     EXPECT_NEAR(boundary_length(mesh, group), 1.0, 1e-12) << name;
   }
-  for (const Eigen::Vector2d& node : mesh.nodes) {
+  for (const Eigen::Vector3d& node : mesh.nodes) {
     EXPECT_TRUE(node.x() >= 0.0 && node.x() <= 1.0 && node.y() >= 0.0 && node.y() <= 1.0);
   }
 }
@@ -112,7 +112,7 @@ TEST(MeshReader, ReadsMsh22WithTagsCoordinatesAndBoundaries) {
   ASSERT_EQ(mesh.blocks.size(), 1u);
   EXPECT_EQ(mesh.blocks[0].type, ElementType::triangle3);
   expect_unit_square_with_named_sides(mesh);
-  const std::map<std::size_t, Eigen::Vector2d> file_nodes = nodes_of_msh22(path);
+  const std::map<std::size_t, Eigen::Vector3d> file_nodes = nodes_of_msh22(path);
   ASSERT_EQ(mesh.node_count(), file_nodes.size());
   for (std::size_t i = 0; i < mesh.node_count(); ++i) {
     ASSERT_EQ(file_nodes.count(mesh.node_tags[i]), 1u);
@@ -130,7 +130,7 @@ TEST(MeshReader, Msh41GivesTheSameMeshAsMsh22) {
   expect_unit_square_with_named_sides(new_format);
   ASSERT_EQ(new_format.node_count(), old_format.node_count());
   EXPECT_EQ(new_format.element_count(), old_format.element_count());
-  std::map<std::size_t, Eigen::Vector2d> old_nodes;
+  std::map<std::size_t, Eigen::Vector3d> old_nodes;
   for (std::size_t i = 0; i < old_format.node_count(); ++i) {
     old_nodes[old_format.node_tags[i]] = old_format.nodes[i];
   }
@@ -209,7 +209,7 @@ TEST(MeshReader, SecondOrderGivesTriangle6WithGmshMidpointOrder) {
   for (std::size_t e = 0; e < block.element_count(); ++e) {
     const int* nodes = &block.connectivity[6 * e];
     for (const auto& [middle, a, b] : {std::tuple{3, 0, 1}, {4, 1, 2}, {5, 2, 0}}) {
-      const Eigen::Vector2d expected = 0.5 * (mesh.nodes[nodes[a]] + mesh.nodes[nodes[b]]);
+      const Eigen::Vector3d expected = 0.5 * (mesh.nodes[nodes[a]] + mesh.nodes[nodes[b]]);
       EXPECT_NEAR((mesh.nodes[nodes[middle]] - expected).norm(), 0.0, 1e-12);
     }
   }
@@ -217,7 +217,7 @@ TEST(MeshReader, SecondOrderGivesTriangle6WithGmshMidpointOrder) {
   ASSERT_EQ(boundary.type, FacetType::line3);
   for (std::size_t e = 0; e < boundary.facet_count(); ++e) {
     const int* nodes = &boundary.connectivity[3 * e];
-    const Eigen::Vector2d expected = 0.5 * (mesh.nodes[nodes[0]] + mesh.nodes[nodes[1]]);
+    const Eigen::Vector3d expected = 0.5 * (mesh.nodes[nodes[0]] + mesh.nodes[nodes[1]]);
     EXPECT_NEAR((mesh.nodes[nodes[2]] - expected).norm(), 0.0, 1e-12);
   }
 }
@@ -302,7 +302,7 @@ TEST(MeshReader, HandWrittenMeshIsCompactedAndReoriented) {
   const Mesh mesh = read_gmsh_mesh(directory.write("hand.msh", small_msh22(7)));
   ASSERT_EQ(mesh.node_count(), 4u);  // node 9 is in no element
   EXPECT_EQ(mesh.node_tags, (std::vector<std::size_t>{1, 2, 3, 4}));
-  EXPECT_EQ(mesh.nodes[1], Eigen::Vector2d(2.0, 0.0));
+  EXPECT_EQ(mesh.nodes[1], Eigen::Vector3d(2.0, 0.0, 0.0));
   ASSERT_EQ(mesh.blocks.size(), 1u);
   // Both triangles, (1, 3, 2) and (2, 3, 4), are clockwise, like their surface: each is
   // reordered, to (1, 2, 3) and (2, 4, 3).

@@ -26,19 +26,19 @@ InterfaceDescription straight_boundary(const Eigen::Vector2d& start, const Eigen
   for (int i = 0; i <= count; ++i) {
     side.node_ids.push_back(first_id + i);
     side.node_tags.push_back(static_cast<std::size_t>(first_id + i + 1));
-    side.coordinates.push_back(start + (end - start) * (static_cast<double>(i) / count));
-    side.normals.push_back(outward);
+    const Eigen::Vector2d point = start + (end - start) * (static_cast<double>(i) / count);
+    side.coordinates.emplace_back(point.x(), point.y(), 0.0);
+    side.normals.emplace_back(outward.x(), outward.y(), 0.0);
     side.weights.push_back(i == 0 || i == count ? 0.5 * length : length);
-    side.x_fixed.push_back(false);
-    side.y_fixed.push_back(false);
+    side.fixed.push_back({false, false, false});
   }
   const Eigen::Vector2d tangent = (end - start).normalized();
   const bool body_on_left = Eigen::Vector2d(tangent.y(), -tangent.x()).dot(outward) > 0.0;
   side.surfaces.emplace_back();
   side.surfaces.back().boundary = "contact";
   for (int i = 0; i < count; ++i) {
-    side.surfaces.back().segments.push_back(body_on_left ? i : i + 1);
-    side.surfaces.back().segments.push_back(body_on_left ? i + 1 : i);
+    side.surfaces.back().facets.push_back(body_on_left ? i : i + 1);
+    side.surfaces.back().facets.push_back(body_on_left ? i + 1 : i);
   }
   return side;
 }
@@ -232,8 +232,8 @@ TEST(MortarCoupling, ANonMortarNodeWithPrescribedNormalDisplacementIsExcluded) {
   // The lower edge's first node is clamped (u_x and u_y prescribed), its second has only u_x
   // prescribed, which leaves its normal (y) displacement free.
   InterfaceDescription lower = lower_edge(0.0, 1.0, 4);
-  lower.x_fixed[0] = lower.y_fixed[0] = true;
-  lower.x_fixed[1] = true;
+  lower.fixed[0][0] = lower.fixed[0][1] = true;
+  lower.fixed[1][0] = true;
   const InterfaceDescription upper = upper_edge(0.0, 0.0, 1.0, 0.0, 3);
   MortarOptions options;
   options.non_mortar_body = 0;

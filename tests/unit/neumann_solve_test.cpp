@@ -28,10 +28,10 @@ CaseDefinition two_blocks() {
 BodyDefinition loaded_body(const BodyCase& body_case) {
   // load_body reads the mesh (the case file leaves definition.mesh empty until then).
   BodyDefinition definition = load_body(body_case);
-  definition.body_force = Eigen::Vector2d(3.0, -20.0);
+  definition.body_force = Eigen::Vector3d(3.0, -20.0, 0.0);
   TractionCondition traction;
   traction.boundary = "right";
-  traction.vector = Eigen::Vector2d(-4.0, 1.5);
+  traction.vector = Eigen::Vector3d(-4.0, 1.5, 0.0);
   definition.tractions.push_back(traction);
   return definition;
 }
@@ -39,7 +39,7 @@ BodyDefinition loaded_body(const BodyCase& body_case) {
 /// Contact nodes with the normal to use at each (pair order), as the 1.x assignment held them.
 struct NodeNormals {
   std::vector<int> node_ids;
-  std::vector<Eigen::Vector2d> normals;
+  std::vector<Eigen::Vector3d> normals;
   std::vector<double> weights;
 };
 
@@ -60,7 +60,7 @@ Eigen::VectorXd normal_trace(const Eigen::VectorXd& displacement, const NodeNorm
   for (std::size_t i = 0; i < assignment.node_ids.size(); ++i) {
     const int node = assignment.node_ids[i];
     trace[static_cast<Eigen::Index>(i)] =
-        displacement.segment<2>(2 * node).dot(assignment.normals[i]);
+        displacement.segment<2>(2 * node).dot(assignment.normals[i].head<2>());
   }
   return trace;
 }
@@ -82,9 +82,9 @@ TEST(NeumannSolve, EqualsTheNormalTraceOfTheDisplacement) {
   const CaseDefinition definition = two_blocks();
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodyDefinition body_definition = loaded_body(definition.bodies[alpha]);
-    for (const auto& [kind, contact_last] :
-         {std::pair{InterfaceOperatorKind::dense, true}, std::pair{InterfaceOperatorKind::dense, false},
-          std::pair{InterfaceOperatorKind::factor, true}}) {
+    for (const auto& [kind, contact_last] : {std::pair{InterfaceOperatorKind::dense, true},
+                                             std::pair{InterfaceOperatorKind::dense, false},
+                                             std::pair{InterfaceOperatorKind::factor, true}}) {
       BodySolverOptions options;
       options.interface_operator = kind;
       options.contact_unknowns_last = contact_last;
@@ -95,10 +95,9 @@ TEST(NeumannSolve, EqualsTheNormalTraceOfTheDisplacement) {
           node_to_node_operator(assignment.node_ids, assignment.normals, assignment.weights));
       const Eigen::VectorXd force = varying_force(body.contact_size());
       const std::string label =
-          body.name() +
-          (kind == InterfaceOperatorKind::factor ? " (F through the factor)"
-           : contact_last                        ? " (dense F from the trailing block)"
-                                                 : " (dense F by blocked solves)");
+          body.name() + (kind == InterfaceOperatorKind::factor ? " (F through the factor)"
+                         : contact_last ? " (dense F from the trailing block)"
+                                        : " (dense F by blocked solves)");
 
       const Eigen::VectorXd trace = body.solve_neumann(force);
       const Eigen::VectorXd expected = normal_trace(body.displacement(force), assignment);

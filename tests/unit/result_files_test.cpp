@@ -27,8 +27,8 @@ using test::TemporaryDirectory;
 
 ContactPair make_pair(Eigen::Vector2d position, Eigen::Vector2d normal, double gap, double weight) {
   ContactPair pair;
-  pair.position = position;
-  pair.normal = normal;
+  pair.position << position, 0.0;
+  pair.normal << normal, 0.0;
   pair.gap = gap;
   pair.weight = weight;
   return pair;
@@ -64,7 +64,7 @@ TEST(ContactResultant, EqualsTheHandSumOfForcesAlongBodyOneNormals) {
   ContactPairing pairing;
   pairing.pairs = {make_pair({0, 0}, {0, 1}, 0, 1), make_pair({1, 0}, {0.6, 0.8}, 0, 1),
                    make_pair({2, 0}, {1, 0}, 0, 1)};
-  const Eigen::Vector2d resultant = contact_resultant(pairing, Eigen::Vector3d(1, 2, 3));
+  const Eigen::Vector3d resultant = contact_resultant(pairing, Eigen::Vector3d(1, 2, 3));
   // (0*1 + 0.6*2 + 1*3, 1*1 + 0.8*2 + 0*3)
   EXPECT_DOUBLE_EQ(resultant.x(), 4.2);
   EXPECT_DOUBLE_EQ(resultant.y(), 2.6);
@@ -81,7 +81,7 @@ TEST(ContactResultant, UniformPressureOnAFlatContactGivesPressureTimesLength) {
     pairing.pairs.push_back(make_pair({0.5 * i, 1.0}, {0, 1}, 0, weight));
     force[i] = pressure * weight;
   }
-  const Eigen::Vector2d resultant = contact_resultant(pairing, force);
+  const Eigen::Vector3d resultant = contact_resultant(pairing, force);
   EXPECT_DOUBLE_EQ(resultant.x(), 0.0);
   EXPECT_DOUBLE_EQ(resultant.y(), pressure * 2.0);
 }
@@ -213,7 +213,8 @@ struct CompressedBlock {
     body.name = "block";
     body.mesh = make_rectangle_mesh(0.0, 0.0, width, 1.0, 4, 2, ElementType::quadrilateral4);
     body.material = make_isotropic_material(young, poisson, model, "test");
-    body.dirichlet = {{"bottom", std::nullopt, 0.0}, {"left", 0.0, std::nullopt}};
+    body.dirichlet = {{"bottom", std::nullopt, 0.0, std::nullopt},
+                      {"left", 0.0, std::nullopt, std::nullopt}};
     body.contact_boundaries = {"top"};
     return body;
   }
@@ -237,7 +238,7 @@ TEST_P(BodyVtuModels, UniaxialCompressionFieldsReadByVtkMatchTheAnalyticSolution
   const InterfaceDescription top = body.contact_boundary();
   ASSERT_EQ(top.node_ids.size(), 5u);
   body.assign_contact(node_to_node_operator(
-      top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1)), top.weights));
+      top.node_ids, std::vector<Eigen::Vector3d>(5, Eigen::Vector3d(0, 1, 0)), top.weights));
   Eigen::VectorXd lambda(5);
   for (int i = 0; i < 5; ++i)
     lambda[i] = Block::pressure * Block::face_weight(top.coordinates[i].x());
@@ -321,7 +322,7 @@ TEST(BodyVtu, VoigtPlaneStrainMaterialHasNoOutOfPlaneStress) {
   BodySolver body(definition);
   const InterfaceDescription top = body.contact_boundary();
   body.assign_contact(node_to_node_operator(
-      top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1)), top.weights));
+      top.node_ids, std::vector<Eigen::Vector3d>(5, Eigen::Vector3d(0, 1, 0)), top.weights));
   Eigen::VectorXd lambda(5);
   for (int i = 0; i < 5; ++i)
     lambda[i] = Block::pressure * Block::face_weight(top.coordinates[i].x());
@@ -348,7 +349,7 @@ TEST(BodyVtu, ContactForceOfTheWrongSizeIsRejectedNamingTheFile) {
   BodySolver body(CompressedBlock::definition());
   const InterfaceDescription top = body.contact_boundary();
   body.assign_contact(node_to_node_operator(
-      top.node_ids, std::vector<Eigen::Vector2d>(5, Eigen::Vector2d(0, 1)), top.weights));
+      top.node_ids, std::vector<Eigen::Vector3d>(5, Eigen::Vector3d(0, 1, 0)), top.weights));
   const TemporaryDirectory directory("result_files");
   expect_error_naming([&] { write_body_vtu(directory.path(), body, Eigen::VectorXd::Zero(3)); },
                       {(directory.path() / "block.vtu").string(), "block", "5", "3"});

@@ -81,7 +81,7 @@ BodyDefinition lower_block_definition() {
   definition.name = "lower";
   definition.mesh = lower_mesh();
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
-  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  definition.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   definition.contact_boundaries = {"contact"};
   return definition;
 }
@@ -133,9 +133,9 @@ protocol::Envelope assign_request(std::uint64_t id, const ContactOperator& conta
 }
 
 ContactOperator assign_all(const InterfaceDescription& interface) {
-  return node_to_node_operator(interface.node_ids,
-                               std::vector<Eigen::Vector2d>(interface.node_ids.size(), {0.0, 1.0}),
-                               interface.weights);
+  return node_to_node_operator(
+      interface.node_ids, std::vector<Eigen::Vector3d>(interface.node_ids.size(), {0.0, 1.0, 0.0}),
+      interface.weights);
 }
 
 /// Every contact boundary node of `interface`, with the normal (0, 1), in ascending id order:
@@ -220,7 +220,7 @@ void expect_interface(const protocol::InterfaceDescription& message,
   EXPECT_EQ(surface.segment_type(), protocol::LINE2);
   ASSERT_EQ(surface.segments_size(), 40);
   EXPECT_EQ(std::vector<int>(surface.segments().begin(), surface.segments().end()),
-            expected.surfaces.at(0).segments);
+            expected.surfaces.at(0).facets);
   std::set<std::uint32_t> covered;
   double length = 0.0;
   for (int e = 0; e < 20; ++e) {
@@ -996,7 +996,7 @@ TEST(SubdomainServer, MeshPathOutsideTheDataDirectoryIsRefusedUnread) {
   definition.name = "square";
   definition.mesh = read_gmsh_mesh(square_msh);
   definition.material = make_isotropic_material(1000.0, 0.3, PlaneModel::plane_strain, "test");
-  definition.dirichlet.push_back({"bottom", 0.0, 0.0});
+  definition.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   definition.contact_boundaries = {"top"};
   const BodySolver reference(definition);
   const InterfaceDescription expected = reference.contact_boundary();
@@ -1390,7 +1390,7 @@ TEST(SubdomainServer, SetLoadFactorScalesTheLoadsAndKeepsTheStateAndF) {
   // The reference: the same body built directly, at factor 1 (the definition's values).
   BodyDefinition definition = lower_block_definition();
   definition.dirichlet[0].y = 0.01;
-  definition.body_force = {0.0, -5.0};
+  definition.body_force = {0.0, -5.0, 0.0};
   BodySolver reference(definition);
   const InterfaceDescription interface = reference.contact_boundary();
   reference.assign_contact(assign_all(interface));

@@ -49,8 +49,8 @@ double written_signed_area(const json& piece, std::size_t cell, int corners) {
 /// (2,0), (3,0), (2,1) with its edge midpoints.
 Mesh make_mixed_mesh() {
   Mesh mesh;
-  mesh.nodes = {{0, 0}, {1, 0}, {1, 1},   {0, 1},     {2, 0},
-                {2, 1}, {3, 0}, {2.5, 0}, {2.5, 0.5}, {2, 0.5}};
+  mesh.nodes = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0},   {0, 1, 0},     {2, 0, 0},
+                {2, 1, 0}, {3, 0, 0}, {2.5, 0, 0}, {2.5, 0.5, 0}, {2, 0.5, 0}};
   mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2, 0, 2, 3}, {}});
   mesh.blocks.push_back({ElementType::quadrilateral4, {1, 4, 5, 2}, {}});
   mesh.blocks.push_back({ElementType::triangle6, {4, 6, 5, 7, 8, 9}, {}});
@@ -63,7 +63,7 @@ TEST(VtuWriter, QuadrilateralRectangleWritesPointsCellsAndFields) {
   ASSERT_EQ(mesh.node_count(), 6u);
   OutputField temperature{"temperature", 1, {}};
   OutputField displacement{"displacement", 2, {}};
-  for (const Eigen::Vector2d& node : mesh.nodes) {
+  for (const Eigen::Vector3d& node : mesh.nodes) {
     temperature.values.push_back(node.x() + 10.0 * node.y());
     displacement.values.insert(displacement.values.end(), {node.x(), -node.y()});
   }
@@ -211,7 +211,7 @@ INSTANTIATE_TEST_SUITE_P(VtuWriter, VtuEncodings,
 TEST_P(VtuEncodings, NumbersRoundTripExactly) {
   const TemporaryDirectory directory("vtu_writer");
   Mesh mesh;
-  mesh.nodes = {{0.1, 0.7}, {1.0 / 3.0, -2.0 / 7.0}, {std::numbers::pi, 1e-17}};
+  mesh.nodes = {{0.1, 0.7, 0}, {1.0 / 3.0, -2.0 / 7.0, 0}, {std::numbers::pi, 1e-17, 0}};
   mesh.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
   const std::vector<double> values = {0.1,
                                       1.0 / 3.0,
@@ -334,7 +334,7 @@ struct QuadraticCase {
   OutputField point_field{"f", 3, {}};
   OutputField cell_field{"cell", 1, {}};
   QuadraticCase() {
-    for (const Eigen::Vector2d& node : mesh.nodes) {
+    for (const Eigen::Vector3d& node : mesh.nodes) {
       point_field.values.insert(
           point_field.values.end(),
           {node.x() + 2 * node.y(), node.x() * node.y(), node.x() * node.x()});
@@ -424,7 +424,7 @@ TEST(VtuWriter, CompressedArraysSpanSeveralBlocksAndAreSmallerThanText) {
   const TemporaryDirectory directory("vtu_writer");
   const Mesh mesh = make_rectangle_mesh(0.0, 0.0, 6.0, 4.0, 60, 40, ElementType::quadrilateral4);
   OutputField field{"sine", 1, {}};
-  for (const Eigen::Vector2d& node : mesh.nodes) {
+  for (const Eigen::Vector3d& node : mesh.nodes) {
     field.values.push_back(std::sin(node.x()) * std::cos(node.y()));
   }
   const auto binary = directory.path() / "binary.vtu";

@@ -102,10 +102,10 @@ Assembly uniaxial_stack(const std::vector<double>& youngs, double push) {
   const char* parts[] = {"bottom", "middle", "top"};
   for (int body = 0; body < 3; ++body) {
     BodyDefinition definition = stack_block(parts[body], youngs[static_cast<std::size_t>(body)]);
-    definition.dirichlet.push_back({"left", 0.0, std::nullopt});
-    definition.dirichlet.push_back({"right", 0.0, std::nullopt});
-    if (body == 0) definition.dirichlet.push_back({"bottom", 0.0, 0.0});
-    if (body == 2) definition.dirichlet.push_back({"top", std::nullopt, -push});
+    definition.dirichlet.push_back({"left", 0.0, std::nullopt, std::nullopt});
+    definition.dirichlet.push_back({"right", 0.0, std::nullopt, std::nullopt});
+    if (body == 0) definition.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
+    if (body == 2) definition.dirichlet.push_back({"top", std::nullopt, -push, std::nullopt});
     if (body < 2) definition.contact_boundaries.push_back("top");
     if (body > 0) definition.contact_boundaries.push_back("bottom");
     definitions.push_back(std::move(definition));
@@ -282,19 +282,19 @@ TEST(FloatingBody, StackOfThreeRobinEqualsTheSeriesSpringsAndTheMonolithicSoluti
 
 /// A floating block [0, 1] x [1, 2] (u_x = 0 on its left side only, body force (b_x, b_y)) on a
 /// block [0, 1] x [0, 1] clamped at its bottom.
-Assembly block_on_block(const Eigen::Vector2d& body_force, bool left_support) {
+Assembly block_on_block(const Eigen::Vector3d& body_force, bool left_support) {
   BodyDefinition base = stack_block("bottom", 1000.0);
-  base.dirichlet.push_back({"bottom", 0.0, 0.0});
+  base.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   base.contact_boundaries.push_back("top");
   BodyDefinition floating = stack_block("middle", 300.0);
-  if (left_support) floating.dirichlet.push_back({"left", 0.0, std::nullopt});
+  if (left_support) floating.dirichlet.push_back({"left", 0.0, std::nullopt, std::nullopt});
   floating.body_force = body_force;
   floating.contact_boundaries.push_back("bottom");
   return couple_stack({base, floating});
 }
 
 TEST(FloatingBody, BlockWithBodyForceOnAClampedBlockRobinEqualsMonolithicInEquilibrium) {
-  const Eigen::Vector2d body_force(4.0, -10.0);  // tilts the block: a genuine 2D contact state
+  const Eigen::Vector3d body_force(4.0, -10.0, 0.0);  // tilts the block: a genuine 2D contact state
   const Assembly assembly = block_on_block(body_force, true);
   ASSERT_EQ(assembly.problem.rigid_modes, (std::vector<int>{0, 1}));
   const MonolithicAssembly reference = solve_monolithic_assembly(assembly);
@@ -326,7 +326,7 @@ TEST(FloatingBody, BlockWithBodyForceOnAClampedBlockRobinEqualsMonolithicInEquil
 /// clamped on its right side) and a bottom ([1, 2] x [-1, 0], clamped at its bottom), pushed
 /// down and to the right by a body force. Contact holds all three motions (the rotation by the
 /// bottom and the walls together).
-Assembly block_in_a_cup(const Eigen::Vector2d& body_force) {
+Assembly block_in_a_cup(const Eigen::Vector3d& body_force) {
   const auto read = [](const std::string& name, const std::string& file, double young) {
     BodyDefinition body;
     body.name = name;
@@ -335,23 +335,23 @@ Assembly block_in_a_cup(const Eigen::Vector2d& body_force) {
     return body;
   };
   BodyDefinition left = read("left wall", "row_block_left.geo", 1000.0);
-  left.dirichlet.push_back({"left", 0.0, 0.0});
+  left.dirichlet.push_back({"left", 0.0, 0.0, std::nullopt});
   left.contact_boundaries = {"right"};
   BodyDefinition floating = read("block", "row_block_middle.geo", 300.0);
   floating.body_force = body_force;
   floating.contact_boundaries = {"left", "right", "bottom"};
   BodyDefinition right = read("right wall", "row_block_right.geo", 1000.0);
-  right.dirichlet.push_back({"right", 0.0, 0.0});
+  right.dirichlet.push_back({"right", 0.0, 0.0, std::nullopt});
   right.contact_boundaries = {"left"};
   BodyDefinition bottom = read("bottom", "cup_bottom.geo", 2000.0);
-  bottom.dirichlet.push_back({"bottom", 0.0, 0.0});
+  bottom.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   bottom.contact_boundaries = {"top"};
   return couple({left, floating, right, bottom},
                 {{0, 1, "right", "left"}, {1, 2, "right", "left"}, {3, 1, "top", "bottom"}});
 }
 
 TEST(FloatingBody, UnsupportedBlockInACupRobinEqualsMonolithicInEquilibrium) {
-  const Eigen::Vector2d body_force(2.0, -5.0);
+  const Eigen::Vector3d body_force(2.0, -5.0, 0.0);
   const Assembly cup = block_in_a_cup(body_force);
   ASSERT_EQ(cup.problem.rigid_modes, (std::vector<int>{0, 3, 0, 0}));
   const MonolithicAssembly reference = solve_monolithic_assembly(cup);
@@ -361,11 +361,12 @@ TEST(FloatingBody, UnsupportedBlockInACupRobinEqualsMonolithicInEquilibrium) {
   const Eigen::VectorXd force = cup.problem.graph.body_part(1, reference.result.contact_force);
   const Eigen::VectorXd field = reference.bodies[1]->contact_force_field(force);
   const Mesh& mesh = reference.bodies[1]->mesh();
-  Eigen::Vector2d resultant = Eigen::Vector2d::Zero();
+  Eigen::Vector3d resultant = Eigen::Vector3d::Zero();
   double moment = 0.0;
   for (std::size_t node = 0; node < mesh.node_count(); ++node) {
-    const Eigen::Vector2d nodal = field.segment<2>(2 * static_cast<Eigen::Index>(node));
-    const Eigen::Vector2d arm = mesh.nodes[node] - Eigen::Vector2d(1.5, 0.5);
+    const Eigen::Vector3d nodal(field[2 * static_cast<Eigen::Index>(node)],
+                                field[2 * static_cast<Eigen::Index>(node) + 1], 0.0);
+    const Eigen::Vector3d arm = mesh.nodes[node] - Eigen::Vector3d(1.5, 0.5, 0.0);
     resultant += nodal;
     moment += arm.x() * nodal.y() - arm.y() * nodal.x();
   }
@@ -395,7 +396,7 @@ std::string singular_body_message(Action action) {
 }
 
 TEST(FloatingBody, BlockPulledAwayFromItsOnlyContactIsRefused) {
-  const Assembly assembly = block_on_block(Eigen::Vector2d(0.0, 10.0), true);  // pulled up
+  const Assembly assembly = block_on_block(Eigen::Vector3d(0.0, 10.0, 0.0), true);  // pulled up
   BodySolver floating(assembly.definitions[1], floating_allowed());
   const std::string message =
       singular_body_message([&] { floating.assign_contact(assembly.operators[1]); });
@@ -405,7 +406,7 @@ TEST(FloatingBody, BlockPulledAwayFromItsOnlyContactIsRefused) {
 }
 
 TEST(FloatingBody, BlockThatCanSlideAlongAFlatInterfaceIsRefused) {
-  const Assembly assembly = block_on_block(Eigen::Vector2d(0.0, -10.0), false);  // no support
+  const Assembly assembly = block_on_block(Eigen::Vector3d(0.0, -10.0, 0.0), false);  // no support
   ASSERT_EQ(assembly.problem.rigid_modes[1], 3);
   BodySolver floating(assembly.definitions[1], floating_allowed());
   const std::string message =
@@ -416,7 +417,7 @@ TEST(FloatingBody, BlockThatCanSlideAlongAFlatInterfaceIsRefused) {
 }
 
 TEST(FloatingBody, WithoutTheOptionAFloatingBodyIsStillRefusedAtSetup) {
-  const Assembly assembly = block_on_block(Eigen::Vector2d(0.0, -10.0), true);
+  const Assembly assembly = block_on_block(Eigen::Vector3d(0.0, -10.0, 0.0), true);
   const std::string message = singular_body_message([&] { BodySolver(assembly.definitions[1]); });
   EXPECT_NE(message.find("leave a rigid motion free"), std::string::npos) << message;
 }
@@ -452,7 +453,7 @@ TEST(FloatingBody, SchemesThatWouldNeedAFloatingBodysNeumannResponseAreRefused) 
   triangle.gaps = triangle.weights = Eigen::VectorXd::Ones(3);
   EXPECT_NE(scheme_refusal(robin, triangle).find("odd cycle"), std::string::npos);
 
-  const Assembly pair = block_on_block(Eigen::Vector2d(0.0, -10.0), true);
+  const Assembly pair = block_on_block(Eigen::Vector3d(0.0, -10.0, 0.0), true);
   CouplingOptions dirichlet_neumann;
   dirichlet_neumann.algorithm = "dirichlet-neumann";
   dirichlet_neumann.contact_body = "1";  // the clamped block: the floating one would be Neumann
@@ -466,7 +467,7 @@ TEST(FloatingBody, SchemesThatWouldNeedAFloatingBodysNeumannResponseAreRefused) 
 }
 
 TEST(FloatingBody, DirichletNeumannWithTheFloatingContactBodyEqualsMonolithic) {
-  const Assembly assembly = block_on_block(Eigen::Vector2d(4.0, -10.0), true);
+  const Assembly assembly = block_on_block(Eigen::Vector3d(4.0, -10.0, 0.0), true);
   const MonolithicAssembly reference = solve_monolithic_assembly(assembly);
   ASSERT_EQ(reference.result.qp.status, QpStatus::converged);
   Ports ports;
@@ -485,7 +486,7 @@ TEST(FloatingBody, DirichletNeumannWithTheFloatingContactBodyEqualsMonolithic) {
 }
 
 TEST(FloatingBody, RobinConstantRunsWithAFloatingBody) {
-  const Assembly assembly = block_on_block(Eigen::Vector2d(4.0, -10.0), true);
+  const Assembly assembly = block_on_block(Eigen::Vector3d(4.0, -10.0, 0.0), true);
   const MonolithicAssembly reference = solve_monolithic_assembly(assembly);
   Ports ports;
   set_up_ports(assembly, ports);

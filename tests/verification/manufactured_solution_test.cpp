@@ -26,14 +26,15 @@ const std::filesystem::path data_directory = ROBIN_TEST_DATA;
 
 constexpr double a = 1.3, b = 0.9, c = 0.8, d = 1.1;
 
-Eigen::Vector2d exact_displacement(const Eigen::Vector2d& x) {
-  return {std::sin(a * x.x()) * std::cos(b * x.y()), std::cos(c * x.x()) * std::sin(d * x.y())};
+Eigen::Vector3d exact_displacement(const Eigen::Vector3d& x) {
+  return {std::sin(a * x.x()) * std::cos(b * x.y()), std::cos(c * x.x()) * std::sin(d * x.y()),
+          0.0};
 }
 
 /// b = -div sigma with sigma = C (u1_x, u2_y, u1_y + u2_x). With s = C e:
 ///   (div sigma)_x = d_x s_xx + d_y s_xy,   (div sigma)_y = d_x s_xy + d_y s_yy,
 /// where d_x e = (u1_xx, u2_xy, u1_xy + u2_xx) and d_y e = (u1_xy, u2_yy, u1_yy + u2_xy).
-Eigen::Vector2d body_force(const Eigen::Matrix3d& stiffness, const Eigen::Vector2d& x) {
+Eigen::Vector3d body_force(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& x) {
   const double sin_ax = std::sin(a * x.x()), cos_ax = std::cos(a * x.x());
   const double sin_by = std::sin(b * x.y()), cos_by = std::cos(b * x.y());
   const double sin_cx = std::sin(c * x.x()), cos_cx = std::cos(c * x.x());
@@ -48,7 +49,7 @@ Eigen::Vector2d body_force(const Eigen::Matrix3d& stiffness, const Eigen::Vector
   const double u2_yy = -d * d * cos_cx * sin_dy;
   const Eigen::Vector3d stress_x = stiffness * Eigen::Vector3d(u1_xx, u2_xy, u1_xy + u2_xx);
   const Eigen::Vector3d stress_y = stiffness * Eigen::Vector3d(u1_xy, u2_yy, u1_yy + u2_xy);
-  return -Eigen::Vector2d(stress_x(0) + stress_y(2), stress_x(2) + stress_y(1));
+  return -Eigen::Vector3d(stress_x(0) + stress_y(2), stress_x(2) + stress_y(1), 0.0);
 }
 
 /// L2 error of the finite-element solution with u prescribed on every boundary node.
@@ -56,7 +57,7 @@ double solve_and_measure(const Mesh& mesh, const Material& material) {
   std::vector<std::optional<double>> prescribed(2 * mesh.node_count());
   for (const auto& [name, group] : mesh.boundaries) {
     for (const int node : group.nodes()) {
-      const Eigen::Vector2d value = exact_displacement(mesh.nodes[node]);
+      const Eigen::Vector3d value = exact_displacement(mesh.nodes[node]);
       prescribed[2 * node] = value.x();
       prescribed[2 * node + 1] = value.y();
     }
@@ -64,7 +65,7 @@ double solve_and_measure(const Mesh& mesh, const Material& material) {
   const DofMap dofs(prescribed);
   const SparseMatrix stiffness = assemble_stiffness(mesh, material);
   const Eigen::VectorXd load = assemble_body_force(
-      mesh, [&](const Eigen::Vector2d& x) { return body_force(material.stiffness, x); });
+      mesh, [&](const Eigen::Vector3d& x) { return body_force(material.stiffness, x); });
   // K_ff u_f = f_f - K_fp u_p
   Eigen::SimplicialLDLT<SparseMatrix> factorization(dofs.reduce_matrix(stiffness));
   EXPECT_EQ(factorization.info(), Eigen::Success);

@@ -36,11 +36,11 @@ BodyDefinition row_block(const std::string& side, double young) {
   body.name = side;
   body.mesh = read_gmsh_mesh(data / ("row_block_" + side + ".geo"), {0.0625, 1, false});
   body.material = make_isotropic_material(young, 0.3, PlaneModel::plane_strain, side);
-  body.dirichlet.push_back({"bottom", 0.0, 0.0});
+  body.dirichlet.push_back({"bottom", 0.0, 0.0, std::nullopt});
   const double pressure = 1.0;
-  if (side == "left") body.tractions.push_back({"left", true, Eigen::Vector2d::Zero(), pressure});
+  if (side == "left") body.tractions.push_back({"left", true, Eigen::Vector3d::Zero(), pressure});
   if (side == "right") {
-    body.tractions.push_back({"right", true, Eigen::Vector2d::Zero(), pressure});
+    body.tractions.push_back({"right", true, Eigen::Vector3d::Zero(), pressure});
   }
   if (side != "right") body.contact_boundaries.push_back("right");
   if (side != "left") body.contact_boundaries.push_back("left");
@@ -171,7 +171,7 @@ TEST(ManyBodies, MonolithicReferenceSatisfiesSignoriniFromTheDisplacementFields)
           displacements[static_cast<std::size_t>(interface)].segment<2>(2 * pair.node1);
       const Eigen::Vector2d u_b =
           displacements[static_cast<std::size_t>(interface) + 1].segment<2>(2 * pair.node2);
-      clearances.push_back(pair.gap - (u_a - u_b).dot(pair.normal));
+      clearances.push_back(pair.gap - (u_a - u_b).dot(pair.normal.head<2>()));
       displacement_scale = std::max({displacement_scale, u_a.norm(), u_b.norm()});
     }
   }
@@ -230,7 +230,7 @@ TEST(ManyBodies, SymmetricPairWhoseInterfaceDoesNotMoveConverges) {
   BodyDefinition left = row_block("left", 1000.0);
   BodyDefinition right = row_block("middle", 1000.0);
   right.contact_boundaries = {"left"};
-  right.tractions.push_back({"right", true, Eigen::Vector2d::Zero(), 1.0});
+  right.tractions.push_back({"right", true, Eigen::Vector3d::Zero(), 1.0});
   Row row;
   row.definitions = {left, right};
   ContactOptions contact;

@@ -27,11 +27,11 @@ std::filesystem::path example(const std::string& name) {
 }
 
 /// Sum of the reaction forces of a body (its Dirichlet boundaries).
-Eigen::Vector2d total_reaction(const BodySolver& body, const Eigen::VectorXd& contact_force) {
+Eigen::Vector3d total_reaction(const BodySolver& body, const Eigen::VectorXd& contact_force) {
   const Eigen::VectorXd reaction = body.reactions(body.displacement(contact_force));
-  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
   for (Eigen::Index node = 0; node < reaction.size() / 2; ++node) {
-    total += reaction.segment<2>(2 * node);
+    total.head<2>() += reaction.segment<2>(2 * node);
   }
   return total;
 }
@@ -41,12 +41,12 @@ Eigen::Vector2d total_reaction(const BodySolver& body, const Eigen::VectorXd& co
 /// Returns the larger of the two imbalances relative to |resultant|.
 double expect_equilibrium(const LocalProblem& problem, const Eigen::VectorXd& force,
                           double tolerance) {
-  const Eigen::Vector2d resultant = contact_resultant(problem.pairing(), force);
+  const Eigen::Vector3d resultant = contact_resultant(problem.pairing(), force);
   double worst = 0.0;
   for (int alpha = 0; alpha < 2; ++alpha) {
     const BodySolver& body = *problem.bodies[alpha];
-    const Eigen::Vector2d contact = alpha == 0 ? Eigen::Vector2d(-resultant) : resultant;
-    const Eigen::Vector2d balance = total_reaction(body, force) + body.applied_force() + contact;
+    const Eigen::Vector3d contact = alpha == 0 ? Eigen::Vector3d(-resultant) : resultant;
+    const Eigen::Vector3d balance = total_reaction(body, force) + body.applied_force() + contact;
     EXPECT_LE(balance.norm(), tolerance * resultant.norm()) << "body " << body.name();
     worst = std::max(worst, balance.norm() / resultant.norm());
   }
@@ -61,8 +61,8 @@ Eigen::VectorXd transpose_trace(const ContactPairing& pairing, int alpha, Eigen:
   for (std::size_t i = 0; i < pairing.size(); ++i) {
     const ContactPair& pair = pairing.pairs[i];
     const int node = alpha == 0 ? pair.node1 : pair.node2;
-    const Eigen::Vector2d normal = alpha == 0 ? pair.normal : Eigen::Vector2d(-pair.normal);
-    load.segment<2>(2 * node) += force[static_cast<Eigen::Index>(i)] * normal;
+    const Eigen::Vector3d normal = alpha == 0 ? pair.normal : Eigen::Vector3d(-pair.normal);
+    load.segment<2>(2 * node) += force[static_cast<Eigen::Index>(i)] * normal.head<2>();
   }
   return load;
 }
@@ -74,8 +74,8 @@ Eigen::VectorXd normal_trace(const ContactPairing& pairing, int alpha,
   for (std::size_t i = 0; i < pairing.size(); ++i) {
     const ContactPair& pair = pairing.pairs[i];
     const int node = alpha == 0 ? pair.node1 : pair.node2;
-    const Eigen::Vector2d normal = alpha == 0 ? pair.normal : Eigen::Vector2d(-pair.normal);
-    trace[static_cast<Eigen::Index>(i)] = displacement.segment<2>(2 * node).dot(normal);
+    const Eigen::Vector3d normal = alpha == 0 ? pair.normal : Eigen::Vector3d(-pair.normal);
+    trace[static_cast<Eigen::Index>(i)] = displacement.segment<2>(2 * node).dot(normal.head<2>());
   }
   return trace;
 }

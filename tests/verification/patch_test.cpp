@@ -25,7 +25,11 @@ struct AffineField {
   Eigen::Vector2d offset{0.011, -0.023};
   Eigen::Matrix2d gradient{{0.012, -0.007}, {0.005, 0.009}};
 
-  Eigen::Vector2d operator()(const Eigen::Vector2d& x) const { return offset + gradient * x; }
+  Eigen::Vector3d operator()(const Eigen::Vector3d& x) const {
+    Eigen::Vector3d u;
+    u << offset + gradient * x.head<2>(), 0.0;
+    return u;
+  }
   /// Engineering strain (G_xx, G_yy, G_xy + G_yx).
   Eigen::Vector3d strain() const {
     return {gradient(0, 0), gradient(1, 1), gradient(0, 1) + gradient(1, 0)};
@@ -45,7 +49,7 @@ Eigen::VectorXd solve_with_fixed_boundaries(const Mesh& mesh, const SparseMatrix
   std::vector<std::optional<double>> prescribed(2 * mesh.node_count());
   for (const std::string& name : fixed) {
     for (const int node : mesh.boundary(name).nodes()) {
-      const Eigen::Vector2d value = field(mesh.nodes[node]);
+      const Eigen::Vector3d value = field(mesh.nodes[node]);
       prescribed[2 * node] = value.x();
       prescribed[2 * node + 1] = value.y();
     }
@@ -61,8 +65,8 @@ double relative_nodal_error(const Mesh& mesh, const Eigen::VectorXd& displacemen
                             const AffineField& field) {
   double error = 0.0, scale = 0.0;
   for (std::size_t i = 0; i < mesh.node_count(); ++i) {
-    const Eigen::Vector2d exact = field(mesh.nodes[i]);
-    error = std::max(error, (displacement.segment<2>(2 * i) - exact).norm());
+    const Eigen::Vector3d exact = field(mesh.nodes[i]);
+    error = std::max(error, (displacement.segment<2>(2 * i) - exact.head<2>()).norm());
     scale = std::max(scale, exact.norm());
   }
   return error / scale;
@@ -126,8 +130,10 @@ TEST_P(PatchTest, TractionOnPartOfTheBoundaryReproducesTheAffineField) {
       PlaneModel::plane_stress, "patch");
   const SparseMatrix stiffness = assemble_stiffness(mesh_, material_);
   const Eigen::Matrix2d stress = field_.stress_tensor(material_);
-  const TractionField traction = [&](const Eigen::Vector2d&, const Eigen::Vector2d& normal) {
-    return Eigen::Vector2d(stress * normal);  // t = sigma n
+  const TractionField traction = [&](const Eigen::Vector3d&, const Eigen::Vector3d& normal) {
+    Eigen::Vector3d t;
+    t << stress * normal.head<2>(), 0.0;  // t = sigma n
+    return t;
   };
   Eigen::VectorXd load = Eigen::VectorXd::Zero(2 * mesh_.node_count());
   std::vector<std::string> fixed;
