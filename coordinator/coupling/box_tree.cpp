@@ -49,8 +49,9 @@ int BoxTree::build(int begin, int end) {
   nodes_.push_back(node);
   constexpr int leaf_size = 4;
   if (end - begin <= leaf_size) return index;
-  const Eigen::Vector2d extent = node.box.second - node.box.first;
-  const int axis = extent.x() >= extent.y() ? 0 : 1;
+  const Eigen::Vector3d extent = node.box.second - node.box.first;
+  int axis = 0;
+  extent.maxCoeff(&axis);  // the longest axis (the first of equal ones)
   const int middle = begin + (end - begin) / 2;
   const auto centre = [&](int box) {
     return boxes_[static_cast<std::size_t>(box)].first[axis] +

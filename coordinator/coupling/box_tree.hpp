@@ -1,6 +1,8 @@
 #pragma once
-// A static bounding-box tree (median splits along the longer axis): the boxes that meet a query
-// box in O(log n + k). The spatial search of mortar coupling (coupling/mortar_coupling.cpp).
+// A static bounding-box tree in three dimensions (median splits along the longest axis): the
+// boxes that meet a query box in O(log n + k). The spatial search of mortar coupling
+// (coupling/mortar_coupling.cpp, which embeds its 2D boxes with z = 0, and
+// coupling/face_mortar.cpp).
 
 #include <Eigen/Core>
 #include <utility>
@@ -8,7 +10,7 @@
 
 namespace robin {
 
-using Box = std::pair<Eigen::Vector2d, Eigen::Vector2d>;  // lower and upper corners
+using Box = std::pair<Eigen::Vector3d, Eigen::Vector3d>;  // lower and upper corners
 
 /// True when the closed boxes share a point.
 bool overlaps(const Box& a, const Box& b);

@@ -20,16 +20,8 @@ Eigen::Vector2d in_plane(const Eigen::Vector3d& point) {
   return point.head<2>();
 }
 
-/// A box tree corner from a plane point: the point itself, or embedded at z = 0 when the tree
-/// takes points in space.
-using Corner = Box::first_type;
-Corner corner(const Eigen::Vector2d& point) {
-  if constexpr (Corner::RowsAtCompileTime == 2) {
-    return point;
-  } else {
-    return Corner(point.x(), point.y(), 0.0);
-  }
-}
+/// A box tree corner (a point in space) from a plane point: embedded at z = 0.
+Eigen::Vector3d corner(const Eigen::Vector2d& point) { return {point.x(), point.y(), 0.0}; }
 
 /// Throws InputError when `description` is of a three-dimensional body.
 void require_plane(const InterfaceDescription& description, const std::string& name) {
