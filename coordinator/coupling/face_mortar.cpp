@@ -276,7 +276,13 @@ double extent(const std::vector<Polygon>& pieces) {
 
 /// Integrates over the clip polygon `overlap` (plane coordinates of `nonmortar`'s auxiliary
 /// plane), cut into triangles from its vertex centroid, mapping each Gauss point back along
-/// the auxiliary normal onto both faces.
+/// the auxiliary normal n0 onto both faces. Along n0 rather than along the normal field n(xi):
+/// n0 is the direction that cut the polygons, so every point of a cell lands inside both
+/// clipped faces and the cells of neighbouring mortar faces tile the face without gaps or
+/// overlaps (along n(xi) a point near a cell's edge can land on the neighbouring mortar face,
+/// whose shape functions would then be extrapolated). The gap is still measured along n(xi),
+/// as in Popp et al.'s dual mortar methods; on a flat non-mortar surface n(xi) = n0 and both
+/// choices coincide with the 2D projection.
 void integrate_polygon(const NonmortarFace& nonmortar, const Face& other, const Polygon& overlap,
                        const std::vector<QuadraturePoint>& rule, const SpatialGap& gap,
                        PairIntegrals& sums) {
