@@ -62,7 +62,8 @@ class Face {
   FacePoint evaluate(const Eigen::Vector2d& reference) const {
     FacePoint point;
     Eigen::MatrixXd gradients;
-    shape_functions(parametrization_, reference, point.values, gradients);
+    shape_functions(parametrization_, Eigen::Vector3d(reference.x(), reference.y(), 0.0),
+                    point.values, gradients);
     point.position.setZero();
     point.along_r.setZero();
     point.along_s.setZero();
@@ -86,7 +87,7 @@ class Face {
 
   /// The geometric (right-hand, outward) unit normal at the reference centroid.
   Eigen::Vector3d outward_normal() const {
-    const FacePoint centre = evaluate(reference_centroid(parametrization_));
+    const FacePoint centre = evaluate(reference_centroid(parametrization_).head<2>());
     return centre.along_r.cross(centre.along_s).normalized();
   }
 
@@ -113,7 +114,7 @@ struct AuxiliaryPlane {
   Eigen::Vector3d centre, normal, first, second;
 
   explicit AuxiliaryPlane(const Face& face) {
-    const FacePoint at = face.evaluate(reference_centroid(face.parametrization()));
+    const FacePoint at = face.evaluate(reference_centroid(face.parametrization()).head<2>());
     centre = at.position;
     normal = face.normal_field(at.values);
     // The in-plane axis closest to the face's first tangent (any would do).
@@ -178,7 +179,7 @@ Polygon clip_polygon(Polygon subject, const Polygon& clip, double merge) {
 /// edge-on, or far outside).
 std::optional<Eigen::Vector2d> project_back(const Face& face, const AuxiliaryPlane& plane,
                                             const Eigen::Vector2d& target) {
-  Eigen::Vector2d reference = reference_centroid(face.parametrization());
+  Eigen::Vector2d reference = reference_centroid(face.parametrization()).head<2>();
   const Eigen::Vector3d point = plane.point(target);
   for (int step = 0; step < 30; ++step) {
     const FacePoint at = face.evaluate(reference);
