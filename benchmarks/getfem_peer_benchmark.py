@@ -1,0 +1,426 @@
+#!/usr/bin/python3
+"""robin-run, robin-monolithic and GetFEM 5.4 on the same meshes (issue 16 item 6; docs/benchmarks.md).
+
+    /usr/bin/python3 benchmarks/getfem_peer_benchmark.py [--build build] [--sizes 0.033 0.0104]
+        [--large] [--repeats 3] [--getfem-max-res 1e-10] [--no-getfem] [--timeout 3600]
+        [--keep DIR]
+
+The case is the partial-contact two-block case, examples/two_blocks_partial.toml (lower block
+[-1, 1] x [-1, 0] clamped at its bottom, upper block [-1, 1] x [0, 1] whose top is displaced by
+(0, -0.01), E = 1000, nu = 0.3, plane strain, linear triangles, node-to-node contact on y = 0
+with the initial gap d(x) = 0.02 x^2). For every mesh size h (default 0.033 and 0.0104, about
+1e4 and 1e5 DOFs; --large adds 0.0033, about 1e6 DOFs, which takes some 15 minutes more) the
+script meshes both .geo bodies ONCE with the gmsh command line (`gmsh -2 -setnumber h H -format
+msh22`; not timed), writes the case with the two .msh files instead of the .geo scripts, and
+then runs, --repeats times interleaved (robin-run, robin-monolithic, GetFEM, robin-run, ...):
+
+  (a) build/bin/robin-run CASE --output DIR (two robin-subdomain servers on this machine);
+  (b) build/bin/robin-monolithic CASE --output DIR;
+  (c) GetFEM 5.4 (python3-getfem, Debian's; seen only by /usr/bin/python3), in a child process
+      of this script (`--getfem-worker`): both bodies in one gf.Model, one P1 vector field per
+      body (the same .msh files, imported with gf.Mesh('import', 'gmsh', ...)), the isotropic
+      linearized elasticity brick (plane strain Lame coefficients, exact one-point quadrature of
+      the constant P1 strains), Dirichlet conditions with simplification (eliminated dofs), and
+      the frictionless contact as GetFEM's basic contact brick between two deformable bodies
+      (add_basic_contact_brick_two_deformable_bodies: B_N1 U_1 + B_N2 U_2 <= gap, the rows the
+      node pairs of the contact line, u1_y - u2_y <= 0.02 x^2, non-symmetric Alart-Curnier
+      augmented Lagrangian with r = E), solved by GetFEM's Newton (Model.solve, 'lsolver'
+      'mumps', 'max_res' --getfem-max-res); the same discrete problem as robin-run's.
+      Skipped with a message when `import getfem` fails (apt-get install -y python3-getfem).
+
+Times: wall time around each process (meshing excluded; reading the .msh files included for
+every tool; GetFEM's includes starting Python and importing getfem, and it writes no VTU, while
+robin-run and robin-monolithic write theirs), the median of the repeats. Peak RSS: VmHWM of every
+process of the run, polled from /proc every 0.1 s (robin-run: the coordinator, the larger
+server and their sum), and the exact ru_maxrss of wait4 for the single-process tools.
+
+Agreement, from the last repeat: the contact nodal forces (contact.csv lambda1 against GetFEM's
+multipliers, matched by x) as the largest difference relative to the largest force, and the
+resultant contact force (summary.json contact_force_resultant against the sum of GetFEM's
+multipliers) relative; the same for robin-run against robin-monolithic.
+
+Prints the machine, the date, the command, the meshing times and two markdown tables.
+"""
+
+import argparse
+import csv
+import json
+import os
+import platform
+import shutil
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+REPOSITORY = Path(__file__).resolve().parent.parent
+CASE = REPOSITORY / "examples" / "two_blocks_partial.toml"
+MESHES = REPOSITORY / "examples" / "meshes"
+E, NU, TOP_DISPLACEMENT, GAP_C = 1000.0, 0.3, -0.01, 0.02  # as in two_blocks_partial.toml
+
+
+# --------------------------------------------------------------------------- GetFEM worker
+
+def physical_names(path):
+    """{name: tag} of an MSH 2.2 file's $PhysicalNames."""
+    text = Path(path).read_text(errors="replace")
+    block = text.split("$PhysicalNames", 1)[1].split("$EndPhysicalNames", 1)[0].split("\n")
+    names = {}
+    for line in block[2:]:
+        if line.strip():
+            _, tag, name = line.split(maxsplit=2)
+            names[name.strip().strip('"')] = int(tag)
+    return names
+
+
+def getfem_worker(lower_path, upper_path, result_path, max_res):
+    """Solves the two-block contact problem with GetFEM; writes the answer and stages as JSON."""
+    stages = {}
+    start = time.monotonic()
+    import numpy as np
+    import getfem as gf
+    stages["import"] = time.monotonic() - start
+
+    clock = time.monotonic()
+    meshes = [gf.Mesh("import", "gmsh", str(lower_path)), gf.Mesh("import", "gmsh", str(upper_path))]
+    regions = [physical_names(lower_path), physical_names(upper_path)]
+    stages["mesh import"] = time.monotonic() - clock
+
+    clock = time.monotonic()
+    lame_lambda = E * NU / ((1 + NU) * (1 - 2 * NU))  # plane strain: the 3D Lame coefficients
+    lame_mu = E / (2 * (1 + NU))
+    model = gf.Model("real")
+    model.add_initialized_data("lambda", [lame_lambda])
+    model.add_initialized_data("mu", [lame_mu])
+    fems = []
+    for index, mesh in enumerate(meshes):
+        fem = gf.MeshFem(mesh, 2)
+        fem.set_classical_fem(1)  # P1, as robin's linear triangles
+        integration = gf.MeshIm(mesh, gf.Integ("IM_TRIANGLE(1)"))  # exact for P1 stiffness
+        model.add_fem_variable(f"u{index}", fem)
+        model.add_isotropic_linearized_elasticity_brick(integration, f"u{index}", "lambda", "mu")
+        fems.append(fem)
+    model.add_initialized_data("bottom_value", [0.0, 0.0])
+    model.add_initialized_data("top_value", [0.0, TOP_DISPLACEMENT])
+    model.add_Dirichlet_condition_with_simplification("u0", regions[0]["bottom"], "bottom_value")
+    model.add_Dirichlet_condition_with_simplification("u1", regions[1]["top"], "top_value")
+
+    def contact_y_dofs(fem, region):
+        dofs = fem.basic_dof_on_region(region)
+        nodes = fem.basic_dof_nodes(dofs)
+        # vector P1: the two components of a node are consecutive dofs, x first
+        return sorted((float(nodes[0, i]), int(dof)) for i, dof in enumerate(dofs) if dof % 2 == 1)
+
+    lower = contact_y_dofs(fems[0], regions[0]["contact"])
+    upper = contact_y_dofs(fems[1], regions[1]["contact"])
+    if len(lower) != len(upper) or any(abs(a[0] - b[0]) > 1e-9 for a, b in zip(lower, upper)):
+        raise SystemExit("the contact nodes of the two meshes do not match")
+    rows = len(lower)
+    bn1 = gf.Spmat("empty", rows, fems[0].nbdof())
+    bn2 = gf.Spmat("empty", rows, fems[1].nbdof())
+    for row, ((_, dof1), (_, dof2)) in enumerate(zip(lower, upper)):
+        bn1[row, dof1] = 1.0   # u1 . n1, n1 = (0, 1)
+        bn2[row, dof2] = -1.0  # u2 . n2, n2 = (0, -1)
+    xs = np.array([x for x, _ in lower])
+    model.add_variable("lambda_n", rows)
+    model.add_initialized_data("r", [E])
+    model.add_initialized_data("gap", GAP_C * xs ** 2)
+    model.add_basic_contact_brick_two_deformable_bodies("u0", "u1", "lambda_n", "r", bn1, bn2,
+                                                        "gap")
+    stages["model"] = time.monotonic() - clock
+
+    clock = time.monotonic()
+    iterations, converged = model.solve("max_iter", 100, "max_res", max_res, "lsolver", "mumps")
+    stages["newton (assembly + MUMPS)"] = time.monotonic() - clock
+    forces = -np.asarray(model.variable("lambda_n"))  # GetFEM's multiplier is <= 0 in contact
+    result = {
+        "dofs": int(fems[0].nbdof() + fems[1].nbdof()),
+        "newton_iterations": int(iterations), "converged": bool(converged),
+        "x": xs.tolist(), "force": forces.tolist(), "resultant": float(forces.sum()),
+        "stages": stages, "in_process": time.monotonic() - start,
+    }
+    Path(result_path).write_text(json.dumps(result))
+
+
+# --------------------------------------------------------------------------- measuring
+
+def children_of(pid):
+    try:
+        with open(f"/proc/{pid}/task/{pid}/children") as handle:
+            return [int(child) for child in handle.read().split()]
+    except OSError:
+        return []
+
+
+def read_hwm(pid):
+    """(command name, VmHWM in KiB) of a process, or None."""
+    try:
+        with open(f"/proc/{pid}/status") as handle:
+            fields = dict(line.split(":", 1) for line in handle if ":" in line)
+        return fields["Name"].strip(), int(fields["VmHWM"].split()[0])
+    except (OSError, KeyError, ValueError):
+        return None
+
+
+def run_measured(command, log_path, timeout, environment=None):
+    """Runs command; returns (exit status, wall seconds, ru_maxrss KiB, {pid: (name, VmHWM KiB)})."""
+    peaks = {}
+    done = threading.Event()
+    with open(log_path, "w") as log:
+        start = time.monotonic()
+        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT,
+                                   stdin=subprocess.DEVNULL, env=environment)
+
+        def poll():
+            while not done.is_set():
+                pending, seen = [process.pid], set()
+                while pending:
+                    pid = pending.pop()
+                    if pid in seen:
+                        continue
+                    seen.add(pid)
+                    value = read_hwm(pid)
+                    if value is not None and value[1] >= peaks.get(pid, ("", 0))[1]:
+                        peaks[pid] = value
+                    pending.extend(children_of(pid))
+                if time.monotonic() - start > timeout:
+                    process.kill()
+                done.wait(0.1)
+
+        poller = threading.Thread(target=poll, daemon=True)
+        poller.start()
+        _, status, usage = os.wait4(process.pid, 0)
+        wall = time.monotonic() - start
+        process.returncode = os.waitstatus_to_exitcode(status)
+        done.set()
+        poller.join()
+    return process.returncode, wall, usage.ru_maxrss, peaks
+
+
+def read_contact_csv(path):
+    with open(path, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    rows.sort(key=lambda row: float(row["x"]))
+    return [float(row["x"]) for row in rows], [float(row["lambda1"]) for row in rows]
+
+
+def compare(reference_x, reference_force, x, force):
+    """Largest nodal force difference relative to the reference's largest force."""
+    if len(reference_x) != len(x) or any(abs(a - b) > 1e-9 for a, b in zip(reference_x, x)):
+        return float("nan")
+    scale = max(abs(value) for value in reference_force)
+    return max(abs(a - b) for a, b in zip(reference_force, force)) / scale
+
+
+def mib(kib):
+    return f"{kib / 1024:.0f}"
+
+
+# --------------------------------------------------------------------------- driver
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--build", default=str(REPOSITORY / "build"),
+                        help="build directory holding bin/robin-run, bin/robin-monolithic")
+    parser.add_argument("--sizes", type=float, nargs="+", default=[0.033, 0.0104],
+                        help="mesh sizes h (default 0.033 0.0104: about 1e4 and 1e5 DOFs)")
+    parser.add_argument("--large", action="store_true", help="add h = 0.0033 (about 1e6 DOFs)")
+    parser.add_argument("--repeats", type=int, default=3, help="interleaved runs per size")
+    parser.add_argument("--getfem-max-res", type=float, default=1e-10,
+                        help="GetFEM Newton's residual target (its 'max_res')")
+    parser.add_argument("--no-getfem", action="store_true", help="skip the GetFEM column")
+    parser.add_argument("--timeout", type=float, default=3600.0, help="seconds per run")
+    parser.add_argument("--keep", help="keep the scratch directory here")
+    parser.add_argument("--getfem-worker", nargs=3, metavar=("LOWER", "UPPER", "RESULT"),
+                        help=argparse.SUPPRESS)
+    arguments = parser.parse_args()
+    if arguments.getfem_worker:
+        getfem_worker(*arguments.getfem_worker, arguments.getfem_max_res)
+        return 0
+
+    binaries = Path(arguments.build).resolve() / "bin"
+    for tool in ("robin-run", "robin-subdomain", "robin-monolithic"):
+        if not (binaries / tool).is_file():
+            sys.exit(f"{binaries / tool} is missing (build it first)")
+    gmsh = shutil.which("gmsh")
+    if gmsh is None:
+        sys.exit("the gmsh command is needed to mesh the bodies (apt-get install -y gmsh)")
+    sizes = list(arguments.sizes) + ([0.0033] if arguments.large else [])
+    getfem_note = None
+    if arguments.no_getfem:
+        getfem_note = "GetFEM column skipped (--no-getfem)"
+    else:
+        probe = subprocess.run([sys.executable, "-c", "import getfem"], capture_output=True,
+                               text=True, check=False)
+        if probe.returncode != 0:
+            getfem_note = ("GetFEM column skipped: `import getfem` failed in "
+                           f"{sys.executable} ({probe.stderr.strip().splitlines()[-1]}); "
+                           "install python3-getfem and run with /usr/bin/python3")
+    if getfem_note:
+        print(getfem_note, flush=True)
+    use_getfem = getfem_note is None
+
+    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
+                if line.startswith("model name")), "?")
+    memory = int(next(line.split()[1] for line in open("/proc/meminfo")
+                      if line.startswith("MemTotal"))) / 1048576
+    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, {memory:.0f} GiB, {cpu}; "
+          f"load average at start {os.getloadavg()[0]:.1f}")
+    print(f"date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
+    print("command: " + " ".join([sys.executable] + sys.argv), flush=True)
+
+    if arguments.keep:
+        scratch = Path(arguments.keep).resolve()
+        scratch.mkdir(parents=True, exist_ok=False)
+    else:
+        scratch = Path(tempfile.mkdtemp(prefix="robin-getfem-peer-"))
+    template = CASE.read_text()
+    results = []
+    try:
+        for size in sizes:
+            work = scratch / f"h_{size}"
+            work.mkdir()
+            case_text = template
+            for body in ("lower", "upper"):
+                clock = time.monotonic()
+                subprocess.run([gmsh, "-2", "-setnumber", "h", repr(size), "-format", "msh22",
+                                str(MESHES / f"block_{body}.geo"), "-o", str(work / f"{body}.msh")],
+                               check=True, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+                print(f"h = {size}: meshed {body} in {time.monotonic() - clock:.1f} s (not timed "
+                      "below)", flush=True)
+                case_text = case_text.replace(f'mesh = "meshes/block_{body}.geo"',
+                                              f'mesh = "{work / (body + ".msh")}"')
+            case_text = "\n".join(line for line in case_text.split("\n")
+                                  if not line.startswith("mesh_size"))
+            case = work / "case.toml"
+            case.write_text(case_text)
+
+            walls = {"dd": [], "mono": [], "getfem": []}
+            rss = {"dd": [], "mono": [], "getfem": []}
+            for repeat in range(arguments.repeats):
+                out = work / f"dd_{repeat}"
+                status, wall, _, peaks = run_measured(
+                    [str(binaries / "robin-run"), str(case), "--output", str(out), "--quiet"],
+                    work / f"dd_{repeat}.log", arguments.timeout)
+                if status != 0:
+                    sys.exit(f"robin-run exit {status} at h = {size}: see {work}/dd_{repeat}.log")
+                walls["dd"].append(wall)
+                servers = [kib for name, kib in peaks.values() if name.startswith("robin-subdom")]
+                coordinator = max((kib for name, kib in peaks.values()
+                                   if name.startswith("robin-run")), default=0)
+                rss["dd"].append((coordinator, max(servers, default=0), coordinator + sum(servers)))
+
+                out = work / f"mono_{repeat}"
+                status, wall, maxrss, _ = run_measured(
+                    [str(binaries / "robin-monolithic"), str(case), "--output", str(out),
+                     "--quiet"], work / f"mono_{repeat}.log", arguments.timeout)
+                if status != 0:
+                    sys.exit(f"robin-monolithic exit {status} at h = {size}")
+                walls["mono"].append(wall)
+                rss["mono"].append(maxrss)
+
+                if use_getfem:
+                    environment = dict(os.environ)
+                    status, wall, maxrss, _ = run_measured(
+                        [sys.executable, str(Path(__file__).resolve()), "--getfem-max-res",
+                         repr(arguments.getfem_max_res), "--getfem-worker",
+                         str(work / "lower.msh"), str(work / "upper.msh"),
+                         str(work / f"getfem_{repeat}.json")],
+                        work / f"getfem_{repeat}.log", arguments.timeout, environment)
+                    if status != 0:
+                        print(f"GetFEM exit {status} at h = {size}: "
+                              + (work / f"getfem_{repeat}.log").read_text()[-500:], flush=True)
+                        use_getfem = False
+                    else:
+                        walls["getfem"].append(wall)
+                        rss["getfem"].append(maxrss)
+                print(f"h = {size}, run {repeat + 1}: robin-run {walls['dd'][-1]:.2f} s, "
+                      f"robin-monolithic {walls['mono'][-1]:.2f} s"
+                      + (f", GetFEM {walls['getfem'][-1]:.2f} s" if walls["getfem"] else ""),
+                      flush=True)
+
+            last = arguments.repeats - 1
+            summary = json.loads((work / f"dd_{last}" / "summary.json").read_text())
+            mono_summary = json.loads((work / f"mono_{last}" / "summary.json").read_text())
+            dd_x, dd_force = read_contact_csv(work / f"dd_{last}" / "contact.csv")
+            mono_x, mono_force = read_contact_csv(work / f"mono_{last}" / "contact.csv")
+            dd_resultant = summary["interfaces"][0]["contact_force_resultant"][1]
+            mono_resultant = mono_summary["interfaces"][0]["contact_force_resultant"][1]
+            row = {
+                "h": size, "dofs": sum(body["dofs"] for body in summary["bodies"]),
+                "pairs": summary["contact_pairs"], "iterations": summary["iterations"],
+                "mono_iterations": mono_summary.get("iterations"),
+                "walls": {key: statistics.median(value) for key, value in walls.items() if value},
+                "rss": rss, "dd_resultant": dd_resultant,
+                "mono_force": compare(mono_x, mono_force, dd_x, dd_force),
+                "mono_resultant": abs(dd_resultant - mono_resultant) / abs(mono_resultant),
+                "profile": summary["profile"],
+            }
+            if walls["getfem"]:
+                peer = json.loads((work / f"getfem_{last}.json").read_text())
+                row.update(getfem=peer,
+                           getfem_force=compare(peer["x"], peer["force"], dd_x, dd_force),
+                           getfem_resultant=abs(dd_resultant - peer["resultant"])
+                           / abs(peer["resultant"]))
+                print(f"    GetFEM: {peer['dofs']} dofs (the Dirichlet ones included), "
+                      f"{peer['newton_iterations']} Newton iterations, converged "
+                      f"{peer['converged']}; stages " + ", ".join(
+                          f"{name} {value:.2f} s" for name, value in peer["stages"].items()),
+                      flush=True)
+            profile = summary["profile"]
+            print(f"    robin-run: {row['iterations']} iterations; profile " + ", ".join(
+                f"{key} {profile[key]:.3f} s" for key in ("launch", "meshing", "setup",
+                                                           "contact_assignment", "iterations",
+                                                           "fields", "output")), flush=True)
+            results.append(row)
+    finally:
+        if not arguments.keep:
+            shutil.rmtree(scratch, ignore_errors=True)
+
+    def median_rss(values, index=None):
+        return statistics.median(value if index is None else value[index] for value in values)
+
+    print(f"\nTimes (median of {arguments.repeats} interleaved runs; meshing excluded) and peak "
+          "RSS (median; MiB):\n")
+    print("| h | DOFs | contact pairs | robin-run wall | robin-monolithic wall | GetFEM wall | "
+          "GetFEM / robin-run | robin-run peak RSS: coordinator, larger server (sum) | "
+          "robin-monolithic peak RSS | GetFEM peak RSS |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for row in results:
+        walls = row["walls"]
+        getfem = "getfem" in walls
+        dd_rss = row["rss"]["dd"]
+        print(f"| {row['h']} | {row['dofs']} | {row['pairs']} | {walls['dd']:.2f} s | "
+              f"{walls['mono']:.2f} s | "
+              + (f"{walls['getfem']:.2f} s | {walls['getfem'] / walls['dd']:.1f} | " if getfem
+                 else "– | – | ")
+              + f"{mib(median_rss(dd_rss, 0))}, {mib(median_rss(dd_rss, 1))} "
+              f"({mib(median_rss(dd_rss, 2))}) | {mib(median_rss(row['rss']['mono']))} | "
+              + (f"{mib(median_rss(row['rss']['getfem']))} |" if getfem else "– |"))
+    print("\nAnswers (last run of each size): robin-run's contact nodal forces against GetFEM's "
+          "and robin-monolithic's (largest difference / largest force), and the resultant "
+          "contact force (relative difference):\n")
+    print("| h | DOFs | robin-run iterations | GetFEM Newton iterations | resultant (robin-run) | "
+          "forces vs GetFEM | resultant vs GetFEM | forces vs robin-monolithic | "
+          "resultant vs robin-monolithic |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for row in results:
+        peer = row.get("getfem")
+        print(f"| {row['h']} | {row['dofs']} | {row['iterations']} | "
+              + (f"{peer['newton_iterations']} | " if peer else "– | ")
+              + f"{row['dd_resultant']:.6f} | "
+              + (f"{row['getfem_force']:.1e} | {row['getfem_resultant']:.1e} | " if peer
+                 else "– | – | ")
+              + f"{row['mono_force']:.1e} | {row['mono_resultant']:.1e} |")
+    if getfem_note:
+        print(f"\n{getfem_note}")
+    return 0
+
+
+if __name__ == "__main__":
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    sys.exit(main())
