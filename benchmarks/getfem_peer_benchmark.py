@@ -2,14 +2,15 @@
 """robin-run, robin-monolithic and GetFEM 5.4 on the same meshes (issue 16 item 6; docs/benchmarks.md).
 
     /usr/bin/python3 benchmarks/getfem_peer_benchmark.py [--build build] [--sizes 0.033 0.0104]
-        [--large] [--repeats 3] [--getfem-max-res 1e-10] [--no-getfem] [--timeout 3600]
-        [--keep DIR]
+        [--large] [--repeats 3] [--large-repeats 1] [--getfem-max-res 1e-10]
+        [--getfem-dirichlet eliminate] [--no-getfem] [--timeout 3600] [--keep DIR]
 
 The case is the partial-contact two-block case, examples/two_blocks_partial.toml (lower block
 [-1, 1] x [-1, 0] clamped at its bottom, upper block [-1, 1] x [0, 1] whose top is displaced by
 (0, -0.01), E = 1000, nu = 0.3, plane strain, linear triangles, node-to-node contact on y = 0
 with the initial gap d(x) = 0.02 x^2). For every mesh size h (default 0.033 and 0.0104, about
-1e4 and 1e5 DOFs; --large adds 0.0033, about 1e6 DOFs, which takes some 15 minutes more) the
+1e4 and 1e5 DOFs; --large adds 0.0033, about 1e6 DOFs, run --large-repeats times, default once:
+some 25 minutes more on 2 shared cores, most of it GetFEM) the
 script meshes both .geo bodies ONCE with the gmsh command line (`gmsh -2 -setnumber h H -format
 msh22`; not timed), writes the case with the two .msh files instead of the .geo scripts, and
 then runs, --repeats times interleaved (robin-run, robin-monolithic, GetFEM, robin-run, ...):
@@ -258,6 +259,9 @@ def main():
                         help="mesh sizes h (default 0.033 0.0104: about 1e4 and 1e5 DOFs)")
     parser.add_argument("--large", action="store_true", help="add h = 0.0033 (about 1e6 DOFs)")
     parser.add_argument("--repeats", type=int, default=3, help="interleaved runs per size")
+    parser.add_argument("--large-repeats", type=int, default=1,
+                        help="interleaved runs for h <= 0.005 (about 1e6 DOFs: GetFEM takes "
+                             "some 20 minutes per run on 2 shared cores)")
     parser.add_argument("--getfem-max-res", type=float, default=1e-10,
                         help="GetFEM Newton's residual target (its 'max_res')")
     parser.add_argument("--getfem-dirichlet", default="eliminate",
@@ -333,7 +337,8 @@ def main():
 
             walls = {"dd": [], "mono": [], "getfem": []}
             rss = {"dd": [], "mono": [], "getfem": []}
-            for repeat in range(arguments.repeats):
+            repeats = arguments.large_repeats if size <= 0.005 else arguments.repeats
+            for repeat in range(repeats):
                 out = work / f"dd_{repeat}"
                 status, wall, _, peaks = run_measured(
                     [str(binaries / "robin-run"), str(case), "--output", str(out), "--quiet"],
@@ -376,7 +381,7 @@ def main():
                       + (f", GetFEM {walls['getfem'][-1]:.2f} s" if walls["getfem"] else ""),
                       flush=True)
 
-            last = arguments.repeats - 1
+            last = repeats - 1
             summary = json.loads((work / f"dd_{last}" / "summary.json").read_text())
             mono_summary = json.loads((work / f"mono_{last}" / "summary.json").read_text())
             dd_x, dd_force = read_contact_csv(work / f"dd_{last}" / "contact.csv")
@@ -391,7 +396,7 @@ def main():
                 "rss": rss, "dd_resultant": dd_resultant,
                 "mono_force": compare(mono_x, mono_force, dd_x, dd_force),
                 "mono_resultant": abs(dd_resultant - mono_resultant) / abs(mono_resultant),
-                "profile": summary["profile"],
+                "profile": summary["profile"], "repeats": repeats,
             }
             if walls["getfem"]:
                 peer = json.loads((work / f"getfem_{last}.json").read_text())
@@ -417,17 +422,17 @@ def main():
     def median_rss(values, index=None):
         return statistics.median(value if index is None else value[index] for value in values)
 
-    print(f"\nTimes (median of {arguments.repeats} interleaved runs; meshing excluded) and peak "
-          "RSS (median; MiB):\n")
-    print("| h | DOFs | contact pairs | robin-run wall | robin-monolithic wall | GetFEM wall | "
+    print("\nTimes (median of the interleaved runs; meshing excluded) and peak RSS (median; MiB):\n")
+    print("| h | DOFs | runs | contact pairs | robin-run wall | robin-monolithic wall | GetFEM wall | "
           "GetFEM / robin-run | robin-run peak RSS: coordinator, larger server (sum) | "
           "robin-monolithic peak RSS | GetFEM peak RSS |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for row in results:
         walls = row["walls"]
         getfem = "getfem" in walls
         dd_rss = row["rss"]["dd"]
-        print(f"| {row['h']} | {row['dofs']} | {row['pairs']} | {walls['dd']:.2f} s | "
+        print(f"| {row['h']} | {row['dofs']} | {row['repeats']} | {row['pairs']} | "
+              f"{walls['dd']:.2f} s | "
               f"{walls['mono']:.2f} s | "
               + (f"{walls['getfem']:.2f} s | {walls['getfem'] / walls['dd']:.1f} | " if getfem
                  else "– | – | ")
