@@ -2,7 +2,8 @@
 """The stage-by-stage profile for N bodies (issue 16 item 7, the N-bodies half; docs/benchmarks.md).
 
     /usr/bin/python3 benchmarks/many_bodies_profile_benchmark.py [--build build]
-        [--counts 2 4 8 16] [--total-dofs 1e5] [--arch-refine 1 4 10] [--repeats 1] [--keep DIR]
+        [--counts 2 4 8 16] [--total-dofs 1e5] [--arch-refine 1 4 10] [--repeats 1]
+        [--robin-timeout SECONDS] [--keep DIR]
 
 Runs robin-run (one robin-subdomain server per body on this machine) and robin-monolithic on
 
@@ -25,6 +26,10 @@ comparable and not shown), "wall" measured around the process, "rest" = wall min
 coordinator's stages, the peak RSS (VmHWM polled from /proc every 0.1 s) of the largest
 robin-subdomain server, of the N servers summed, of the coordinator (robin-run) and of
 robin-monolithic's one process (exact, wait4's ru_maxrss).
+
+--robin-timeout passes robin-run's --timeout (the deadline of an interface-sized request such as
+AssignContact; default 60 s): on 2 shared cores the arch refined tenfold needs more (its floating
+keystone's interface operator took 74 s in robin-monolithic on 2026-11-26).
 
 With --repeats R > 1 each column is the run with the median wall time of R interleaved runs.
 A run that fails or does not converge is reported in its column's "status" row.
@@ -122,7 +127,8 @@ def column_of(summary, status, wall, peaks, maxrss, tool):
         "wall (measured)": wall,
         "rest (wall - sum)": wall - stages if stages is not None else None,
         "outer iterations": summary.get("iterations") if tool == "robin-run" else "–",
-        "status": summary.get("status", f"exit {status}") if status != 0 else "converged",
+        "status": "converged" if status == 0 else
+            f"exit {status}: {summary.get('message') or summary.get('status') or 'no summary'}",
         "peak RSS, largest server (MiB)": max(servers) / 1024 if servers else None,
         "peak RSS, servers summed (MiB)": sum(servers) / 1024 if servers else None,
         "peak RSS, coordinator / robin-monolithic (MiB)":
@@ -155,6 +161,8 @@ def main():
     parser.add_argument("--repeats", type=int, default=1,
                         help="interleaved runs per column; the median-wall one is shown")
     parser.add_argument("--timeout", type=float, default=1800.0, help="seconds per run")
+    parser.add_argument("--robin-timeout", type=float,
+                        help="robin-run's --timeout (request deadline, s); default: robin-run's")
     parser.add_argument("--keep", help="keep the scratch directory here")
     arguments = parser.parse_args()
 
@@ -193,9 +201,11 @@ def main():
                 runs = []
                 for repeat in range(arguments.repeats):
                     output = scratch / f"case{index}_{tool}_{repeat}"
+                    timeout = ([] if arguments.robin_timeout is None or tool != "robin-run"
+                               else ["--timeout", repr(arguments.robin_timeout)])
                     status, wall, maxrss, peaks = run_measured(
                         [str(binaries / tool), str(case), "--output", str(output), "--quiet",
-                         *overrides], scratch / f"case{index}_{tool}_{repeat}.log",
+                         *overrides, *timeout], scratch / f"case{index}_{tool}_{repeat}.log",
                         arguments.timeout)
                     try:
                         summary = json.loads((output / "summary.json").read_text())
@@ -227,6 +237,8 @@ def main():
     for key in extras[0]:
         digits = 0 if "MiB" in key else 3
         print(f"| {key} | " + " | ".join(cell(extra[key], digits) for extra in extras) + " |")
+    if failures:
+        print(f"\n{failures} run(s) failed or did not converge (see the status row)")
     return 1 if failures else 0
 
 
