@@ -9,8 +9,9 @@ The case is the partial-contact two-block case, examples/two_blocks_partial.toml
 [-1, 1] x [-1, 0] clamped at its bottom, upper block [-1, 1] x [0, 1] whose top is displaced by
 (0, -0.01), E = 1000, nu = 0.3, plane strain, linear triangles, node-to-node contact on y = 0
 with the initial gap d(x) = 0.02 x^2). For every mesh size h (default 0.033 and 0.0104, about
-1e4 and 1e5 DOFs; --large adds 0.0033, about 1e6 DOFs, run --large-repeats times, default once:
-some 25 minutes more on 2 shared cores, most of it GetFEM) the
+1e4 and 1e5 DOFs; --large adds 0.0033, about 1e6 DOFs, run --large-repeats times, default once;
+on 2 shared cores GetFEM did not finish it within 48 minutes on 2026-11-26, and --timeout, default
+3600 s, bounds every run: a GetFEM run killed by it leaves that size's GetFEM cells empty) the
 script meshes both .geo bodies ONCE with the gmsh command line (`gmsh -2 -setnumber h H -format
 msh22`; not timed), writes the case with the two .msh files instead of the .geo scripts, and
 then runs, --repeats times interleaved (robin-run, robin-monolithic, GetFEM, robin-run, ...):
@@ -261,7 +262,7 @@ def main():
     parser.add_argument("--repeats", type=int, default=3, help="interleaved runs per size")
     parser.add_argument("--large-repeats", type=int, default=1,
                         help="interleaved runs for h <= 0.005 (about 1e6 DOFs: GetFEM takes "
-                             "some 20 minutes per run on 2 shared cores)")
+                             "more than 48 minutes per run on 2 shared cores)")
     parser.add_argument("--getfem-max-res", type=float, default=1e-10,
                         help="GetFEM Newton's residual target (its 'max_res')")
     parser.add_argument("--getfem-dirichlet", default="eliminate",
