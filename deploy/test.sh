@@ -20,18 +20,7 @@ export ROBIN_REQUIRE_PARAVIEW=1
 ctest --test-dir build --output-on-failure -j "$jobs"
 
 ./deploy/build.sh --sanitize
-# The Hertz tests mesh circles with Gmsh, whose uninstrumented libgmsh frees an Eigen-aligned
-# block with free() in its curve intersection (fullMatrix::luSolve, from bowyerWatsonFrontal):
-# the block was allocated through an Eigen symbol that the instrumented test executable defines
-# and exports to libgmsh (handmade_aligned_malloc), so ASan reports "attempting free on address
-# which was not malloc()-ed" inside libgmsh. Which executables export such a symbol depends on the
-# Eigen code they instantiate: MortarHertz did before, since the floating-body numerics the other
-# Hertz cases do too (NodeToNodeRegression.Hertz..., LoadSteps.ColdSteps... and HertzStepsTest on
-# hertz_steps, MonolithicContact.Hertz..., RobinVersusMonolithic.Hertz and ...OnEveryCase). These
-# tests run (and pass) in the Release tier above.
-ctest --test-dir build-sanitize -L 'unit|verification' \
-  -E 'Hertz|^LoadSteps\.ColdStepsStartFromTheInitialObstacleLikeFreshRuns$|^RobinVersusMonolithic\.AcceleratedMethodsOnEveryCase$' \
-  --output-on-failure -j "$jobs"
+ctest --test-dir build-sanitize -L 'unit|verification' --output-on-failure -j "$jobs"
 
 ./deploy/build.sh --fuzz
 ctest --test-dir build-fuzz -L fuzz --output-on-failure -j "$jobs"

@@ -612,8 +612,10 @@ class PrivateDirectory {
 
 #if defined(__SANITIZE_ADDRESS__)
 /// LeakSanitizer hook: Gmsh 4.8 itself leaks a few bytes per read (parser strings,
-/// quadrilateral recombination); those leaks are not ours to fix.
-extern "C" const char* __lsan_default_suppressions() {
+/// quadrilateral recombination); those leaks are not ours to fix. GCC's sanitizer runtime is a
+/// shared library (libasan.so) that finds this hook through the dynamic symbol table: it stays
+/// visible although the build hides our symbols (CMAKE_CXX_VISIBILITY_PRESET, CMakeLists.txt).
+extern "C" __attribute__((visibility("default"))) const char* __lsan_default_suppressions() {
   return "leak:libgmsh.so\n";
 }
 #endif
