@@ -172,7 +172,8 @@ TEST(RobinVersusMonolithic, AitkenOnTheAsymmetricPairAtHOverEightStopsNearTheAns
 }
 
 TEST(RobinVersusMonolithic, DefaultMethodBeatsTheBestFixedDeltaTenfoldOnTheAsymmetricPair) {
-  const std::string default_method = AccelerationOptions{}.method;
+  const AccelerationOptions defaults;  // named: see case_file_overrides_test.cpp
+  const std::string default_method = defaults.method;
   const std::size_t accelerated = expect_matches_monolithic("asymmetric.toml", default_method, 0.5);
   const std::size_t plain = expect_matches_monolithic("asymmetric.toml", "none", 0.02);
   EXPECT_LE(10 * accelerated, plain);
