@@ -32,22 +32,6 @@ protocol::CellType to_protocol(ElementType type) {
   return protocol::CELL_TYPE_UNSPECIFIED;
 }
 
-protocol::CellType to_protocol(FacetType type) {
-  switch (type) {
-    case FacetType::line2:
-      return protocol::LINE2;
-    case FacetType::line3:
-      return protocol::LINE3;
-    case FacetType::triangle3:
-      return protocol::TRIANGLE3;
-    case FacetType::triangle6:
-      return protocol::TRIANGLE6;
-    case FacetType::quadrilateral4:
-      return protocol::QUADRILATERAL4;
-  }
-  return protocol::CELL_TYPE_UNSPECIFIED;
-}
-
 /// The domain cell types of a mesh of `dimension` (2 or 3).
 std::optional<ElementType> element_type(protocol::CellType type, unsigned dimension) {
   if (dimension == 2) {
@@ -249,6 +233,22 @@ void check_nodes_used(const Mesh& mesh, const MeshErrors& errors) {
 }
 
 }  // namespace
+
+protocol::CellType to_protocol(FacetType type) {
+  switch (type) {
+    case FacetType::line2:
+      return protocol::LINE2;
+    case FacetType::line3:
+      return protocol::LINE3;
+    case FacetType::triangle3:
+      return protocol::TRIANGLE3;
+    case FacetType::triangle6:
+      return protocol::TRIANGLE6;
+    case FacetType::quadrilateral4:
+      return protocol::QUADRILATERAL4;
+  }
+  return protocol::CELL_TYPE_UNSPECIFIED;
+}
 
 protocol::MeshData encode_mesh(const Mesh& mesh) {
   protocol::MeshData data;

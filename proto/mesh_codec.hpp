@@ -10,6 +10,9 @@
 
 namespace robin {
 
+/// The protocol's cell type of a boundary facet (LINE2 ... QUADRILATERAL4).
+protocol::CellType to_protocol(FacetType type);
+
 /// The mesh as MeshData: its dimension (2 or 3), `dimension` coordinates per node, node and
 /// element tags, element blocks and named boundaries, `mesh.source` as the source.
 protocol::MeshData encode_mesh(const Mesh& mesh);

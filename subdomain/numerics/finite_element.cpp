@@ -471,22 +471,6 @@ std::optional<NodeElementMap::ElementIndex> NodeElementMap::element_with(
 
 namespace {
 
-/// The corner count of a facet (its linear shape): 2 for edges, 3 for triangles, 4 for
-/// quadrilaterals.
-int facet_corner_count(FacetType type) {
-  switch (type) {
-    case FacetType::line2:
-    case FacetType::line3:
-      return 2;
-    case FacetType::triangle3:
-    case FacetType::triangle6:
-      return 3;
-    case FacetType::quadrilateral4:
-      return 4;
-  }
-  throw std::invalid_argument("facet_corner_count: unknown facet type");
-}
-
 /// The facet's own (not yet oriented) normal direction and measure element from the columns of
 /// dx/dxi: an edge's tangent turned clockwise, a face's dx/dr x dx/ds.
 Eigen::Vector3d facet_normal_direction(const Eigen::MatrixXd& derivatives) {
@@ -550,16 +534,9 @@ FacetGeometry::FacetGeometry(const Mesh& mesh, const BoundaryGroup& group, std::
   // Outward: the facet's own normal at its centre points away from the element's centroid.
   const ElementBlock& block = mesh.blocks[element->first];
   const int* nodes = &block.connectivity[element->second * nodes_per_element(block.type)];
-  const std::vector<Eigen::Vector3d> element_corners = reference_nodes(block.type);
+  const int corner_count = element_corner_count(block.type);
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  int corner_count = 0;
-  for (std::size_t i = 0; i < element_corners.size(); ++i) {
-    // Corner nodes come first in every supported element; midside nodes are skipped.
-    if (block.type == ElementType::triangle6 && i >= 3) break;
-    if (block.type == ElementType::tetrahedron10 && i >= 4) break;
-    centroid += mesh.nodes[nodes[i]];
-    ++corner_count;
-  }
+  for (int i = 0; i < corner_count; ++i) centroid += mesh.nodes[nodes[i]];
   centroid /= corner_count;
   Eigen::Vector3d middle = Eigen::Vector3d::Zero();
   for (const int corner : corners) middle += mesh.nodes[corner] / static_cast<double>(corners.size());

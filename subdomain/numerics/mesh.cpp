@@ -41,6 +41,35 @@ int nodes_per_facet(FacetType type) {
   throw std::invalid_argument("nodes_per_facet: unknown facet type");
 }
 
+int element_corner_count(ElementType type) {
+  switch (type) {
+    case ElementType::triangle3:
+    case ElementType::triangle6:
+      return 3;
+    case ElementType::quadrilateral4:
+    case ElementType::tetrahedron4:
+    case ElementType::tetrahedron10:
+      return 4;
+    case ElementType::hexahedron8:
+      return 8;
+  }
+  throw std::invalid_argument("element_corner_count: unknown element type");
+}
+
+int facet_corner_count(FacetType type) {
+  switch (type) {
+    case FacetType::line2:
+    case FacetType::line3:
+      return 2;
+    case FacetType::triangle3:
+    case FacetType::triangle6:
+      return 3;
+    case FacetType::quadrilateral4:
+      return 4;
+  }
+  throw std::invalid_argument("facet_corner_count: unknown facet type");
+}
+
 int element_dimension(ElementType type) {
   switch (type) {
     case ElementType::triangle3:

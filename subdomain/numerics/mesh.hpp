@@ -32,6 +32,11 @@ enum class FacetType {
 
 int nodes_per_element(ElementType type);
 int nodes_per_facet(FacetType type);
+/// The corner (vertex) count: the first nodes of every element and facet are its corners,
+/// midside nodes follow (3 for triangles, 4 for quadrilaterals and tetrahedra, 8 for
+/// hexahedra; 2 for edges).
+int element_corner_count(ElementType type);
+int facet_corner_count(FacetType type);
 /// 2 for the area elements, 3 for the volume elements.
 int element_dimension(ElementType type);
 /// 1 for edges, 2 for faces.

@@ -200,21 +200,6 @@ struct FacetKeyHash {
   }
 };
 
-/// The corner count of a facet type (2 for edges, 3 or 4 for faces).
-int facet_corners(FacetType type) {
-  switch (type) {
-    case FacetType::line2:
-    case FacetType::line3:
-      return 2;
-    case FacetType::triangle3:
-    case FacetType::triangle6:
-      return 3;
-    case FacetType::quadrilateral4:
-      return 4;
-  }
-  return 2;
-}
-
 /// For every facet of every boundary (name order), the flat index of an element that has it as
 /// a side (matched by its corner nodes), -1 when none has.
 std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
@@ -235,7 +220,7 @@ std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
   std::vector<std::int64_t> adjacent;
   for (const auto& [name, group] : mesh.boundaries) {
     const auto nodes = static_cast<std::size_t>(nodes_per_facet(group.type));
-    const int corners = facet_corners(group.type);
+    const int corners = facet_corner_count(group.type);
     for (std::size_t k = 0; k < group.facet_count(); ++k) {
       const auto found = element_of_side.find(facet_key(&group.connectivity[k * nodes], corners));
       adjacent.push_back(found == element_of_side.end() ? -1 : found->second);

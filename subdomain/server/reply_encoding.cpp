@@ -1,5 +1,7 @@
 #include "server/reply_encoding.hpp"
 
+#include "mesh_codec.hpp"
+
 namespace robin {
 namespace {
 
@@ -7,22 +9,6 @@ namespace {
 void add_vector(const Eigen::Vector3d& vector, int dimension,
                 google::protobuf::RepeatedField<double>& values) {
   for (int component = 0; component < dimension; ++component) values.Add(vector[component]);
-}
-
-protocol::CellType facet_cell_type(FacetType type) {
-  switch (type) {
-    case FacetType::line2:
-      return protocol::LINE2;
-    case FacetType::line3:
-      return protocol::LINE3;
-    case FacetType::triangle3:
-      return protocol::TRIANGLE3;
-    case FacetType::triangle6:
-      return protocol::TRIANGLE6;
-    case FacetType::quadrilateral4:
-      return protocol::QUADRILATERAL4;
-  }
-  return protocol::CELL_TYPE_UNSPECIFIED;
 }
 
 void add_values(const Eigen::VectorXd& vector, google::protobuf::RepeatedField<double>& values) {
@@ -62,7 +48,7 @@ void encode_mesh(const Mesh& mesh, protocol::FieldsReply& message) {
     protocol::NamedBoundary& boundary = *message.add_boundaries();
     boundary.set_name(name);
     protocol::CellBlock& segments = *boundary.mutable_segments();
-    segments.set_type(facet_cell_type(group.type));
+    segments.set_type(to_protocol(group.type));
     segments.mutable_connectivity()->Assign(group.connectivity.begin(), group.connectivity.end());
   }
 }
@@ -88,7 +74,7 @@ void encode_interface(const std::string& body_name, const InterfaceDescription& 
   for (const ContactSurfaceDescription& contact_surface : interface.surfaces) {
     protocol::ContactSurface& surface = *message.add_surfaces();
     surface.set_boundary(contact_surface.boundary);
-    surface.set_segment_type(facet_cell_type(contact_surface.facet_type));
+    surface.set_segment_type(to_protocol(contact_surface.facet_type));
     surface.mutable_segments()->Assign(contact_surface.facets.begin(),
                                        contact_surface.facets.end());
   }
