@@ -15,8 +15,9 @@ namespace robin {
 
 namespace {
 
-const std::vector<std::string> root_keys{"title", "gap",     "solver",    "coupling", "contact",
-                                         "body",  "loading", "reference", "interface"};
+const std::vector<std::string> root_keys{"title",     "dimension", "gap",  "solver",
+                                         "coupling",  "contact",   "body", "loading",
+                                         "reference", "interface"};
 const std::vector<std::string> contact_keys{"method", "non_mortar"};
 const std::vector<std::string> gap_keys{"expression", "constants"};
 const std::vector<std::string> solver_keys{
@@ -97,7 +98,7 @@ void read_gap(const CheckedTable& root, CaseDefinition& definition) {
                                    "' is not a valid constant name (a letter or '_', then "
                                    "letters, digits or '_')");
     }
-    if (name == "x" || name == "y") {
+    if (name == "x" || name == "y" || name == "z") {
       table->fail("constants", "'" + name + "' is a variable of the expression, not a constant");
     }
   }
@@ -105,6 +106,16 @@ void read_gap(const CheckedTable& root, CaseDefinition& definition) {
   // Parses and evaluates once: a bad expression is reported here, with its line.
   const GapFunction validation(*definition.gap_expression, definition.gap_constants,
                                definition.gap_context);
+}
+
+/// dimension = 2 (plane bodies, the default) or 3 (solid bodies).
+int read_dimension(const CheckedTable& root) {
+  const auto dimension = root.optional_integer("dimension");
+  if (dimension && *dimension != 2 && *dimension != 3) {
+    root.fail("dimension",
+              "must be 2 (plane bodies) or 3 (solid bodies), got " + std::to_string(*dimension));
+  }
+  return dimension.value_or(2);
 }
 
 void read_solver(const CheckedTable& root, SolverOptions& solver) {
@@ -242,8 +253,8 @@ std::vector<TableEntry> read_bodies(const CheckedTable& root,
   const ContactBoundaryKey contact_key =
       graph ? ContactBoundaryKey::refused : ContactBoundaryKey::required;
   for (std::size_t index = 0; index < entries.size(); ++index) {
-    definition.bodies.push_back(
-        read_body_case(entries[index], root.context(), directory, contact_key));
+    definition.bodies.push_back(read_body_case(entries[index], root.context(), directory,
+                                               contact_key, definition.dimension));
     for (std::size_t earlier = 0; earlier < index; ++earlier) {
       if (definition.bodies[earlier].definition.name != definition.bodies[index].definition.name)
         continue;
@@ -337,6 +348,7 @@ static CaseDefinition read_case_document(const std::filesystem::path& path,
   definition.file = path;
   definition.overrides = overrides;
   definition.title = root.optional_string("title").value_or(path.stem().string());
+  definition.dimension = read_dimension(root);
   read_gap(root, definition);
   read_solver(root, definition.solver);
   read_coupling(root, definition.coupling);
@@ -350,8 +362,9 @@ static CaseDefinition read_case_document(const std::filesystem::path& path,
     table->fail("non_mortar",
                 "'" + definition.contact.non_mortar + "' is not the name of a body (nor \"auto\")");
   }
-  read_interfaces(root, bodies, definition);    // [[interface]]: coupling/case_file_interface.hpp
-  definition.reference = read_reference(root);  // after the bodies: their materials give E*
+  read_interfaces(root, bodies, definition);  // [[interface]]: coupling/case_file_interface.hpp
+  definition.reference =
+      read_reference(root, definition.dimension);  // after the bodies: their materials give E*
   return definition;
 }
 
@@ -397,13 +410,19 @@ InputError mesh_error(const std::vector<BodyCase*>& bodies, const InputError& er
   return error;
 }
 
-/// The case format describes plane bodies (2-component vectors, 3 x 3 Voigt matrices, a plane
-/// model): a three-dimensional mesh is refused until it describes solid ones.
-void require_plane_mesh(const BodyCase& body, const Mesh& mesh) {
-  if (mesh.dimension == 2) return;
-  throw InputError(mesh_context(body) +
-                   ": three-dimensional bodies: a solid (3D) mesh in a case file is not "
-                   "supported yet (the case format describes plane bodies)");
+/// The body's mesh is of the case's dimension (a plane mesh in a case of plane bodies, a solid
+/// one with dimension = 3).
+void require_mesh_dimension(const BodyCase& body, const Mesh& mesh) {
+  if (mesh.dimension == body.dimension) return;
+  const std::string hint = mesh.dimension == 3
+                               ? "set dimension = 3 at the top of the case file for solid bodies "
+                                 "(and remove the plane model)"
+                               : "a case with dimension = 3 takes solid (volume) meshes only";
+  throw InputError(mesh_context(body) + ": mesh '" + body.mesh_path.string() + "' is " +
+                   (mesh.dimension == 3 ? "three-dimensional (volume elements)"
+                                        : "two-dimensional (area elements)") +
+                   " but the case file has dimension = " + std::to_string(body.dimension) + ": " +
+                   hint);
 }
 
 }  // namespace
@@ -415,7 +434,7 @@ BodyDefinition load_body(const BodyCase& body) {
   } catch (const InputError& error) {
     throw InputError(mesh_context(body) + ": " + error.what());
   }
-  require_plane_mesh(body, definition.mesh);
+  require_mesh_dimension(body, definition.mesh);
   check_boundary_names(body, definition);
   return definition;
 }
@@ -435,7 +454,7 @@ void load_meshes(CaseDefinition& definition) {
   }
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     bodies[k]->definition.mesh = std::move(meshes[k]);
-    require_plane_mesh(*bodies[k], bodies[k]->definition.mesh);
+    require_mesh_dimension(*bodies[k], bodies[k]->definition.mesh);
     check_boundary_names(*bodies[k], bodies[k]->definition);
   }
 }

@@ -45,6 +45,8 @@ struct BodyCase {
   /// [[body]] floating = true: contact alone may hold the body (its supports may leave rigid
   /// motions free; docs/method.md, "Floating bodies"). false: such a body is an error.
   bool floating = false;
+  /// The case's dimension: 2 (a plane body) or 3 (a solid one); its mesh must have it.
+  int dimension = 2;
 };
 
 /// Options of the Robin iteration (coordinator); command-line flags override them.
@@ -99,6 +101,9 @@ inline constexpr std::size_t maximum_body_count = 256;
 struct CaseDefinition {
   std::filesystem::path file;
   std::string title;
+  /// `dimension` = 2 (plane bodies, the default) or 3 (solid bodies): every body's mesh, vectors
+  /// and material are of this dimension.
+  int dimension = 2;
   /// Two or more bodies, in file order; body alpha's definition.contact_boundaries are the
   /// boundaries its interfaces name, in interface order, each once.
   std::vector<BodyCase> bodies;

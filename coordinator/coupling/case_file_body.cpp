@@ -15,7 +15,7 @@ const std::vector<std::string> body_keys{"name",       "mesh",      "mesh_size",
                                          "recombine",  "model",     "material",  "contact_boundary",
                                          "body_force", "dirichlet", "traction",  "floating"};
 const std::vector<std::string> material_keys{"young", "poisson", "voigt"};
-const std::vector<std::string> dirichlet_keys{"boundary", "x", "y", "fix"};
+const std::vector<std::string> dirichlet_keys{"boundary", "x", "y", "z", "fix"};
 const std::vector<std::string> traction_keys{"boundary", "vector", "pressure"};
 
 bool is_valid_body_name(const std::string& name) {
@@ -93,8 +93,14 @@ void read_mesh(const CheckedTable& table, const std::filesystem::path& directory
   }
 }
 
-/// young + poisson, or voigt; the material functions check the values.
-Material read_material(const CheckedTable& body, PlaneModel model) {
+/// A plane vector [x, y] as the point (x, y, 0); a solid one [x, y, z] as it is.
+Eigen::Vector3d spatial(const Eigen::VectorXd& vector) {
+  return {vector[0], vector[1], vector.size() == 3 ? vector[2] : 0.0};
+}
+
+/// young + poisson, or voigt (3 x 3 for a plane body, 6 x 6 for a solid one); the material
+/// functions check the values. `model` is empty for a solid body.
+Material read_material(const CheckedTable& body, std::optional<PlaneModel> model) {
   const CheckedTable table = body.table("material", material_keys);
   const bool has_young = table.contains("young");
   const bool has_poisson = table.contains("poisson");
@@ -104,54 +110,101 @@ Material read_material(const CheckedTable& body, PlaneModel model) {
                "give either young and poisson, or voigt, not both");
   }
   if (!has_voigt && !has_young && !has_poisson) {
-    table.fail("", "give either young and poisson (isotropic), or voigt (3x3 stiffness)");
+    table.fail("", std::string("give either young and poisson (isotropic), or voigt (") +
+                       (model ? "3x3" : "6x6") + " stiffness)");
   }
   const std::string context = table.context().prefix(table.line()) + ": material";
-  if (has_voigt) return make_voigt_material(*table.optional_matrix("voigt"), model, context);
+  if (has_voigt) {
+    const Eigen::MatrixXd voigt = *table.optional_matrix("voigt", model ? 3 : 6);
+    return make_voigt_material(voigt, model.value_or(PlaneModel::plane_strain), context);
+  }
   if (!has_poisson) table.fail("poisson", "missing: young needs poisson");
   if (!has_young) table.fail("young", "missing: poisson needs young");
-  return make_isotropic_material(table.number("young"), table.number("poisson"), model, context);
+  const double young = table.number("young");
+  const double poisson = table.number("poisson");
+  if (!model) return make_isotropic_solid_material(young, poisson, context);
+  return make_isotropic_material(young, poisson, *model, context);
 }
 
-DirichletCondition read_dirichlet(const CheckedTable& table,
+/// The components a [[body.dirichlet]] table may prescribe: x and y, and z in a solid body.
+std::vector<std::string> displacement_components(int dimension) {
+  if (dimension == 3) return {"x", "y", "z"};
+  return {"x", "y"};
+}
+
+std::optional<double>& component_of(DirichletCondition& condition, const std::string& component) {
+  if (component == "x") return condition.x;
+  if (component == "y") return condition.y;
+  return condition.z;
+}
+
+/// fix = "both" (plane) or "all" (solid) fixes every component, fix = "x" | "y" | "z" one.
+void read_fixed_components(const CheckedTable& table, int dimension,
+                           DirichletCondition& condition) {
+  const std::string every = dimension == 3 ? "all" : "both";
+  std::vector<std::string> choices = displacement_components(dimension);
+  choices.insert(choices.begin(), every);
+  const auto fix = table.optional_choice("fix", choices);
+  if (!fix) return;
+  for (const std::string& component : displacement_components(dimension)) {
+    if (*fix != every && *fix != component) continue;
+    std::optional<double>& value = component_of(condition, component);
+    if (value) {
+      table.fail("fix", "fix = \"" + *fix + "\" sets u_" + component +
+                            " = 0 and cannot be combined with " + component + " = " +
+                            format_number(*value));
+    }
+    value = 0.0;
+  }
+}
+
+DirichletCondition read_dirichlet(const CheckedTable& table, int dimension,
                                   std::vector<BoundaryReference>& references) {
   DirichletCondition condition;
   condition.boundary = read_boundary_name(table, "boundary", references);
   condition.x = table.optional_number("x");
   condition.y = table.optional_number("y");
-  if (auto fix = table.optional_choice("fix", {"both", "x", "y"})) {
-    for (const std::string component : {"x", "y"}) {
-      if (*fix != "both" && *fix != component) continue;
-      std::optional<double>& value = component == "x" ? condition.x : condition.y;
-      if (value) {
-        table.fail("fix", "fix = \"" + *fix + "\" sets u_" + component +
-                              " = 0 and cannot be combined with " + component + " = " +
-                              format_number(*value));
-      }
-      value = 0.0;
-    }
+  if (table.contains("z") && dimension != 3) {
+    table.fail("z", "u_z applies to solid bodies only (a case file with dimension = 3)");
   }
-  if (!condition.x && !condition.y) {
-    table.fail("", "prescribes nothing: give x and/or y, or fix = \"both\" | \"x\" | \"y\"");
+  condition.z = table.optional_number("z");
+  read_fixed_components(table, dimension, condition);
+  if (!condition.x && !condition.y && !condition.z) {
+    table.fail("", dimension == 3 ? "prescribes nothing: give x, y and/or z, or fix = \"all\" | "
+                                    "\"x\" | \"y\" | \"z\""
+                                  : "prescribes nothing: give x and/or y, or fix = \"both\" | "
+                                    "\"x\" | \"y\"");
   }
   return condition;
 }
 
-TractionCondition read_traction(const CheckedTable& table,
+TractionCondition read_traction(const CheckedTable& table, int dimension,
                                 std::vector<BoundaryReference>& references) {
   TractionCondition condition;
   condition.boundary = read_boundary_name(table, "boundary", references);
-  const auto vector = table.optional_vector("vector");
+  const auto vector = table.optional_vector("vector", dimension);
   const auto pressure = table.optional_number("pressure");
   if (vector && pressure) table.fail("pressure", "give either vector or pressure, not both");
-  if (!vector && !pressure) table.fail("", "give either vector = [tx, ty] or pressure = p");
+  if (!vector && !pressure) {
+    table.fail("", dimension == 3 ? "give either vector = [tx, ty, tz] or pressure = p"
+                                  : "give either vector = [tx, ty] or pressure = p");
+  }
   condition.is_pressure = pressure.has_value();
-  if (vector) condition.vector << *vector, 0.0;  // a plane body's traction (z = 0)
+  if (vector) condition.vector = spatial(*vector);
   if (pressure) condition.pressure = *pressure;
   return condition;
 }
 
-PlaneModel read_model(const CheckedTable& table) {
+/// The plane model of a plane body (required); none for a solid body (refused).
+std::optional<PlaneModel> read_model(const CheckedTable& table, int dimension) {
+  if (dimension == 3) {
+    if (table.contains("model")) {
+      table.fail("model",
+                 "a solid body (dimension = 3) has no plane model; remove model, or set "
+                 "dimension = 2 for plane bodies");
+    }
+    return std::nullopt;
+  }
   const auto model = table.optional_choice("model", {"plane_strain", "plane_stress"});
   if (!model) table.fail("model", "missing required key (\"plane_strain\" or \"plane_stress\")");
   return *model == "plane_strain" ? PlaneModel::plane_strain : PlaneModel::plane_stress;
@@ -167,7 +220,8 @@ std::string format_number(double value) {
 }
 
 BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
-                        const std::filesystem::path& directory, ContactBoundaryKey contact_key) {
+                        const std::filesystem::path& directory, ContactBoundaryKey contact_key,
+                        int dimension) {
   // The name goes into every later message, so it is looked at before the keys are checked.
   const auto name_node = (*entry.table)["name"].value<std::string>();
   CaseContext context = file;
@@ -181,8 +235,9 @@ BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
                            "' is not a valid body name (letters, digits, '_' and '-' only)");
   }
   body.context = file.file + ": body '" + definition.name + "'";
+  body.dimension = dimension;
   read_mesh(table, directory, body);
-  const PlaneModel model = read_model(table);
+  const std::optional<PlaneModel> model = read_model(table, dimension);
   if (contact_key == ContactBoundaryKey::required) {
     definition.contact_boundaries = {
         read_boundary_name(table, "contact_boundary", body.boundary_references)};
@@ -191,18 +246,18 @@ BodyCase read_body_case(const TableEntry& entry, const CaseContext& file,
                "the case has [[interface]] tables: give the contact boundaries there "
                "(interface.boundaries)");
   }
-  const Eigen::Vector2d body_force =
-      table.optional_vector("body_force").value_or(Eigen::Vector2d::Zero());
-  definition.body_force << body_force, 0.0;  // a plane body's (z = 0)
+  if (const auto body_force = table.optional_vector("body_force", dimension)) {
+    definition.body_force = spatial(*body_force);
+  }
   body.floating = table.optional_boolean("floating").value_or(false);
   definition.material = read_material(table, model);
   for (const TableEntry& item : table.array_of_tables("dirichlet")) {
     const CheckedTable condition(*item.table, item.path, context, dirichlet_keys);
-    definition.dirichlet.push_back(read_dirichlet(condition, body.boundary_references));
+    definition.dirichlet.push_back(read_dirichlet(condition, dimension, body.boundary_references));
   }
   for (const TableEntry& item : table.array_of_tables("traction")) {
     const CheckedTable condition(*item.table, item.path, context, traction_keys);
-    definition.tractions.push_back(read_traction(condition, body.boundary_references));
+    definition.tractions.push_back(read_traction(condition, dimension, body.boundary_references));
   }
   return body;
 }

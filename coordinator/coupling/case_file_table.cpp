@@ -200,31 +200,46 @@ std::array<std::string, 2> CheckedTable::string_pair(std::string_view key) const
   return pair;
 }
 
-std::optional<Eigen::Vector2d> CheckedTable::optional_vector(std::string_view key) const {
+namespace {
+
+const std::array<std::string, 7> count_words{"zero", "one", "two", "three", "four", "five", "six"};
+
+/// "two" for 2: the sizes of case-file vectors and matrices are at most six.
+std::string count_word(int count) {
+  return count >= 0 && count < static_cast<int>(count_words.size())
+             ? count_words[static_cast<std::size_t>(count)]
+             : std::to_string(count);
+}
+
+}  // namespace
+
+std::optional<Eigen::VectorXd> CheckedTable::optional_vector(std::string_view key, int size) const {
   const toml::node* node = table_.get(key);
   if (node == nullptr) return std::nullopt;
   const auto* array = node->as_array();
-  if (array == nullptr || array->size() != 2) {
-    fail(key, "expected an array of two numbers [x, y]");
+  if (array == nullptr || array->size() != static_cast<std::size_t>(size)) {
+    fail(key, "expected an array of " + count_word(size) + " numbers " +
+                  (size == 3 ? "[x, y, z]" : "[x, y]"));
   }
-  Eigen::Vector2d vector;
-  for (int i = 0; i < 2; ++i) vector(i) = checked_number(key, *array->get(i));
+  Eigen::VectorXd vector(size);
+  for (int i = 0; i < size; ++i) vector(i) = checked_number(key, *array->get(i));
   return vector;
 }
 
-std::optional<Eigen::Matrix3d> CheckedTable::optional_matrix(std::string_view key) const {
+std::optional<Eigen::MatrixXd> CheckedTable::optional_matrix(std::string_view key, int size) const {
   const toml::node* node = table_.get(key);
   if (node == nullptr) return std::nullopt;
-  const std::string shape =
-      "expected three rows of three numbers [[a, b, c], [d, e, f], [g, h, i]]";
+  const std::string shape = "expected " + count_word(size) + " rows of " + count_word(size) +
+                            " numbers" +
+                            (size == 3 ? " [[a, b, c], [d, e, f], [g, h, i]]" : " (by rows)");
   const auto* rows = node->as_array();
-  if (rows == nullptr || rows->size() != 3) fail(key, shape);
-  Eigen::Matrix3d matrix;
-  for (int row = 0; row < 3; ++row) {
-    const auto* entries = rows->get(row)->as_array();
-    if (entries == nullptr || entries->size() != 3) fail(key, shape);
-    for (int column = 0; column < 3; ++column) {
-      matrix(row, column) = checked_number(key, *entries->get(column));
+  if (rows == nullptr || rows->size() != static_cast<std::size_t>(size)) fail(key, shape);
+  Eigen::MatrixXd matrix(size, size);
+  for (int row = 0; row < size; ++row) {
+    const auto* entries = rows->get(static_cast<std::size_t>(row))->as_array();
+    if (entries == nullptr || entries->size() != static_cast<std::size_t>(size)) fail(key, shape);
+    for (int column = 0; column < size; ++column) {
+      matrix(row, column) = checked_number(key, *entries->get(static_cast<std::size_t>(column)));
     }
   }
   return matrix;

@@ -72,12 +72,12 @@ class CheckedTable {
   /// A string that must be one of `choices`.
   std::optional<std::string> optional_choice(std::string_view key,
                                              const std::vector<std::string>& choices) const;
-  /// [a, b] of two numbers.
-  std::optional<Eigen::Vector2d> optional_vector(std::string_view key) const;
+  /// [a, b] (size 2) or [a, b, c] (size 3) of numbers.
+  std::optional<Eigen::VectorXd> optional_vector(std::string_view key, int size) const;
   /// ["a", "b"] of two non-empty strings (required).
   std::array<std::string, 2> string_pair(std::string_view key) const;
-  /// [[a, b, c], [d, e, f], [g, h, i]] of numbers, by rows.
-  std::optional<Eigen::Matrix3d> optional_matrix(std::string_view key) const;
+  /// A size x size matrix of numbers, by rows ([[a, b, c], [d, e, f], [g, h, i]] for size 3).
+  std::optional<Eigen::MatrixXd> optional_matrix(std::string_view key, int size) const;
   /// A table whose keys are free names and whose values are numbers.
   std::map<std::string, double> number_map(std::string_view key) const;
 

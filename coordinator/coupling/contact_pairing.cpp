@@ -275,7 +275,7 @@ ContactPairing pair_contact_nodes(const InterfaceDescription& body1, const std::
     pair.position2 = body2.coordinates[j];
     pair.normal = (body1.normals[i] - body2.normals[j]).normalized();
     pair.gap = (body2.coordinates[j] - point).dot(pair.normal);
-    if (gap != nullptr) pair.gap += (*gap)(point.x(), point.y());
+    if (gap != nullptr) pair.gap += (*gap)(point.x(), point.y(), point.z());
     pair.weight = 0.5 * (body1.weights[i] + body2.weights[j]);
     const bool fixed1 = normal_is_prescribed(body1.fixed[i], pair.normal);
     const bool fixed2 = normal_is_prescribed(body2.fixed[static_cast<std::size_t>(j)], pair.normal);

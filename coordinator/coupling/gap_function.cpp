@@ -16,6 +16,7 @@ struct GapFunction::Implementation {
   mu::Parser parser;
   double x = 0.0;
   double y = 0.0;
+  double z = 0.0;
 };
 
 namespace {
@@ -39,7 +40,7 @@ std::string describe_parser_error(const mu::Parser::exception_type& error,
 void define_constants(mu::Parser& parser, const std::map<std::string, double>& constants,
                       const std::string& context) {
   for (const auto& [name, value] : constants) {
-    if (name == "x" || name == "y") {
+    if (name == "x" || name == "y" || name == "z") {
       throw InputError(context + ": constant '" + name +
                        "' would hide the variable of the same name; choose another name");
     }
@@ -66,9 +67,10 @@ GapFunction::GapFunction(const std::string& expression,
   try {
     parser.DefineVar("x", &implementation_->x);
     parser.DefineVar("y", &implementation_->y);
+    parser.DefineVar("z", &implementation_->z);
     parser.SetExpr(expression_);
     // muParser reports syntax errors and unknown names only when it compiles the expression,
-    // on the first Eval; the value at (0, 0) itself is not checked here.
+    // on the first Eval; the value at (0, 0, 0) itself is not checked here.
     static_cast<void>(parser.Eval());
   } catch (const mu::Parser::exception_type& error) {
     throw InputError(context_ + ": " + describe_parser_error(error, expression_));
@@ -77,9 +79,10 @@ GapFunction::GapFunction(const std::string& expression,
 
 GapFunction::~GapFunction() = default;
 
-double GapFunction::operator()(double x, double y) const {
+double GapFunction::operator()(double x, double y, double z) const {
   implementation_->x = x;
   implementation_->y = y;
+  implementation_->z = z;
   double value = 0.0;
   try {
     value = implementation_->parser.Eval();
@@ -89,8 +92,8 @@ double GapFunction::operator()(double x, double y) const {
   if (!std::isfinite(value)) {
     std::ostringstream message;
     message.precision(17);
-    message << context_ << ": '" << expression_ << "' is not finite at (x, y) = (" << x << ", " << y
-            << "): " << value;
+    message << context_ << ": '" << expression_ << "' is not finite at (x, y, z) = (" << x << ", "
+            << y << ", " << z << "): " << value;
     throw InputError(message.str());
   }
   return value;

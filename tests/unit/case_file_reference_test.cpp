@@ -103,7 +103,7 @@ TEST_F(ReferenceTable, EveryKeyIsReadAsWritten) {
       "contact_modulus = 1.1e5\ncenter = [0.5, -2]\n");
   ASSERT_TRUE(definition.reference.has_value());
   const ReferenceSolution& reference = *definition.reference;
-  EXPECT_EQ(reference.kind, "hertz_cylinder");
+  EXPECT_EQ(reference.kind, ReferenceKind::hertz_cylinder);
   ASSERT_TRUE(reference.load.has_value());
   EXPECT_EQ(*reference.load, 100.0);
   EXPECT_EQ(reference.radius, 10.0);
@@ -156,9 +156,14 @@ TEST_F(ReferenceTable, NonPositiveLoadAndModulusAreErrors) {
 }
 
 TEST_F(ReferenceTable, UnknownKindKeyAndMissingKeysAreErrors) {
-  const std::string kind = "[reference]\nkind = \"hertz_sphere\"\nradius = 1\n";
-  EXPECT_EQ(error(kind),
-            at(kind, "kind =") + "reference.kind: 'hertz_sphere' is not one of: hertz_cylinder");
+  const std::string kind = "[reference]\nkind = \"hertz_cone\"\nradius = 1\n";
+  EXPECT_EQ(error(kind), at(kind, "kind =") +
+                             "reference.kind: 'hertz_cone' is not one of: hertz_cylinder, "
+                             "hertz_sphere");
+  const std::string sphere = "[reference]\nkind = \"hertz_sphere\"\nradius = 1\n";
+  EXPECT_EQ(error(sphere), at(sphere, "kind =") +
+                               "reference.kind: \"hertz_sphere\" is the reference of solid "
+                               "bodies; a case with dimension = 2 takes \"hertz_cylinder\"");
   const std::string unknown = "[reference]\nkind = \"hertz_cylinder\"\nradius = 1\nradios = 2\n";
   EXPECT_NE(error(unknown).find(at(unknown, "radios =") + "unknown key 'reference.radios'"),
             std::string::npos)

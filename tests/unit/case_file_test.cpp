@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "coupling/gap_function.hpp"
 #include "numerics/errors.hpp"
 
 namespace robin {
@@ -411,8 +412,8 @@ std::vector<ErrorCase> error_cases() {
        "titel = ",
        "titel",
        1,
-       {"case.toml:{line}: unknown key 'titel' (expected one of: title, gap, solver, coupling, "
-        "contact, body, loading, reference, interface)"}},
+       {"case.toml:{line}: unknown key 'titel' (expected one of: title, dimension, gap, solver, "
+        "coupling, contact, body, loading, reference, interface)"}},
       {"UnknownSolverKey",
        "interface_operator",
        "interface_operators",
@@ -443,7 +444,7 @@ std::vector<ErrorCase> error_cases() {
        "fixed",
        1,
        {"case.toml:{line}: body 'lower': unknown key 'body[2].dirichlet[1].fixed' (expected "
-        "one of: boundary, x, y, fix)"}},
+        "one of: boundary, x, y, z, fix)"}},
       {"UnknownTractionKey",
        "vector = ",
        "vectr = ",
@@ -856,10 +857,10 @@ std::vector<ErrorCase> error_cases() {
        {"case.toml:{line}: gap.expression: ", "parenthesis"}},
       {"GapUnknownVariable",
        "x^2 / (2*R)",
-       "x + z",
+       "x + w",
        "expression",
        1,
-       {"case.toml:{line}: gap.expression: ", "\"z\"", "position 4"}},
+       {"case.toml:{line}: gap.expression: ", "\"w\"", "position 4"}},
       {"GapConstantNotANumber",
        "R = 50.0",
        "R = \"50\"",
@@ -1069,6 +1070,175 @@ TEST(LoadBody, HandBuiltBodyCaseIsCheckedToo) {
                          0),
               0u)
         << error.what();
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Solid bodies (dimension = 3)
+
+/// A valid case of two solid blocks; `@DATA@` is the test data directory.
+std::string solid_case() {
+  std::string text = R"toml(title = "solid blocks"
+dimension = 3
+
+[gap]
+expression = "(x^2 + y^2) / (2*R) + z"
+constants = { R = 50.0 }
+
+[[body]]
+name = "upper"
+mesh = "@DATA@/solid_block.geo"
+mesh_size = 0.3
+contact_boundary = "bottom"
+body_force = [0.0, 0.0, -1.0]
+
+[body.material]
+young = 1000.0
+poisson = 0.3
+
+[[body.dirichlet]]
+boundary = "top"
+z = -0.01
+
+[[body.dirichlet]]
+boundary = "left"
+fix = "all"
+
+[[body.traction]]
+boundary = "right"
+vector = [1.0, 2.0, 3.0]
+
+[[body]]
+name = "lower"
+mesh = "@DATA@/solid_block_hexahedra.geo"
+contact_boundary = "top"
+
+[body.material]
+voigt = [[10, 1, 2, 0, 0, 0], [1, 11, 3, 0, 0, 0], [2, 3, 12, 0, 0, 0],
+         [0, 0, 0, 4, 0, 0], [0, 0, 0, 0, 5, 0], [0, 0, 0, 0, 0, 6]]
+
+[[body.dirichlet]]
+boundary = "bottom"
+fix = "z"
+)toml";
+  for (std::size_t at = text.find("@DATA@"); at != std::string::npos; at = text.find("@DATA@")) {
+    text.replace(at, 6, data_directory.string());
+  }
+  return text;
+}
+
+/// The isotropic solid stiffness (Voigt xx, yy, zz, yz, xz, xy; engineering shear strains),
+/// written out from the textbook formulas C = lambda 1 1' + 2 mu I, mu on the shear entries.
+Eigen::MatrixXd isotropic_solid_stiffness(double young, double nu) {
+  const double lambda = young * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  const double mu = young / (2.0 * (1.0 + nu));
+  Eigen::MatrixXd stiffness = Eigen::MatrixXd::Zero(6, 6);
+  stiffness.topLeftCorner(3, 3).setConstant(lambda);
+  for (int i = 0; i < 3; ++i) stiffness(i, i) += 2.0 * mu;
+  for (int i = 3; i < 6; ++i) stiffness(i, i) = mu;
+  return stiffness;
+}
+
+TEST(SolidCaseFile, ReadsVectorsMaterialsAndSupportsOfSolidBodies) {
+  const fs::path path = write_case(solid_case());
+  CaseDefinition definition = read_case_file(path);
+  EXPECT_EQ(definition.dimension, 3);
+  const BodyDefinition& upper = definition.bodies[0].definition;
+  EXPECT_EQ(upper.body_force, Eigen::Vector3d(0.0, 0.0, -1.0));
+  ASSERT_EQ(upper.tractions.size(), 1u);
+  EXPECT_EQ(upper.tractions[0].vector, Eigen::Vector3d(1.0, 2.0, 3.0));
+  ASSERT_EQ(upper.dirichlet.size(), 2u);
+  EXPECT_FALSE(upper.dirichlet[0].x.has_value());
+  EXPECT_EQ(upper.dirichlet[0].z, -0.01);
+  EXPECT_EQ(upper.dirichlet[1].x, 0.0);
+  EXPECT_EQ(upper.dirichlet[1].y, 0.0);
+  EXPECT_EQ(upper.dirichlet[1].z, 0.0);
+  const Eigen::MatrixXd expected = isotropic_solid_stiffness(1000.0, 0.3);
+  ASSERT_EQ(upper.material.stiffness.rows(), 6);
+  EXPECT_LE((upper.material.stiffness - expected).cwiseAbs().maxCoeff(), 1e-12 * 1000.0);
+  const BodyDefinition& lower = definition.bodies[1].definition;
+  ASSERT_EQ(lower.material.stiffness.rows(), 6);
+  EXPECT_EQ(lower.material.stiffness(2, 1), 3.0);
+  EXPECT_EQ(lower.material.stiffness(5, 5), 6.0);
+  EXPECT_EQ(lower.dirichlet[0].z, 0.0);
+  EXPECT_FALSE(lower.dirichlet[0].x.has_value());
+  load_meshes(definition);
+  EXPECT_EQ(definition.bodies[0].definition.mesh.dimension, 3);
+  EXPECT_EQ(definition.bodies[1].definition.mesh.dimension, 3);
+}
+
+TEST(SolidCaseFile, TheGapFunctionTakesZ) {
+  const GapFunction gap("(x^2 + y^2) / (2*R) + z", {{"R", 50.0}}, "test");
+  EXPECT_DOUBLE_EQ(gap(3.0, 4.0, 0.5), 25.0 / 100.0 + 0.5);
+  EXPECT_DOUBLE_EQ(gap(3.0, 4.0), 25.0 / 100.0);  // plane bodies: z = 0
+  const std::string constant = replaced(solid_case(), "R = 50.0", "z = 50.0");
+  const fs::path path = write_case(constant);
+  EXPECT_NE(read_error(path).find("'z' is a variable of the expression, not a constant"),
+            std::string::npos)
+      << read_error(path);
+}
+
+/// The error of `text`, expected to start with "FILE:LINE" of the line containing `marker`.
+void expect_solid_error(const std::string& text, const std::string& marker,
+                        const std::string& message) {
+  const fs::path path = write_case(text);
+  const std::string error = read_error(path);
+  EXPECT_EQ(error.rfind(location(path, line_containing(text, marker)), 0), 0u) << error;
+  EXPECT_NE(error.find(message), std::string::npos) << error;
+}
+
+TEST(SolidCaseFile, PlaneKeysAndSizesAreErrorsInASolidCase) {
+  const std::string base = solid_case();
+  expect_solid_error(replaced(base, "dimension = 3", "dimension = 4"), "dimension = 4",
+                     "dimension: must be 2 (plane bodies) or 3 (solid bodies), got 4");
+  expect_solid_error(replaced(base, "mesh_size = 0.3", "mesh_size = 0.3\nmodel = \"plane_strain\""),
+                     "model =", "a solid body (dimension = 3) has no plane model");
+  expect_solid_error(replaced(base, "vector = [1.0, 2.0, 3.0]", "vector = [1.0, 2.0]"),
+                     "vector = [1.0, 2.0]", "expected an array of three numbers [x, y, z]");
+  expect_solid_error(replaced(base, "body_force = [0.0, 0.0, -1.0]", "body_force = [0.0, -1.0]"),
+                     "body_force =", "expected an array of three numbers [x, y, z]");
+  expect_solid_error(replaced(base, "fix = \"all\"", "fix = \"both\""), "fix = \"both\"",
+                     "'both' is not one of: all, x, y, z");
+  expect_solid_error(replaced(base, "[[10, 1, 2, 0, 0, 0]", "[[10, 1, 2, 0, 0]"),
+                     "voigt =", "expected six rows of six numbers");
+  expect_solid_error(replaced(base, "fix = \"z\"", "fix = \"z\"\nz = 0.5"), "fix = \"z\"",
+                     "cannot be combined with z = 0.5");
+}
+
+TEST(SolidCaseFile, ZIsAnErrorInAPlaneCase) {
+  const std::string text = replaced(base_case(), "y = -0.01", "y = -0.01\nz = 0.0");
+  const fs::path path = write_case(text);
+  const std::string error = read_error(path);
+  EXPECT_EQ(error.rfind(location(path, line_containing(text, "z = 0.0")), 0), 0u) << error;
+  EXPECT_NE(error.find("u_z applies to solid bodies only"), std::string::npos) << error;
+}
+
+TEST(SolidCaseFile, AMeshOfTheOtherDimensionIsAnErrorNamingTheBodyAndMesh) {
+  const std::string plane_mesh =
+      replaced(solid_case(), "solid_block_hexahedra.geo", "case_lower.msh");
+  CaseDefinition solid = read_case_file(write_case(plane_mesh));
+  try {
+    static_cast<void>(load_body(solid.bodies[1]));
+    ADD_FAILURE() << "a plane mesh in a solid case was accepted";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("body 'lower'"), std::string::npos) << message;
+    EXPECT_NE(message.find("case_lower.msh"), std::string::npos) << message;
+    EXPECT_NE(message.find("' is two-dimensional (area elements) but the case file has "
+                           "dimension = 3"),
+              std::string::npos)
+        << message;
+  }
+  const std::string solid_mesh = replaced(base_case(), "case_lower.msh", "solid_block.geo");
+  CaseDefinition plane = read_case_file(write_case(solid_mesh));
+  try {
+    static_cast<void>(load_body(plane.bodies[1]));
+    ADD_FAILURE() << "a solid mesh in a plane case was accepted";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("solid_block.geo"), std::string::npos) << message;
+    EXPECT_NE(message.find("set dimension = 3 at the top of the case file"), std::string::npos)
+        << message;
   }
 }
 
