@@ -19,6 +19,14 @@ the per-body columns of three bodies; robin-plot draws one row of panels per int
 curves are those numbers, and names the contact file that is missing. These need no build of
 the C++ tools (robin-plot of the build when there is one, else the source copy).
 
+A 3D contact surface (SolidContactSurface) is written by the test too, in the columns of
+write_contact_csv (coordinator/coupling/result_files.cpp): the Hertz pressure of a sphere
+p(r) = p0 sqrt(1 - r^2/a^2), p0 = 150, a = 0.2, on a 25 x 25 grid of spacing a/8 in a plane
+normal to z or inclined (n = (1, 2, 2)/3); robin-plot's pressure map has the range 0 .. p0, its
+printed centre, p0 and a are the analytic ones, the farthest loaded point lies within one
+spacing inside a and the total force within 2 % of P = 2/3 pi a^2 p0. A contact file without nz
+and one with a ragged row are refused, naming the file and line.
+
 The tools are those of the build directory named by ROBIN_CONTACT_BIN (set by CTest), default
 build/bin. Needs Debian's matplotlib and numpy (/usr/bin/python3).
 """
@@ -573,6 +581,274 @@ class ContactGraphDirectory(unittest.TestCase):
         self.assertEqual(pressure_axis.get_ylabel(), "contact pressure (force / length)")
         self.assertEqual(list(pressure_axis.get_lines()[0].get_ydata()), INTERFACE1["pressure"])
         self.assertEqual(gap_axis.get_ylabel(), "final normal gap d - u1_N - u2_N")
+
+
+# --- A 3D contact surface: contact.csv written by the test from the Hertz pressure ------------
+
+# write_contact_csv (coordinator/coupling/result_files.cpp) for a solid (3D) pairing.
+SOLID_HEADER = ["pair", "x", "y", "z", "nx", "ny", "nz", "gap0", "un1", "un2", "lambda1",
+                "lambda2", "pressure"]
+# The Hertz pressure of a sphere on a plane: p(r) = p0 sqrt(1 - r^2/a^2), total force
+# P = 2/3 pi a^2 p0. The contact points: a square grid of spacing h = a/8, 25 x 25 points, whose
+# middle point is the centre of the contact; every point's area is h^2.
+PEAK, CONTACT_RADIUS, SPACING, HALF_POINTS, SPHERE_RADIUS = 150.0, 0.2, 0.025, 12, 1.0
+
+
+def exact_text(value):
+    """The shortest text that reads back as value, as std::to_chars writes it ("150", not
+    "150.0")."""
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def hertz_surface(center, normal, tangent):
+    """The rows of a 3D contact.csv: the grid in the plane through center spanned by tangent and
+    normal x tangent, normal (unit) the contact normal; the Hertz pressure about center, the
+    forces lambda1 = lambda2 = p h^2, the initial gap r^2/(2R) of a sphere of radius R and the
+    displacements un1 = un2 = min(gap0, a^2/(2R))/2, so the final gap is max(0, (r^2-a^2)/(2R)).
+    Returns (rows as lists of floats, the distances r)."""
+    center, normal, first = (np.asarray(vector, dtype=float) for vector in (center, normal,
+                                                                             tangent))
+    second = np.cross(normal, first)
+    rows, distances = [], []
+    for i in range(-HALF_POINTS, HALF_POINTS + 1):
+        for j in range(-HALF_POINTS, HALF_POINTS + 1):
+            point = center + i * SPACING * first + j * SPACING * second
+            r = math.hypot(i * SPACING, j * SPACING)
+            pressure = PEAK * math.sqrt(max(0.0, 1.0 - r ** 2 / CONTACT_RADIUS ** 2))
+            gap0 = r ** 2 / (2.0 * SPHERE_RADIUS)
+            un = 0.5 * min(gap0, CONTACT_RADIUS ** 2 / (2.0 * SPHERE_RADIUS))
+            force = pressure * SPACING ** 2
+            rows.append(list(point) + list(normal) + [gap0, un, un, force, force, pressure])
+            distances.append(r)
+    return rows, distances
+
+
+def write_solid_contact_file(path, rows, header=SOLID_HEADER):
+    """contact.csv as write_contact_csv writes it: the pair index, then every value in its
+    shortest exact text; header names the columns (a column left out of it is left out of the
+    rows too)."""
+    keep = [SOLID_HEADER[1:].index(name) for name in header[1:]]
+    lines = [",".join(header)]
+    for index, row in enumerate(rows):
+        lines.append(",".join([str(index)] + [exact_text(row[k]) for k in keep]))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def png_header(path):
+    """(width, height, bit depth, colour type) of a PNG file, from its signature and IHDR chunk,
+    and whether it ends with the IEND chunk."""
+    data = path.read_bytes()
+    if data[:8] != b"\x89PNG\r\n\x1a\n" or data[12:16] != b"IHDR":
+        return None
+    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    return width, height, data[24], data[25], data[-8:-4] == b"IEND"
+
+
+SURFACE_LINE = re.compile(
+    r"contact\.png: 3D contact surface, (\d+) contact rows, (\d+) loaded, largest pressure "
+    r"(\S+), total normal force (\S+), mean normal \(([^)]*)\), centre of pressure \(([^)]*)\); "
+    r"fit of p\^2 = p0\^2 \(1 - r\^2/a\^2\): p0 = (\S+), a = (\S+); farthest loaded point "
+    r"r = (\S+)")
+
+
+class SolidContactSurface(unittest.TestCase):
+    """robin-plot on a 3D contact.csv written here from the analytic Hertz pressure."""
+
+    CENTER = (0.1, -0.05, 0.3)
+
+    def setUp(self):
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-plot-solid-"))
+        self.tool = plot_executable()
+        self.plot = load_plot_module(self.tool)
+
+    def tearDown(self):
+        shutil.rmtree(self.scratch, ignore_errors=True)
+
+    def directory_with(self, name, rows, header=SOLID_HEADER, summary=True):
+        directory = self.scratch / name
+        directory.mkdir()
+        write_solid_contact_file(directory / "contact.csv", rows, header)
+        if summary:
+            force = sum(row[9] for row in rows)
+            (directory / "summary.json").write_text(json.dumps(
+                {"status": "converged", "converged": True, "title": "sphere on a plane",
+                 "contact_force_resultant": [0.0, 0.0, 2.0 * force]}))
+        return directory
+
+    def check_printed_numbers(self, stdout, rows, distances, normal, center):
+        match = SURFACE_LINE.search(stdout)
+        self.assertIsNotNone(match, stdout)
+        (count, loaded, largest, total, printed_normal, printed_center, peak, radius,
+         farthest) = match.groups()
+        self.assertEqual(int(count), (2 * HALF_POINTS + 1) ** 2)  # 625
+        inside = [r for r in distances if r < CONTACT_RADIUS]
+        self.assertEqual(int(loaded), len(inside))
+        self.assertEqual(float(largest), PEAK)  # the middle point carries p0 itself
+        # The printed numbers have six significant digits.
+        np.testing.assert_allclose([float(value) for value in printed_normal.split(",")],
+                                   normal, atol=5e-6)
+        np.testing.assert_allclose([float(value) for value in printed_center.split(",")],
+                                   center, atol=5e-7)
+        # p^2 is linear in r^2 at every loaded point: the fit gives p0 and a exactly.
+        self.assertAlmostEqual(float(peak), PEAK, delta=5e-6 * PEAK)
+        self.assertAlmostEqual(float(radius), CONTACT_RADIUS, delta=5e-6 * CONTACT_RADIUS)
+        # The farthest loaded grid point lies within one spacing inside the contact radius.
+        self.assertAlmostEqual(float(farthest), max(inside), delta=5e-6 * CONTACT_RADIUS)
+        self.assertLess(CONTACT_RADIUS - SPACING, float(farthest))
+        self.assertLess(float(farthest), CONTACT_RADIUS)
+        # The total normal force: sum of (lambda1 + lambda2)/2 = sum of p h^2, within 2 % of
+        # Hertz's P = 2/3 pi a^2 p0 = 12.566 at h = a/8 (the sum is a quadrature of p).
+        forces = sum(row[9] for row in rows)
+        self.assertAlmostEqual(float(total), forces, delta=5e-6 * forces)
+        hertz_load = 2.0 / 3.0 * math.pi * CONTACT_RADIUS ** 2 * PEAK
+        self.assertLess(abs(float(total) / hertz_load - 1.0), 0.02)
+
+    def test_robin_plot_draws_the_pressure_map_of_a_flat_contact(self):
+        rows, distances = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        directory = self.directory_with("flat", rows)
+        case = self.scratch / "case.toml"
+        case.write_text('[reference]\nkind = "hertz_cylinder"\nradius = 1.0\n')
+        status, stdout, stderr = run(self.tool, "--case", case, directory)
+        self.assertEqual(status, 0, stderr)
+        # A PNG of the figure's size at 120 dpi (16 x 5.2 inches), 8-bit RGBA, complete.
+        self.assertEqual(png_header(directory / "contact.png"), (1920, 624, 8, 6, True))
+        self.check_printed_numbers(stdout, rows, distances, (0.0, 0.0, 1.0), self.CENTER)
+        self.assertIn("contact.png: the case's [reference] table (a plane Hertz contact) is not "
+                      "drawn over a 3D contact surface", stdout)
+        self.assertNotIn("history.png", stdout)
+
+    def test_the_maps_carry_the_pressure_and_the_gap(self):
+        rows, distances = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        directory = self.directory_with("flat", rows)
+        summary = json.loads((directory / "summary.json").read_text())
+        tables = self.plot.contact_tables(directory, summary)
+        self.assertTrue(tables[0]["solid"])
+        figure, lines, analysis = self.plot.surface_figure(tables[0]["columns"], summary)
+        pressure_axis, profile_axis, gap_axis = figure.axes[:3]
+        pressures = [row[11] for row in rows]
+        # The pressure map: the pressures in file order, its colour range 0 .. p0 exactly.
+        pressure_map = pressure_axis.collections[0]
+        self.assertEqual(list(pressure_map.get_array()), pressures)
+        self.assertEqual(pressure_map.get_clim(), (0.0, PEAK))
+        self.assertEqual(pressure_map.colorbar.ax.get_ylabel(),
+                         "contact pressure (force / area)")
+        self.assertEqual(pressure_axis.get_aspect(), 1.0)
+        # Normal +z: the map is drawn over x and y themselves.
+        self.assertEqual(pressure_axis.get_xlabel(), "x (model length unit)")
+        self.assertEqual(pressure_axis.get_ylabel(), "y (model length unit)")
+        np.testing.assert_array_equal(pressure_map._triangulation.x, [row[0] for row in rows])
+        np.testing.assert_array_equal(pressure_map._triangulation.y, [row[1] for row in rows])
+        circle = pressure_axis.patches[0]
+        self.assertAlmostEqual(circle.get_radius(), CONTACT_RADIUS, delta=1e-12)
+        np.testing.assert_allclose(circle.center, self.CENTER[:2], atol=1e-15)
+        # The radial profile: every point at its distance from the centre.
+        points = profile_axis.get_lines()[0]
+        np.testing.assert_allclose(points.get_xdata(), distances, atol=1e-15)
+        self.assertEqual(list(points.get_ydata()), pressures)
+        fit = profile_axis.get_lines()[1]
+        self.assertAlmostEqual(max(fit.get_ydata()), PEAK, delta=1e-10 * PEAK)
+        self.assertAlmostEqual(fit.get_xdata()[-1], CONTACT_RADIUS, delta=1e-12)
+        self.assertIn("p0 = 150, a = 0.2", fit.get_label())
+        # The final-gap map: max(0, (r^2 - a^2)/(2R)).
+        gap_map = gap_axis.collections[0]
+        expected_gap = [max(0.0, (r ** 2 - CONTACT_RADIUS ** 2) / (2.0 * SPHERE_RADIUS))
+                        for r in distances]
+        np.testing.assert_allclose(gap_map.get_array(), expected_gap, atol=1e-15)
+        self.assertEqual(gap_map.get_clim()[1], max(gap_map.get_array()))
+        self.assertTrue(analysis["fitted"])
+        self.assertAlmostEqual(analysis["peak"], PEAK, delta=1e-10 * PEAK)
+        self.assertAlmostEqual(analysis["contact_radius"], CONTACT_RADIUS,
+                               delta=1e-10 * CONTACT_RADIUS)
+        np.testing.assert_allclose(analysis["center"], self.CENTER, atol=1e-15)
+        self.assertEqual(figure._suptitle.get_text(),
+                         "3D contact surface: 625 contact rows, 193 loaded (sphere on a plane)")
+        self.assertEqual(len(lines), 1)
+
+    def test_an_inclined_contact_is_projected_onto_its_plane(self):
+        # The contact plane normal to n = (1, 2, 2)/3, the grid along t = (2, -1, 0)/sqrt(5).
+        normal = np.array([1.0, 2.0, 2.0]) / 3.0
+        tangent = np.array([2.0, -1.0, 0.0]) / math.sqrt(5.0)
+        center = (0.4, -0.2, 1.5)
+        rows, distances = hertz_surface(center, normal, tangent)
+        directory = self.directory_with("inclined", rows, summary=False)
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 0, stderr)
+        self.check_printed_numbers(stdout, rows, distances, normal, center)
+        columns = self.plot.read_columns(directory / "contact.csv")
+        figure, _, analysis = self.plot.surface_figure(columns, {})
+        np.testing.assert_allclose(analysis["normal"], normal, atol=1e-15)
+        np.testing.assert_allclose(analysis["center"], center, atol=1e-14)
+        np.testing.assert_allclose(analysis["r"], distances, atol=1e-14)
+        self.assertAlmostEqual(analysis["peak"], PEAK, delta=1e-10 * PEAK)
+        self.assertAlmostEqual(analysis["contact_radius"], CONTACT_RADIUS,
+                               delta=1e-10 * CONTACT_RADIUS)
+        pressure_axis = figure.axes[0]
+        self.assertEqual(pressure_axis.collections[0].get_clim(), (0.0, PEAK))
+        # n's largest components are y and z (a tie: the first, y): x' and z' span the plane.
+        self.assertTrue(pressure_axis.get_xlabel().startswith("x' (x projected onto the plane"))
+        self.assertTrue(pressure_axis.get_ylabel().startswith("z' (z projected onto the plane"))
+
+    def test_a_contact_file_without_nz_is_refused(self):
+        rows, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        header = [name for name in SOLID_HEADER if name != "nz"]
+        directory = self.directory_with("no-nz", rows, header)
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 1)
+        self.assertEqual(stdout, "")
+        self.assertEqual(stderr.strip(), f"robin-plot: {directory / 'contact.csv'}:1: the header "
+                                         "lacks nz: a 3D contact file (its header has z or nz) "
+                                         "has the columns pair,x,y,z,nx,ny,nz,gap0,un1,un2,"
+                                         "lambda1,lambda2,pressure (docs/outputs.md)")
+        self.assertFalse((directory / "contact.png").exists())
+
+    def test_a_ragged_row_is_refused_with_its_line(self):
+        rows, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        directory = self.directory_with("ragged", rows)
+        path = directory / "contact.csv"
+        lines = path.read_text().splitlines()
+        lines[5] = lines[5].rsplit(",", 1)[0]  # line 6 (the fifth row) loses its pressure
+        path.write_text("\n".join(lines) + "\n")
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 1)
+        self.assertEqual(stdout, "")
+        self.assertEqual(stderr.strip(), f"robin-plot: {path}:6: 12 fields, but the header "
+                                         f"(line 1) has 13 ({','.join(SOLID_HEADER)})")
+        self.assertFalse((directory / "contact.png").exists())
+        # One field too many, on line 3.
+        lines = path.read_text().splitlines()
+        lines[5] = lines[6]
+        lines[2] += ",7"
+        path.write_text("\n".join(lines) + "\n")
+        status, _, stderr = run(self.tool, directory)
+        self.assertEqual(status, 1)
+        self.assertIn(f"{path}:3: 14 fields, but the header (line 1) has 13", stderr)
+
+    def test_interfaces_of_solid_bodies_are_drawn_as_maps(self):
+        directory = self.scratch / "graph"
+        directory.mkdir()
+        first, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        second, _ = hertz_surface((1.0, 0.25, -0.5), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+        write_solid_contact_file(directory / "contact_1_lower_middle.csv", first)
+        write_solid_contact_file(directory / "contact_2_middle_side-block.csv", second)
+        status, stdout, stderr = run(self.tool, directory)
+        self.assertEqual(status, 0, stderr)
+        self.assertEqual(png_header(directory / "contact.png")[2:], (8, 6, True))
+        for k, (file, center, normal) in enumerate(
+                (("contact_1_lower_middle.csv", self.CENTER, (0, 0, 1)),
+                 ("contact_2_middle_side-block.csv", (1, 0.25, -0.5), (1, 0, 0))), start=1):
+            line = next(line for line in stdout.splitlines()
+                        if line.startswith(f"robin-plot: contact.png: interface {k}: {file}: 3D"))
+            self.assertTrue(line.endswith(f"({file})"), line)
+            self.assertIn(f"mean normal ({', '.join(str(v) for v in normal)})", line)
+            self.assertIn(f"centre of pressure ({', '.join(f'{v:.6g}' for v in center)})", line)
+            self.assertIn("p0 = 150, a = 0.2;", line)
+        tables = self.plot.contact_tables(directory, {})
+        figure, _ = self.plot.interfaces_figure(tables, {})
+        pressure2 = figure.axes[2]
+        self.assertEqual(pressure2.get_xlabel(), "y (model length unit)")  # normal +x: y, z
+        self.assertEqual(pressure2.get_ylabel(), "z (model length unit)")
+        self.assertEqual(pressure2.collections[0].get_clim(), (0.0, PEAK))
 
 
 if __name__ == "__main__":
