@@ -10,12 +10,13 @@ docs quote are made with this script (docs/iteration-study.md, "The shipped exam
 Not a test: it asserts nothing.
 """
 import argparse
-import csv
 import json
 import pathlib
 import subprocess
 import sys
 import tempfile
+
+from benchmark_support import read_csv_rows, table_rule, tool_directory
 
 REPOSITORY = pathlib.Path(__file__).resolve().parents[1]
 CASES = ["two_blocks", "two_blocks_partial", "asymmetric", "hertz", "hertz_cylinder",
@@ -33,8 +34,7 @@ METHODS = [
 
 
 def read_contact(path):
-    with open(path, newline="") as handle:
-        rows = list(csv.DictReader(handle))
+    rows = read_csv_rows(path)
     return {key: [float(row[key]) for row in rows] for key in ("un1", "un2", "lambda1", "lambda2")}
 
 
@@ -49,12 +49,12 @@ def main():
     parser.add_argument("--output", help="where the result directories go (default: temporary)")
     parser.add_argument("--tolerance", help="--tolerance of every run (default: the case's)")
     options = parser.parse_args()
-    tools = pathlib.Path(options.build) / "bin"
+    tools = tool_directory(options.build)
     scratch = pathlib.Path(options.output or tempfile.mkdtemp(prefix="example-iterations-"))
     extra = ["--tolerance", options.tolerance] if options.tolerance else []
     print("| case | pairs | " + " | ".join(name for name, _ in METHODS) +
           " | default vs monolithic: λ, u_N |")
-    print("|---" * (len(METHODS) + 3) + "|")
+    print(table_rule(len(METHODS) + 3))
     for case in CASES:
         case_file = REPOSITORY / "examples" / f"{case}.toml"
         monolithic = scratch / f"{case}-monolithic"

@@ -51,19 +51,17 @@ Prints the machine, the date, the command, the meshing times and two markdown ta
 """
 
 import argparse
-import csv
 import json
 import os
-import platform
 import shutil
-import signal
 import statistics
 import subprocess
 import sys
-import tempfile
-import threading
 import time
 from pathlib import Path
+
+from benchmark_support import (exit_on_sigterm, print_machine_header, read_csv_rows,
+                               run_measured, scratch_directory, table_rule, tool_directory)
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 CASE = REPOSITORY / "examples" / "two_blocks_partial.toml"
@@ -178,62 +176,8 @@ def getfem_worker(lower_path, upper_path, result_path, max_res, dirichlet):
 
 # --------------------------------------------------------------------------- measuring
 
-def children_of(pid):
-    try:
-        with open(f"/proc/{pid}/task/{pid}/children") as handle:
-            return [int(child) for child in handle.read().split()]
-    except OSError:
-        return []
-
-
-def read_hwm(pid):
-    """(command name, VmHWM in KiB) of a process, or None."""
-    try:
-        with open(f"/proc/{pid}/status") as handle:
-            fields = dict(line.split(":", 1) for line in handle if ":" in line)
-        return fields["Name"].strip(), int(fields["VmHWM"].split()[0])
-    except (OSError, KeyError, ValueError):
-        return None
-
-
-def run_measured(command, log_path, timeout, environment=None):
-    """Runs command; returns (exit status, wall seconds, ru_maxrss KiB, {pid: (name, VmHWM KiB)})."""
-    peaks = {}
-    done = threading.Event()
-    with open(log_path, "w") as log:
-        start = time.monotonic()
-        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT,
-                                   stdin=subprocess.DEVNULL, env=environment)
-
-        def poll():
-            while not done.is_set():
-                pending, seen = [process.pid], set()
-                while pending:
-                    pid = pending.pop()
-                    if pid in seen:
-                        continue
-                    seen.add(pid)
-                    value = read_hwm(pid)
-                    if value is not None and value[1] >= peaks.get(pid, ("", 0))[1]:
-                        peaks[pid] = value
-                    pending.extend(children_of(pid))
-                if time.monotonic() - start > timeout:
-                    process.kill()
-                done.wait(0.1)
-
-        poller = threading.Thread(target=poll, daemon=True)
-        poller.start()
-        _, status, usage = os.wait4(process.pid, 0)
-        wall = time.monotonic() - start
-        process.returncode = os.waitstatus_to_exitcode(status)
-        done.set()
-        poller.join()
-    return process.returncode, wall, usage.ru_maxrss, peaks
-
-
 def read_contact_csv(path):
-    with open(path, newline="") as handle:
-        rows = list(csv.DictReader(handle))
+    rows = read_csv_rows(path)
     rows.sort(key=lambda row: float(row["x"]))
     return [float(row["x"]) for row in rows], [float(row["lambda1"]) for row in rows]
 
@@ -279,10 +223,8 @@ def main():
                       arguments.getfem_dirichlet)
         return 0
 
-    binaries = Path(arguments.build).resolve() / "bin"
-    for tool in ("robin-run", "robin-subdomain", "robin-monolithic"):
-        if not (binaries / tool).is_file():
-            sys.exit(f"{binaries / tool} is missing (build it first)")
+    binaries = tool_directory(arguments.build,
+                              ("robin-run", "robin-subdomain", "robin-monolithic"))
     gmsh = shutil.which("gmsh")
     if gmsh is None:
         sys.exit("the gmsh command is needed to mesh the bodies (apt-get install -y gmsh)")
@@ -301,20 +243,9 @@ def main():
         print(getfem_note, flush=True)
     use_getfem = getfem_note is None
 
-    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
-                if line.startswith("model name")), "?")
-    memory = int(next(line.split()[1] for line in open("/proc/meminfo")
-                      if line.startswith("MemTotal"))) / 1048576
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, {memory:.0f} GiB, {cpu}; "
-          f"load average at start {os.getloadavg()[0]:.1f}")
-    print(f"date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
-    print("command: " + " ".join([sys.executable] + sys.argv), flush=True)
+    print_machine_header()
 
-    if arguments.keep:
-        scratch = Path(arguments.keep).resolve()
-        scratch.mkdir(parents=True, exist_ok=False)
-    else:
-        scratch = Path(tempfile.mkdtemp(prefix="robin-getfem-peer-"))
+    scratch = scratch_directory(arguments.keep, "robin-getfem-peer-")
     template = CASE.read_text()
     results = []
     try:
@@ -427,7 +358,7 @@ def main():
     print("| h | DOFs | runs | contact pairs | robin-run wall | robin-monolithic wall | GetFEM wall | "
           "GetFEM / robin-run | robin-run peak RSS: coordinator, larger server (sum) | "
           "robin-monolithic peak RSS | GetFEM peak RSS |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print(table_rule(11))
     for row in results:
         walls = row["walls"]
         getfem = "getfem" in walls
@@ -446,7 +377,7 @@ def main():
     print("| h | DOFs | robin-run iterations | GetFEM Newton iterations | resultant (robin-run) | "
           "forces vs GetFEM | resultant vs GetFEM | forces vs robin-monolithic | "
           "resultant vs robin-monolithic |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print(table_rule(9))
     for row in results:
         peer = row.get("getfem")
         print(f"| {row['h']} | {row['dofs']} | {row['iterations']} | "
@@ -461,5 +392,5 @@ def main():
 
 
 if __name__ == "__main__":
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    exit_on_sigterm()
     sys.exit(main())

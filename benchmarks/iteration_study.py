@@ -16,14 +16,14 @@ Usage:  /usr/bin/python3 benchmarks/iteration_study.py [--build build] [--output
 """
 
 import argparse
-import csv
 import json
 import os
 import platform
 import re
-import subprocess
 import sys
 import time
+
+from benchmark_support import read_csv_rows, run_timed, table_row, table_rule
 
 EXAMPLES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples")
 TOLERANCE = 1e-8
@@ -107,8 +107,7 @@ def reference_case(case_path):
 
 
 def read_contact_forces(directory):
-    with open(os.path.join(directory, "contact.csv")) as file:
-        rows = list(csv.DictReader(file))
+    rows = read_csv_rows(os.path.join(directory, "contact.csv"))
     return [float(row["lambda1"]) for row in rows], [float(row["lambda2"]) for row in rows]
 
 
@@ -119,18 +118,15 @@ def relative_force_error(run_directory, reference):
 
 
 def run(command, log_path):
-    start = time.monotonic()
-    with open(log_path, "w") as log:
-        completed = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT)
-    return completed.returncode, time.monotonic() - start
+    """(exit status, wall seconds) of command, its output in log_path; stdin inherited."""
+    return run_timed(command, log_path, stdin=None)
 
 
 def read_history(directory):
     path = os.path.join(directory, "history.csv")
     if not os.path.exists(path):
         return []
-    with open(path) as file:
-        rows = list(csv.DictReader(file))
+    rows = read_csv_rows(path)
     keys = ["obstacle_change", "penetration", "force_balance", "complementarity", "correction"]
     history = []
     for row in rows:
@@ -269,8 +265,8 @@ def write_tables(results, scans, path):
             next(r["h"] for r in rows if r["level"] == level),
             next(r["dofs"] for r in rows if r["level"] == level)) for level in levels]
         lines += ["### %s: %s" % (case, rows[0]["description"]), "",
-                  "| " + " | ".join(header + ["largest force error"]) + " |",
-                  "|" + "---|" * (len(header) + 1)]
+                  table_row(header + ["largest force error"]),
+                  table_rule(len(header) + 1)]
         for method in [m[0] for m in methods()]:
             cells, errors = [], []
             for level in levels:
@@ -281,7 +277,7 @@ def write_tables(results, scans, path):
                 else:
                     cells.append("%s (%s)" % (record.get("status"), record.get("iterations")))
             error = "%.1e" % max(errors) if errors else "-"
-            lines.append("| " + " | ".join([method] + cells + [error]) + " |")
+            lines.append(table_row([method] + cells + [error]))
         lines.append("")
     if scans:
         lines += ["### Single fixed delta (plain iteration, coarsest mesh)", "",

@@ -37,18 +37,14 @@ A run that fails or does not converge is reported in its column's "status" row.
 
 import argparse
 import json
-import os
-import platform
 import re
 import shutil
-import statistics
 import sys
-import tempfile
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from getfem_peer_benchmark import run_measured  # noqa: E402 (same directory)
+from benchmark_support import (print_machine_header, run_measured,  # noqa: E402 (same directory)
+                               scratch_directory, table_row, table_rule, tool_directory)
 from many_bodies_service_benchmark import mesh_size, write_row_case  # noqa: E402
 
 REPOSITORY = Path(__file__).resolve().parent.parent
@@ -166,23 +162,10 @@ def main():
     parser.add_argument("--keep", help="keep the scratch directory here")
     arguments = parser.parse_args()
 
-    binaries = Path(arguments.build).resolve() / "bin"
-    for tool in ("robin-run", "robin-subdomain", "robin-monolithic"):
-        if not (binaries / tool).is_file():
-            sys.exit(f"{binaries / tool} is missing (build it first)")
-    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
-                if line.startswith("model name")), "?")
-    memory = int(next(line.split()[1] for line in open("/proc/meminfo")
-                      if line.startswith("MemTotal"))) / 1048576
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, {memory:.0f} GiB, {cpu}; "
-          f"load average at start {os.getloadavg()[0]:.1f}")
-    print(f"date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
-    print("command: " + " ".join([sys.executable] + sys.argv), flush=True)
-    if arguments.keep:
-        scratch = Path(arguments.keep).resolve()
-        scratch.mkdir(parents=True, exist_ok=False)
-    else:
-        scratch = Path(tempfile.mkdtemp(prefix="robin-many-bodies-profile-"))
+    binaries = tool_directory(arguments.build,
+                              ("robin-run", "robin-subdomain", "robin-monolithic"))
+    print_machine_header()
+    scratch = scratch_directory(arguments.keep, "robin-many-bodies-profile-")
 
     cases = []  # (label, case file, extra arguments)
     for count in arguments.counts:
@@ -229,14 +212,14 @@ def main():
         if not arguments.keep:
             shutil.rmtree(scratch, ignore_errors=True)
 
-    print("\n| stage (s) | " + " | ".join(headers) + " |")
-    print("|---|" + "---|" * len(headers))
+    print("\n" + table_row(["stage (s)"] + headers))
+    print(table_rule(len(headers) + 1))
     for index, (label, _, _) in enumerate(ROWS):
-        print("| %s | %s |" % (label.replace("  ", "&nbsp;&nbsp;"),
-                               " | ".join(cell(column[index]) for column in columns)))
+        print(table_row([label.replace("  ", "&nbsp;&nbsp;")]
+                        + [cell(column[index]) for column in columns]))
     for key in extras[0]:
         digits = 0 if "MiB" in key else 3
-        print(f"| {key} | " + " | ".join(cell(extra[key], digits) for extra in extras) + " |")
+        print(table_row([key] + [cell(extra[key], digits) for extra in extras]))
     if failures:
         print(f"\n{failures} run(s) failed or did not converge (see the status row)")
     return 1 if failures else 0

@@ -47,16 +47,16 @@ time, and the DD-versus-monolithic difference. The largest cases run once (no re
 """
 
 import argparse
-import csv
 import json
 import os
 import shutil
 import signal
 import subprocess
 import sys
-import tempfile
-import time
 from pathlib import Path
+
+from benchmark_support import (exit_on_sigterm, read_csv_rows, run_timed, scratch_directory,
+                               table_row, table_rule, tool_directory)
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 
@@ -181,20 +181,6 @@ CASES = {"row": write_row_case, "stack": write_stack_case,
          "square-stack": write_square_stack_case}
 
 
-def run_timed(command, log_path, timeout):
-    """Runs command (stdout and stderr to log_path); returns (exit status, wall seconds)."""
-    start = time.monotonic()
-    with open(log_path, "w") as log:
-        process = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT,
-                                 stdin=subprocess.DEVNULL, timeout=timeout, check=False)
-    return process.returncode, time.monotonic() - start
-
-
-def read_contact(path):
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
-
-
 def contact_difference(reference_directory, directory):
     """The largest difference of un1, un2, lambda1, lambda2 over every interface, each relative
     to that column's largest magnitude in the reference; raises ValueError when the files do not
@@ -209,7 +195,8 @@ def contact_difference(reference_directory, directory):
     largest = dict.fromkeys(columns, 0.0)
     scale = dict.fromkeys(columns, 0.0)
     for name in files:
-        reference, other = read_contact(reference_directory / name), read_contact(directory / name)
+        reference = read_csv_rows(reference_directory / name)
+        other = read_csv_rows(directory / name)
         if len(reference) != len(other):
             raise ValueError(f"{name}: {len(other)} rows against {len(reference)}")
         for a, b in zip(reference, other):
@@ -290,9 +277,9 @@ def row_text(label, count, summary, status, dd_wall, mono_wall, difference, acce
             f"{timings['server_compute']:.2f} s | {mono} | {difference:.1e} |")
 
 
-HEADER = ("| N | DOFs | outer iterations | robin-run wall | iteration | messaging share of the "
-          "iteration | server compute (sum) | robin-monolithic wall | DD vs monolithic |\n"
-          "|---|---|---|---|---|---|---|---|---|")
+HEADER = (table_row(["N", "DOFs", "outer iterations", "robin-run wall", "iteration",
+                     "messaging share of the iteration", "server compute (sum)",
+                     "robin-monolithic wall", "DD vs monolithic"]) + "\n" + table_rule(9))
 
 
 def main():
@@ -315,15 +302,9 @@ def main():
     parser.add_argument("--keep", help="keep the scratch directory here instead of removing it")
     arguments = parser.parse_args()
     PLATE.update(length=arguments.plate_length, thickness=arguments.plate_thickness)
-    binaries = Path(arguments.build).resolve() / "bin"
-    for tool in ("robin-run", "robin-subdomain", "robin-monolithic"):
-        if not (binaries / tool).is_file():
-            sys.exit(f"{binaries / tool} is missing (build it first)")
-    if arguments.keep:
-        scratch = Path(arguments.keep).resolve()
-        scratch.mkdir(parents=True, exist_ok=False)
-    else:
-        scratch = Path(tempfile.mkdtemp(prefix="robin-many-bodies-service-"))
+    binaries = tool_directory(arguments.build,
+                              ("robin-run", "robin-subdomain", "robin-monolithic"))
+    scratch = scratch_directory(arguments.keep, "robin-many-bodies-service-")
     namespace_counts = arguments.namespaces
     if namespace_counts is not None and not namespace_counts:
         namespace_counts = [4, 8]
@@ -435,5 +416,5 @@ def main():
 
 
 if __name__ == "__main__":
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    exit_on_sigterm()
     sys.exit(main())

@@ -26,6 +26,8 @@ import time
 import numpy as np
 import zmq
 
+from benchmark_support import resident_megabytes, table_rule, table_row, tool_directory
+
 repository = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(repository / "python"))
 from robin_subdomain.proto_module import load_protocol  # noqa: E402
@@ -103,19 +105,13 @@ def exchange(socket, request_id, **content):
     return reply
 
 
-def resident_megabytes(pid):
-    with open("/proc/%d/status" % pid) as status:
-        for line in status:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024.0
-    return float("nan")
-
-
 def start_server(arguments, data_directory=None):
     if arguments.python:
         command = [sys.executable, str(repository / "python" / "robin-subdomain-py")]
     else:
-        command = [str(repository / arguments.build / "bin" / "robin-subdomain")]
+        # --build is relative to the repository, not to the current directory
+        command = [str(tool_directory(repository / arguments.build, ("robin-subdomain",))
+                       / "robin-subdomain")]
     command += ["--listen", "tcp://127.0.0.1:*", "--log-level", "warn"]
     if data_directory:
         command += ["--data-directory", data_directory]
@@ -155,8 +151,8 @@ def soak(arguments, mesh, mesh_path, data_directory):
         "robin-subdomain-py" if arguments.python else "robin-subdomain", arguments.setups,
         2 * arguments.cells ** 2, "mesh_path " + mesh_path if mesh_path else "MeshData",
         arguments.every))
-    print("| setups | RSS (MiB) | seconds |")
-    print("|---|---|---|")
+    print(table_row(["setups", "RSS (MiB)", "seconds"]))
+    print(table_rule(3))
     start, request_id = time.time(), 0
     try:
         for setup in range(1, arguments.setups + 1):
