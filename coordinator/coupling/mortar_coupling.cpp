@@ -1,12 +1,15 @@
 #include "coupling/mortar_coupling.hpp"
 
 #include "coupling/box_tree.hpp"
+#include "coupling/face_mortar.hpp"
+#include "coupling/mortar_rows.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <utility>
 
 #include "numerics/errors.hpp"
@@ -21,34 +24,19 @@ Eigen::Vector2d in_plane(const Eigen::Vector3d& point) {
 }
 
 /// A box tree corner (a point in space) from a plane point: embedded at z = 0.
-Eigen::Vector3d corner(const Eigen::Vector2d& point) { return {point.x(), point.y(), 0.0}; }
-
-/// Throws InputError when `description` is of a three-dimensional body.
-void require_plane(const InterfaceDescription& description, const std::string& name) {
-  if (description.dimension == 2) return;
-  throw InputError("mortar coupling: body '" + name +
-                   "': three-dimensional bodies: mortar coupling is not supported yet (use "
-                   "[contact] method = \"node-to-node\" on matching meshes)");
+Eigen::Vector3d corner(const Eigen::Vector2d& point) {
+  return {point.x(), point.y(), 0.0};
 }
 
-/// One contact boundary: its interface description (of that one boundary) seen as segments.
+/// One contact boundary of a plane body: its interface description (of that one boundary) seen
+/// as segments.
 struct Side {
-  Side(const InterfaceDescription& description, std::string body_name, int body_index)
-      : interface(&description), name(std::move(body_name)), body(body_index) {
-    require_plane(description, name);
-    if (description.surfaces.size() > 1) {
-      throw InputError("mortar coupling: body '" + name + "' has " +
-                       std::to_string(description.surfaces.size()) +
-                       " contact boundaries; couple one boundary of each body "
-                       "(restrict_to_boundary)");
-    }
+  explicit Side(const InterfaceDescription& description) : interface(&description) {
     if (!description.surfaces.empty()) surface = &description.surfaces.front();
   }
 
   const InterfaceDescription* interface = nullptr;
   const ContactSurfaceDescription* surface = nullptr;  // null: no segments
-  std::string name;
-  int body = 0;  // 0 or 1
 
   FacetType segment_type() const { return surface ? surface->facet_type : FacetType::line2; }
   int nodes_per_segment() const { return nodes_per_facet(segment_type()); }
@@ -143,14 +131,6 @@ double project_onto_normal_field(const Side& side, int segment, const Eigen::Vec
   return std::nan("");
 }
 
-/// Integrals of one non-mortar node's row, in the dual and the standard basis.
-struct RowIntegrals {
-  std::map<int, double> dual_nonmortar, standard_nonmortar;  // by non-mortar position
-  std::map<int, double> dual_mortar, standard_mortar;        // by mortar position
-  double dual_gap = 0.0, standard_gap = 0.0;
-  double covered = 0.0;  // int over the overlap of phi_j
-};
-
 /// Dual basis coefficients A = diag(int phi) M_e^{-1} of a non-mortar segment (psi = A phi).
 Eigen::MatrixXd dual_coefficients(const Side& side, int segment) {
   const int count = side.nodes_per_segment();
@@ -237,17 +217,11 @@ struct SearchRange {
   }
 };
 
-/// What the projection found, for the error when nothing faces.
-struct Coupling {
-  std::vector<RowIntegrals> rows;  // by non-mortar position
-  int facing_candidates = 0;       // mortar segments in reach whose normal opposes
-  int same_direction_candidates = 0;
-};
-
 /// Segment-to-segment integration over the overlap of non-mortar `segment` and mortar
 /// segment `other`, added to `coupling`.
 void integrate_overlap(const Side& nonmortar, int segment, const Eigen::MatrixXd& dual,
-                       const Side& mortar, int other, const GapFunction* gap, Coupling& coupling) {
+                       const Side& mortar, int other, const GapFunction* gap,
+                       FaceCoupling& coupling) {
   const int ends = 2;  // the endpoints are local nodes 0 and 1 for line2 and line3
   double low = 2.0, high = -2.0;
   for (int end = 0; end < ends; ++end) {
@@ -273,7 +247,7 @@ void integrate_overlap(const Side& nonmortar, int segment, const Eigen::MatrixXd
     const double measure = 0.5 * gauss.weight * (high - low) * at.tangent.norm();
     const Eigen::VectorXd dual_values = dual * at.values;
     for (int a = 0; a < count; ++a) {
-      RowIntegrals& row = coupling.rows[static_cast<std::size_t>(nonmortar.node(segment, a))];
+      FaceRowIntegrals& row = coupling.rows[static_cast<std::size_t>(nonmortar.node(segment, a))];
       row.covered += measure * at.values[a];
       row.dual_gap += measure * dual_values[a] * distance;
       row.standard_gap += measure * at.values[a] * distance;
@@ -299,8 +273,8 @@ bool facing(const Side& nonmortar, int segment, const Side& mortar, int other) {
   return outward.dot(other_outward) < 0.0;
 }
 
-Coupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
-  Coupling coupling;
+FaceCoupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
+  FaceCoupling coupling;
   coupling.rows.resize(nonmortar.interface->node_ids.size());
   const SearchRange range(nonmortar, mortar);
   const BoxTree tree = segment_tree(mortar);
@@ -325,8 +299,8 @@ Coupling integrate(const Side& nonmortar, const Side& mortar, const GapFunction*
 }
 
 /// Node-to-segment collocation: row j from the projection of node j along n_j.
-Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
-  Coupling coupling;
+FaceCoupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction* gap) {
+  FaceCoupling coupling;
   coupling.rows.resize(nonmortar.interface->node_ids.size());
   const SearchRange range(nonmortar, mortar);
   const BoxTree tree = segment_tree(mortar);
@@ -341,7 +315,7 @@ Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction*
       const double distance = (target.position - point).dot(normal);
       if (std::abs(distance) >= best) continue;
       best = std::abs(distance);
-      RowIntegrals row;
+      FaceRowIntegrals row;
       row.covered = nonmortar.interface->weights[j];
       row.dual_nonmortar[static_cast<int>(j)] = row.covered;
       for (int l = 0; l < mortar.nodes_per_segment(); ++l) {
@@ -355,148 +329,109 @@ Coupling collocate(const Side& nonmortar, const Side& mortar, const GapFunction*
   return coupling;
 }
 
-/// normal_is_prescribed (coupling/contact_pairing.hpp) of the node at `position`.
-bool prescribed_along(const InterfaceDescription& side, int position,
-                      const Eigen::Vector3d& normal) {
-  return normal_is_prescribed(side.fixed[static_cast<std::size_t>(position)], normal);
+/// The mortar integrals of two plane bodies' boundaries (segments).
+FaceCoupling integrate_segments(const InterfaceDescription& nonmortar_description,
+                                const InterfaceDescription& mortar_description,
+                                const GapFunction* gap, MortarIntegration integration) {
+  const Side nonmortar(nonmortar_description), mortar(mortar_description);
+  return integration == MortarIntegration::segment_to_segment ? integrate(nonmortar, mortar, gap)
+                                                              : collocate(nonmortar, mortar, gap);
 }
 
-/// Appends `coefficients` (by position of `side`) times `normal` to the row under
-/// construction of `contact`, dropping round-off entries.
-void add_entries(ContactOperator& contact, const Side& side, const std::map<int, double>& values,
-                 double scale, const Eigen::Vector2d& normal) {
-  double largest = 0.0;
-  for (const auto& [position, value] : values) largest = std::max(largest, std::abs(value));
-  for (const auto& [position, value] : values) {
-    if (std::abs(value) <= 1e-13 * largest) continue;
-    const int node = side.interface->node_ids[static_cast<std::size_t>(position)];
-    for (int component = 0; component < 2; ++component) {
-      if (normal[component] != 0.0) {
-        contact.add_entry(node, component, value / scale * normal[component]);
-      }
-    }
+/// A solid body's contact boundary (a description of that one boundary) as a MortarSurface: the
+/// same node positions, the description's averaged normals and its outward-oriented faces.
+MortarSurface mortar_surface(const InterfaceDescription& description) {
+  MortarSurface surface;
+  surface.coordinates = description.coordinates;
+  surface.normals = description.normals;
+  if (description.surfaces.empty()) return surface;
+  surface.face_type = description.surfaces.front().facet_type;
+  surface.faces = description.surfaces.front().facets;
+  return surface;
+}
+
+/// The mean face size of a solid body's contact boundary: the square root of its mean face
+/// area (0 without faces).
+double mean_face_size(const InterfaceDescription& description) {
+  const MortarSurface surface = mortar_surface(description);
+  const std::size_t faces = surface.faces.size() / nodes_per_facet(surface.face_type);
+  if (faces == 0) return 0.0;
+  const std::vector<double> supports = support_integrals(surface);
+  const double area = std::accumulate(supports.begin(), supports.end(), 0.0);
+  return std::sqrt(area / static_cast<double>(faces));
+}
+
+/// The mortar integrals of two solid bodies' contact surfaces (face_mortar.hpp), the initial
+/// gap g0(x, y) evaluated at the non-mortar point's x and y.
+FaceCoupling integrate_faces(const InterfaceDescription& nonmortar,
+                             const InterfaceDescription& mortar, const GapFunction* gap,
+                             MortarIntegration integration, const std::string& nonmortar_name) {
+  if (integration != MortarIntegration::segment_to_segment) {
+    throw InputError("node-to-segment collocation of body '" + nonmortar_name +
+                     "': three-dimensional bodies are not supported (use [contact] method = "
+                     "\"mortar\")");
+  }
+  SpatialGap spatial_gap;
+  if (gap != nullptr) {
+    spatial_gap = [gap](const Eigen::Vector3d& point) { return (*gap)(point.x(), point.y()); };
+  }
+  return integrate_face_mortar(mortar_surface(nonmortar), mortar_surface(mortar), spatial_gap);
+}
+
+/// Throws InputError unless `description` has exactly one contact boundary with facets.
+void require_one_boundary(const InterfaceDescription& description, const std::string& name) {
+  if (description.surfaces.size() > 1) {
+    throw InputError("mortar coupling: body '" + name + "' has " +
+                     std::to_string(description.surfaces.size()) +
+                     " contact boundaries; couple one boundary of each body "
+                     "(restrict_to_boundary)");
+  }
+  if (description.surfaces.empty() || description.surfaces.front().facets.empty() ||
+      description.node_ids.empty()) {
+    throw InputError("mortar coupling: the contact boundary of body '" + name + "' has no " +
+                     (description.dimension == 3 ? "faces" : "segments"));
   }
 }
 
-std::string describe(const Side& side, int position) {
-  const Eigen::Vector2d point = side.coordinates(position);
-  return "body '" + side.name + "' contact node (tag " +
-         std::to_string(side.interface->node_tags[static_cast<std::size_t>(position)]) + ") at (" +
-         std::to_string(point.x()) + ", " + std::to_string(point.y()) + ")";
-}
-
-bool completely_covered(const Side& nonmortar, const Coupling& coupling, int position) {
-  const double full = nonmortar.interface->weights[static_cast<std::size_t>(position)];
-  return std::abs(coupling.rows[static_cast<std::size_t>(position)].covered - full) <= 1e-9 * full;
-}
-
-/// The constraint of non-mortar node `position` (before its operator rows are written).
-ContactPair constraint_of(const Side& nonmortar, const Coupling& coupling, int position) {
-  const RowIntegrals& integrals = coupling.rows[static_cast<std::size_t>(position)];
-  const bool complete = completely_covered(nonmortar, coupling, position);
-  ContactPair pair;
-  pair.normal = (nonmortar.body == 0 ? 1.0 : -1.0) *
-                nonmortar.interface->normals[static_cast<std::size_t>(position)];
-  // Both at the non-mortar node: where the constraint is (contact.csv, clearance checks).
-  pair.position = nonmortar.interface->coordinates[static_cast<std::size_t>(position)];
-  pair.position2 = pair.position;
-  pair.weight = complete ? integrals.dual_nonmortar.at(position) : integrals.covered;
-  pair.gap = (complete ? integrals.dual_gap : integrals.standard_gap) / pair.weight;
-  const int node = nonmortar.interface->node_ids[static_cast<std::size_t>(position)];
-  (nonmortar.body == 0 ? pair.node1 : pair.node2) = node;
-  return pair;
-}
-
-/// Writes row `position` into both operators: the dual row (the node itself, and -M/m on
-/// the mortar side) when the mortar side covers the node's support, else the standard one.
-void write_rows(const Side& nonmortar, const Side& mortar, const Coupling& coupling, int position,
-                double weight, ContactPairing& pairing) {
-  const RowIntegrals& integrals = coupling.rows[static_cast<std::size_t>(position)];
-  const Eigen::Vector2d normal = nonmortar.normal(position);
-  ContactOperator& own = pairing.operators[static_cast<std::size_t>(nonmortar.body)];
-  ContactOperator& other = pairing.operators[static_cast<std::size_t>(mortar.body)];
-  if (completely_covered(nonmortar, coupling, position)) {
-    add_entries(own, nonmortar, {{position, 1.0}}, 1.0, normal);
-    add_entries(other, mortar, integrals.dual_mortar, -weight, normal);
-  } else {
-    add_entries(own, nonmortar, integrals.standard_nonmortar, weight, normal);
-    add_entries(other, mortar, integrals.standard_mortar, -weight, normal);
-  }
-  own.finish_row(weight);
-  other.finish_row(weight);
-}
-
-/// The rows of `coupling` as a ContactPairing: the covered non-mortar nodes (covered over more
-/// than a thousandth of their support) ordered along the zone, those with a prescribed normal
-/// displacement excluded.
-ContactPairing assemble_rows(const Side& nonmortar, const Side& mortar, const Coupling& coupling) {
-  ContactPairing pairing;
-  std::vector<int> constrained;
-  std::vector<Eigen::Vector3d> points;
-  for (std::size_t j = 0; j < coupling.rows.size(); ++j) {
-    const int position = static_cast<int>(j);
-    if (!(coupling.rows[j].covered > 1e-3 * nonmortar.interface->weights[j])) continue;
-    const Eigen::Vector3d& normal = nonmortar.interface->normals[j];
-    if (prescribed_along(*nonmortar.interface, position, normal)) {
-      pairing.excluded.push_back(describe(nonmortar, position) +
-                                 ": normal displacement prescribed by a Dirichlet condition; "
-                                 "constraint excluded from contact");
-      pairing.excluded_pairs.push_back(constraint_of(nonmortar, coupling, position));
-      continue;
-    }
-    constrained.push_back(position);
-    points.push_back(nonmortar.interface->coordinates[j]);
-  }
-  for (const std::size_t k : order_along_zone(points)) {
-    const ContactPair pair = constraint_of(nonmortar, coupling, constrained[k]);
-    write_rows(nonmortar, mortar, coupling, constrained[k], pair.weight, pairing);
-    pairing.pairs.push_back(pair);
-  }
-  return pairing;
-}
-
-void require_segments(const Side& side) {
-  if (side.segment_count() == 0 || side.interface->node_ids.empty()) {
-    throw InputError("mortar coupling: the contact boundary of body '" + side.name +
-                     "' has no segments");
-  }
+/// The row assembly's view of one side: the weights of a plane body's nodes, the support
+/// integrals of a solid body's faces.
+MortarSide mortar_side(const InterfaceDescription& description, const std::string& name, int body) {
+  MortarSide side{&description, name, body, description.weights};
+  if (description.dimension == 3) side.support = support_integrals(mortar_surface(description));
+  return side;
 }
 
 }  // namespace
 
 int finer_side(const InterfaceDescription& body1, const InterfaceDescription& body2) {
-  const Side first(body1, "", 0), second(body2, "", 1);
+  if (body1.dimension == 3) return mean_face_size(body2) < mean_face_size(body1) ? 1 : 0;
+  const Side first(body1), second(body2);
   return mean_segment_length(second) < mean_segment_length(first) ? 1 : 0;
 }
 
 ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const std::string& name1,
                                      const InterfaceDescription& body2, const std::string& name2,
                                      const GapFunction* gap, const MortarOptions& options) {
-  const std::array<Side, 2> sides = {Side(body1, name1, 0), Side(body2, name2, 1)};
-  for (const Side& side : sides) require_segments(side);
+  require_one_boundary(body1, name1);
+  require_one_boundary(body2, name2);
+  if (body1.dimension != body2.dimension) {
+    throw InputError("mortar coupling: bodies '" + name1 + "' and '" + name2 +
+                     "' are of different dimensions (" + std::to_string(body1.dimension) + " and " +
+                     std::to_string(body2.dimension) + ")");
+  }
   const int nonmortar_body =
       options.non_mortar_body >= 0 ? options.non_mortar_body : finer_side(body1, body2);
-  const Side& nonmortar = sides[static_cast<std::size_t>(nonmortar_body)];
-  const Side& mortar = sides[static_cast<std::size_t>(1 - nonmortar_body)];
-  const Coupling coupling = options.integration == MortarIntegration::segment_to_segment
-                                ? integrate(nonmortar, mortar, gap)
-                                : collocate(nonmortar, mortar, gap);
-  ContactPairing pairing = assemble_rows(nonmortar, mortar, coupling);
-  if (pairing.pairs.empty() && pairing.excluded.empty()) {
-    const std::string reason =
-        coupling.same_direction_candidates > 0 && coupling.facing_candidates == 0
-            ? "their outward normals point the same way (check which side of each body the "
-              "contact boundary is on)"
-            : "no point of one projects onto the other along its normals within reach (check "
-              "that the two contact boundaries lie opposite each other)";
-    throw InputError("mortar coupling: the contact boundaries of bodies '" + name1 + "' and '" +
-                     name2 + "' do not face each other: " + reason);
-  }
-  require_constraints_left(pairing, "mortar coupling", "constraints", name1, name2);
-  pairing.non_mortar_body = nonmortar_body;
-  pairing.uncovered = static_cast<int>(nonmortar.interface->node_ids.size()) -
-                      static_cast<int>(pairing.pairs.size() + pairing.excluded.size());
-  return pairing;
+  const MortarSide nonmortar =
+      nonmortar_body == 0 ? mortar_side(body1, name1, 0) : mortar_side(body2, name2, 1);
+  const MortarSide mortar =
+      nonmortar_body == 0 ? mortar_side(body2, name2, 1) : mortar_side(body1, name1, 0);
+  const bool solid = body1.dimension == 3;
+  const FaceCoupling coupling =
+      solid ? integrate_faces(*nonmortar.interface, *mortar.interface, gap, options.integration,
+                              nonmortar.name)
+            : integrate_segments(*nonmortar.interface, *mortar.interface, gap, options.integration);
+  const FacetType facet_type = nonmortar.interface->surfaces.front().facet_type;
+  return assemble_mortar_rows(nonmortar, mortar, coupling, dual_row_of(facet_type));
 }
 
 }  // namespace robin
