@@ -364,18 +364,29 @@ double mean_face_size(const InterfaceDescription& description) {
 /// The mortar integrals of two solid bodies' contact surfaces (face_mortar.hpp), the initial
 /// gap g0(x, y) evaluated at the non-mortar point's x and y.
 FaceCoupling integrate_faces(const InterfaceDescription& nonmortar,
-                             const InterfaceDescription& mortar, const GapFunction* gap,
-                             MortarIntegration integration, const std::string& nonmortar_name) {
-  if (integration != MortarIntegration::segment_to_segment) {
-    throw InputError("node-to-segment collocation of body '" + nonmortar_name +
-                     "': three-dimensional bodies are not supported (use [contact] method = "
-                     "\"mortar\")");
-  }
+                             const InterfaceDescription& mortar, const GapFunction* gap) {
   SpatialGap spatial_gap;
   if (gap != nullptr) {
     spatial_gap = [gap](const Eigen::Vector3d& point) { return (*gap)(point.x(), point.y()); };
   }
   return integrate_face_mortar(mortar_surface(nonmortar), mortar_surface(mortar), spatial_gap);
+}
+
+/// Throws InputError unless both bodies are plane or both solid, and node-to-segment
+/// collocation is of plane bodies.
+void require_supported(const InterfaceDescription& body1, const std::string& name1,
+                       const InterfaceDescription& body2, const std::string& name2,
+                       MortarIntegration integration) {
+  const std::string bodies = "mortar coupling of bodies '" + name1 + "' and '" + name2 + "': ";
+  if (body1.dimension != body2.dimension) {
+    throw InputError(bodies + "bodies of different dimensions (" + std::to_string(body1.dimension) +
+                     " and " + std::to_string(body2.dimension) + ") cannot be in contact");
+  }
+  if (body1.dimension == 3 && integration == MortarIntegration::node_to_segment) {
+    throw InputError(bodies +
+                     "node-to-segment collocation is for plane bodies only (use [contact] "
+                     "method = \"mortar\" for solid bodies)");
+  }
 }
 
 /// Throws InputError unless `description` has exactly one contact boundary with facets.
@@ -414,11 +425,7 @@ ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const st
                                      const GapFunction* gap, const MortarOptions& options) {
   require_one_boundary(body1, name1);
   require_one_boundary(body2, name2);
-  if (body1.dimension != body2.dimension) {
-    throw InputError("mortar coupling: bodies '" + name1 + "' and '" + name2 +
-                     "' are of different dimensions (" + std::to_string(body1.dimension) + " and " +
-                     std::to_string(body2.dimension) + ")");
-  }
+  require_supported(body1, name1, body2, name2, options.integration);
   const int nonmortar_body =
       options.non_mortar_body >= 0 ? options.non_mortar_body : finer_side(body1, body2);
   const MortarSide nonmortar =
@@ -427,8 +434,7 @@ ContactPairing build_mortar_coupling(const InterfaceDescription& body1, const st
       nonmortar_body == 0 ? mortar_side(body2, name2, 1) : mortar_side(body1, name1, 0);
   const bool solid = body1.dimension == 3;
   const FaceCoupling coupling =
-      solid ? integrate_faces(*nonmortar.interface, *mortar.interface, gap, options.integration,
-                              nonmortar.name)
+      solid ? integrate_faces(*nonmortar.interface, *mortar.interface, gap)
             : integrate_segments(*nonmortar.interface, *mortar.interface, gap, options.integration);
   const FacetType facet_type = nonmortar.interface->surfaces.front().facet_type;
   return assemble_mortar_rows(nonmortar, mortar, coupling, dual_row_of(facet_type));
