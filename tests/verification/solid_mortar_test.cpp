@@ -5,6 +5,10 @@
 //    the rows of Popp et al.'s transformed basis with alpha = 1/5: a corner's row is the corner
 //    alone with weight sum 2S/15 over its faces, a mid-edge node's row is (5/3) u_m - (1/3)(u_c +
 //    u_c') with weight sum S/5, on both sides;
+//  - partial coverage: a non-mortar face larger than the mortar one; each node's covered integral
+//    (the product of its hat functions' 1D integrals over the overlap) is its weight, the two
+//    fully covered nodes keep the node-alone dual rows, every row's coefficients sum to 1 and -1,
+//    and a linear field continuous across the interface closes every row;
 //  - the contact patch test: two blocks with non-matching meshes (tetrahedra against
 //    hexahedra), the lower one fixed at its bottom, the upper one pushed down by delta at its top,
 //    lateral symmetry supports (u_x = 0 on x = const, u_y = 0 on y = const): uniform uniaxial
@@ -16,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -30,12 +35,13 @@
 namespace robin {
 namespace {
 
-/// One block [0, 1] x [0, 1] x [bottom, top] of a contact test.
+/// One block [0, 1] x [0, 1] x [bottom, top] of a contact test (or [low, high] in x and y).
 struct Block {
   double bottom = 0.0, top = 1.0;
   Eigen::Vector3i cells{1, 1, 1};
   ElementType type = ElementType::hexahedron8;
   double young = 1.0, poisson = 0.3;
+  Eigen::Vector2d low{0.0, 0.0}, high{1.0, 1.0};
 };
 
 /// The block as a body: lateral symmetry supports (u_x = 0 on left and right, u_y = 0 on front
@@ -45,8 +51,8 @@ BodyDefinition block_body(const std::string& name, const Block& block, const std
                           std::optional<double> bottom_z, std::optional<double> top_z) {
   BodyDefinition body;
   body.name = name;
-  body.mesh =
-      make_box_mesh({0.0, 0.0, block.bottom}, {1.0, 1.0, block.top}, block.cells, block.type);
+  body.mesh = make_box_mesh({block.low.x(), block.low.y(), block.bottom},
+                            {block.high.x(), block.high.y(), block.top}, block.cells, block.type);
   body.material = make_isotropic_solid_material(block.young, block.poisson, name);
   body.dirichlet = {{"left", 0.0, std::nullopt, std::nullopt},
                     {"right", 0.0, std::nullopt, std::nullopt},
@@ -298,6 +304,98 @@ INSTANTIATE_TEST_SUITE_P(NonMortarSide, SolidMortarPatchTest,
                                   (side < 0 ? std::string("_finer")
                                             : "_body" + std::to_string(side));
                          });
+
+/// The integral over [a, b] of the hat function of the node at `node` of a uniform mesh of
+/// [0, 1] with `spacing`: the trapezoidal rule on its linear pieces (exact).
+double hat_integral(double node, double spacing, double a, double b) {
+  const auto hat = [&](double t) { return std::max(0.0, 1.0 - std::abs(t - node) / spacing); };
+  a = std::max(a, 0.0);
+  b = std::min(b, 1.0);
+  if (b <= a) return 0.0;
+  std::vector<double> points = {a, b};
+  for (const double kink : {node - spacing, node, node + spacing}) {
+    if (kink > a && kink < b) points.push_back(kink);
+  }
+  std::sort(points.begin(), points.end());
+  double integral = 0.0;
+  for (std::size_t k = 0; k + 1 < points.size(); ++k) {
+    integral += 0.5 * (points[k + 1] - points[k]) * (hat(points[k]) + hat(points[k + 1]));
+  }
+  return integral;
+}
+
+/// sum over the row's entries of coefficient * field component at the entry's node.
+double apply_row(const ContactOperator& contact, std::size_t row,
+                 const std::map<int, Eigen::Vector3d>& field) {
+  double value = 0.0;
+  for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
+    value += contact.values[k] * field.at(contact.nodes[k])[contact.components[k]];
+  }
+  return value;
+}
+
+/// A linear displacement field at the contact nodes of `side`, added to `field`.
+void add_linear_field(const InterfaceDescription& side, std::map<int, Eigen::Vector3d>& field) {
+  for (std::size_t k = 0; k < side.node_ids.size(); ++k) {
+    const Eigen::Vector3d& x = side.coordinates[k];
+    field[side.node_ids[k]] = Eigen::Vector3d(0.02 - 0.01 * x.y(), 0.01 * x.x() + 0.03 * x.z(),
+                                              0.3 + 0.7 * x.x() - 0.4 * x.y());
+  }
+}
+
+TEST(SolidMortar, PartlyCoveredNodesGetTheStandardRowsOverTheCoveredPart) {
+  // Non-mortar: the top of a 5 x 5 hexahedron block on [0, 1]^2 (nodes every 0.2). Mortar: the
+  // bottom of a tetrahedron block on [0.3, 0.95] x [0.2, 0.9], 0.01 above. The covered integral
+  // of node (x_j, y_j) is the product of its hat functions' integrals over the two intervals.
+  const Block lower_block{0.0, 0.5, {5, 5, 1}, ElementType::hexahedron8, 1.0, 0.3};
+  const Block upper_block{0.51, 0.8, {3, 4, 1},  ElementType::tetrahedron4,
+                          1.0,  0.3, {0.3, 0.2}, {0.95, 0.9}};
+  const BodySolver lower(block_body("lower", lower_block, "top", 0.0, std::nullopt));
+  const BodySolver upper(block_body("upper", upper_block, "bottom", std::nullopt, 0.0));
+  const InterfaceDescription lower_side = lower.contact_boundary();
+  const InterfaceDescription upper_side = upper.contact_boundary();
+  MortarOptions options;
+  options.non_mortar_body = 0;
+  const ContactPairing mortar =
+      build_mortar_coupling(lower_side, "lower", upper_side, "upper", nullptr, options);
+  std::map<int, Eigen::Vector3d> field;
+  add_linear_field(lower_side, field);
+  add_linear_field(upper_side, field);
+  int covered_nodes = 0, fully_covered_nodes = 0;
+  for (std::size_t k = 0; k < lower_side.node_ids.size(); ++k) {
+    const Eigen::Vector3d& x = lower_side.coordinates[k];
+    const double support = hat_integral(x.x(), 0.2, 0.0, 1.0) * hat_integral(x.y(), 0.2, 0.0, 1.0);
+    const double covered = hat_integral(x.x(), 0.2, 0.3, 0.95) * hat_integral(x.y(), 0.2, 0.2, 0.9);
+    const std::size_t row = row_at(mortar, x);
+    if (covered == 0.0) {
+      EXPECT_EQ(row, static_cast<std::size_t>(-1)) << "node at " << x.transpose();
+      continue;
+    }
+    ++covered_nodes;
+    ASSERT_LT(row, mortar.size()) << "node at " << x.transpose();
+    const bool full = std::abs(covered - support) <= 1e-12 * support;
+    fully_covered_nodes += full ? 1 : 0;
+    EXPECT_NEAR(mortar.pairs[row].weight, covered, 1e-14) << "node at " << x.transpose();
+    EXPECT_NEAR(mortar.pairs[row].gap, 0.01, 1e-13) << "node at " << x.transpose();
+    const RowEntries own = row_entries(mortar.operators[0], row);
+    // The dual row of a fully covered node is the node alone; a standard row has neighbours.
+    EXPECT_EQ(own.size() == 1u, full) << "node at " << x.transpose();
+    double own_sum = 0.0, mortar_sum = 0.0;
+    for (const auto& [key, value] : own) own_sum += value;
+    for (const auto& [key, value] : row_entries(mortar.operators[1], row)) mortar_sum += value;
+    EXPECT_NEAR(own_sum, 1.0, 1e-12) << "node at " << x.transpose();
+    EXPECT_NEAR(mortar_sum, -1.0, 1e-12) << "node at " << x.transpose();
+    // A linear field continuous across the interface closes every row exactly.
+    EXPECT_NEAR(
+        apply_row(mortar.operators[0], row, field) + apply_row(mortar.operators[1], row, field),
+        0.0, 1e-13)
+        << "node at " << x.transpose();
+  }
+  EXPECT_EQ(covered_nodes, 25);       // the 6 x 6 nodes but those on x = 0 or y = 0
+  EXPECT_EQ(fully_covered_nodes, 2);  // (0.6, 0.4) and (0.6, 0.6)
+  EXPECT_EQ(static_cast<int>(mortar.size()), covered_nodes);
+  EXPECT_EQ(mortar.uncovered, 11);
+}
 
 TEST(SolidMortar, NodeToSegmentCollocationIsRefusedIn3D) {
   const MatchingBlocks blocks(ElementType::hexahedron8);
