@@ -15,7 +15,8 @@
 //    strain, whose pressure from Hooke's law is p = delta / (H1 / M1 + H2 / M2) with M = E (1 -
 //    nu) / ((1 + nu) (1 - 2 nu)) the P-wave modulus of each block. Every row's lambda_j / m_j
 //    equals p to 1e-10 relative in the monolithic solution, with either side as the non-mortar
-//    side, for 4- and 10-node tetrahedra.
+//    side, for 4- and 10-node tetrahedra; the Robin iteration on in-process ports (4-node
+//    tetrahedra) converges to the monolithic contact forces (1e-8 relative) and to p (1e-8).
 
 #include <gtest/gtest.h>
 
@@ -25,9 +26,12 @@
 #include <map>
 #include <utility>
 
+#include "coupling/case_file.hpp"
 #include "coupling/contact_pairing.hpp"
+#include "coupling/in_process_port.hpp"
 #include "coupling/monolithic_solver.hpp"
 #include "coupling/mortar_coupling.hpp"
+#include "coupling/robin_iteration.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/box_mesher.hpp"
 #include "numerics/material.hpp"
@@ -304,6 +308,52 @@ INSTANTIATE_TEST_SUITE_P(NonMortarSide, SolidMortarPatchTest,
                                   (side < 0 ? std::string("_finer")
                                             : "_body" + std::to_string(side));
                          });
+
+class SolidMortarRobinTest : public ::testing::TestWithParam<int> {};
+
+TEST_P(SolidMortarRobinTest, InProcessRobinIterationConvergesToTheMonolithicSolution) {
+  // The patch test (4-node tetrahedra against hexahedra) with each body behind an in-process
+  // port, iterated by the Robin iteration (default options, tolerance 1e-8).
+  const PatchTest test;
+  const PatchResult reference = solve_patch_test(test, GetParam());
+  ASSERT_EQ(reference.solution.qp.status, QpStatus::converged);
+  BodyCase lower_case, upper_case;
+  lower_case.definition = block_body("lower", test.lower, "top", 0.0, std::nullopt);
+  upper_case.definition =
+      block_body("upper", test.upper, "bottom", std::nullopt, -PatchTest::delta);
+  SolverOptions solver;
+  solver.qp.relative_tolerance = 1e-14;
+  InProcessPort lower, upper;
+  const InterfaceDescription lower_side = lower.setup(lower_case, solver);
+  const InterfaceDescription upper_side = upper.setup(upper_case, solver);
+  MortarOptions options;
+  options.non_mortar_body = GetParam();
+  const ContactPairing pairing =
+      build_mortar_coupling(lower_side, "lower", upper_side, "upper", nullptr, options);
+  lower.assign_contact(pairing.assignment(0));
+  upper.assign_contact(pairing.assignment(1));
+  const CouplingOptions coupling;
+  const RobinResult robin = run_robin_iteration(lower, upper, pairing, coupling);
+  ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
+  const Eigen::VectorXd& expected = reference.solution.contact_force;
+  const double scale = expected.lpNorm<Eigen::Infinity>();
+  double largest_error = 0.0;
+  for (const BodyInterfaceState& body : robin.state.bodies) {
+    largest_error =
+        std::max(largest_error, (body.contact_force - expected).lpNorm<Eigen::Infinity>());
+  }
+  PatchResult iterated{pairing, reference.solution};
+  iterated.solution.contact_force = robin.state.bodies[0].contact_force;
+  const double pressure_error = largest_pressure_error(iterated, test.exact_pressure());
+  std::printf(
+      "3D patch test, Robin iteration, non-mortar body %d: %zu iterations, contact force "
+      "%.3e from the monolithic one (relative), largest pressure error %.3e\n",
+      GetParam(), robin.history.size(), largest_error / scale, pressure_error);
+  EXPECT_LE(largest_error, 1e-8 * scale);
+  EXPECT_LE(pressure_error, 1e-8);
+}
+
+INSTANTIATE_TEST_SUITE_P(NonMortarSide, SolidMortarRobinTest, ::testing::Values(0, 1));
 
 /// The integral over [a, b] of the hat function of the node at `node` of a uniform mesh of
 /// [0, 1] with `spacing`: the trapezoidal rule on its linear pieces (exact).
