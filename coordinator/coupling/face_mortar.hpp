@@ -43,9 +43,10 @@ struct MortarSurface {
   std::vector<int> faces;
 };
 
-/// The integrals of one non-mortar node's row, by node position (index into coordinates).
-/// Same meaning as the 2D RowIntegrals of coupling/mortar_coupling.cpp, with phi~_j (the
-/// transformed basis, = phi_j for linear faces) as the standard basis.
+/// The integrals of one non-mortar node's row, by node position (index into coordinates), with
+/// phi~_j (the transformed basis, = phi_j for linear faces) as the standard basis. The 2D
+/// segment integration of coupling/mortar_coupling.cpp fills the same struct (segments for
+/// faces), and coupling/mortar_rows.hpp assembles the rows of both.
 struct FaceRowIntegrals {
   std::map<int, double> dual_nonmortar;      // D_jk = int psi_j phi_k
   std::map<int, double> standard_nonmortar;  // int phi~_j phi_k

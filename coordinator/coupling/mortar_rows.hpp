@@ -9,6 +9,8 @@
 // couple the edge's corners: DualRow says which. A node covered in part gets the standard basis
 // phi~_j instead (its weight the covered integral int phi~_j, its row coupling the non-mortar
 // neighbours); a node covered over less than a thousandth of its support carries no row.
+// The integrals come as a FaceCoupling (face_mortar.hpp): from integrate_face_mortar in 3D, from
+// the segment integration of mortar_coupling.cpp in 2D.
 
 #include <string>
 #include <vector>
@@ -26,7 +28,8 @@ struct MortarSide {
   int body = 0;                                     // 0 or 1
   /// Per node (position into the description), int phi~_j over its whole support: the
   /// `covered` integral of a node the other side covers entirely (the description's weights in
-  /// 2D; support_integrals() of the faces in 3D, which differ on triangle6 faces).
+  /// 2D; support_integrals() of the faces in 3D, which differ on triangle6 faces). Read on the
+  /// non-mortar side only.
   std::vector<double> support;
 };
 

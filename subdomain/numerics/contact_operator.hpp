@@ -6,7 +6,8 @@
 // c = components[k]. Node-to-node contact is the special case of one row per contact node with
 // the components of its unit normal; mortar coupling gives rows with several nodes. Each row has
 // a weight m_j > 0 (pressure_j = lambda_j / m_j): the boundary weight of its node for
-// node-to-node rows, the diagonal mortar integral for dual multipliers.
+// node-to-node rows, the mortar weight m_j = sum_k D_jk for dual multipliers (D_jj on linear
+// segments and faces; coupling/mortar_rows.hpp).
 
 #include <Eigen/Core>
 #include <cstddef>
