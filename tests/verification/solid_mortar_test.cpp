@@ -23,6 +23,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <utility>
 
@@ -34,6 +35,7 @@
 #include "coupling/robin_iteration.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/box_mesher.hpp"
+#include "numerics/errors.hpp"
 #include "numerics/material.hpp"
 
 namespace robin {
@@ -454,6 +456,35 @@ TEST(SolidMortar, NodeToSegmentCollocationIsRefusedIn3D) {
   EXPECT_THROW(build_mortar_coupling(blocks.lower.contact_boundary(), "lower",
                                      blocks.upper.contact_boundary(), "upper", nullptr, options),
                InputError);
+}
+
+/// The message of the InputError `action` throws ("" when it throws none).
+std::string input_error_of(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(SolidMortar, BoundariesThatDoNotFaceEachOtherAreErrorsNamingBothBodies) {
+  // The upper block's top (outward normal +z) against the lower block's top (+z).
+  const BodySolver lower(block_body("lower", {0.0, 0.5, {3, 2, 1}}, "top", 0.0, std::nullopt));
+  const BodySolver upper(block_body("upper", {0.6, 1.0, {2, 2, 1}}, "top", 0.0, std::nullopt));
+  const InterfaceDescription lower_side = lower.contact_boundary();
+  const InterfaceDescription upper_side = upper.contact_boundary();
+  const std::string message = input_error_of(
+      [&] { build_mortar_coupling(lower_side, "lower", upper_side, "upper", nullptr, {}); });
+  EXPECT_NE(message.find("'lower' and 'upper' do not face each other"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("outward normals point the same way"), std::string::npos) << message;
+  InterfaceDescription plane = upper_side;
+  plane.dimension = 2;
+  const std::string dimensions = input_error_of(
+      [&] { build_mortar_coupling(lower_side, "lower", plane, "upper", nullptr, {}); });
+  EXPECT_NE(dimensions.find("bodies 'lower' and 'upper'"), std::string::npos) << dimensions;
+  EXPECT_NE(dimensions.find("different dimensions"), std::string::npos) << dimensions;
 }
 
 }  // namespace
