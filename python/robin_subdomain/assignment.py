@@ -15,13 +15,13 @@ import numpy as np
 
 from .errors import RequestError
 
-DIMENSION = 2
-
 
 class ContactOperator:
-    """B as entries: entry_rows, node_ids, components, values (entries), weights (rows)."""
+    """B as entries: entry_rows, node_ids, components, values (entries), weights (rows), on a
+    body of `dimension` components per node."""
 
-    def __init__(self, row_offsets, node_ids, components, values, weights):
+    def __init__(self, row_offsets, node_ids, components, values, weights, dimension=2):
+        self.dimension = dimension
         offsets = np.asarray(row_offsets, dtype=np.int64)
         self.row_count = len(offsets) - 1
         self.entry_rows = np.repeat(np.arange(self.row_count), np.diff(offsets))
@@ -31,15 +31,16 @@ class ContactOperator:
         self.weights = np.asarray(weights, dtype=float)
 
     def dofs(self):
-        """The global degree of freedom of every entry (node i has u_x at 2i, u_y at 2i + 1)."""
-        return DIMENSION * self.node_ids + self.components
+        """The global degree of freedom of every entry (node i has component c at d i + c)."""
+        return self.dimension * self.node_ids + self.components
 
     @classmethod
     def node_to_node(cls, node_ids, normals, weights):
-        """One row per node: (B u)_i = u(node_i) . n_i, with normals (nodes x 2)."""
-        count = len(node_ids)
-        return cls(np.arange(0, DIMENSION * count + 1, DIMENSION), np.repeat(node_ids, DIMENSION),
-                   np.tile(np.arange(DIMENSION), count), np.ravel(normals), weights)
+        """One row per node: (B u)_i = u(node_i) . n_i, with normals (nodes x d)."""
+        count, dimension = np.shape(normals)
+        return cls(np.arange(0, dimension * count + 1, dimension),
+                   np.repeat(node_ids, dimension), np.tile(np.arange(dimension), count),
+                   np.ravel(normals), weights, dimension)
 
 
 def _invalid(body_name, field, problem):
@@ -80,7 +81,7 @@ def _check_offsets(message, body_name):
     return offsets.astype(np.int64)
 
 
-def _check_numbers(message, body_name):
+def _check_numbers(message, body_name, dimension):
     for field, values in (("values", message.values), ("weights", message.weights)):
         array = np.array(values, dtype=float)
         bad = np.flatnonzero(~np.isfinite(array))
@@ -92,10 +93,11 @@ def _check_numbers(message, body_name):
         raise _invalid(body_name, "weights[%d]" % bad[0], "is %.6g, expected > 0" %
                        weights[bad[0]])
     components = np.array(message.components, dtype=np.int64)
-    bad = np.flatnonzero(components >= DIMENSION)
+    bad = np.flatnonzero(components >= dimension)
     if len(bad):
-        raise _invalid(body_name, "components[%d]" % bad[0], "is %d, expected 0 (x) or 1 (y)" %
-                       components[bad[0]])
+        expected = "0 (x) or 1 (y)" if dimension == 2 else "0 (x), 1 (y) or 2 (z)"
+        raise _invalid(body_name, "components[%d]" % bad[0], "is %d, expected %s" %
+                       (components[bad[0]], expected))
 
 
 def _check_nodes(message, contact_node_ids, body_name):
@@ -129,15 +131,16 @@ def _check_distinct(operator, node_tags, body_name):
                                              operator.entry_rows[entry]))
 
 
-def decode_assign_contact(message, contact_node_ids, node_tags, body_name):
+def decode_assign_contact(message, contact_node_ids, node_tags, body_name, dimension=2):
     """The ContactOperator of an AssignContact whose node ids must be among contact_node_ids
-    (ascending; node_tags names the mesh's nodes in messages). RequestError INVALID_ARGUMENT
-    for any inconsistent size or value (see the module comment)."""
+    (ascending; node_tags names the mesh's nodes in messages) on a body of `dimension`.
+    RequestError INVALID_ARGUMENT for any inconsistent size or value (see the module
+    comment)."""
     _check_sizes(message, body_name)
     offsets = _check_offsets(message, body_name)
-    _check_numbers(message, body_name)
+    _check_numbers(message, body_name, dimension)
     _check_nodes(message, contact_node_ids, body_name)
     operator = ContactOperator(offsets, message.node_ids, message.components, message.values,
-                               message.weights)
+                               message.weights, dimension)
     _check_distinct(operator, node_tags, body_name)
     return operator

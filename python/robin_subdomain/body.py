@@ -21,9 +21,9 @@ from .errors import InputError, SingularBodyError
 
 
 class BodyDefinition:
-    """Plain data: name, mesh, material, body_force (2), dirichlet [(boundary, x or None,
-    y or None)], tractions [(boundary, vector (2) or None, pressure or None)],
-    contact_boundaries (names of mesh boundaries, at least one)."""
+    """Plain data: name, mesh, material, body_force (d), dirichlet [(boundary, x or None,
+    y or None[, z or None])], tractions [(boundary, vector (d) or None, pressure or None)],
+    contact_boundaries (names of mesh boundaries, at least one); d = mesh.dimension."""
 
     def __init__(self, name, mesh, material, body_force=(0.0, 0.0), dirichlet=(), tractions=(),
                  contact_boundaries=()):
@@ -39,55 +39,67 @@ class BodyDefinition:
 def prescribed_values(definition):
     """Per dof: the prescribed value, NaN when free. Conflicting values are an InputError."""
     mesh = definition.mesh
-    values = np.full(2 * mesh.node_count(), np.nan)
+    dimension = mesh.dimension
+    values = np.full(mesh.dof_count(), np.nan)
     source = {}
-    for boundary, x, y in definition.dirichlet:
+    for boundary, *components in definition.dirichlet:
         for node in mesh.boundaries[boundary].nodes():
-            for component, value in ((0, x), (1, y)):
+            for component, value in enumerate(components[:dimension]):
                 if value is None:
                     continue
-                dof = 2 * node + component
+                dof = dimension * node + component
                 differs = abs(values[dof] - value) > 1e-14 * (1 + abs(value))
                 if not np.isnan(values[dof]) and differs:
                     raise InputError(
                         "body '%s': Dirichlet conditions on '%s' and '%s' prescribe different "
                         "values to node tag %d (%s)" % (definition.name, source[dof], boundary,
                                                         mesh.node_tags[node],
-                                                        "u_x" if component == 0 else "u_y"))
+                                                        ("u_x", "u_y", "u_z")[component]))
                 values[dof] = value
                 source[dof] = boundary
     return values
 
 
+# The rotations of the rigid modes: (axis row, component, sign, coordinate): the rotation about
+# the axis moves `component` by sign * (x_coordinate - centre) / scale. One in 2D (about z),
+# three in 3D (about x, y, z).
+ROTATIONS = {2: [(2, 0, -1.0, 1), (2, 1, 1.0, 0)],
+             3: [(3, 1, -1.0, 2), (3, 2, 1.0, 1), (4, 0, 1.0, 2), (4, 2, -1.0, 0),
+                 (5, 0, -1.0, 1), (5, 1, 1.0, 0)]}
+
+
 def removes_rigid_motions(nodes, prescribed):
-    """True when the prescribed dofs block the rigid modes (1, 0), (0, 1) and the rotation
-    (-(y - yc), x - xc) / scale: the Gram matrix of the modes on those dofs has rank 3."""
+    """True when the prescribed dofs block the rigid modes: the d translations and the
+    rotations (about z in 2D: (-(y - yc), x - xc) / scale; about x, y and z in 3D). The Gram
+    matrix of the modes on those dofs has full rank (3 in 2D, 6 in 3D)."""
+    count, dimension = nodes.shape
     centre = nodes.mean(axis=0)
-    scale = np.max(np.hypot(*(nodes - centre).T)) or 1.0
+    scale = np.max(np.linalg.norm(nodes - centre, axis=1)) or 1.0
     relative = (nodes - centre) / scale
-    rows = np.zeros((len(prescribed), 3))
-    rows[0::2, 0] = 1.0
-    rows[0::2, 2] = -relative[:, 1]
-    rows[1::2, 1] = 1.0
-    rows[1::2, 2] = relative[:, 0]
+    modes = 3 if dimension == 2 else 6
+    rows = np.zeros((count * dimension, modes))
+    for component in range(dimension):
+        rows[component::dimension, component] = 1.0
+    for mode, component, sign, coordinate in ROTATIONS[dimension]:
+        rows[component::dimension, mode] = sign * relative[:, coordinate]
     rows = rows[prescribed]
     eigenvalues = np.linalg.eigvalsh(rows.T @ rows)
-    return eigenvalues[2] > 0.0 and eigenvalues[0] > 1e-10 * eigenvalues[2]
+    return eigenvalues[-1] > 0.0 and eigenvalues[0] > 1e-10 * eigenvalues[-1]
 
 
 def external_load(definition):
     """f: body force plus tractions (pressure p: traction -p n, compression positive)."""
     mesh = definition.mesh
-    load = np.zeros(2 * mesh.node_count())
+    load = np.zeros(mesh.dof_count())
     if np.any(definition.body_force != 0.0):
         load += fem.assemble_body_force(mesh, definition.body_force)
     for boundary, vector, pressure in definition.tractions:
-        edges = fem.EdgeSet(mesh, boundary, mesh.boundaries[boundary])
+        facets = fem.facet_set(mesh, boundary, mesh.boundaries[boundary])
         if pressure is not None:
-            load += fem.assemble_traction(mesh, edges, lambda x, n: -pressure * n)
+            load += fem.assemble_traction(mesh, facets, lambda x, n: -pressure * n)
         else:
             constant = np.asarray(vector, dtype=float)
-            load += fem.assemble_traction(mesh, edges,
+            load += fem.assemble_traction(mesh, facets,
                                           lambda x, n: np.broadcast_to(constant, x.shape))
     return load
 
@@ -107,8 +119,8 @@ class Body:
         if not removes_rigid_motions(self.mesh.nodes, self.is_prescribed):
             raise SingularBodyError(
                 "body '%s': the Dirichlet conditions leave a rigid motion free (translation or "
-                "rotation); fix u_x and u_y on a boundary segment, or enough components on "
-                "several boundaries" % self.name)
+                "rotation); fix every displacement component on a boundary, or enough "
+                "components on several boundaries" % self.name)
         self.interface = ContactBoundaries(self.mesh, definition.contact_boundaries,
                                            self.is_prescribed)
         self.free_dofs = np.flatnonzero(~self.is_prescribed)
@@ -156,7 +168,7 @@ class Body:
         self.contact.set_load_factor(self.load_factor)
 
     def displacement(self, contact_force):
-        """Full displacement (2 per node): u_f = K^-1 (t f - B' lambda), prescribed values t u_p
+        """Full displacement (d per node): u_f = K^-1 (t f - B' lambda), prescribed values t u_p
         (t the load factor)."""
         free_values = self.load_factor * self.free_solution
         if len(contact_force) and np.max(np.abs(contact_force)) > 0.0:
@@ -172,4 +184,4 @@ class Body:
         return reaction
 
     def applied_force(self):
-        return self.load_factor * self.full_load.reshape(-1, 2).sum(axis=0)
+        return self.load_factor * self.full_load.reshape(-1, self.mesh.dimension).sum(axis=0)

@@ -193,7 +193,7 @@ def solve_bound_qp(matrix, right_hand_side, start, tolerance, max_iterations, no
 class ContactInterface:
     """B, e, F and the warm start of one contact assignment (a ContactOperator) of `body`:
     trace = B on the free dofs (rows x free), prescribed_trace = B u_p (rows),
-    full_operator = B on all dofs (rows x 2n), free_trace e, compliance F.
+    full_operator = B on all dofs (rows x dn), free_trace e, compliance F.
 
     It keeps the body's factor and reduced load, not the body: the body holds its
     ContactInterface (Body.contact), and a reference back would make each body a reference
@@ -232,7 +232,7 @@ class ContactInterface:
         self.free_trace = factor * self.unit_free_trace
 
     def nodal_forces(self, contact_force):
-        """B' lambda on every dof (2n): minus the contact forces acting on the body."""
+        """B' lambda on every dof (dn): minus the contact forces acting on the body."""
         return self.full_operator.T @ contact_force
 
     def _dense_compliance(self):

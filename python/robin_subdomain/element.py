@@ -2,12 +2,15 @@
 
 Reference triangle (0,0), (1,0), (0,1) (area 1/2); reference quadrilateral [-1, 1]^2 with
 corners (-1,-1), (1,-1), (1,1), (-1,1); reference edge [-1, 1] with the endpoints at -1, 1 and
-the midpoint (3-node lines) at 0. Node orders are Gmsh's.
+the midpoint (3-node lines) at 0. Solid cells (protocol 2.4): reference tetrahedron (0,0,0),
+(1,0,0), (0,1,0), (0,0,1) (volume 1/6); reference hexahedron [-1, 1]^3, bottom face z = -1
+counter-clockwise seen from above, then the top face. Node orders are Gmsh's. The rules are
+those of the C++ server (subdomain/numerics/finite_element.cpp).
 """
 
 import numpy as np
 
-from .mesh import LINE2, QUADRILATERAL4, TRIANGLE3, TRIANGLE6
+from .mesh import HEXAHEDRON8, LINE2, QUADRILATERAL4, TETRAHEDRON4, TRIANGLE3, TRIANGLE6
 
 
 def gauss_legendre(point_count):
@@ -72,9 +75,52 @@ def quadrilateral_quadrature(degree):
     return np.column_stack([xi.ravel(), eta.ravel()]), (weight_xi * weight_eta).ravel()
 
 
+def _collapsed_tetrahedron_rule(degree):
+    # Duffy: x = u (1 - v)(1 - w), y = v (1 - w), z = w on the unit cube, Jacobian
+    # (1 - v)(1 - w)^2.
+    points, weights = gauss_legendre(degree // 2 + 2)
+    rule = []
+    for point_u, weight_u in zip(points, weights):
+        for point_v, weight_v in zip(points, weights):
+            for point_w, weight_w in zip(points, weights):
+                u, v, w = 0.5 * (point_u + 1.0), 0.5 * (point_v + 1.0), 0.5 * (point_w + 1.0)
+                weight = 0.125 * weight_u * weight_v * weight_w * (1.0 - v) * (1.0 - w) ** 2
+                rule.append((u * (1.0 - v) * (1.0 - w), v * (1.0 - w), w, weight))
+    return rule
+
+
+def tetrahedron_quadrature(degree):
+    """The centroid rule (degree 1), the symmetric 4-point rule (degree 2), else the collapsed
+    Gauss rule: (points, weights) with weights summing to 1/6."""
+    if degree <= 1:
+        rule = [(0.25, 0.25, 0.25, 1.0 / 6.0)]
+    elif degree == 2:
+        a = (5.0 - np.sqrt(5.0)) / 20.0
+        b = 1.0 - 3.0 * a
+        rule = [(a, a, a, 1.0 / 24.0), (b, a, a, 1.0 / 24.0), (a, b, a, 1.0 / 24.0),
+                (a, a, b, 1.0 / 24.0)]
+    else:
+        rule = _collapsed_tetrahedron_rule(degree)
+    table = np.array(rule)
+    return table[:, :3], table[:, 3]
+
+
+def hexahedron_quadrature(degree):
+    """Tensor Gauss rule with degree // 2 + 1 points per direction, xi fastest."""
+    points, weights = gauss_legendre(degree // 2 + 1)
+    zeta, eta, xi = np.meshgrid(points, points, points, indexing="ij")
+    weight_zeta, weight_eta, weight_xi = np.meshgrid(weights, weights, weights, indexing="ij")
+    return (np.column_stack([xi.ravel(), eta.ravel(), zeta.ravel()]),
+            (weight_xi * weight_eta * weight_zeta).ravel())
+
+
 def element_quadrature(element_type, degree):
     if element_type == QUADRILATERAL4:
         return quadrilateral_quadrature(degree)
+    if element_type == TETRAHEDRON4:
+        return tetrahedron_quadrature(degree)
+    if element_type == HEXAHEDRON8:
+        return hexahedron_quadrature(degree)
     return triangle_quadrature(degree)
 
 
@@ -84,9 +130,18 @@ def edge_quadrature(degree):
 
 
 QUADRILATERAL_CORNERS = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+HEXAHEDRON_CORNERS = np.array([[-1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [1.0, 1.0, -1.0],
+                               [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0], [1.0, -1.0, 1.0],
+                               [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]])
+TETRAHEDRON_CORNERS = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+                                [0.0, 0.0, 1.0]])
 
 
 def reference_nodes(element_type):
+    if element_type == TETRAHEDRON4:
+        return TETRAHEDRON_CORNERS.copy()
+    if element_type == HEXAHEDRON8:
+        return HEXAHEDRON_CORNERS.copy()
     if element_type == TRIANGLE3:
         return np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     if element_type == TRIANGLE6:
@@ -97,11 +152,30 @@ def reference_nodes(element_type):
 def reference_centroid(element_type):
     if element_type == QUADRILATERAL4:
         return np.array([0.0, 0.0])
+    if element_type == TETRAHEDRON4:
+        return np.array([0.25, 0.25, 0.25])
+    if element_type == HEXAHEDRON8:
+        return np.array([0.0, 0.0, 0.0])
     return np.array([1.0 / 3.0, 1.0 / 3.0])
 
 
+def _solid_shape_functions(element_type, reference):
+    r, s, t = reference
+    if element_type == TETRAHEDRON4:
+        return (np.array([1.0 - r - s - t, r, s, t]),
+                np.array([[-1.0, -1.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+    # N_i = (1 + xi_i xi)(1 + eta_i eta)(1 + zeta_i zeta) / 8
+    along = 1.0 + HEXAHEDRON_CORNERS * np.array([r, s, t])           # 8 x 3
+    values = 0.125 * along[:, 0] * along[:, 1] * along[:, 2]
+    gradients = 0.125 * HEXAHEDRON_CORNERS * np.column_stack(
+        [along[:, 1] * along[:, 2], along[:, 0] * along[:, 2], along[:, 0] * along[:, 1]])
+    return values, gradients
+
+
 def shape_functions(element_type, reference):
-    """Values N (k) and reference gradients dN/dxi (k x 2) at one reference point."""
+    """Values N (k) and reference gradients dN/dxi (k x d) at one reference point."""
+    if element_type in (TETRAHEDRON4, HEXAHEDRON8):
+        return _solid_shape_functions(element_type, reference)
     r, s = reference
     if element_type == TRIANGLE3:
         return (np.array([1.0 - r - s, r, s]),

@@ -2,11 +2,12 @@
 the bytes of their VTK XML unstructured-grid file (binary zlib-compressed .vtu, with the named
 boundaries as line cells; paths.write_under_root writes it).
 
-Point fields: displacement (2), stress (6: XX, YY, ZZ, XY, YZ, XZ; nodal average; ZZ =
-out_of_plane_poisson (XX + YY), YZ = XZ = 0), von_mises,
-contact_pressure (|(B' lambda) at the node| / m_i, m_i the node's weight on the contact
-boundaries; 0 off them), contact_force (2: -B' lambda at each node), reaction (2: K u - f at
-prescribed dofs). Cell fields: stress (6, element centroids), von_mises.
+Point fields, d = 2 (plane) or 3 (solid) components per vector: displacement (d), stress (6:
+XX, YY, ZZ, XY, YZ, XZ; nodal average; plane: ZZ = out_of_plane_poisson (XX + YY),
+YZ = XZ = 0), von_mises, contact_pressure (|(B' lambda) at the node| / m_i, m_i the node's
+weight on the contact boundaries; 0 off them), contact_force (d: -B' lambda at each node),
+reaction (d: K u - f at prescribed dofs). Cell fields: stress (6, element centroids),
+von_mises. A solid body's .vtu has its tetrahedra and hexahedra and its boundary faces.
 reaction_resultant: sum of the reactions; applied_force: sum of body forces and tractions.
 """
 
@@ -17,7 +18,8 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from . import fem
-from .mesh import LINE2, LINE3, QUADRILATERAL4, VTK_CELL_TYPE
+from .material import stress_tensors
+from .mesh import CORNER_COUNT, LINE2, LINE3, QUADRILATERAL4, TRIANGLE3, VTK_CELL_TYPE
 
 
 class BodyFields:
@@ -32,41 +34,33 @@ def body_fields(body, contact_force):
     """The fields of `body` (with an assigned contact) under contact forces lambda (one per
     constraint)."""
     mesh = body.mesh
+    dimension = mesh.dimension
     displacement = body.displacement(contact_force)
     element_stress, nodal_stress, element_von_mises, nodal_von_mises = fem.recover_stress(
         mesh, body.definition.material, displacement)
     reaction = body.reactions(displacement)
-    force_field = -body.contact.nodal_forces(contact_force).reshape(-1, 2)
+    force_field = -body.contact.nodal_forces(contact_force).reshape(-1, dimension)
     weights = body.interface.node_weights
     pressure = np.zeros(mesh.node_count())
     positive = weights > 0.0
-    pressure[positive] = np.hypot(force_field[positive, 0],
-                                  force_field[positive, 1]) / weights[positive]
+    pressure[positive] = np.linalg.norm(force_field[positive], axis=1) / weights[positive]
     material = body.definition.material
-    point_fields = [("displacement", 2, displacement.reshape(-1, 2)),
+    point_fields = [("displacement", dimension, displacement.reshape(-1, dimension)),
                     ("stress", 6, stress_tensors(material, nodal_stress)),
                     ("von_mises", 1, nodal_von_mises[:, None]),
                     ("contact_pressure", 1, pressure[:, None]),
-                    ("contact_force", 2, force_field), ("reaction", 2, reaction.reshape(-1, 2))]
+                    ("contact_force", dimension, force_field),
+                    ("reaction", dimension, reaction.reshape(-1, dimension))]
     cell_fields = [("stress", 6, stress_tensors(material, element_stress)),
                    ("von_mises", 1, element_von_mises[:, None])]
-    return BodyFields(point_fields, cell_fields, reaction.reshape(-1, 2).sum(axis=0),
+    return BodyFields(point_fields, cell_fields, reaction.reshape(-1, dimension).sum(axis=0),
                       body.applied_force())
 
 
 VTU_BLOCK_SIZE = 32768  # uncompressed bytes per zlib block (vtkZLibDataCompressor's default)
-VTK_EDGE_TYPE = {LINE2: 3, LINE3: 21}  # VTK_LINE, VTK_QUADRATIC_EDGE (endpoints, then midpoint)
+# VTK_LINE, VTK_QUADRATIC_EDGE (endpoints, then midpoint); boundary faces of solid meshes.
+VTK_EDGE_TYPE = {LINE2: 3, LINE3: 21, TRIANGLE3: 5, QUADRILATERAL4: 9}
 STRESS_COMPONENTS = ("XX", "YY", "ZZ", "XY", "YZ", "XZ")
-
-
-def stress_tensors(material, stress):
-    """Stresses (count x 3: s_xx, s_yy, s_xy) as symmetric tensors in ParaView's order (count x
-    6: XX, YY, ZZ, XY, YZ, XZ) with s_zz = out_of_plane_poisson (s_xx + s_yy) (nu in isotropic
-    plane strain, 0 otherwise) and YZ = XZ = 0."""
-    tensors = np.zeros((len(stress), 6))
-    tensors[:, [0, 1, 3]] = stress
-    tensors[:, 2] = material.out_of_plane_poisson * (stress[:, 0] + stress[:, 1])
-    return tensors
 
 
 def _compressed_record(raw):
@@ -79,13 +73,31 @@ def _compressed_record(raw):
     return header + b"".join(blocks)
 
 
+def _adjacent_cells(mesh, boundary_names):
+    """For every face of the boundaries of a solid mesh (in the given order), the index of the
+    first volume element holding all its corners, -1 when none does."""
+    firsts = np.cumsum([0] + [len(block.connectivity) for block in mesh.blocks])
+    groups = [mesh.boundaries[name].connectivity for name in boundary_names]
+    nodes = np.unique(np.concatenate([group.ravel() for group in groups] + [[0]]))
+    owners = fem.node_elements(mesh, nodes)
+    adjacent = []
+    for group in groups:
+        for corners in group:
+            found = fem.element_with(mesh, owners, corners)
+            adjacent.append(-1 if found is None else firsts[found[0]] + found[1])
+    return np.array(adjacent, dtype=np.int64)
+
+
 def _adjacent_elements(mesh, boundary_names):
     """For every edge of the boundaries (in the given order), the index of an area element that
-    has it as a side (its two endpoints are corners of the element), -1 when none has."""
+    has it as a side (its two endpoints are corners of the element), -1 when none has; in 3D
+    the face's volume element (_adjacent_cells)."""
+    if mesh.dimension == 3:
+        return _adjacent_cells(mesh, boundary_names)
     side_of = {}
     first = 0
     for block in mesh.blocks:
-        corners = 4 if block.type == QUADRILATERAL4 else 3
+        corners = CORNER_COUNT[block.type]
         for a in range(corners):
             ends = np.sort(block.connectivity[:, [a, (a + 1) % corners]], axis=1)
             for element, (low, high) in enumerate(ends.tolist()):
@@ -146,7 +158,7 @@ def vtu_bytes(mesh, fields):
             padding = np.full((len(extra), components), np.nan)
             padding[extra >= 0] = values[extra[extra >= 0]]
             values = np.vstack([values, padding])
-        if components == 2:
+        if components == 2 and mesh.dimension == 2:
             values = np.column_stack([values, np.zeros(len(values))])
         labels = STRESS_COMPONENTS if name == "stress" and components == 6 else ()
         return data_array("Float64", name, values, values.shape[1], labels)
@@ -167,7 +179,9 @@ def vtu_bytes(mesh, fields):
               for name, components, values in fields.cell_fields]
     parts.append(data_array("Int32", "boundary_id", boundary_id))
     parts.append('      </CellData>\n      <Points>\n')
-    points = np.column_stack([mesh.nodes, np.zeros(mesh.node_count())])
+    points = mesh.nodes
+    if mesh.dimension == 2:
+        points = np.column_stack([mesh.nodes, np.zeros(mesh.node_count())])
     parts.append(data_array("Float64", "Points", points, 3))
     parts.append('      </Points>\n      <Cells>\n')
     parts += [data_array("Int64", "connectivity", connectivity),

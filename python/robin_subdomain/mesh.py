@@ -31,9 +31,18 @@ from .errors import InputError, RequestError
 
 TRIANGLE3, TRIANGLE6, QUADRILATERAL4 = "triangle3", "triangle6", "quadrilateral4"
 LINE2, LINE3 = "line2", "line3"
+# Solid cells (protocol 2.4, received as MeshData only): Gmsh's node order.
+TETRAHEDRON4, TETRAHEDRON10, HEXAHEDRON8 = "tetrahedron4", "tetrahedron10", "hexahedron8"
 ELEMENT_ORDER = (TRIANGLE3, TRIANGLE6, QUADRILATERAL4)
-NODES_PER_ELEMENT = {TRIANGLE3: 3, TRIANGLE6: 6, QUADRILATERAL4: 4, LINE2: 2, LINE3: 3}
-VTK_CELL_TYPE = {TRIANGLE3: 5, TRIANGLE6: 22, QUADRILATERAL4: 9}
+NODES_PER_ELEMENT = {TRIANGLE3: 3, TRIANGLE6: 6, QUADRILATERAL4: 4, LINE2: 2, LINE3: 3,
+                     TETRAHEDRON4: 4, TETRAHEDRON10: 10, HEXAHEDRON8: 8}
+# The spatial dimension of each domain cell type; the corners of each cell and facet type.
+ELEMENT_DIMENSION = {TRIANGLE3: 2, TRIANGLE6: 2, QUADRILATERAL4: 2, TETRAHEDRON4: 3,
+                     TETRAHEDRON10: 3, HEXAHEDRON8: 3}
+CORNER_COUNT = {TRIANGLE3: 3, TRIANGLE6: 3, QUADRILATERAL4: 4, LINE2: 2, LINE3: 2,
+                TETRAHEDRON4: 4, TETRAHEDRON10: 4, HEXAHEDRON8: 8}
+VTK_CELL_TYPE = {TRIANGLE3: 5, TRIANGLE6: 22, QUADRILATERAL4: 9, TETRAHEDRON4: 10,
+                 HEXAHEDRON8: 12}
 # Gmsh element type numbers.
 GMSH_AREA_TYPES = {2: TRIANGLE3, 9: TRIANGLE6, 3: QUADRILATERAL4}
 GMSH_EDGE_TYPES = {1: LINE2, 8: LINE3}
@@ -68,7 +77,8 @@ class ElementBlock:
 
 
 class BoundaryGroup:
-    """A named boundary: its edges (edge_count x 2 or 3; endpoints first, then the midpoint)."""
+    """A named boundary: its edges (edge_count x 2 or 3; endpoints first, then the midpoint), or
+    in 3D its faces (face_count x 3 or 4 corners)."""
 
     def __init__(self, edge_type, connectivity):
         self.type = edge_type
@@ -81,13 +91,18 @@ class BoundaryGroup:
 
 
 class Mesh:
-    """nodes (n x 2), node_tags (n), blocks (list of ElementBlock), boundaries (name -> group)."""
+    """nodes (n x d), node_tags (n), blocks (list of ElementBlock), boundaries (name -> group);
+    dimension d = 2 (plane) or 3 (solid, since protocol 2.4)."""
 
     def __init__(self, nodes, node_tags, blocks, boundaries):
         self.nodes = nodes
         self.node_tags = node_tags
         self.blocks = blocks
         self.boundaries = boundaries
+        self.dimension = nodes.shape[1] if np.ndim(nodes) == 2 else 2
+
+    def dof_count(self):
+        return self.dimension * self.node_count()
 
     def node_count(self):
         return len(self.nodes)

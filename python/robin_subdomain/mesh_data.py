@@ -4,16 +4,20 @@ A mesh received on the wire is data only: nothing in it is opened, run or given 
 size is compared with the message's own array lengths before anything proportional to it is
 allocated, and every index is checked before it is used. Each problem is an InputError (protocol
 BAD_INPUT) naming the body, the SetupBody.mesh field and MeshData.source:
-  - dimension is 2;
-  - coordinates: 2 per node (a multiple of 2, at least one node), all finite;
+  - dimension is 2, or 3 (a solid body, protocol 2.4);
+  - coordinates: d per node (a multiple of d, at least one node), all finite;
   - node_tags: empty (the nodes are then named 1, 2, ...) or one per node, each < 2^63;
-  - cells: TRIANGLE3, TRIANGLE6 or QUADRILATERAL4 blocks, at least one cell in all; each block's
-    connectivity a multiple of its nodes per cell, every index < the node count; tags empty or
-    one per cell; every node is a node of a domain cell;
+  - cells: TRIANGLE3, TRIANGLE6 or QUADRILATERAL4 blocks (2D), TETRAHEDRON4 or HEXAHEDRON8
+    blocks (3D), at least one cell in all; each block's connectivity a multiple of its nodes per
+    cell, every index < the node count; tags empty or one per cell; every node is a node of a
+    domain cell;
   - boundaries: names [A-Za-z0-9_.-]+ of at most 64 characters, unique; segments LINE2 or LINE3
-    cells, at least one, checked like the domain's;
+    cells (2D), TRIANGLE3 or QUADRILATERAL4 faces (3D), at least one, checked like the domain's;
+  - TETRAHEDRON10 cells and TRIANGLE6 faces of a solid mesh are valid protocol 2.4 but not
+    implemented here: RequestError UNSUPPORTED naming the cell type and the field;
   - every domain cell has a strictly positive Jacobian at its nodes, its centroid and every
-    quadrature point used on it (counter-clockwise, not folded, not degenerate); a bad cell is
+    quadrature point used on it (counter-clockwise or positively oriented, not folded, not
+    degenerate); a bad cell is
     named by its tag, or by its 1-based position in its block when the block has no tags.
 Cells are kept as sent: the sender orients them (no reordering, unlike the .msh reader).
 """
@@ -23,13 +27,19 @@ import re
 import numpy as np
 
 from . import fem
-from .errors import InputError
-from .mesh import (LINE2, LINE3, NODES_PER_ELEMENT, QUADRILATERAL4, TRIANGLE3, TRIANGLE6,
-                   BoundaryGroup, ElementBlock, Mesh)
+from .errors import InputError, RequestError
+from .mesh import (HEXAHEDRON8, LINE2, LINE3, NODES_PER_ELEMENT, QUADRILATERAL4, TETRAHEDRON4,
+                   TRIANGLE3, TRIANGLE6, BoundaryGroup, ElementBlock, Mesh)
 
-DOMAIN_CELL_TYPES = {"TRIANGLE3": TRIANGLE3, "TRIANGLE6": TRIANGLE6,
-                     "QUADRILATERAL4": QUADRILATERAL4}
-SEGMENT_TYPES = {"LINE2": LINE2, "LINE3": LINE3}
+# Per dimension: the domain cells and boundary facets (protocol name -> Mesh type) served, and
+# those of the protocol this server does not implement (UNSUPPORTED, not BAD_INPUT).
+DOMAIN_CELL_TYPES = {2: {"TRIANGLE3": TRIANGLE3, "TRIANGLE6": TRIANGLE6,
+                         "QUADRILATERAL4": QUADRILATERAL4},
+                     3: {"TETRAHEDRON4": TETRAHEDRON4, "HEXAHEDRON8": HEXAHEDRON8}}
+SEGMENT_TYPES = {2: {"LINE2": LINE2, "LINE3": LINE3},
+                 3: {"TRIANGLE3": TRIANGLE3, "QUADRILATERAL4": QUADRILATERAL4}}
+UNSUPPORTED_CELL_TYPES = {2: (), 3: ("TETRAHEDRON10",)}
+UNSUPPORTED_FACET_TYPES = {2: (), 3: ("TRIANGLE6",)}
 BOUNDARY_NAME = re.compile(r"[A-Za-z0-9_.-]+")
 MAXIMUM_NAME_LENGTH = 64
 LARGEST_NODE_TAG = 2 ** 63 - 1
@@ -61,15 +71,17 @@ def _cell_type_name(protocol, value):
 
 
 def _nodes(message, report):
-    """(coordinates (n x 2), node tags (n)) of the MeshData."""
-    if message.dimension != 2:
-        report.fail("dimension", "is %d, expected 2 (plane problems)" % message.dimension)
+    """(coordinates (n x d), node tags (n)) of the MeshData."""
+    dimension = message.dimension
+    if dimension not in (2, 3):
+        report.fail("dimension", "is %d, expected 2 (plane problems) or 3 (solid bodies)" %
+                    dimension)
     count = len(message.coordinates)
-    if count == 0 or count % 2 != 0:
-        report.fail("coordinates", "has %d values, expected 2 per node (x, y), at least one node"
-                    % count)
-    node_count = count // 2
-    coordinates = np.array(message.coordinates, dtype=float).reshape(node_count, 2)
+    if count == 0 or count % dimension != 0:
+        report.fail("coordinates", "has %d values, expected %d per node (%s), at least one node"
+                    % (count, dimension, "x, y" if dimension == 2 else "x, y, z"))
+    node_count = count // dimension
+    coordinates = np.array(message.coordinates, dtype=float).reshape(node_count, dimension)
     bad = np.flatnonzero(~np.all(np.isfinite(coordinates), axis=1))
     if len(bad):
         report.fail("coordinates", "of node %d (1-based position) are not finite numbers" %
@@ -87,10 +99,17 @@ def _nodes(message, report):
     return coordinates, tags.astype(np.int64)
 
 
-def _cell_block(block, field, node_count, allowed_types, protocol, report):
+def _cell_block(block, field, node_count, allowed_types, protocol, report, unsupported=()):
     """(cell type, connectivity (cells x nodes per cell), tags or None) of a CellBlock whose
-    type must be one of `allowed_types` (protocol name -> Mesh cell type)."""
+    type must be one of `allowed_types` (protocol name -> Mesh cell type); a type named in
+    `unsupported` is a RequestError UNSUPPORTED."""
     type_name = _cell_type_name(protocol, block.type)
+    if type_name in unsupported:
+        raise RequestError("UNSUPPORTED", "%s: SetupBody.mesh.%s.type is %s, which this server "
+                           "(robin-subdomain-py) does not implement: it solves %s; run the body "
+                           "on robin-subdomain (mesh %s)" %
+                           (report.context, field, type_name, " and ".join(allowed_types),
+                            report.source))
     if type_name not in allowed_types:
         report.fail(field + ".type", "is %s, expected %s" % (type_name,
                                                              " or ".join(allowed_types)))
@@ -125,11 +144,13 @@ def _check_jacobians(nodes, block, field, report):
         return
     cell = bad_cells[0]
     point = int(np.argmin(determinants[cell]))
+    orientation = ("counter-clockwise" if len(points[point]) == 2 else
+                   "positively oriented ((x1 - x0) x (x2 - x0) . (x3 - x0) > 0)")
     report.fail(field + ":", "cell %s (%s) is inverted, folded or degenerate: its Jacobian "
-                "is %.6g at reference point (%g, %g); domain cells must be counter-clockwise "
-                "with a positive Jacobian everywhere; fix the mesh" %
+                "is %.6g at reference point %s; domain cells must be %s with a positive "
+                "Jacobian everywhere; fix the mesh" %
                 (block.element_label(cell), block.type, determinants[cell, point],
-                 points[point][0], points[point][1]))
+                 fem.format_reference(points[point]), orientation))
 
 
 def _domain_blocks(message, nodes, protocol, report):
@@ -137,17 +158,19 @@ def _domain_blocks(message, nodes, protocol, report):
     Jacobian positive."""
     blocks = []
     used = np.zeros(len(nodes), dtype=bool)
+    dimension = nodes.shape[1]
     for index, block in enumerate(message.cells):
         field = "cells[%d]" % index
-        cell_type, connectivity, tags = _cell_block(block, field, len(nodes), DOMAIN_CELL_TYPES,
-                                                    protocol, report)
+        cell_type, connectivity, tags = _cell_block(block, field, len(nodes),
+                                                    DOMAIN_CELL_TYPES[dimension], protocol,
+                                                    report, UNSUPPORTED_CELL_TYPES[dimension])
         if len(connectivity) == 0:
             continue
         blocks.append((field, ElementBlock(cell_type, connectivity, tags)))
         used[connectivity.ravel()] = True
     if not blocks:
-        report.fail("cells", "holds no domain cell: send the triangles or quadrilaterals of the "
-                    "body")
+        report.fail("cells", "holds no domain cell: send the %s of the body" % (
+            "triangles or quadrilaterals" if dimension == 2 else "tetrahedra or hexahedra"))
     unused = np.flatnonzero(~used)
     if len(unused):
         report.fail("coordinates", "define node %d (1-based position), which is not a node of "
@@ -157,7 +180,7 @@ def _domain_blocks(message, nodes, protocol, report):
     return [block for _, block in blocks]
 
 
-def _boundaries(message, node_count, protocol, report):
+def _boundaries(message, node_count, dimension, protocol, report):
     """name -> BoundaryGroup of MeshData.boundaries."""
     boundaries = {}
     for index, boundary in enumerate(message.boundaries):
@@ -168,8 +191,9 @@ def _boundaries(message, node_count, protocol, report):
                         "characters)" % (quoted(name), MAXIMUM_NAME_LENGTH))
         if name in boundaries:
             report.fail(field + ".name", "'%s' names two boundaries: names are unique" % name)
-        segment_type, connectivity, _ = _cell_block(boundary.segments, field + ".segments",
-                                                    node_count, SEGMENT_TYPES, protocol, report)
+        segment_type, connectivity, _ = _cell_block(
+            boundary.segments, field + ".segments", node_count, SEGMENT_TYPES[dimension],
+            protocol, report, UNSUPPORTED_FACET_TYPES[dimension])
         if len(connectivity) == 0:
             report.fail(field + ".segments", "of boundary '%s' holds no segment" % name)
         boundaries[name] = BoundaryGroup(segment_type, connectivity)
@@ -182,5 +206,5 @@ def decode_mesh_data(message, protocol, context):
     report = _Report(context, message.source)
     nodes, node_tags = _nodes(message, report)
     blocks = _domain_blocks(message, nodes, protocol, report)
-    boundaries = _boundaries(message, len(nodes), protocol, report)
+    boundaries = _boundaries(message, len(nodes), nodes.shape[1], protocol, report)
     return Mesh(nodes, node_tags, blocks, boundaries)

@@ -35,6 +35,11 @@ WRONG_STATE ("... now belongs to another run ..."), the state unchanged: another
 the body up. An empty run_id (a 1.0 or 1.1 coordinator) is served as before. Replies echo the
 request's run_id.
 
+Since 2.4, solid bodies: a MeshData of dimension 3 with TETRAHEDRON4 or HEXAHEDRON8 cells and
+TRIANGLE3 or QUADRILATERAL4 boundary faces is served like a plane body (InterfaceDescription and
+FieldsReply with dimension 3, three components per vector); TETRAHEDRON10 cells and TRIANGLE6
+faces are refused with UNSUPPORTED naming the cell type (mesh_data.py).
+
 Every reply echoes the request_id and carries version (protocol_major, 1). Failures are Error
 replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH (another
 major version, e.g. a 1.x request), WRONG_STATE (also for another run's run_id),
@@ -55,12 +60,12 @@ from .assignment import decode_assign_contact
 from .body import Body
 from .errors import InputError, RequestError, SingularBodyError
 from .fields import body_fields, vtu_bytes
-from .mesh import LINE2, VTK_CELL_TYPE
+from .mesh import VTK_CELL_TYPE
 from .mesh_data import quoted
 from .paths import PathRefused, check_output_directory, write_under_root
 from .setup_decoding import decode_setup_body
 
-PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 2
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 4
 MAXIMUM_LOAD_FACTOR = 1e6         # SetLoadFactor: a larger magnitude is BAD_INPUT
 AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
 REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction",
@@ -273,7 +278,7 @@ class SubdomainProtocol:
 
     def _check_size(self, definition):
         """InputError when the body is above --max-dofs (before any assembly)."""
-        dof_count = 2 * definition.mesh.node_count()
+        dof_count = definition.mesh.dof_count()
         if self.maximum_dofs and dof_count > self.maximum_dofs:
             raise InputError("body '%s': %d degrees of freedom, above this server's limit of %d "
                              "(robin-subdomain-py --max-dofs raises it)" %
@@ -321,7 +326,7 @@ class SubdomainProtocol:
         """Fills the InterfaceDescription of `body` (contact_boundaries.ContactBoundaries)."""
         interface = body.interface
         description.body_name = body.name
-        description.dimension = 2
+        description.dimension = body.mesh.dimension
         description.node_ids.extend(int(node) for node in interface.node_ids)
         description.node_tags.extend(int(tag) for tag in interface.node_tags)
         description.coordinates.extend(interface.coordinates.ravel().tolist())
@@ -331,8 +336,7 @@ class SubdomainProtocol:
         for surface in interface.surfaces:
             message = description.surfaces.add()
             message.boundary = surface.name
-            message.segment_type = (self.protocol.LINE2 if surface.segment_type == LINE2
-                                    else self.protocol.LINE3)
+            message.segment_type = self.protocol.CellType.Value(surface.segment_type.upper())
             message.segments.extend(int(position) for position in surface.segments.ravel())
         description.dof_count = body.free_dof_count()
         description.setup_seconds = body.assembly_seconds + body.factorization_seconds
@@ -341,7 +345,8 @@ class SubdomainProtocol:
         self._require_same_run(request, "AssignContact")
         self._require_state(AWAITING_ASSIGNMENT, "AssignContact")
         operator = decode_assign_contact(request.assign_contact, self.body.interface.node_ids,
-                                         self.body.mesh.node_tags, self.body.name)
+                                         self.body.mesh.node_tags, self.body.name,
+                                         self.body.mesh.dimension)
         self.state = AWAITING_ASSIGNMENT  # until the body accepted the assignment
         start = time.perf_counter()
         self.body.assign_contact(operator)
@@ -472,6 +477,8 @@ class SubdomainProtocol:
     def _fill_fields_reply(self, fields, out):
         """The mesh and the BodyFields of the body in a FieldsReply."""
         mesh = self.body.mesh
+        if mesh.dimension == 3:
+            out.dimension = 3   # since 2.4; absent (2) for a plane body
         out.node_coordinates.extend(mesh.nodes.ravel().tolist())
         out.node_tags.extend(int(tag) for tag in mesh.node_tags)
         out.cell_offsets.append(0)
@@ -483,8 +490,7 @@ class SubdomainProtocol:
             boundary = out.boundaries.add()
             boundary.name = name
             group = mesh.boundaries[name]
-            boundary.segments.type = (self.protocol.LINE2 if group.type == LINE2
-                                      else self.protocol.LINE3)
+            boundary.segments.type = self.protocol.CellType.Value(group.type.upper())
             boundary.segments.connectivity.extend(int(node) for node in group.connectivity.ravel())
         for target, source in ((out.point_fields, fields.point_fields),
                                (out.cell_fields, fields.cell_fields)):

@@ -6,6 +6,11 @@ The mesh is SetupBody.mesh (MeshData, decoded by mesh_data.py: data only, never 
 or else SetupBody.mesh_path: a .msh or .geo file of the server's operator under the data
 directory given at start (--data-directory; paths.resolve_data_file), read by mesh.read_mesh.
 Without a data directory every mesh_path is refused.
+
+Solid bodies (protocol 2.4): a SetupBody whose MeshData has dimension 3 has a solid material
+(36 Voigt values, or E and nu of the isotropic solid; `model` is ignored), 3-component body
+force and traction vectors, and Dirichlet conditions that may prescribe z. A mesh file
+(mesh_path) is always read as a plane mesh.
 """
 
 import math
@@ -16,7 +21,7 @@ from .body import BodyDefinition
 from .errors import InputError
 from .mesh_data import decode_mesh_data, quoted
 from .paths import PathRefused, resolve_data_file
-from .material import PLANE_STRAIN, PLANE_STRESS, isotropic_material, voigt_material
+from .material import PLANE_STRAIN, PLANE_STRESS, SOLID, isotropic_material, voigt_material
 
 DEFAULT_QP_TOLERANCE = 1e-12
 DEFAULT_QP_MAX_ITERATIONS = 20000
@@ -46,7 +51,16 @@ def _body_name(name):
     return name
 
 
-def _model(message, protocol, context):
+def _dimension(message):
+    """3 for a solid body (SetupBody.mesh of dimension 3), else 2: the dimension the material,
+    loads and Dirichlet conditions are read in (the mesh decoding checks the dimension itself).
+    """
+    return 3 if message.HasField("mesh") and message.mesh.dimension == 3 else 2
+
+
+def _model(message, protocol, context, dimension):
+    if dimension == 3:
+        return SOLID
     if message.model == protocol.PLANE_STRAIN:
         return PLANE_STRAIN
     if message.model == protocol.PLANE_STRESS:
@@ -54,8 +68,8 @@ def _model(message, protocol, context):
     _fail(context, "model", "is unspecified: give PLANE_STRAIN or PLANE_STRESS")
 
 
-def _material(message, protocol, context):
-    model = _model(message, protocol, context)
+def _material(message, protocol, context, dimension):
+    model = _model(message, protocol, context, dimension)
     material_context = context + ": SetupBody material"
     if len(message.voigt) == 0:
         return isotropic_material(message.young_modulus, message.poisson_ratio, model,
@@ -63,17 +77,21 @@ def _material(message, protocol, context):
     if message.young_modulus != 0.0 or message.poisson_ratio != 0.0:
         _fail(context, "voigt", "is given together with young_modulus/poisson_ratio: give one of "
               "them")
-    if len(message.voigt) != 9:
+    if dimension == 3 and len(message.voigt) != 36:
+        _fail(context, "voigt", "has %d values, expected 36 (row-major 6x6, order xx, yy, zz, "
+              "yz, xz, xy) for a solid body" % len(message.voigt))
+    if dimension == 2 and len(message.voigt) != 9:
         _fail(context, "voigt", "has %d values, expected 9 (row-major 3x3)" % len(message.voigt))
     return voigt_material(list(message.voigt), model, material_context)
 
 
-def _vector(values, context, field):
-    if len(values) != 2:
-        _fail(context, field, "has %d values, expected 2 (x, y)" % len(values))
-    if not (math.isfinite(values[0]) and math.isfinite(values[1])):
+def _vector(values, context, field, dimension=2):
+    if len(values) != dimension:
+        _fail(context, field, "has %d values, expected %s" % (
+            len(values), "2 (x, y)" if dimension == 2 else "3 (x, y, z)"))
+    if not all(math.isfinite(value) for value in values):
         _fail(context, field, "has a value that is not a finite number")
-    return (float(values[0]), float(values[1]))
+    return tuple(float(value) for value in values)
 
 
 def _solver(message, context):
@@ -150,24 +168,26 @@ def _contact_boundaries(message, mesh, context):
 
 
 def _dirichlet(message, mesh, context, field):
+    """(boundary, x, y) or, for a solid body, (boundary, x, y, z); None where not given."""
     _check_boundary(mesh, message.boundary, context, field + ".boundary")
-    has_x, has_y = message.HasField("x"), message.HasField("y")
-    if message.HasField("z"):
+    if message.HasField("z") and mesh.dimension == 2:
         _fail(context, field + ".z", "is given, but the body is two-dimensional: give x and y "
               "only")
-    if not has_x and not has_y:
-        _fail(context, field, "prescribes neither x nor y: give at least one")
-    x = message.x if has_x else None
-    y = message.y if has_y else None
-    if (x is not None and not math.isfinite(x)) or (y is not None and not math.isfinite(y)):
+    names = ("x", "y", "z")[:mesh.dimension]
+    values = [getattr(message, name) if message.HasField(name) else None for name in names]
+    if all(value is None for value in values):
+        _fail(context, field, "prescribes neither x nor y: give at least one" if mesh.dimension
+              == 2 else "prescribes none of x, y and z: give at least one")
+    if any(value is not None and not math.isfinite(value) for value in values):
         _fail(context, field, "has a value that is not a finite number")
-    return (message.boundary, x, y)
+    return (message.boundary, *values)
 
 
 def _traction(message, mesh, context, field):
     _check_boundary(mesh, message.boundary, context, field + ".boundary")
     if not message.is_pressure:
-        return (message.boundary, _vector(message.vector, context, field + ".vector"), None)
+        return (message.boundary, _vector(message.vector, context, field + ".vector",
+                                          mesh.dimension), None)
     if len(message.vector) != 0:
         _fail(context, field + ".vector", "is given with is_pressure = true: give one of them")
     if not math.isfinite(message.pressure):
@@ -180,10 +200,11 @@ def decode_setup_body(message, protocol, data_directory=None):
     `data_directory` the directory mesh_path is resolved in (None: mesh_path refused)."""
     name = _body_name(message.body_name)
     context = "body '%s'" % name
-    material = _material(message, protocol, context)
-    body_force = (0.0, 0.0)
+    dimension = _dimension(message)
+    material = _material(message, protocol, context, dimension)
+    body_force = (0.0,) * dimension
     if len(message.body_force):
-        body_force = _vector(message.body_force, context, "body_force")
+        body_force = _vector(message.body_force, context, "body_force", dimension)
     settings = _solver(message.solver, context)
     mesh = _mesh(message, protocol, data_directory, context)
     contact_boundaries = _contact_boundaries(message, mesh, context)

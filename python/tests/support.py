@@ -187,3 +187,135 @@ def passwd_lines():
             return [line.rstrip("\n") for line in stream if line.strip()]
     except OSError:
         return []
+
+
+# Solid meshes (protocol 2.4), built here independently of the package.
+
+def _box_grid(cells, lengths, perturbation):
+    """Nodes (n x 3) of a (cells + 1) grid on the box [0, L]; interior nodes moved by
+    `perturbation` cell widths along a fixed pseudo-random direction per node."""
+    counts = np.asarray(cells) + 1
+    widths = np.asarray(lengths, dtype=float) / np.asarray(cells)
+    k, j, i = np.meshgrid(*(np.arange(count) for count in counts[::-1]), indexing="ij")
+    index = np.column_stack([i.ravel(), j.ravel(), k.ravel()])
+    nodes = index * widths
+    interior = np.all((index > 0) & (index < counts - 1), axis=1)
+    angles = np.arange(len(nodes))[:, None] * np.array([0.7548776662, 0.5698402910, 0.3355])
+    offsets = perturbation * widths * np.sin(2.0 * np.pi * angles)
+    nodes[interior] += offsets[interior]
+    return nodes, index
+
+
+def _node_number(cells, i, j, k):
+    return i + (cells[0] + 1) * (j + (cells[1] + 1) * k)
+
+
+# The cube's corners as offsets (Gmsh's hexahedron order) and the six Kuhn tetrahedra around the
+# diagonal 0-6: each path from corner (0,0,0) to (1,1,1) along the axes.
+HEXAHEDRON_OFFSETS = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1),
+                      (1, 1, 1), (0, 1, 1)]
+KUHN_PATHS = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
+SIDE_NAMES = ("x0", "x1", "y0", "y1", "z0", "z1")
+
+
+def _box_sides(cells, triangles):
+    """name -> faces of the six sides x0, x1, y0, y1, z0, z1 (low, high side per axis): each
+    square as a quadrilateral, or as two triangles split along the diagonal from its low to its
+    high corner (the faces of the Kuhn tetrahedra)."""
+    sides = {}
+    for axis in range(3):
+        first, second = [a for a in range(3) if a != axis]
+        for side in (0, 1):
+            faces = []
+            for p in range(cells[first]):
+                for q in range(cells[second]):
+                    corners = []
+                    for a, b in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                        index = [0, 0, 0]
+                        index[axis] = side * cells[axis]
+                        index[first], index[second] = p + a, q + b
+                        corners.append(_node_number(cells, *index))
+                    if triangles:
+                        faces += [[corners[0], corners[1], corners[2]],
+                                  [corners[0], corners[3], corners[2]]]
+                    else:
+                        faces.append(corners)
+            sides[SIDE_NAMES[2 * axis + side]] = np.array(faces, dtype=np.int64)
+    return sides
+
+
+def box_tetrahedra(cells, lengths, perturbation=0.0):
+    """A box [0, L] of cells[0] x cells[1] x cells[2] cubes, each split into the six Kuhn
+    tetrahedra (positively oriented), with its six sides as triangle boundaries. Returns
+    (nodes, tetrahedra, sides)."""
+    nodes, _ = _box_grid(cells, lengths, perturbation)
+    tetrahedra = []
+    for k in range(cells[2]):
+        for j in range(cells[1]):
+            for i in range(cells[0]):
+                for path in KUHN_PATHS:
+                    corner = np.array([i, j, k])
+                    vertices = [corner.copy()]
+                    for axis in path:
+                        corner[axis] += 1
+                        vertices.append(corner.copy())
+                    tetrahedron = [_node_number(cells, *vertex) for vertex in vertices]
+                    x = nodes[tetrahedron]
+                    if np.cross(x[1] - x[0], x[2] - x[0]).dot(x[3] - x[0]) < 0.0:
+                        tetrahedron[1], tetrahedron[2] = tetrahedron[2], tetrahedron[1]
+                    tetrahedra.append(tetrahedron)
+    return nodes, np.array(tetrahedra, dtype=np.int64), _box_sides(cells, True)
+
+
+def box_hexahedra(cells, lengths, perturbation=0.0):
+    """The same box as 8-node hexahedra (Gmsh's order) with quadrilateral sides."""
+    nodes, _ = _box_grid(cells, lengths, perturbation)
+    hexahedra = [[_node_number(cells, i + a, j + b, k + c) for a, b, c in HEXAHEDRON_OFFSETS]
+                 for k in range(cells[2]) for j in range(cells[1]) for i in range(cells[0])]
+    return nodes, np.array(hexahedra, dtype=np.int64), _box_sides(cells, False)
+
+
+def solid_mesh_data(protocol, nodes, cell_type, cells, sides, source="box"):
+    """MeshData (dimension 3) of one block of `cell_type` (protocol name) with tags 1, 2, ...
+    and the sides as boundaries (TRIANGLE3 or QUADRILATERAL4 faces)."""
+    message = protocol.MeshData(dimension=3, source=source)
+    message.coordinates.extend(np.ravel(nodes).tolist())
+    block = message.cells.add(type=protocol.CellType.Value(cell_type))
+    block.connectivity.extend(int(node) for node in np.ravel(cells))
+    block.tags.extend(range(1, len(cells) + 1))
+    for name, faces in sorted(sides.items()):
+        boundary = message.boundaries.add(name=name)
+        boundary.segments.type = protocol.TRIANGLE3 if faces.shape[1] == 3 else \
+            protocol.QUADRILATERAL4
+        boundary.segments.connectivity.extend(int(node) for node in np.ravel(faces))
+    return message
+
+
+def solid_node_to_node_assignment(protocol, interface):
+    """node_to_node_assignment of a solid body's InterfaceDescription (3 components)."""
+    count = len(interface.node_ids)
+    return protocol.AssignContact(
+        row_offsets=range(0, 3 * count + 1, 3), node_ids=np.repeat(interface.node_ids, 3),
+        components=[0, 1, 2] * count, values=interface.normals, weights=interface.weights)
+
+
+def isotropic_solid_voigt(young, poisson):
+    """The 6x6 Voigt stiffness (xx, yy, zz, yz, xz, xy) of an isotropic solid, written out here."""
+    lame = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson))
+    shear = young / (2.0 * (1.0 + poisson))
+    matrix = np.diag([2.0 * shear] * 3 + [shear] * 3)
+    matrix[:3, :3] += lame
+    return matrix
+
+
+def orthotropic_compliance(moduli, poissons, shears):
+    """The 6x6 compliance S (strain = S stress, Voigt xx, yy, zz, yz, xz, xy) of an orthotropic
+    solid: moduli (E1, E2, E3), poissons (nu12, nu13, nu23), shears (G23, G13, G12)."""
+    e1, e2, e3 = moduli
+    nu12, nu13, nu23 = poissons
+    compliance = np.zeros((6, 6))
+    compliance[:3, :3] = [[1.0 / e1, -nu12 / e1, -nu13 / e1],
+                          [-nu12 / e1, 1.0 / e2, -nu23 / e2],
+                          [-nu13 / e1, -nu23 / e2, 1.0 / e3]]
+    compliance[3:, 3:] = np.diag(1.0 / np.asarray(shears, dtype=float))
+    return compliance

@@ -82,7 +82,7 @@ class ServerTestCase(unittest.TestCase):
     def ask(self, data):
         reply = protocol.Envelope()
         reply.ParseFromString(self.server.handle(data))
-        self.assertEqual((reply.version.major, reply.version.minor), (2, 2))
+        self.assertEqual((reply.version.major, reply.version.minor), (2, 4))
         return reply
 
     def expect_error(self, data, code, state):
@@ -118,7 +118,7 @@ class StateMachine(ServerTestCase):
         for major, minor in ((1, 2), (1, 0), (3, 1)):
             message = self.expect_error(request(major=major, minor=minor, hello=protocol.Hello()),
                                         "VERSION_MISMATCH", "awaiting_setup")
-            self.assertIn("the request speaks %d.%d, this server 2.2" % (major, minor), message)
+            self.assertIn("the request speaks %d.%d, this server 2.4" % (major, minor), message)
         self.expect_error(request(major=1, minor=2, setup_body=setup_body()), "VERSION_MISMATCH",
                           "awaiting_setup")
         self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
@@ -454,7 +454,8 @@ class BadBodies(ServerTestCase):
             self.assertTrue(message.startswith("body 'lower': SetupBody.mesh."), message)
             self.assertIn("(mesh 'block_lower.geo')", message)
 
-        refused(lambda mesh: setattr(mesh, "dimension", 3), "mesh.dimension is 3, expected 2")
+        refused(lambda mesh: setattr(mesh, "dimension", 4),
+                "mesh.dimension is 4, expected 2 (plane problems) or 3 (solid bodies)")
         refused(lambda mesh: mesh.coordinates.append(0.5),
                 "mesh.coordinates has %d values, expected 2 per node" % (2 * node_count + 1))
         refused(lambda mesh: mesh.coordinates.__setitem__(5, float("inf")),
