@@ -19,6 +19,7 @@
 #include "protocol_version.hpp"
 #include "remote/conformance_body.hpp"
 #include "remote/conformance_session.hpp"
+#include "remote/conformance_solid.hpp"
 #include "remote/curve_options.hpp"
 #include "remote/request_channel.hpp"
 #include "robin.pb.h"
@@ -63,6 +64,7 @@ class ServerChecks {
       return refused(load_factor_request(2.0), "SetLoadFactor after EndRun",
                      {protocol::WRONG_STATE}, "awaiting_setup");
     });
+    run_solid_checks(session_, server_minor_, neumann_offered_);
     session_.run("oversized_message", [this] { return oversized_message(); });
     if (session_.options().include_shutdown) {
       session_.run("shutdown", [this] { return shutdown(); });
