@@ -8,7 +8,10 @@
 // neumann_solve) conforms. The run rule of protocol 1.2 (Envelope.run_id: another run's requests
 // are WRONG_STATE) holds for every 2.x server and is judged on each (also one announcing minor
 // version 1), and a proxy that strips run_id fails the check; a 1.x server (major version 1)
-// cannot conform to 2.0 and is not judged on run ids.
+// cannot conform to 2.0 and is not judged on run ids. Solid bodies (protocol 2.4): the reference
+// server passes the solid-body checks; a server that answers the solid SetupBody with
+// UNSUPPORTED (a plane-only server) still conforms, its verdict "3D: not supported", and one
+// whose solid fields are wrong fails 'solid_fields'.
 
 #include "remote/conformance_check.hpp"
 
@@ -258,12 +261,20 @@ TEST_F(ConformanceTest, ReferenceServerPassesEveryCheck) {
                            "neumann_solve_contact_consistency",
                            "other_run_refused",
                            "status",
-                           "status_idle"}) {
+                           "status_idle",
+                           "solid_setup_body",
+                           "solid_assign_contact",
+                           "solid_contact_solve",
+                           "solid_correction",
+                           "solid_neumann_solve",
+                           "solid_fields",
+                           "solid_end_run"}) {
     EXPECT_TRUE(passes(report, name)) << name;
   }
   EXPECT_EQ(find_check(report, "neumann_solve_capability")->explanation, "announced: checked");
   EXPECT_EQ(find_check(report, "status")->explanation, "announced: checked");
   EXPECT_EQ(find_check(report, "other_run_refused")->explanation, "");  // judged, no note
+  EXPECT_EQ(find_check(report, "solid_setup_body")->explanation, "");   // solved, no note
   EXPECT_EQ(find_check(report, "neumann_solve_unsupported"), nullptr);
   EXPECT_EQ(find_check(report, "shutdown"), nullptr);  // only with include_shutdown
   std::cout << "reference server: " << report.checks.size() << " checks in " << seconds << " s\n";
@@ -319,6 +330,54 @@ TEST_F(ConformanceTest, ServerWithoutTheOptionalNeumannSolveConforms) {
   ASSERT_NE(run_check, nullptr);
   EXPECT_EQ(run_check->explanation.find("not applicable"), std::string::npos)
       << run_check->explanation;
+}
+
+/// A proxy to robin-subdomain that plays a plane-only 2.4 server: a SetupBody of a solid body
+/// is forwarded as an EndRun (the server stays without a body) and answered UNSUPPORTED.
+Responder plane_only_proxy(const std::string& endpoint) {
+  auto solid_setup = std::make_shared<bool>(false);
+  return proxy_to(
+      endpoint,
+      [solid_setup](Envelope& request) {
+        *solid_setup = request.has_setup_body() && request.setup_body().mesh().dimension() == 3;
+        if (*solid_setup) request.mutable_end_run();
+      },
+      [solid_setup](Envelope& reply) {
+        if (!*solid_setup) return;
+        reply.mutable_error()->set_code(protocol::UNSUPPORTED);
+        reply.mutable_error()->set_message("solid bodies are not implemented by this server");
+        reply.mutable_error()->set_state("awaiting_setup");
+      });
+}
+
+TEST_F(ConformanceTest, PlaneOnlyServerConformsWithoutSolidBodies) {
+  FakeServer proxy(plane_only_proxy(reference_endpoint()));
+  const ConformanceReport report = check_server(proxy.endpoint(), quick_options());
+  EXPECT_TRUE(report.conforms()) << failed_checks(report);
+  ASSERT_TRUE(passes(report, "solid_setup_body"));
+  const std::string note = find_check(report, "solid_setup_body")->explanation;
+  EXPECT_EQ(note.rfind("3D: not supported", 0), 0u) << note;
+  EXPECT_NE(note.find("UNSUPPORTED"), std::string::npos) << note;
+  for (const char* name : {"solid_assign_contact", "solid_contact_solve", "solid_fields"}) {
+    EXPECT_EQ(find_check(report, name), nullptr) << name;
+  }
+  EXPECT_NE(format_report(report).find("PASS solid_setup_body (3D: not supported"),
+            std::string::npos);
+}
+
+TEST_F(ConformanceTest, WrongSolidDisplacementFailsTheSolidFieldsCheck) {
+  // The solid FieldsReply (dimension 3) with every displacement value doubled.
+  FakeServer proxy(proxy_to(reference_endpoint(), {}, [](Envelope& reply) {
+    if (!reply.has_fields_reply() || reply.fields_reply().dimension() != 3) return;
+    for (protocol::Field& field : *reply.mutable_fields_reply()->mutable_point_fields()) {
+      if (field.name() != "displacement") continue;
+      for (double& value : *field.mutable_values()) value *= 2.0;
+    }
+  }));
+  const ConformanceReport report = check_server(proxy.endpoint(), quick_options());
+  EXPECT_TRUE(fails_with(report, "solid_fields", {"point field 'displacement'", "reference"}));
+  EXPECT_TRUE(passes(report, "solid_contact_solve"));
+  EXPECT_TRUE(passes(report, "fields_structure"));  // the plane fields are untouched
 }
 
 TEST_F(ConformanceTest, ServerOfMinorVersion1IsJudgedOnRunIds) {

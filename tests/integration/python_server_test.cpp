@@ -11,7 +11,8 @@
 //    server with one solve of its own factor) equals the C++ server's (e - F lambda) to 1e-9
 //    relative on both bodies of two_blocks.toml;
 //  - the conformance checker (robin-coordinator --check-server) passes on the Python server,
-//    its Neumann-solve checks included;
+//    its Neumann-solve checks and its solid-body checks (protocol 2.4: a tetrahedron cube
+//    compared with the checker's in-process reference) included;
 //  - the process: exactly one "listening on" line with the ephemeral port resolved; garbage
 //    bytes and a multi-frame message get MALFORMED_MESSAGE replies and the server goes on;
 //    Shutdown, SIGTERM and SIGINT end it with exit status 0.
@@ -226,13 +227,21 @@ TEST(PythonServer, PassesTheConformanceCheckIncludingTheNeumannSolve) {
   for (const char* name :
        {"neumann_solve_before_setup", "neumann_solve_before_assignment",
         "neumann_solve_wrong_length", "neumann_solve_non_finite", "neumann_solve_free",
-        "neumann_solve_equation", "neumann_solve_contact_consistency"}) {
+        "neumann_solve_equation", "neumann_solve_contact_consistency", "solid_setup_body",
+        "solid_assign_contact", "solid_contact_solve", "solid_correction", "solid_neumann_solve",
+        "solid_fields", "solid_end_run"}) {
     const auto found =
         std::find_if(report.checks.begin(), report.checks.end(),
                      [&](const ConformanceCheck& check) { return check.name == name; });
     ASSERT_NE(found, report.checks.end()) << name;
     EXPECT_TRUE(found->passed) << name << ": " << found->explanation;
   }
+  // It solves the solid body (no "3D: not supported" note).
+  const auto solid = std::find_if(
+      report.checks.begin(), report.checks.end(),
+      [](const ConformanceCheck& check) { return check.name == "solid_setup_body"; });
+  ASSERT_NE(solid, report.checks.end());
+  EXPECT_EQ(solid->explanation, "");
   // It does not announce the optional "status" and must refuse StatusRequest.
   const auto refused = std::find_if(
       report.checks.begin(), report.checks.end(),
