@@ -43,6 +43,12 @@
 // equivalent to its isotropic material; the partial-contact solve and the correction w(r1) must
 // equal those of the isotropic definition to the tolerance.
 //
+// Solid bodies (protocol 2.4; conformance_solid.hpp): a unit cube of 4-node tetrahedra is set
+// up after the plane checks and every reply about it (InterfaceDescription, contact solve,
+// correction, Neumann solve when announced, fields) is compared with the same body solved in
+// process. A server that refuses it with UNSUPPORTED (or, below protocol 2.4, BAD_INPUT) passes
+// 'solid_setup_body' with the note "3D: not supported" and the other solid checks do not run.
+//
 // Runs (protocol 1.2, Envelope.run_id): 'other_run_refused' sets the body up and assigns it with
 // run_id A, then a ContactSolveRequest and an EndRun with run_id B must each be refused as
 // WRONG_STATE with Error.state 'ready', after which a ContactSolveRequest with run_id A and one

@@ -93,8 +93,8 @@ void field_problems(const std::vector<OutputField>& actual,
                          std::to_string(reference.components));
       continue;
     }
-    const std::string problem = compare(field_values(*found), values, tolerance, scale,
-                                        kind + " '" + reference.name + "'");
+    const std::string problem =
+        compare(field_values(*found), values, tolerance, scale, kind + " '" + reference.name + "'");
     if (!problem.empty()) problems.push_back(problem);
   }
 }
@@ -165,9 +165,9 @@ void SolidChecks::run_all() {
   if (neumann_offered_) session_.run("solid_neumann_solve", [this] { return neumann_solve(); });
   session_.run("solid_fields", [this] { return fields(); });
   session_.run("solid_end_run", [this] {
-    return in_context("EndRun after the solid body",
-                      expect_acknowledge(session_.request(end_run_request(), "EndRun"),
-                                         "awaiting_setup"));
+    return in_context(
+        "EndRun after the solid body",
+        expect_acknowledge(session_.request(end_run_request(), "EndRun"), "awaiting_setup"));
   });
 }
 
@@ -225,8 +225,8 @@ std::string SolidChecks::match_nodes(const InterfaceDescription& description) {
     const Eigen::Vector3d& x = reference_nodes_.coordinates[j];
     std::size_t k = 0;
     while (k < count && (description.coordinates[k] - x).norm() > tolerance_) ++k;
-    const std::string node = "the node at (" + number(x.x()) + ", " + number(x.y()) + ", " +
-                             number(x.z()) + ")";
+    const std::string node =
+        "the node at (" + number(x.x()) + ", " + number(x.y()) + ", " + number(x.z()) + ")";
     if (k == count) {
       problems.push_back(node + " is missing");
       continue;
@@ -266,8 +266,10 @@ std::string SolidChecks::surface_problems(const InterfaceDescription& descriptio
     };
     const Eigen::Vector3d normal = (corner(1) - corner(0)).cross(corner(2) - corner(0));
     if (!(normal.z() > 0.0)) {
-      return "face " + std::to_string(first / 3) + " is not oriented outward: its right-hand "
-             "normal (x1 - x0) x (x2 - x0) has z = " + number(normal.z()) + ", expected > 0";
+      return "face " + std::to_string(first / 3) +
+             " is not oriented outward: its right-hand "
+             "normal (x1 - x0) x (x2 - x0) has z = " +
+             number(normal.z()) + ", expected > 0";
     }
     area += 0.5 * normal.norm();
   }
@@ -283,8 +285,8 @@ std::string SolidChecks::assign_contact() {
   reference_->assign_contact(
       node_to_node_operator(reference_nodes_.node_ids, normals, reference_nodes_.weights));
   Envelope request;
-  *request.mutable_assign_contact() =
-      encode_contact_operator(node_to_node_operator(server_ids_, normals, reference_nodes_.weights));
+  *request.mutable_assign_contact() = encode_contact_operator(
+      node_to_node_operator(server_ids_, normals, reference_nodes_.weights));
   const std::string problem =
       expect_acknowledge(session_.request(request, "AssignContact of the solid body"), "ready");
   assigned_ = problem.empty();
@@ -296,7 +298,8 @@ std::string SolidChecks::contact_solve() {
   const std::string what = "ContactSolveRequest of the solid body with g = e + lift (x - 1/2)";
   Eigen::VectorXd obstacle = reference_->free_trace();
   for (long j = 0; j < contact_count(); ++j) {
-    obstacle(j) += solid_lift * (reference_nodes_.coordinates[static_cast<std::size_t>(j)].x() - 0.5);
+    obstacle(j) +=
+        solid_lift * (reference_nodes_.coordinates[static_cast<std::size_t>(j)].x() - 0.5);
   }
   const ContactSolveResult expected = reference_->solve_contact(obstacle);
   ContactSolution solution;
@@ -332,8 +335,8 @@ std::string SolidChecks::correction() {
   const Eigen::VectorXd force = probe_force(contact_count());
   const Eigen::VectorXd expected = reference_->solve_correction(force);
   Eigen::VectorXd trace;
-  if (const std::string problem =
-          read_correction(session_.request(correction_request(force), what), contact_count(), trace);
+  if (const std::string problem = read_correction(session_.request(correction_request(force), what),
+                                                  contact_count(), trace);
       !problem.empty()) {
     return what + ": " + problem;
   }

@@ -237,9 +237,9 @@ TEST(PythonServer, PassesTheConformanceCheckIncludingTheNeumannSolve) {
     EXPECT_TRUE(found->passed) << name << ": " << found->explanation;
   }
   // It solves the solid body (no "3D: not supported" note).
-  const auto solid = std::find_if(
-      report.checks.begin(), report.checks.end(),
-      [](const ConformanceCheck& check) { return check.name == "solid_setup_body"; });
+  const auto solid =
+      std::find_if(report.checks.begin(), report.checks.end(),
+                   [](const ConformanceCheck& check) { return check.name == "solid_setup_body"; });
   ASSERT_NE(solid, report.checks.end());
   EXPECT_EQ(solid->explanation, "");
   // It does not announce the optional "status" and must refuse StatusRequest.
