@@ -249,6 +249,25 @@ class HertzRun(unittest.TestCase):
         self.assertIn(f"Hertz p0 = {peak:.6g}, a = {half_width:.6g} (P = 2.5 from reference.load)",
                       stdout)
 
+    def test_model_fraction_divides_the_computed_resultant(self):
+        # A half model (model_fraction = 0.5): P is twice the run's resultant.
+        case = self.scratch / "hertz_half.toml"
+        text = HERTZ.read_text().replace('kind = "hertz_cylinder"',
+                                         'kind = "hertz_cylinder"\nmodel_fraction = 0.5')
+        text = text.replace('"meshes/', f'"{REPOSITORY / "examples" / "meshes"}/')
+        case.write_text(text)
+        status, stdout, stderr = run(BIN / "robin-plot", "--case", case, self.directory)
+        self.assertEqual(status, 0, stderr)
+        resultant = math.hypot(*self.summary["contact_force_resultant"])
+        load = 2.0 * resultant
+        modulus = YOUNG / (2.0 * (1.0 - POISSON ** 2))
+        half_width = math.sqrt(4.0 * load * RADIUS / (math.pi * modulus))
+        peak = 2.0 * load / (math.pi * half_width)
+        self.assertIn(f"Hertz p0 = {peak:.6g}, a = {half_width:.6g} (P = {load:.6g} from the "
+                      f"computed contact resultant {resultant:.6g} / model_fraction 0.5)",
+                      stdout)
+        self.assertNotIn("warning", stdout)
+
 
 @unittest.skipUnless((BIN / "robin-run").exists(), f"no robin-run in {BIN}: build it first")
 class UnconvergedRun(unittest.TestCase):
@@ -846,6 +865,286 @@ class SolidContactSurface(unittest.TestCase):
         self.assertEqual(pressure2.get_xlabel(), "y (model length unit)")  # normal +x: y, z
         self.assertEqual(pressure2.get_ylabel(), "z (model length unit)")
         self.assertEqual(pressure2.collections[0].get_clim(), (0.0, PEAK))
+
+
+# --- The Hertz sphere of a [reference] table over a 3D contact surface -------------------------
+
+# The synthetic surface above is Hertz's sphere for P = 2/3 pi a^2 p0 = 4 pi (p0 = 150, a = 0.2);
+# with R = 1, a^3 = 3 P R / (4 E*) gives E* = 3 P R / (4 a^3) = 375 pi. Two bodies of one
+# isotropic material give 1/E* = 2 (1 - nu^2) / E: nu = 0.3, E = 2 * 0.91 * 375 pi = 682.5 pi.
+SPHERE_LOAD = 2.0 / 3.0 * math.pi * CONTACT_RADIUS ** 2 * PEAK  # 4 pi
+SPHERE_MODULUS = 3.0 * SPHERE_LOAD * SPHERE_RADIUS / (4.0 * CONTACT_RADIUS ** 3)  # 375 pi
+SPHERE_YOUNG, SPHERE_POISSON = 2.0 * (1.0 - 0.3 ** 2) * SPHERE_MODULUS, 0.3
+
+HERTZ_LINE = re.compile(r"contact\.png: Hertz p0 = (\S+), a = (\S+) \(P = (\S+) from (.*)\); "
+                        r"computed p0 = (\S+) \((\S+)%\), a = (\S+) \((\S+)%\)")
+
+
+def sphere_case(path, reference, dimension=3, bodies=True):
+    """A case file with dimension = 3 (none when dimension is 2), two [[body]] tables of the
+    isotropic material above when bodies, and the [reference] table whose lines are given."""
+    text = "" if dimension == 2 else f"dimension = {dimension}\n"
+    text += "[reference]\n" + "".join(line + "\n" for line in reference)
+    if bodies:
+        for name in ("flat", "sphere"):
+            text += (f'\n[[body]]\nname = "{name}"\nmesh = "{name}.msh"\n'
+                     f'contact_boundary = "contact"\n[body.material]\n'
+                     f"young = {SPHERE_YOUNG!r}\npoisson = {SPHERE_POISSON!r}\n")
+    path.write_text(text)
+    return path
+
+
+class SolidHertzReference(unittest.TestCase):
+    """robin-plot draws and checks [reference] kind = "hertz_sphere" over the synthetic surface
+    whose p0 and a are Hertz's for the table's P, R and E*."""
+
+    CENTER = (0.1, -0.05, 0.3)
+
+    def setUp(self):
+        self.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-plot-sphere-"))
+        self.tool = plot_executable()
+        self.plot = load_plot_module(self.tool)
+
+    def tearDown(self):
+        shutil.rmtree(self.scratch, ignore_errors=True)
+
+    def directory_with(self, name, rows, resultant):
+        directory = self.scratch / name
+        directory.mkdir()
+        write_solid_contact_file(directory / "contact.csv", rows)
+        (directory / "summary.json").write_text(json.dumps(
+            {"status": "converged", "converged": True, "title": "sphere on a plane",
+             "contact_force_resultant": resultant}))
+        return directory
+
+    def check_hertz_line(self, stdout, source):
+        match = HERTZ_LINE.search(stdout)
+        self.assertIsNotNone(match, stdout)
+        peak, radius, load, printed_source, computed_peak, peak_error, computed_radius, \
+            radius_error = match.groups()
+        self.assertAlmostEqual(float(peak), PEAK, delta=5e-6 * PEAK)  # six digits
+        self.assertAlmostEqual(float(radius), CONTACT_RADIUS, delta=5e-6 * CONTACT_RADIUS)
+        self.assertAlmostEqual(float(load), SPHERE_LOAD, delta=5e-6 * SPHERE_LOAD)
+        self.assertEqual(printed_source, source)
+        self.assertAlmostEqual(float(computed_peak), PEAK, delta=5e-6 * PEAK)
+        self.assertAlmostEqual(float(computed_radius), CONTACT_RADIUS,
+                               delta=5e-6 * CONTACT_RADIUS)
+        self.assertEqual(abs(float(peak_error)), 0.0)  # printed "+0.00%" or "-0.00%"
+        self.assertEqual(abs(float(radius_error)), 0.0)
+
+    def check_figure(self, directory, case, origin):
+        """The figure of the module: Hertz's p(r) over the profile is p0 sqrt(1 - r^2/a^2) of the
+        synthetic p0 and a to round-off, its circle r = a about the origin on the map, and the
+        errors of the fitted p0 and a against Hertz vanish (p^2 is linear in r^2 at every
+        loaded point, so the fit is exact)."""
+        summary = json.loads((directory / "summary.json").read_text())
+        tables = self.plot.contact_tables(directory, summary)
+        reference = self.plot.read_reference(case, summary, True, directory / "contact.csv")
+        figure, lines, analysis = self.plot.surface_figure(tables[0]["columns"], summary,
+                                                           reference=reference)
+        comparison = analysis["comparison"]
+        self.assertAlmostEqual(comparison["peak_pressure"], PEAK, delta=1e-12 * PEAK)
+        self.assertAlmostEqual(comparison["contact_radius"], CONTACT_RADIUS,
+                               delta=1e-12 * CONTACT_RADIUS)
+        self.assertLess(abs(comparison["peak_pressure_error"]), 1e-12)
+        self.assertLess(abs(comparison["contact_radius_error"]), 1e-12)
+        self.assertTrue(comparison["fitted"])
+        pressure_axis, profile_axis = figure.axes[0], figure.axes[1]
+        hertz = next(line for line in profile_axis.get_lines()
+                     if line.get_label().startswith("Hertz"))
+        r, p = np.asarray(hertz.get_xdata()), np.asarray(hertz.get_ydata())
+        self.assertEqual(r[0], 0.0)
+        self.assertAlmostEqual(r[-1], CONTACT_RADIUS, delta=1e-15)
+        np.testing.assert_allclose(p, PEAK * np.sqrt(np.maximum(
+            0.0, 1.0 - r ** 2 / CONTACT_RADIUS ** 2)), rtol=0, atol=1e-12)
+        self.assertIn("p0 = 150, a = 0.2", hertz.get_label())
+        labels = [text.get_text() for text in profile_axis.get_legend().get_texts()]
+        computed = next(label for label in labels if label.startswith("computed (fit of"))
+        self.assertRegex(computed, r"p0 [+-]0\.00%, a [+-]0\.00% against Hertz$")
+        circle = next(patch for patch in pressure_axis.patches
+                      if patch.get_label().startswith("Hertz r = a"))
+        self.assertAlmostEqual(circle.get_radius(), CONTACT_RADIUS, delta=1e-15)
+        np.testing.assert_allclose(circle.center, origin[:2], atol=1e-15)
+        np.testing.assert_allclose(analysis["origin"], origin, atol=1e-15)
+        return lines
+
+    def test_hertz_sphere_of_the_synthetic_surface(self):
+        rows, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        directory = self.directory_with("full", rows, [0.0, 0.0, 1.0])
+        case = sphere_case(self.scratch / "case.toml",
+                           ['kind = "hertz_sphere"', "radius = 1.0", f"load = {SPHERE_LOAD!r}",
+                            f"contact_modulus = {SPHERE_MODULUS!r}"], bodies=False)
+        status, stdout, stderr = run(self.tool, "--case", case, directory)
+        self.assertEqual(status, 0, stderr)
+        self.check_hertz_line(stdout, "reference.load")
+        # Without a center, r is measured from the centre of pressure, here the grid's middle.
+        self.assertIsNotNone(SURFACE_LINE.search(stdout), stdout)
+        self.assertNotIn("warning", stdout)
+        self.check_figure(directory, case, self.CENTER)
+
+    def test_default_contact_modulus_and_the_computed_resultant(self):
+        # E* from the bodies' materials, P = |contact_force_resultant| = 4 pi, center given.
+        rows, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        directory = self.directory_with("default", rows, [0.0, 0.0, -SPHERE_LOAD])
+        case = sphere_case(self.scratch / "case.toml",
+                           ['kind = "hertz_sphere"', "radius = 1.0",
+                            f"center = [{', '.join(repr(value) for value in self.CENTER)}]"])
+        reference = self.plot.read_reference(case, {"contact_force_resultant": [0, 0, 1.0]})
+        self.assertAlmostEqual(reference["contact_modulus"], SPHERE_MODULUS,
+                               delta=1e-12 * SPHERE_MODULUS)
+        status, stdout, stderr = run(self.tool, "--case", case, directory)
+        self.assertEqual(status, 0, stderr)
+        self.check_hertz_line(stdout, "the computed contact resultant")
+        self.assertIn("r from the [reference] center (0.1, -0.05, 0.3)", stdout)
+        self.check_figure(directory, case, self.CENTER)
+
+    def test_a_quarter_model_gives_the_same_contact(self):
+        # The quarter x >= 0.1, y >= -0.05 of the grid (13 x 13 points, a quarter of the load:
+        # the resultant is pi) with model_fraction = 0.25: P = 4 pi again, the same a and p0.
+        rows, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        quarter = [row for row in rows
+                   if row[0] >= self.CENTER[0] - 1e-12 and row[1] >= self.CENTER[1] - 1e-12]
+        self.assertEqual(len(quarter), (HALF_POINTS + 1) ** 2)
+        directory = self.directory_with("quarter", quarter, [0.0, 0.0, SPHERE_LOAD / 4.0])
+        center = f"center = [{', '.join(repr(value) for value in self.CENTER)}]"
+        case = sphere_case(self.scratch / "case.toml",
+                           ['kind = "hertz_sphere"', "radius = 1.0", center,
+                            "model_fraction = 0.25"])
+        status, stdout, stderr = run(self.tool, "--case", case, directory)
+        self.assertEqual(status, 0, stderr)
+        self.check_hertz_line(stdout, f"the computed contact resultant {math.pi:.6g} / "
+                                      "model_fraction 0.25")
+        self.check_figure(directory, case, self.CENTER)
+        # The same quarter without a center: r would be measured from the centre of pressure,
+        # which is off the axis of a partial model; robin-plot says so.
+        case = sphere_case(self.scratch / "no-center.toml",
+                           ['kind = "hertz_sphere"', "radius = 1.0", "model_fraction = 0.25"])
+        status, stdout, stderr = run(self.tool, "--case", case, directory)
+        self.assertEqual(status, 0, stderr)
+        self.assertIn(f"contact.png: warning: {case} gives reference.model_fraction = 0.25 but "
+                      "no center", stdout)
+
+    def refused(self, directory, case):
+        status, stdout, stderr = run(self.tool, "--case", case, directory)
+        self.assertEqual(status, 1, stdout)
+        self.assertEqual(stdout, "")
+        self.assertFalse((directory / "contact.png").exists())
+        return stderr.strip()
+
+    def test_a_kind_of_the_other_dimension_is_refused(self):
+        rows, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        solid = self.directory_with("solid", rows, [0.0, 0.0, SPHERE_LOAD])
+        # "hertz_sphere" in a case of plane bodies: the C++ reader's message.
+        case = sphere_case(self.scratch / "plane.toml", ['kind = "hertz_sphere"', "radius = 1"],
+                           dimension=2, bodies=False)
+        self.assertEqual(self.refused(solid, case),
+                         f"robin-plot: {case}:2: reference.kind: \"hertz_sphere\" is the "
+                         "reference of solid bodies; a case with dimension = 2 takes "
+                         "\"hertz_cylinder\"")
+        # "hertz_cylinder" of a plane case over a 3D contact.csv: both files named.
+        case = sphere_case(self.scratch / "cylinder.toml",
+                           ['kind = "hertz_cylinder"', "radius = 1"], dimension=2, bodies=False)
+        self.assertEqual(self.refused(solid, case),
+                         f"robin-plot: {case}:2: reference.kind: \"hertz_cylinder\" does not "
+                         f"describe {solid / 'contact.csv'}, a 3D contact surface (its header "
+                         "has z and nz: solid bodies), which takes \"hertz_sphere\": is "
+                         f"{case} the case file of this run?")
+        # "hertz_cylinder" in a case of dimension = 3.
+        case = sphere_case(self.scratch / "solid-cylinder.toml",
+                           ['kind = "hertz_cylinder"', "radius = 1"], bodies=False)
+        self.assertEqual(self.refused(solid, case),
+                         f"robin-plot: {case}:3: reference.kind: \"hertz_cylinder\" is the "
+                         "reference of plane bodies; a case with dimension = 3 takes "
+                         "\"hertz_sphere\"")
+        # "hertz_sphere" of a solid case over a plane contact.csv.
+        plane = self.scratch / "plane"
+        plane.mkdir()
+        write_contact_file(plane / "contact.csv", INTERFACE1, WEIGHTS[0])
+        (plane / "summary.json").write_text(json.dumps({"contact_force_resultant": [0, 1.0]}))
+        case = sphere_case(self.scratch / "sphere.toml", ['kind = "hertz_sphere"', "radius = 1"])
+        self.assertEqual(self.refused(plane, case),
+                         f"robin-plot: {case}:3: reference.kind: \"hertz_sphere\" does not "
+                         f"describe {plane / 'contact.csv'}, a plane contact (x, y: plane "
+                         f"bodies), which takes \"hertz_cylinder\": is {case} the case file of "
+                         "this run?")
+
+    def test_a_center_or_model_fraction_out_of_shape_is_refused(self):
+        rows, _ = hertz_surface(self.CENTER, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+        solid = self.directory_with("solid", rows, [0.0, 0.0, SPHERE_LOAD])
+        case = sphere_case(self.scratch / "center.toml",
+                           ['kind = "hertz_sphere"', "radius = 1", "center = [0.0, 0.0]"])
+        self.assertEqual(self.refused(solid, case),
+                         f"robin-plot: {case}:5: reference.center: expected an array of three "
+                         "numbers [x, y, z]")
+        plane = self.scratch / "plane"
+        plane.mkdir()
+        write_contact_file(plane / "contact.csv", INTERFACE1, WEIGHTS[0])
+        (plane / "summary.json").write_text(json.dumps({"contact_force_resultant": [0, 1.0]}))
+        case = sphere_case(self.scratch / "plane.toml",
+                           ['kind = "hertz_cylinder"', "radius = 1", "center = [1]"],
+                           dimension=2)
+        self.assertEqual(self.refused(plane, case),
+                         f"robin-plot: {case}:4: reference.center: expected an array of two "
+                         "numbers [x, y]")
+        case = sphere_case(self.scratch / "fraction.toml",
+                           ['kind = "hertz_sphere"', "radius = 1", "model_fraction = 1.5"])
+        self.assertEqual(self.refused(solid, case),
+                         f"robin-plot: {case}:5: reference.model_fraction: must be in (0, 1], "
+                         "got 1.5")
+
+
+# examples/hertz_3d.toml: a quarter model (model_fraction = 0.25) of a sphere of R = 1 on a flat,
+# both E = 1000, nu = 0.3: 1/E* = 2 (1 - nu^2) / E.
+HERTZ_3D = REPOSITORY / "examples" / "hertz_3d.toml"
+
+
+@unittest.skipUnless((BIN / "robin-run").exists(), f"no robin-run in {BIN}: build it first")
+class HertzSphereRun(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.scratch = pathlib.Path(tempfile.mkdtemp(prefix="robin-plot-sphere-run-"))
+        cls.directory = cls.scratch / "hertz_3d"
+        cls.status, _, cls.log = run(BIN / "robin-run", HERTZ_3D, "--output", cls.directory)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.scratch, ignore_errors=True)
+
+    def test_robin_plot_compares_the_run_with_hertz(self):
+        self.assertEqual(self.status, 0, self.log)
+        summary = json.loads((self.directory / "summary.json").read_text())
+        status, stdout, stderr = run(BIN / "robin-plot", self.directory)
+        self.assertEqual(status, 0, stderr)
+        self.assertEqual(png_header(self.directory / "contact.png")[2:], (8, 6, True))
+        # Hertz from the run's resultant, computed here: P = |resultant| / 0.25.
+        resultant = math.sqrt(sum(value ** 2 for value in summary["contact_force_resultant"]))
+        load = resultant / 0.25
+        modulus = YOUNG / (2.0 * (1.0 - POISSON ** 2))
+        radius = math.cbrt(3.0 * load * RADIUS / (4.0 * modulus))
+        peak = 3.0 * load / (2.0 * math.pi * radius ** 2)
+        match = HERTZ_LINE.search(stdout)
+        self.assertIsNotNone(match, stdout)
+        (hertz_peak, hertz_radius, printed_load, source, computed_peak, peak_error,
+         computed_radius, radius_error) = match.groups()
+        self.assertAlmostEqual(float(printed_load), load, delta=5e-6 * load)
+        self.assertEqual(source, f"the computed contact resultant {resultant:.6g} / "
+                                 "model_fraction 0.25")
+        self.assertAlmostEqual(float(hertz_peak), peak, delta=5e-6 * peak)
+        self.assertAlmostEqual(float(hertz_radius), radius, delta=5e-6 * radius)
+        self.assertAlmostEqual(float(peak_error) / 100, float(computed_peak) / peak - 1.0,
+                               delta=5e-5)
+        self.assertAlmostEqual(float(radius_error) / 100, float(computed_radius) / radius - 1.0,
+                               delta=5e-5)
+        # The solution at h = 0.01 against Hertz (robin-plot's fit; measured +0.40 % and
+        # -2.62 %): both within 3 %.
+        self.assertLess(abs(float(peak_error)), 3.0)
+        self.assertLess(abs(float(radius_error)), 3.0)
+        self.assertIn("r from the [reference] center (0, 0, 0)", stdout)
+        self.assertNotIn("warning", stdout)
+        # The largest computed pressure (the node on the axis) is within 3 % of Hertz's p0 too.
+        rows = read_csv(self.directory / "contact.csv")
+        largest = max(float(row["pressure"]) for row in rows)
+        self.assertLess(abs(largest / peak - 1.0), 0.03)
 
 
 if __name__ == "__main__":
