@@ -27,6 +27,16 @@ printed centre, p0 and a are the analytic ones, the farthest loaded point lies w
 spacing inside a and the total force within 2 % of P = 2/3 pi a^2 p0. A contact file without nz
 and one with a ragged row are refused, naming the file and line.
 
+The same surface with a case file of [reference] kind = "hertz_sphere" (SolidHertzReference)
+whose P = 4 pi, R = 1 and E* = 375 pi (given, or from two bodies of E = 682.5 pi, nu = 0.3) are
+Hertz's for that p0 and a: robin-plot prints Hertz p0 = 150, a = 0.2 and errors of 0.00 %, its
+drawn Hertz curve is p0 sqrt(1 - r^2/a^2) to 1e-12 and its circle r = a lies about the center;
+a quarter of the grid with a resultant of pi and model_fraction = 0.25 gives the same. A kind of
+the other dimension than the case or the contact file, a center of the wrong length and a
+model_fraction out of (0, 1] are refused naming the case file and line. HertzSphereRun runs
+examples/hertz_3d.toml (a quarter model) and checks robin-plot's Hertz numbers against P = 4 x
+the resultant computed here, and its errors of p0 and a below 3 %.
+
 The tools are those of the build directory named by ROBIN_CONTACT_BIN (set by CTest), default
 build/bin. Needs Debian's matplotlib and numpy (/usr/bin/python3).
 """
