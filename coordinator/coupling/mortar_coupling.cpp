@@ -367,7 +367,9 @@ FaceCoupling integrate_faces(const InterfaceDescription& nonmortar,
                              const InterfaceDescription& mortar, const GapFunction* gap) {
   SpatialGap spatial_gap;
   if (gap != nullptr) {
-    spatial_gap = [gap](const Eigen::Vector3d& point) { return (*gap)(point.x(), point.y()); };
+    spatial_gap = [gap](const Eigen::Vector3d& point) {
+      return (*gap)(point.x(), point.y(), point.z());
+    };
   }
   return integrate_face_mortar(mortar_surface(nonmortar), mortar_surface(mortar), spatial_gap);
 }

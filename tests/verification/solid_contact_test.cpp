@@ -4,12 +4,17 @@
 //    peak pressure fitted to the computed pressures against Hertz's a = (3PR/(4E*))^(1/3) and
 //    p0 = 3P/(2 pi a^2), P the computed load, within 3 % on the finest mesh, the contact
 //    radius's error falling as the mesh is refined;
-//  - the Robin iteration (in-process ports) equals the monolithic solution to 1e-8 on the same
-//    case, also with the sphere 100 times stiffer than the flat.
+//  - the three-dimensional contact patch test (examples/non_matching_solids.toml: tetrahedra
+//    against hexahedra, non-matching, mortar): the exact uniaxial pressure
+//    p = delta / (H1/E1 + H2/E2) at every multiplier node to 1e-10, from the case file through
+//    the monolithic solve and through the Robin iteration;
+//  - the Robin iteration (in-process ports) equals the monolithic solution to 1e-8 on these
+//    cases, also with the sphere 100 times stiffer than the flat.
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -109,6 +114,56 @@ double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& 
   return (value - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>();
 }
 
+/// Largest |lambda_j / m_j - p| / p over the rows.
+double largest_pressure_error(const ContactPairing& pairing, const Eigen::VectorXd& force,
+                              double pressure) {
+  double error = 0.0;
+  for (std::size_t j = 0; j < pairing.size(); ++j) {
+    const double value = force[static_cast<Eigen::Index>(j)] / pairing.pairs[j].weight;
+    error = std::max(error, std::abs(value - pressure) / pressure);
+  }
+  return error;
+}
+
+/// The exact pressure of examples/non_matching_solids.toml (uniaxial stress, rollers).
+double exact_patch_pressure() {
+  return 0.01 / (0.5 / 1000.0 + 0.4 / 400.0);
+}
+
+CaseDefinition patch_case_with(const std::vector<std::string>& overrides) {
+  return read_case_file(std::filesystem::path(ROBIN_EXAMPLES) / "non_matching_solids.toml",
+                        overrides);
+}
+
+CaseDefinition patch_case() {
+  return patch_case_with({});
+}
+
+TEST(SolidMortarPatch, PressureIsExactAtEveryMultiplierNodeFromTheCaseFile) {
+  for (const std::string non_mortar : {"", "lower", "upper"}) {
+    CaseDefinition definition = patch_case();
+    definition.contact.non_mortar = non_mortar;
+    const LocalProblem problem = prepare_local_problem(definition);
+    ASSERT_GT(problem.pairing().size(), 0u);
+    const MonolithicResult result = solve_reference(problem);
+    ASSERT_EQ(result.qp.status, QpStatus::converged);
+    EXPECT_LE(
+        largest_pressure_error(problem.pairing(), result.contact_force, exact_patch_pressure()),
+        1e-10)
+        << "non-mortar side '" << non_mortar << "'";
+    definition.solver.qp.relative_tolerance = 1e-14;
+    definition.coupling.tolerance = 1e-12;
+    InProcessPort port1, port2;
+    const CoupledRunResult robin =
+        run_coupled_case(definition, {&port1, &port2}, definition.coupling);
+    ASSERT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
+    EXPECT_LE(largest_pressure_error(robin.pairing(), robin.iteration.state.bodies[0].contact_force,
+                                     exact_patch_pressure()),
+              1e-10)
+        << "non-mortar side '" << non_mortar << "'";
+  }
+}
+
 /// The Robin iteration on `definition` against its monolithic solution.
 void expect_robin_matches_monolithic(CaseDefinition definition) {
   definition.solver.qp.relative_tolerance = 1e-13;
@@ -134,6 +189,14 @@ void expect_robin_matches_monolithic(CaseDefinition definition) {
 
 TEST(SolidRobinVersusMonolithic, HertzSphereOnAFlat) {
   expect_robin_matches_monolithic(hertz_case(0.04));
+}
+
+TEST(SolidRobinVersusMonolithic, NonMatchingSolidsByMortar) {
+  expect_robin_matches_monolithic(patch_case());
+}
+
+TEST(SolidRobinVersusMonolithic, NonMatchingSolidsOneHundredTimesStiffer) {
+  expect_robin_matches_monolithic(patch_case_with({"body[2].material.young=100000"}));
 }
 
 TEST(SolidRobinVersusMonolithic, SphereHundredTimesStifferThanTheFlat) {
