@@ -71,9 +71,9 @@ TEST(GapFunction, MissingParenthesisIsReported) {
 }
 
 TEST(GapFunction, UnknownVariableIsNamed) {
-  const std::string message = error_message([&] { const GapFunction gap("x + z", {}, context); });
+  const std::string message = error_message([&] { const GapFunction gap("x + w", {}, context); });
   EXPECT_NE(message.find(context), std::string::npos) << message;
-  EXPECT_NE(message.find("\"z\""), std::string::npos) << message;
+  EXPECT_NE(message.find("\"w\""), std::string::npos) << message;
   EXPECT_NE(message.find("position 4"), std::string::npos) << message;
 }
 
@@ -90,11 +90,25 @@ TEST(GapFunction, EmptyExpressionIsRejected) {
 }
 
 TEST(GapFunction, ConstantCannotHideAVariable) {
-  const std::string message = error_message([&] {
-    const GapFunction gap("x", {{"x", 1.0}}, context);
-  });
-  EXPECT_NE(message.find(context), std::string::npos) << message;
-  EXPECT_NE(message.find("'x'"), std::string::npos) << message;
+  for (const std::string name : {"x", "y", "z"}) {
+    const std::string message = error_message([&] {
+      const GapFunction gap(name, {{name, 1.0}}, context);
+    });
+    EXPECT_NE(message.find(context), std::string::npos) << message;
+    EXPECT_NE(message.find("'" + name + "'"), std::string::npos) << message;
+  }
+}
+
+TEST(GapFunction, ThirdVariableOfSolidBodies) {
+  const GapFunction sphere("(x^2 + y^2 + z^2) / (2*R)", {{"R", 2.0}}, context);
+  EXPECT_DOUBLE_EQ(sphere(1.0, 2.0, 3.0), 14.0 / 4.0);
+  EXPECT_DOUBLE_EQ(sphere(1.0, 2.0), 5.0 / 4.0);  // z = 0 on plane bodies
+  const std::string message = error_message([&] { static_cast<void>(sphere(0.0, 0.0, 0.0)); });
+  EXPECT_TRUE(message.empty()) << message;
+  const GapFunction pole("1/z", {}, context);
+  const std::string pole_message = error_message([&] { static_cast<void>(pole(1.0, 2.0, 0.0)); });
+  EXPECT_NE(pole_message.find("not finite at (x, y, z) = (1, 2, 0)"), std::string::npos)
+      << pole_message;
 }
 
 TEST(GapFunction, NonFiniteConstantIsRejected) {
@@ -107,7 +121,7 @@ TEST(GapFunction, NonFiniteConstantIsRejected) {
 }
 
 TEST(GapFunction, NonFiniteValueThrowsWhereItOccurs) {
-  // Parsing evaluates at (0, 0) without checking the value; evaluation checks it.
+  // Parsing evaluates at (0, 0, 0) without checking the value; evaluation checks it.
   const GapFunction gap("1/x", {}, context);
   EXPECT_DOUBLE_EQ(gap(4.0, 0.0), 0.25);
   const std::string message = error_message([&] { static_cast<void>(gap(0.0, 2.0)); });
