@@ -1,5 +1,6 @@
-// The lower body of examples/hertz_3d.toml: a quarter block [0, 1]^2 x [-1, 0], its contact
-// face z = 0 graded towards the origin (hertz_3d_block.geo; `h` the finest cell size).
+// The lower body of examples/hertz_3d.toml (the flat): a quarter block
+// [0, 1]^2 x [-1, 0] whose contact face z = 0 has cells of size h near the axis
+// (hertz_3d_block.geo; the same grid for both bodies: matching meshes).
 DefineConstant[ h = 0.01 ];
 depth = -1.0;
 Include "hertz_3d_block.geo";

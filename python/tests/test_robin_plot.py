@@ -1145,8 +1145,8 @@ class HertzSphereRun(unittest.TestCase):
                                delta=5e-5)
         self.assertAlmostEqual(float(radius_error) / 100, float(computed_radius) / radius - 1.0,
                                delta=5e-5)
-        # The solution at h = 0.01 against Hertz (robin-plot's fit; measured +0.40 % and
-        # -2.62 %): both within 3 %.
+        # The solution at h = 0.02 against Hertz (robin-plot's fit; measured +0.32 % and
+        # -0.50 %): both within 3 %.
         self.assertLess(abs(float(peak_error)), 3.0)
         self.assertLess(abs(float(radius_error)), 3.0)
         self.assertIn("r from the [reference] center (0, 0, 0)", stdout)

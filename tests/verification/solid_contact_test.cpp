@@ -2,8 +2,8 @@
 //  - Hertz point contact (examples/hertz_3d.toml: a sphere of radius R, its curvature the
 //    initial gap (x^2 + y^2)/(2R), on a flat body; a quarter model): the contact radius and the
 //    peak pressure fitted to the computed pressures against Hertz's a = (3PR/(4E*))^(1/3) and
-//    p0 = 3P/(2 pi a^2), P the computed load, within 3 % on the finest mesh, the contact
-//    radius's error falling as the mesh is refined;
+//    p0 = 3P/(2 pi a^2), P the computed load, within 3 % on the finest mesh (that of the
+//    example), both errors falling as the mesh is refined;
 //  - the three-dimensional contact patch test (examples/non_matching_solids.toml: tetrahedra
 //    against hexahedra, non-matching, mortar): the exact uniaxial pressure
 //    p = delta / (H1/E1 + H2/E2) at every multiplier node to 1e-10, from the case file through
@@ -85,7 +85,7 @@ TEST(SolidHertz, ContactRadiusAndPeakPressureWithinThreePercentOfHertz) {
   std::printf("%8s %8s %10s %10s %10s %10s %10s\n", "h", "rows", "P", "a", "error(a)", "p0",
               "error(p0)");
   std::vector<double> radius_errors, peak_errors;
-  for (const double mesh_size : {0.02, 0.01, 0.005}) {
+  for (const double mesh_size : {0.08, 0.04, 0.02}) {
     const LocalProblem problem = prepare_local_problem(hertz_case(mesh_size));
     const MonolithicResult result = solve_reference(problem);
     ASSERT_EQ(result.qp.status, QpStatus::converged);
@@ -98,16 +98,16 @@ TEST(SolidHertz, ContactRadiusAndPeakPressureWithinThreePercentOfHertz) {
                 fit.load, fit.radius, radius_errors.back(), fit.peak, peak_errors.back());
   }
   for (std::size_t k = 1; k < radius_errors.size(); ++k) {
-    std::printf("observed order between h = %g and h/2: a %.2f, p0 %.2f\n", 0.02 / (1 << (k - 1)),
+    std::printf("observed order between h = %g and h/2: a %.2f, p0 %.2f\n", 0.08 / (1 << (k - 1)),
                 std::log2(radius_errors[k - 1] / radius_errors[k]),
                 std::log2(peak_errors[k - 1] / peak_errors[k]));
   }
-  // The peak pressure's error is already at the level of the finite bodies' departure from
-  // Hertz's half-spaces on the coarsest mesh; the contact radius's falls with h.
   EXPECT_LE(radius_errors.back(), 0.03);
-  for (const double error : peak_errors) EXPECT_LE(error, 0.03);
-  EXPECT_LT(radius_errors[2], radius_errors[1]);
-  EXPECT_LT(radius_errors[1], radius_errors[0]);
+  EXPECT_LE(peak_errors.back(), 0.03);
+  for (std::size_t k = 1; k < radius_errors.size(); ++k) {
+    EXPECT_LT(radius_errors[k], radius_errors[k - 1]);
+    EXPECT_LT(peak_errors[k], peak_errors[k - 1]);
+  }
 }
 
 double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& reference) {
