@@ -1,0 +1,112 @@
+// Solid (3D) bodies through the real service, against numbers from outside the code:
+//  - robin-run (two robin-subdomain processes) on examples/non_matching_solids.toml (tetrahedra
+//    against hexahedra, mortar) writes the patch test's exact pressure into every row of
+//    contact.csv;
+//  - robin-run and robin-monolithic on examples/hertz_3d.toml write the same contact forces;
+//  - robin-coordinator's coupling with the independent Python server owning the hexahedral
+//    block and robin-subdomain the tetrahedral one gives the monolithic mortar solution.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "coupling/coupled_run.hpp"
+#include "coupling/local_problem.hpp"
+#include "coupling/monolithic_solver.hpp"
+#include "remote/remote_port.hpp"
+#include "remote_test_support.hpp"
+
+namespace robin {
+namespace {
+
+using testing::example;
+using testing::TemporaryDirectory;
+
+/// The exact pressure of examples/non_matching_solids.toml: p = delta / (H1/E1 + H2/E2).
+double exact_patch_pressure() {
+  return 0.01 / (0.5 / 1000.0 + 0.4 / 400.0);
+}
+
+/// Runs `tool` on `case_file` with `extra` arguments into `directory`/`name`; returns the
+/// columns of its contact.csv.
+std::map<std::string, std::vector<std::string>> run_case(const std::string& tool,
+                                                         const std::string& case_file,
+                                                         const std::vector<std::string>& extra,
+                                                         const TemporaryDirectory& directory,
+                                                         const std::string& name) {
+  std::vector<std::string> arguments = {example(case_file).string(), "--output",
+                                        (directory.path() / name).string(), "--log-level", "warn"};
+  arguments.insert(arguments.end(), extra.begin(), extra.end());
+  const testing::ProcessOutcome outcome = testing::run_tool(tool, arguments, directory.path(), 300);
+  EXPECT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
+  return testing::read_csv(directory.path() / name / "contact.csv");
+}
+
+TEST(SolidService, RobinRunReproducesTheThreeDimensionalPatchTestPressure) {
+  const TemporaryDirectory output("solid-patch");
+  const auto columns = run_case("robin-run", "non_matching_solids.toml", {}, output, "run");
+  ASSERT_TRUE(columns.count("z") && columns.count("nz")) << "contact.csv of a solid case has z, nz";
+  const std::vector<std::string>& pressures = columns.at("pressure");
+  ASSERT_GT(pressures.size(), 20u);
+  for (const std::string& pressure : pressures) {
+    EXPECT_NEAR(std::stod(pressure), exact_patch_pressure(), 1e-8 * exact_patch_pressure());
+  }
+}
+
+TEST(SolidService, RobinRunEqualsRobinMonolithicOnTheSphere) {
+  const TemporaryDirectory output("solid-hertz");
+  const std::vector<std::string> coarse = {"--set", "body[1].mesh_size=0.04", "--set",
+                                           "body[2].mesh_size=0.04"};
+  std::vector<std::string> tight = coarse;
+  tight.insert(tight.end(), {"--tolerance", "1e-11"});
+  const auto run = run_case("robin-run", "hertz_3d.toml", tight, output, "run");
+  const auto monolithic = run_case("robin-monolithic", "hertz_3d.toml", coarse, output, "mono");
+  ASSERT_EQ(run.at("lambda1").size(), monolithic.at("lambda1").size());
+  double largest = 0.0;
+  for (const std::string& value : monolithic.at("lambda1")) {
+    largest = std::max(largest, std::abs(std::stod(value)));
+  }
+  ASSERT_GT(largest, 0.0);
+  for (const char* column : {"lambda1", "lambda2"}) {
+    for (std::size_t k = 0; k < run.at(column).size(); ++k) {
+      EXPECT_NEAR(std::stod(run.at(column)[k]), std::stod(monolithic.at(column)[k]), 1e-8 * largest)
+          << column << " row " << k;
+    }
+  }
+}
+
+TEST(SolidService, PythonServerOwningTheHexahedraEqualsMonolithic) {
+  const TemporaryDirectory logs("solid-python");
+  CaseDefinition definition = read_case_file(example("non_matching_solids.toml"));
+  definition.solver.qp.relative_tolerance = 1e-13;
+  definition.coupling.tolerance = 1e-11;
+  SubdomainServer cpp(definition.bodies[0].definition.name, testing::server_options(logs.path()));
+  SubdomainServer python(definition.bodies[1].definition.name,
+                         testing::python_server_options(logs.path()));
+  cpp.await_listening();
+  python.await_listening();
+  RemotePortOptions port_options;
+  port_options.request_timeout_seconds = 120.0;
+  RemotePort body1(cpp.endpoint(), definition.bodies[0].definition.name, port_options);
+  RemotePort body2(python.endpoint(), definition.bodies[1].definition.name, port_options);
+  const CoupledRunResult run = run_coupled_case(definition, {&body1, &body2}, definition.coupling);
+  EXPECT_EQ(body2.server_name().rfind("robin-subdomain-py ", 0), 0u) << body2.server_name();
+  body1.end_run();
+  body2.end_run();
+  ASSERT_EQ(run.iteration.status, IterationStatus::converged) << run.iteration.message;
+  const LocalProblem problem = prepare_local_problem(definition);
+  MprgpParameters reference = definition.solver.qp;
+  reference.relative_tolerance = 1e-14;
+  const MonolithicResult monolithic =
+      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), reference);
+  ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
+  std::printf("non_matching_solids.toml, C++ and Python servers: %zu iterations\n",
+              run.iteration.history.size());
+  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[0].contact_force,
+                                     monolithic.contact_force, 1e-8));
+  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[1].contact_force,
+                                     monolithic.contact_force, 1e-8));
+}
+
+}  // namespace
+}  // namespace robin
