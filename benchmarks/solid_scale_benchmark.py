@@ -178,9 +178,10 @@ def run_guarded(command, log_path, timeout, memory_limit_mib):
     """Runs command, polling its processes every 0.1 s: their VmHWM (peaks by pid, with a label)
     and the sum of their VmRSS. Over `timeout` seconds or `memory_limit_mib` summed: SIGTERM to
     the command, after 10 s SIGKILL to every process seen. Returns (exit status, wall seconds,
-    ru_maxrss KiB, {pid: (label, VmHWM KiB)}, largest summed VmRSS MiB, why stopped or None)."""
-    peaks, labels = {}, {}
-    state = {"largest_sum": 0.0, "stopped": None, "term_time": None}
+    ru_maxrss KiB, {pid: (label, VmHWM KiB)}, largest summed VmRSS MiB, why stopped or None,
+    [(seconds, {label: VmRSS MiB})] every 10 s)."""
+    peaks, labels, timeline = {}, {}, []
+    state = {"largest_sum": 0.0, "stopped": None, "term_time": None, "sampled": -1e9}
     done = threading.Event()
     with open(log_path, "w") as log:
         start = time.monotonic()
@@ -189,7 +190,7 @@ def run_guarded(command, log_path, timeout, memory_limit_mib):
 
         def poll():
             while not done.is_set():
-                pending, seen, total = [process.pid], set(), 0.0
+                pending, seen, total, sample = [process.pid], set(), 0.0, {}
                 while pending:
                     pid = pending.pop()
                     if pid in seen:
@@ -202,12 +203,17 @@ def run_guarded(command, log_path, timeout, memory_limit_mib):
                         if value[1] >= peaks.get(pid, ("", 0))[1]:
                             peaks[pid] = (labels[pid], value[1])
                         try:
-                            total += resident_megabytes(pid)
+                            resident = resident_megabytes(pid)
+                            total += resident
+                            sample[labels[pid]] = round(resident)
                         except OSError:
                             pass
                     pending.extend(children_of(pid))
                 state["largest_sum"] = max(state["largest_sum"], total)
                 elapsed = time.monotonic() - start
+                if elapsed - state["sampled"] >= 10:
+                    timeline.append((round(elapsed, 1), sample))
+                    state["sampled"] = elapsed
                 if state["stopped"] is None:
                     if elapsed > timeout:
                         state["stopped"] = f"stopped after {timeout:.0f} s"
@@ -233,7 +239,7 @@ def run_guarded(command, log_path, timeout, memory_limit_mib):
         done.set()
         poller.join()
     return (process.returncode, wall, usage.ru_maxrss, peaks, state["largest_sum"],
-            state["stopped"])
+            state["stopped"], timeline)
 
 
 def contact_forces(output):
@@ -268,7 +274,7 @@ def run_one(binaries, tool, case, operator, output, arguments):
                "--set", f"solver.interface_operator={operator}"]
     if tool == "robin-run":
         command += ["--timeout", repr(arguments.robin_timeout)]
-    status, wall, maxrss, peaks, largest_sum, stopped = run_guarded(
+    status, wall, maxrss, peaks, largest_sum, stopped, timeline = run_guarded(
         command, output.parent / f"{output.name}.log", arguments.timeout,
         arguments.memory_limit * 1024)
     try:
@@ -298,13 +304,14 @@ def run_one(binaries, tool, case, operator, output, arguments):
         "operator_applications": summary.get("operator_applications"),
         "messaging_share": timings.get("messaging_share_of_iteration"),
         "messaging": timings.get("messaging"),
-        "server_rss": [mib for _, mib in servers],
+        "server_rss": [(label.split(" ", 1)[-1], mib) for label, mib in servers],
         "coordinator_rss": max(coordinator) if coordinator else None,
         "process_rss": maxrss / 1024,
         "largest_resident_sum": largest_sum,
         "factor_nonzeros": [body.get("factor_nonzeros") for body in summary.get("bodies", [])
                             if body.get("factor_nonzeros") is not None],
         "message": summary.get("message"),
+        "timeline": timeline,
         "forces": contact_forces(output),
         "resultant": (summary.get("contact_force_resultant") or [None] * 3)[-1],
     }
@@ -376,6 +383,10 @@ def main():
                     print(f"{size:g} DOFs (n = {n}, {result['dofs']} DOFs), {operator}, {tool}: "
                           f"{status_text(result)}, {result['wall']:.1f} s, largest resident "
                           f"sum {result['largest_resident_sum']:.0f} MiB", flush=True)
+                    if result["stopped"] or result["wall"] > 120:
+                        for seconds, sample in result["timeline"]:
+                            print(f"    resident at {seconds:6.0f} s (MiB): " + ", ".join(
+                                f"{label} {mib}" for label, mib in sorted(sample.items())))
                     (scratch / "results.json").write_text(json.dumps(results, indent=1))
     finally:
         if not arguments.keep:
@@ -397,7 +408,7 @@ def main():
                         else r["operator_applications"])),
         ("status", status_text),
         ("peak RSS per server (MiB)",
-         lambda r: ", ".join("%.0f" % m for m in r["server_rss"]) if r["server_rss"] else "–"),
+         lambda r: ", ".join("%s %.0f" % s for s in r["server_rss"]) if r["server_rss"] else "–"),
         ("peak RSS, coordinator / robin-monolithic (MiB)",
          lambda r: cell(r["coordinator_rss"] if r["tool"] == "robin-run" else r["process_rss"],
                         0)),
@@ -439,7 +450,7 @@ def main():
                 cell(dd["wall"], 1) if dd else "–",
                 cell(mono["wall"], 1) if mono else "–",
                 cell(ratio, 2),
-                ", ".join("%.0f" % m for m in dd["server_rss"]) if dd else "–",
+                ", ".join("%s %.0f" % s for s in dd["server_rss"]) if dd else "–",
                 cell(mono["process_rss"], 0) if mono else "–",
                 "%.1e" % difference if difference is not None else "–",
             ]))
