@@ -5,6 +5,7 @@
         [--sizes 1e4 1e5 1e6] [--include-3e6] [--operators dense factor]
         [--tools robin-run robin-monolithic] [--timeout 900] [--memory-limit 18]
         [--robin-timeout 1800] [--keep DIR]
+    /usr/bin/python3 benchmarks/solid_scale_benchmark.py --tabulate DIR/results.json ...
 
 The case is examples/hertz_3d.toml (quarter model of a sphere of radius R = 1 pressed onto a
 flat through the gap (x^2 + y^2) / (2 R), both bodies E = 1000, nu = 0.3, the upper body's far
@@ -326,6 +327,80 @@ def status_text(result):
     return f"exit {result['status']}: {result['message'] or 'no summary'}"
 
 
+def print_tables(results):
+    """The two Markdown tables of the module docstring; returns the number of runs that failed,
+    were stopped or did not converge."""
+    for r in results:
+        if r.get("dofs") is None:
+            r["dofs"] = 2 * body_dofs(r["n"])
+    # Table 1: the stages, one column per run.
+    headers = [f"n = {r['n']}, {r['dofs']} DOFs, {r['operator']}, "
+               f"{'DD' if r['tool'] == 'robin-run' else 'mono'}" for r in results]
+    print("\n" + table_row(["stage (s)"] + headers))
+    print(table_rule(len(headers) + 1))
+    for index, (label, _, _) in enumerate(ROWS):
+        print(table_row([label.replace("  ", "&nbsp;&nbsp;")]
+                        + [cell(r["column"][index]) for r in results]))
+    extra = [
+        ("sum of the stages (not indented)", lambda r: cell(r["stages"])),
+        ("wall (measured)", lambda r: cell(r["wall"])),
+        ("outer iterations (DD) / operator applications (mono)",
+         lambda r: cell(r["iterations"] if r["tool"] == "robin-run"
+                        else r["operator_applications"])),
+        ("status", status_text),
+        ("peak RSS per server (MiB)",
+         lambda r: ", ".join("%s %.0f" % tuple(s) for s in r["server_rss"]) if r["server_rss"] else "–"),
+        ("peak RSS, coordinator / robin-monolithic (MiB)",
+         lambda r: cell(r["coordinator_rss"] if r["tool"] == "robin-run" else r["process_rss"],
+                        0)),
+        ("largest resident sum of the run's processes (MiB)",
+         lambda r: cell(r["largest_resident_sum"], 0)),
+        ("nonzeros of L per body (mono)",
+         lambda r: ", ".join("%.3g" % v for v in r["factor_nonzeros"])
+         if r["factor_nonzeros"] else "–"),
+    ]
+    for label, function in extra:
+        print(table_row([label] + [function(r) for r in results]))
+
+    # Table 2: one row per size and operator.
+    print("\n" + table_row(["DOFs (n)", "contact nodes", "F", "DD outer iterations",
+                            "DD iterations (s)", "messaging share of the iterations",
+                            "DD wall (s)", "mono wall (s)", "DD / mono",
+                            "peak RSS per server (MiB)", "mono peak RSS (MiB)",
+                            "max rel. difference of the contact forces, DD vs mono"]))
+    print(table_rule(12))
+    failures = 0
+    pairs = []
+    for r in results:
+        if (r["n"], r["operator"]) not in pairs:
+            pairs.append((r["n"], r["operator"]))
+    for n, operator in pairs:
+        if True:
+            dd = next((r for r in results if r["n"] == n and r["operator"] == operator
+                       and r["tool"] == "robin-run"), None)
+            mono = next((r for r in results if r["n"] == n and r["operator"] == operator
+                         and r["tool"] == "robin-monolithic"), None)
+            for r in (dd, mono):
+                failures += r is not None and (r["status"] != 0 or r["stopped"] is not None)
+            ok = lambda r: r is not None and r["status"] == 0 and not r["stopped"]  # noqa: E731
+            dofs = (dd or mono or {}).get("dofs") or 2 * body_dofs(n)
+            ratio = dd["wall"] / mono["wall"] if ok(dd) and ok(mono) else None
+            difference = agreement(dd["forces"], mono["forces"]) if ok(dd) and ok(mono) else None
+            print(table_row([
+                f"{dofs} ({n})", (n + 1) ** 2, operator,
+                cell(dd["iterations"]) if ok(dd) else "–",
+                cell(dd["column"][12]) if ok(dd) else "–",
+                cell(dd["messaging_share"], 2) if ok(dd) else "–",
+                cell(dd["wall"], 1) if dd else "–",
+                cell(mono["wall"], 1) if mono else "–",
+                cell(ratio, 2),
+                ", ".join("%s %.0f" % tuple(s) for s in dd["server_rss"]) if dd else "–",
+                cell(mono["process_rss"], 0) if mono else "–",
+                "%.1e" % difference if difference is not None else "–",
+            ]))
+    return failures
+
+
 def main():
     parser = argparse.ArgumentParser(
         description=__doc__.split("\n\n")[0],
@@ -352,7 +427,19 @@ def main():
                         help="robin-run's --timeout, the deadline of an interface-sized request "
                              "such as AssignContact, in seconds (default 1800)")
     parser.add_argument("--keep", help="keep the scratch directory here (must not exist)")
+    parser.add_argument("--tabulate", nargs="+", metavar="RESULTS_JSON",
+                        help="run nothing: print the tables of the results.json files of "
+                             "earlier runs (their --keep directories), one after the other")
     arguments = parser.parse_args()
+
+    if arguments.tabulate:
+        results = []
+        for path in arguments.tabulate:
+            results += json.loads(Path(path).read_text())
+        failures = print_tables(results)
+        if failures:
+            print(f"\n{failures} run(s) failed, were stopped or did not converge (see 'status')")
+        return 0
 
     sizes = list(arguments.sizes)
     if arguments.include_3e6 and 3e6 not in sizes:
@@ -394,68 +481,7 @@ def main():
         if not arguments.keep:
             shutil.rmtree(scratch, ignore_errors=True)
 
-    # Table 1: the stages, one column per run.
-    headers = [f"n = {r['n']}, {r['dofs']} DOFs, {r['operator']}, "
-               f"{'DD' if r['tool'] == 'robin-run' else 'mono'}" for r in results]
-    print("\n" + table_row(["stage (s)"] + headers))
-    print(table_rule(len(headers) + 1))
-    for index, (label, _, _) in enumerate(ROWS):
-        print(table_row([label.replace("  ", "&nbsp;&nbsp;")]
-                        + [cell(r["column"][index]) for r in results]))
-    extra = [
-        ("sum of the stages (not indented)", lambda r: cell(r["stages"])),
-        ("wall (measured)", lambda r: cell(r["wall"])),
-        ("outer iterations (DD) / operator applications (mono)",
-         lambda r: cell(r["iterations"] if r["tool"] == "robin-run"
-                        else r["operator_applications"])),
-        ("status", status_text),
-        ("peak RSS per server (MiB)",
-         lambda r: ", ".join("%s %.0f" % s for s in r["server_rss"]) if r["server_rss"] else "–"),
-        ("peak RSS, coordinator / robin-monolithic (MiB)",
-         lambda r: cell(r["coordinator_rss"] if r["tool"] == "robin-run" else r["process_rss"],
-                        0)),
-        ("largest resident sum of the run's processes (MiB)",
-         lambda r: cell(r["largest_resident_sum"], 0)),
-        ("nonzeros of L per body (mono)",
-         lambda r: ", ".join("%.3g" % v for v in r["factor_nonzeros"])
-         if r["factor_nonzeros"] else "–"),
-    ]
-    for label, function in extra:
-        print(table_row([label] + [function(r) for r in results]))
-
-    # Table 2: one row per size and operator.
-    print("\n" + table_row(["DOFs (n)", "contact nodes", "F", "DD outer iterations",
-                            "DD iterations (s)", "messaging share of the iterations",
-                            "DD wall (s)", "mono wall (s)", "DD / mono",
-                            "peak RSS per server (MiB)", "mono peak RSS (MiB)",
-                            "max rel. difference of the contact forces, DD vs mono"]))
-    print(table_rule(12))
-    failures = 0
-    for size in sizes:
-        n = cells_for(size)
-        for operator in arguments.operators:
-            dd = next((r for r in results if r["n"] == n and r["operator"] == operator
-                       and r["tool"] == "robin-run"), None)
-            mono = next((r for r in results if r["n"] == n and r["operator"] == operator
-                         and r["tool"] == "robin-monolithic"), None)
-            for r in (dd, mono):
-                failures += r is not None and (r["status"] != 0 or r["stopped"] is not None)
-            ok = lambda r: r is not None and r["status"] == 0 and not r["stopped"]  # noqa: E731
-            dofs = (dd or mono or {}).get("dofs") or 2 * body_dofs(n)
-            ratio = dd["wall"] / mono["wall"] if ok(dd) and ok(mono) else None
-            difference = agreement(dd["forces"], mono["forces"]) if ok(dd) and ok(mono) else None
-            print(table_row([
-                f"{dofs} ({n})", (n + 1) ** 2, operator,
-                cell(dd["iterations"]) if ok(dd) else "–",
-                cell(dd["column"][12]) if ok(dd) else "–",
-                cell(dd["messaging_share"], 2) if ok(dd) else "–",
-                cell(dd["wall"], 1) if dd else "–",
-                cell(mono["wall"], 1) if mono else "–",
-                cell(ratio, 2),
-                ", ".join("%s %.0f" % s for s in dd["server_rss"]) if dd else "–",
-                cell(mono["process_rss"], 0) if mono else "–",
-                "%.1e" % difference if difference is not None else "–",
-            ]))
+    failures = print_tables(results)
     if failures:
         print(f"\n{failures} run(s) failed, were stopped or did not converge (see 'status')")
     return 1 if failures else 0
