@@ -41,7 +41,12 @@ every 0.1 s). A run is stopped (SIGTERM, then SIGKILL of the processes seen) whe
 than --timeout seconds or when the resident memory of its processes summed exceeds
 --memory-limit GiB; its column then says so. robin-run's own request deadline (--timeout of
 robin-run: AssignContact builds the dense F, which takes minutes at 1e6 DOFs) is raised to
---robin-timeout. --keep DIR keeps the case files, logs, outputs and results.json.
+--robin-timeout. --keep DIR keeps the case files, logs, outputs and results.json; --tabulate
+prints the tables again from such results.json files (several invocations in one table).
+
+On 2 cores and 24 GiB the default 1e6 size does not fit: its two servers were stopped by the
+memory guard (18 GiB) after 677 s, still factorizing (docs/benchmarks.md, "Solid bodies (3D) at
+scale"); 4.9e5 DOFs (--sizes 5e5) took 410 s with robin-run and 461 s with robin-monolithic.
 No time is asserted anywhere: the tables are measurements on a machine that may be shared.
 """
 
@@ -225,7 +230,9 @@ def run_guarded(command, log_path, timeout, memory_limit_mib):
                         state["term_time"] = elapsed
                         process.send_signal(signal.SIGTERM)
                 elif elapsed - state["term_time"] > 10:
-                    for pid in list(peaks):
+                    for pid in list(peaks):  # still the process seen (not a reused pid)
+                        if process_label(pid) != labels.get(pid):
+                            continue
                         try:
                             os.kill(pid, signal.SIGKILL)
                         except OSError:
