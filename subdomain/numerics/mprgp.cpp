@@ -78,6 +78,8 @@ class MprgpIteration {
   void recompute_gradient();
   double feasible_step_length(Eigen::Index& blocking_index) const;
   bool conjugate_gradient_or_expansion();
+  bool null_direction_step();
+  double null_curvature(const Eigen::VectorXd& direction) const;
   void expansion(double feasible_step, Eigen::Index blocking_index);
   bool proportioning();
   bool confirm_convergence();
@@ -231,11 +233,14 @@ bool MprgpIteration::conjugate_gradient_or_expansion() {
   matrix_.apply(direction_, product_);
   ++result_.operator_applications;
   const double curvature = direction_.dot(product_);
-  if (!(curvature > 0.0) || !std::isfinite(curvature)) {
+  if (!std::isfinite(curvature) || curvature < -null_curvature(direction_)) {
     return stop(QpStatus::breakdown, "p'Ap = " + format_number(curvature) +
                                          " <= 0 in a conjugate gradient step: the operator is "
                                          "not positive definite on the free set");
   }
+  // 0 >= p'Ap >= -null_curvature: zero to round-off (a positive p'Ap, however small, keeps
+  // the conjugate gradient step).
+  if (curvature <= 0.0) return null_direction_step();
   // alpha_cg = g'p / p'Ap, alpha_f = max{alpha : x - alpha p >= l}
   const double conjugate_gradient_step = gradient_.dot(direction_) / curvature;
   if (!std::isfinite(conjugate_gradient_step)) {
@@ -258,6 +263,42 @@ bool MprgpIteration::conjugate_gradient_or_expansion() {
   direction_ *= -conjugation;
   direction_ += free_gradient_;
   ++result_.conjugate_gradient_steps;
+  return true;
+}
+
+/// The size of p'Ap that round-off alone gives for p in the null space of A: 1e-13 ||A|| p'p
+/// (||A|| = step_factor / expansion step). A semidefinite A whose smallest positive eigenvalue
+/// is below 1e-13 ||A|| is not told from a singular one.
+double MprgpIteration::null_curvature(const Eigen::VectorXd& direction) const {
+  return 1e-13 * parameters_.step_factor / expansion_step_ * direction.squaredNorm();
+}
+
+/// p'Ap <= 0 is zero to round-off: p lies in the null space of A on the free set (A semidefinite,
+/// e.g. the dual contact operator of a body whose trace has fewer degrees of freedom than the
+/// constraint has rows), where q(x - t p) = q(x) - t g'p is linear in t. With g'p != 0 the
+/// iterate moves along the descent direction to the nearest bound (an expansion step; none:
+/// the problem is unbounded). With g'p = 0 too, p is of no use: the conjugate directions
+/// restart from the free gradient.
+bool MprgpIteration::null_direction_step() {
+  const double slope = gradient_.dot(direction_);
+  if (std::abs(slope) <=
+      64.0 * std::numeric_limits<double>::epsilon() * gradient_.norm() * direction_.norm()) {
+    compute_free_gradient(direction_);
+    return true;
+  }
+  if (slope < 0.0) {  // -p is then the descent direction: g'p > 0
+    direction_ = -direction_;
+    product_ = -product_;
+  }
+  Eigen::Index blocking_index = -1;
+  const double feasible_step = feasible_step_length(blocking_index);
+  if (blocking_index < 0) {
+    return stop(QpStatus::breakdown,
+                "the objective decreases without bound along a null direction of the operator "
+                "(p'Ap = 0, g'p != 0, no bound in the way): the problem is unbounded");
+  }
+  // product_ = A p is zero to round-off; expansion moves g along it as in a CG step.
+  expansion(feasible_step, blocking_index);
   return true;
 }
 

@@ -63,7 +63,10 @@ struct MprgpResult {
   std::string message;         // reason for not_converged / breakdown
 };
 
-/// Solves the QP from the starting point `initial` (projected onto the feasible set).
+/// Solves the QP from the starting point `initial` (projected onto the feasible set). A may be
+/// semidefinite: a conjugate direction p with p'Ap = 0 (to round-off, 1e-13 ||A|| p'p) moves the
+/// iterate along it to the nearest bound; breakdown is reported for a p'Ap below that (A
+/// indefinite) and for a problem unbounded along a null direction.
 /// Converged means ||g^P|| <= max(relative_tolerance ||b||, absolute_tolerance) for the
 /// gradient recomputed as A x - b (the recurrence gradient is replaced when it drifts). Entries
 /// of `lower` may be -infinity (unbounded); NaN or +infinity, or sizes that differ from

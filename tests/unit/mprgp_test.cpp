@@ -351,6 +351,95 @@ TEST(Mprgp, IndefiniteOperatorBreaksDown) {
   EXPECT_NE(conjugate_gradient.message.find("p'Ap"), std::string::npos);
 }
 
+/// The minimum of q = x'Ax/2 - b'x on x >= 0 for a semidefinite A: every active set S (x_S = 0)
+/// whose free block system A_FF x_F = b_F is consistent (a least-squares solution with zero
+/// residual) and gives a KKT point (x_F >= 0, g_S >= 0) is a global minimiser of the convex q;
+/// the smallest q over them (they all agree) is returned.
+double enumerated_minimum(const MatrixXd& matrix, const VectorXd& right_hand_side) {
+  const int size = static_cast<int>(matrix.rows());
+  double best = std::numeric_limits<double>::infinity();
+  const double scale = matrix.norm() * (1.0 + right_hand_side.norm());
+  for (unsigned mask = 0; mask < (1u << size); ++mask) {
+    std::vector<int> free;
+    for (int i = 0; i < size; ++i) {
+      if ((mask & (1u << i)) == 0) free.push_back(i);
+    }
+    VectorXd candidate = VectorXd::Zero(size);
+    if (!free.empty()) {
+      const int count = static_cast<int>(free.size());
+      MatrixXd block(count, count);
+      VectorXd right(count);
+      for (int r = 0; r < count; ++r) {
+        right[r] = right_hand_side[free[r]];
+        for (int c = 0; c < count; ++c) block(r, c) = matrix(free[r], free[c]);
+      }
+      const VectorXd solution = block.completeOrthogonalDecomposition().solve(right);
+      if ((block * solution - right).norm() > 1e-10 * scale) continue;  // inconsistent
+      for (int r = 0; r < count; ++r) candidate[free[r]] = solution[r];
+    }
+    const VectorXd gradient = matrix * candidate - right_hand_side;
+    bool optimal = true;
+    for (int i = 0; i < size; ++i) {
+      const bool active = (mask & (1u << i)) != 0;
+      if ((!active && candidate[i] < -1e-10) || (active && gradient[i] < -1e-10 * scale)) {
+        optimal = false;
+      }
+    }
+    if (optimal) {
+      best =
+          std::min(best, 0.5 * candidate.dot(matrix * candidate) - right_hand_side.dot(candidate));
+    }
+  }
+  return best;
+}
+
+TEST(Mprgp, SemidefiniteOperatorMovesAlongItsNullDirectionToTheBound) {
+  // q = (x1 + x2)^2 / 2 + x3^2 / 2 - x1 - 3 x2 - x3 on x >= 0; A is singular, with null vector
+  // (1, -1, 0), along which q is linear. For s = x1 + x2 fixed, q is least with x1 = 0
+  // (x2 = s), then s^2/2 - 3 s is least at s = 3: the solution is (0, 3, 1). From x = (1, 1, 1)
+  // the gradient A x - b = (1, -1, 0) is itself a null vector: p'Ap = 0 on the first step.
+  MatrixXd matrix(3, 3);
+  matrix << 1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0;
+  const MprgpResult result = solve_mprgp(DenseOperator(matrix), Eigen::Vector3d(1.0, 3.0, 1.0),
+                                         VectorXd::Zero(3), Eigen::Vector3d(1.0, 1.0, 1.0));
+  ASSERT_EQ(result.status, QpStatus::converged) << result.message;
+  EXPECT_NEAR(result.solution[0], 0.0, 1e-12);
+  EXPECT_NEAR(result.solution[1], 3.0, 1e-12);
+  EXPECT_NEAR(result.solution[2], 1.0, 1e-12);
+
+  // Without bounds the same problem is unbounded below along (1, -1, 0): reported, not a
+  // silent answer.
+  const VectorXd free = VectorXd::Constant(3, -std::numeric_limits<double>::infinity());
+  const MprgpResult unbounded = solve_mprgp(DenseOperator(matrix), Eigen::Vector3d(1.0, 3.0, 1.0),
+                                            free, Eigen::Vector3d(1.0, 1.0, 1.0));
+  EXPECT_EQ(unbounded.status, QpStatus::breakdown);
+  EXPECT_NE(unbounded.message.find("unbounded"), std::string::npos) << unbounded.message;
+}
+
+TEST(Mprgp, SemidefiniteRandomProblemsMatchActiveSetEnumeration) {
+  // A = B B' of rank 3 in 5 unknowns, b = A y + c with c >= 0 off the range of A on purpose:
+  // the bounds x >= 0 keep q bounded (c'x >= 0 grows along the null directions that keep x
+  // feasible only if they increase x). Solutions from the active-set enumeration.
+  std::mt19937_64 generator(17);
+  for (int trial = 0; trial < 20; ++trial) {
+    const MatrixXd factor = MatrixXd::NullaryExpr(
+        5, 3, [&] { return std::uniform_real_distribution<double>(-1.0, 1.0)(generator); });
+    const MatrixXd matrix = factor * factor.transpose();
+    const VectorXd right =
+        matrix * random_vector(5, generator) - random_vector(5, generator).cwiseAbs();
+    const VectorXd lower = VectorXd::Zero(5);
+    MprgpParameters parameters;
+    parameters.relative_tolerance = 1e-12;
+    const MprgpResult result =
+        solve_mprgp(DenseOperator(matrix), right, lower, VectorXd::Constant(5, 0.5), parameters);
+    ASSERT_EQ(result.status, QpStatus::converged) << "trial " << trial << ": " << result.message;
+    const double value =
+        0.5 * result.solution.dot(matrix * result.solution) - right.dot(result.solution);
+    EXPECT_NEAR(value, enumerated_minimum(matrix, right), 1e-9 * (1.0 + std::abs(value)))
+        << "trial " << trial;
+  }
+}
+
 /// y = A x for A = tridiag(-1, 2 + shift, -1): a shifted 1D Laplacian, applied matrix-free.
 class TridiagonalOperator final : public LinearOperator {
  public:

@@ -131,6 +131,27 @@ TEST(MortarOnMatchingMeshes, GivesTheNodeToNodeAnswer) {
   EXPECT_LE((first.contact_force - second.contact_force).lpNorm<Eigen::Infinity>(), 1e-10 * scale);
 }
 
+TEST(MortarSideCoarser, SemidefiniteContactProblemOfTheMortarBodyConverges) {
+  // More rows than the mortar body's edge has normal degrees of freedom: that body's F is
+  // singular. robin-run stopped on a contact QP breakdown here (p'Ap = -6.55e-27) before MPRGP
+  // moved along null directions (mprgp.cpp, null_direction_step).
+  const CaseDefinition definition =
+      read_case_file(std::filesystem::path(ROBIN_TEST_DATA) / "row_pair_mortar.toml");
+  const LocalProblem problem = prepare_local_problem(definition);
+  EXPECT_EQ(problem.pairing().non_mortar_body, 1);
+  EXPECT_EQ(problem.pairing().size(), 7u);  // on 6 free normal degrees of freedom of the left edge
+  InProcessPort port1, port2;
+  const CoupledRunResult robin =
+      run_coupled_case(definition, {&port1, &port2}, definition.coupling);
+  ASSERT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
+  const MonolithicResult reference = solve_reference(problem);
+  ASSERT_EQ(reference.qp.status, QpStatus::converged);
+  const double scale = reference.contact_force.lpNorm<Eigen::Infinity>();
+  EXPECT_LE((robin.iteration.state.bodies[0].contact_force - reference.contact_force)
+                .lpNorm<Eigen::Infinity>(),
+            1e-8 * scale);
+}
+
 TEST(AutomaticContactMethod, ChoosesMortarForNonMatchingAndNodeToNodeForMatchingMeshes) {
   CaseDefinition matching = example("two_blocks.toml");
   EXPECT_EQ(prepare_local_problem(matching).pairing().non_mortar_body, -1);
