@@ -2,6 +2,7 @@
 //  - robin-run (two robin-subdomain processes) on examples/non_matching_solids.toml (tetrahedra
 //    against hexahedra, mortar) writes the patch test's exact pressure into every row of
 //    contact.csv;
+//  - robin-coordinator against two robin-subdomain servers started beforehand writes the same;
 //  - robin-run and robin-monolithic on examples/hertz_3d.toml write the same contact forces;
 //  - robin-coordinator's coupling with the independent Python server owning the hexahedral
 //    block and robin-subdomain the tetrahedral one gives the monolithic mortar solution.
@@ -14,6 +15,7 @@
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
 #include "remote/remote_port.hpp"
+#include "remote/server_launcher.hpp"
 #include "remote_test_support.hpp"
 
 namespace robin {
@@ -49,6 +51,22 @@ TEST(SolidService, RobinRunReproducesTheThreeDimensionalPatchTestPressure) {
   const std::vector<std::string>& pressures = columns.at("pressure");
   ASSERT_GT(pressures.size(), 20u);
   for (const std::string& pressure : pressures) {
+    EXPECT_NEAR(std::stod(pressure), exact_patch_pressure(), 1e-8 * exact_patch_pressure());
+  }
+}
+
+TEST(SolidService, RobinCoordinatorAgainstTwoServersReproducesThePatchTestPressure) {
+  const TemporaryDirectory output("solid-coordinator");
+  SubdomainServer lower("lower", testing::server_options(output.path()));
+  SubdomainServer upper("upper", testing::server_options(output.path()));
+  lower.await_listening();
+  upper.await_listening();
+  const auto columns =
+      run_case("robin-coordinator", "non_matching_solids.toml",
+               {"--subdomain", lower.endpoint(), "--subdomain", upper.endpoint()}, output, "run");
+  ASSERT_TRUE(columns.count("pressure"));
+  ASSERT_GT(columns.at("pressure").size(), 20u);
+  for (const std::string& pressure : columns.at("pressure")) {
     EXPECT_NEAR(std::stod(pressure), exact_patch_pressure(), 1e-8 * exact_patch_pressure());
   }
 }
