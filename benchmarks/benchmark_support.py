@@ -148,3 +148,33 @@ def read_csv_rows(path):
     """The rows of a CSV file with a header row, as dicts of strings."""
     with open(path, newline="") as handle:
         return list(csv.DictReader(handle))
+
+# --------------------------------------------------------------------------- run profiles
+
+def profile_rows(bodies_label):
+    """The rows of a stage table from summary.json's profile, as (label, where, key): "run" is
+    profile[key], "body" the largest over profile.bodies. `bodies_label` names the bodies of the
+    setup row ("both bodies", "all bodies")."""
+    return [
+        ("launch", "run", "launch"),
+        ("meshing (.geo, Gmsh)", "run", "meshing"),
+        (f"setup ({bodies_label})", "run", "setup"),
+        ("  transfer", "body", "transfer"),
+        ("  server: setup request", "body", "server_setup"),
+        ("  server: mesh decoding", "body", "mesh"),
+        ("  server: assembly", "body", "assembly"),
+        ("  server: ordering", "body", "ordering"),
+        ("  server: factorization", "body", "factorization"),
+        ("contact coupling", "run", "contact_coupling"),
+        ("contact assignment", "run", "contact_assignment"),
+        ("  server: interface operator", "body", "interface_operator"),
+        ("iterations", "run", "iterations"),
+        ("fields", "run", "fields"),
+        ("  server: fields", "body", "fields"),
+        ("output", "run", "output"),
+    ]
+
+
+# The coordinator's stages of summary.json's profile, whose sum is compared with the wall time.
+COORDINATOR_KEYS = ["launch", "meshing", "setup", "contact_coupling", "contact_assignment",
+                    "iterations", "fields", "output"]

@@ -43,33 +43,14 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchmark_support import (print_machine_header, run_measured,  # noqa: E402 (same directory)
-                               scratch_directory, table_row, table_rule, tool_directory)
+from benchmark_support import (COORDINATOR_KEYS, print_machine_header, profile_rows,  # noqa: E402
+                               run_measured, scratch_directory, table_row, table_rule,
+                               tool_directory)
 from many_bodies_service_benchmark import mesh_size, write_row_case  # noqa: E402
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 
-ROWS = [  # (label, where, key): "run" = profile[key], "body" = max over profile.bodies
-    ("launch", "run", "launch"),
-    ("meshing (.geo)", "run", "meshing"),
-    ("setup (all bodies)", "run", "setup"),
-    ("  transfer", "body", "transfer"),
-    ("  server: setup request", "body", "server_setup"),
-    ("  server: mesh decoding", "body", "mesh"),
-    ("  server: assembly", "body", "assembly"),
-    ("  server: ordering", "body", "ordering"),
-    ("  server: factorization", "body", "factorization"),
-    ("contact coupling", "run", "contact_coupling"),
-    ("contact assignment", "run", "contact_assignment"),
-    ("  server: interface operator", "body", "interface_operator"),
-    ("iterations", "run", "iterations"),
-    ("fields", "run", "fields"),
-    ("  server: fields", "body", "fields"),
-    ("output", "run", "output"),
-]
-COORDINATOR_KEYS = ["launch", "meshing", "setup", "contact_coupling", "contact_assignment",
-                    "iterations", "fields", "output"]
-
+ROWS = profile_rows("all bodies")
 
 def row_dofs(count, h):
     """Free DOFs of the row at h: (m + 1)^2 nodes per block (m = Round(1 / h_k)), two DOFs per

@@ -62,34 +62,15 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchmark_support import (children_of, exit_on_sigterm,  # noqa: E402 (same directory)
+from benchmark_support import (COORDINATOR_KEYS, children_of, exit_on_sigterm,  # noqa: E402
                                print_machine_header, read_csv_rows, read_hwm,
                                resident_megabytes, scratch_directory, table_row, table_rule,
-                               tool_directory)
+                               tool_directory, profile_rows)
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 MESHES = REPOSITORY / "benchmarks" / "meshes"
 
-ROWS = [  # (label, where, key): "run" = profile[key], "body" = max over profile.bodies
-    ("launch", "run", "launch"),
-    ("meshing (.geo, Gmsh)", "run", "meshing"),
-    ("setup (both bodies)", "run", "setup"),
-    ("  transfer", "body", "transfer"),
-    ("  server: setup request", "body", "server_setup"),
-    ("  server: mesh decoding", "body", "mesh"),
-    ("  server: assembly", "body", "assembly"),
-    ("  server: ordering", "body", "ordering"),
-    ("  server: factorization", "body", "factorization"),
-    ("contact coupling", "run", "contact_coupling"),
-    ("contact assignment", "run", "contact_assignment"),
-    ("  server: interface operator", "body", "interface_operator"),
-    ("iterations", "run", "iterations"),
-    ("fields", "run", "fields"),
-    ("  server: fields", "body", "fields"),
-    ("output", "run", "output"),
-]
-COORDINATOR_KEYS = ["launch", "meshing", "setup", "contact_coupling", "contact_assignment",
-                    "iterations", "fields", "output"]
+ROWS = profile_rows("both bodies")
 
 CASE = """\
 # Written by benchmarks/solid_scale_benchmark.py: examples/hertz_3d.toml on n = {n} cells per
