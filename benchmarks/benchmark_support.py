@@ -175,6 +175,20 @@ def profile_rows(bodies_label):
     ]
 
 
+def profile_column(profile, rows):
+    """The seconds of each row of `rows` (profile_rows) in summary.json's `profile`: the run's
+    value, or the largest over its bodies; None where the profile has none."""
+    column = []
+    for _, where, key in rows:
+        if where == "run":
+            column.append(profile.get(key))
+        else:
+            values = [body.get(key) for body in profile.get("bodies", [])]
+            values = [value for value in values if value is not None]
+            column.append(max(values) if values else None)
+    return column
+
+
 # The coordinator's stages of summary.json's profile, whose sum is compared with the wall time.
 COORDINATOR_KEYS = ["launch", "meshing", "setup", "contact_coupling", "contact_assignment",
                     "iterations", "fields", "output"]

@@ -43,9 +43,9 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchmark_support import (COORDINATOR_KEYS, print_machine_header, profile_rows,  # noqa: E402
-                               run_measured, scratch_directory, table_row, table_rule,
-                               tool_directory)
+from benchmark_support import (COORDINATOR_KEYS, print_machine_header,  # noqa: E402
+                               profile_column, profile_rows, run_measured, scratch_directory,
+                               table_row, table_rule, tool_directory)
 from many_bodies_service_benchmark import mesh_size, write_row_case  # noqa: E402
 
 REPOSITORY = Path(__file__).resolve().parent.parent
@@ -88,14 +88,7 @@ def arch_overrides(factor):
 
 def column_of(summary, status, wall, peaks, maxrss, tool):
     profile = summary.get("profile", {})
-    column = []
-    for _, where, key in ROWS:
-        if where == "run":
-            column.append(profile.get(key))
-        else:
-            values = [body.get(key) for body in profile.get("bodies", [])]
-            values = [value for value in values if value is not None]
-            column.append(max(values) if values else None)
+    column = profile_column(profile, ROWS)
     stages = sum(profile.get(key) or 0.0 for key in COORDINATOR_KEYS) if profile else None
     servers = [kib for name, kib in peaks.values() if name.startswith("robin-subdom")]
     coordinator = [kib for name, kib in peaks.values() if name.startswith("robin-run")]

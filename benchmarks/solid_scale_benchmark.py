@@ -65,7 +65,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from benchmark_support import (COORDINATOR_KEYS, children_of, exit_on_sigterm,  # noqa: E402
                                print_machine_header, read_csv_rows, read_hwm,
                                resident_megabytes, scratch_directory, table_row, table_rule,
-                               tool_directory, profile_rows)
+                               tool_directory, profile_rows, profile_column)
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 MESHES = REPOSITORY / "benchmarks" / "meshes"
@@ -271,14 +271,7 @@ def run_one(binaries, tool, case, operator, output, arguments):
     except (OSError, ValueError):
         summary = {}
     profile = summary.get("profile", {})
-    column = []
-    for _, where, key in ROWS:
-        if where == "run":
-            column.append(profile.get(key))
-        else:
-            values = [body.get(key) for body in profile.get("bodies", [])]
-            values = [value for value in values if value is not None]
-            column.append(max(values) if values else None)
+    column = profile_column(profile, ROWS)
     servers = sorted(((label, kib / 1024) for label, kib in peaks.values()
                       if label.startswith("robin-subdom")), key=lambda item: item[0])
     coordinator = [kib / 1024 for label, kib in peaks.values() if label.startswith("robin-run")]
