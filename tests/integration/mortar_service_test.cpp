@@ -12,6 +12,7 @@
 #include "coupling/coupled_run.hpp"
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
+#include "python_coupling_support.hpp"
 #include "remote/remote_port.hpp"
 #include "remote_test_support.hpp"
 
@@ -19,8 +20,6 @@ namespace robin {
 namespace {
 
 using testing::example;
-using testing::python_server_options;
-using testing::server_options;
 using testing::TemporaryDirectory;
 
 /// The patch test's exact pressure (examples/non_matching_blocks.toml).
@@ -52,39 +51,9 @@ TEST(MortarService, RobinRunReproducesThePatchTestPressureInContactCsv) {
   EXPECT_NE(text.str().find("mortar coupling (non-mortar side: body 'upper')"), std::string::npos);
 }
 
-/// Runs `case_file` with body 1 on robin-subdomain and body 2 on robin-subdomain-py, and compares
-/// the contact forces with the monolithic mortar solution of the same discretization.
+/// Runs the example `case_file` across robin-subdomain and robin-subdomain-py.
 void expect_python_and_cpp_equal_monolithic(const std::string& case_file) {
-  const TemporaryDirectory logs("mortar-python");
-  CaseDefinition definition = read_case_file(example(case_file));
-  definition.solver.qp.relative_tolerance = 1e-13;
-  SubdomainServer cpp(definition.bodies[0].definition.name, server_options(logs.path()));
-  SubdomainServer python(definition.bodies[1].definition.name, python_server_options(logs.path()));
-  cpp.await_listening();
-  python.await_listening();
-  RemotePortOptions port_options;
-  port_options.request_timeout_seconds = 120.0;
-  RemotePort body1(cpp.endpoint(), definition.bodies[0].definition.name, port_options);
-  RemotePort body2(python.endpoint(), definition.bodies[1].definition.name, port_options);
-  const CoupledRunResult run = run_coupled_case(definition, {&body1, &body2}, definition.coupling);
-  EXPECT_EQ(body2.server_name().rfind("robin-subdomain-py ", 0), 0u) << body2.server_name();
-  body1.end_run();
-  body2.end_run();
-  ASSERT_EQ(run.iteration.status, IterationStatus::converged) << run.iteration.message;
-  EXPECT_GE(run.pairing().non_mortar_body, 0);
-
-  const LocalProblem problem = prepare_local_problem(definition);
-  MprgpParameters reference = definition.solver.qp;
-  reference.relative_tolerance = 1e-14;
-  const MonolithicResult monolithic =
-      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), reference);
-  ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
-  std::printf("%s, C++ and Python servers: %zu iterations\n", case_file.c_str(),
-              run.iteration.history.size());
-  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[0].contact_force,
-                                     monolithic.contact_force, 1e-8));
-  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[1].contact_force,
-                                     monolithic.contact_force, 1e-8));
+  testing::expect_python_and_cpp_equal_monolithic(read_case_file(example(case_file)), case_file);
 }
 
 TEST(MortarService, PythonServerWithItsOwnMeshAgainstTheCppServerEqualsMonolithic) {

@@ -14,6 +14,7 @@
 #include "coupling/coupled_run.hpp"
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
+#include "python_coupling_support.hpp"
 #include "remote/remote_port.hpp"
 #include "remote/server_launcher.hpp"
 #include "remote_test_support.hpp"
@@ -94,36 +95,9 @@ TEST(SolidService, RobinRunEqualsRobinMonolithicOnTheSphere) {
 }
 
 TEST(SolidService, PythonServerOwningTheHexahedraEqualsMonolithic) {
-  const TemporaryDirectory logs("solid-python");
   CaseDefinition definition = read_case_file(example("non_matching_solids.toml"));
-  definition.solver.qp.relative_tolerance = 1e-13;
   definition.coupling.tolerance = 1e-11;
-  SubdomainServer cpp(definition.bodies[0].definition.name, testing::server_options(logs.path()));
-  SubdomainServer python(definition.bodies[1].definition.name,
-                         testing::python_server_options(logs.path()));
-  cpp.await_listening();
-  python.await_listening();
-  RemotePortOptions port_options;
-  port_options.request_timeout_seconds = 120.0;
-  RemotePort body1(cpp.endpoint(), definition.bodies[0].definition.name, port_options);
-  RemotePort body2(python.endpoint(), definition.bodies[1].definition.name, port_options);
-  const CoupledRunResult run = run_coupled_case(definition, {&body1, &body2}, definition.coupling);
-  EXPECT_EQ(body2.server_name().rfind("robin-subdomain-py ", 0), 0u) << body2.server_name();
-  body1.end_run();
-  body2.end_run();
-  ASSERT_EQ(run.iteration.status, IterationStatus::converged) << run.iteration.message;
-  const LocalProblem problem = prepare_local_problem(definition);
-  MprgpParameters reference = definition.solver.qp;
-  reference.relative_tolerance = 1e-14;
-  const MonolithicResult monolithic =
-      solve_monolithic(*problem.bodies[0], *problem.bodies[1], problem.pairing(), reference);
-  ASSERT_EQ(monolithic.qp.status, QpStatus::converged);
-  std::printf("non_matching_solids.toml, C++ and Python servers: %zu iterations\n",
-              run.iteration.history.size());
-  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[0].contact_force,
-                                     monolithic.contact_force, 1e-8));
-  EXPECT_TRUE(testing::vectors_close(run.iteration.state.bodies[1].contact_force,
-                                     monolithic.contact_force, 1e-8));
+  testing::expect_python_and_cpp_equal_monolithic(definition, "non_matching_solids.toml");
 }
 
 }  // namespace
