@@ -233,14 +233,14 @@ bool MprgpIteration::conjugate_gradient_or_expansion() {
   matrix_.apply(direction_, product_);
   ++result_.operator_applications;
   const double curvature = direction_.dot(product_);
-  if (!std::isfinite(curvature) || curvature < -null_curvature(direction_)) {
+  if (!(curvature > 0.0) || !std::isfinite(curvature)) {
+    // 0 >= p'Ap >= -null_curvature is zero to round-off (a positive p'Ap, however small, keeps
+    // the conjugate gradient step); below that, or not finite, A is not positive semidefinite.
+    if (curvature <= 0.0 && curvature >= -null_curvature(direction_)) return null_direction_step();
     return stop(QpStatus::breakdown, "p'Ap = " + format_number(curvature) +
                                          " <= 0 in a conjugate gradient step: the operator is "
                                          "not positive definite on the free set");
   }
-  // 0 >= p'Ap >= -null_curvature: zero to round-off (a positive p'Ap, however small, keeps
-  // the conjugate gradient step).
-  if (curvature <= 0.0) return null_direction_step();
   // alpha_cg = g'p / p'Ap, alpha_f = max{alpha : x - alpha p >= l}
   const double conjugate_gradient_step = gradient_.dot(direction_) / curvature;
   if (!std::isfinite(conjugate_gradient_step)) {
