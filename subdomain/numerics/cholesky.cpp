@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "numerics/errors.hpp"
+#include "numerics/fill_reducing_ordering.hpp"
 
 namespace robin {
 namespace {
@@ -50,66 +51,6 @@ class SupernodalCholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eige
     m_factorizationIsOk = false;
   }
 };
-
-/// Lower triangle of the matrix restricted to the unknowns j with new_index[j] >= 0, renumbered
-/// to new_index[j].
-SparseMatrix lower_sub_block(const SparseMatrix& matrix, const std::vector<int>& new_index,
-                             int size) {
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int column = 0; column < matrix.outerSize(); ++column) {
-    if (new_index[column] < 0) continue;
-    for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
-      const int row = static_cast<int>(entry.row());
-      if (row >= column && new_index[row] >= 0) {
-        entries.emplace_back(new_index[row], new_index[column], entry.value());
-      }
-    }
-  }
-  SparseMatrix block(size, size);
-  block.setFromTriplets(entries.begin(), entries.end());
-  return block;
-}
-
-/// Elimination order: CHOLMOD's fill-reducing order (AMD, or METIS when AMD fills too much) of
-/// the matrix without the trailing unknowns, then the trailing unknowns in the given order.
-std::vector<int> ordering_with_trailing(const SparseMatrix& matrix,
-                                        const std::vector<int>& trailing, cholmod_common& common,
-                                        const std::string& body_name) {
-  const int size = static_cast<int>(matrix.rows());
-  std::vector<int> new_index(static_cast<std::size_t>(size), 0);
-  for (int unknown : trailing) {
-    if (unknown < 0 || unknown >= size || new_index[unknown] < 0) {
-      throw std::invalid_argument("body '" + body_name + "': trailing unknown " +
-                                  std::to_string(unknown) + " is out of range or repeated");
-    }
-    new_index[unknown] = -1;
-  }
-  std::vector<int> leading;
-  for (int unknown = 0; unknown < size; ++unknown) {
-    if (new_index[unknown] < 0) continue;
-    new_index[unknown] = static_cast<int>(leading.size());
-    leading.push_back(unknown);
-  }
-  std::vector<int> ordering;
-  ordering.reserve(static_cast<std::size_t>(size));
-  if (!leading.empty()) {
-    const SparseMatrix block = lower_sub_block(matrix, new_index, static_cast<int>(leading.size()));
-    cholmod_sparse view = Eigen::viewAsCholmod(block.selfadjointView<Eigen::Lower>());
-    const int supernodal = common.supernodal;
-    common.supernodal = CHOLMOD_SIMPLICIAL;  // only the permutation is wanted
-    cholmod_factor* symbolic = cholmod_analyze(&view, &common);
-    common.supernodal = supernodal;
-    if (symbolic == nullptr || common.status < CHOLMOD_OK) {
-      throw std::runtime_error("body '" + body_name + "': CHOLMOD ordering failed (status " +
-                               std::to_string(common.status) + ")");
-    }
-    const auto* permutation = static_cast<const int*>(symbolic->Perm);
-    for (std::size_t k = 0; k < leading.size(); ++k) ordering.push_back(leading[permutation[k]]);
-    cholmod_free_factor(&symbolic, &common);
-  }
-  ordering.insert(ordering.end(), trailing.begin(), trailing.end());
-  return ordering;
-}
 
 /// The trailing block L(first:, first:) of a supernodal LL' factor, dense lower triangular.
 /// Supernode s holds columns super[s] .. super[s+1]-1 as a column-major block of nrows rows
@@ -202,13 +143,8 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
   common.print = 0;                // CHOLMOD prints nothing, not even warnings
   common.error_handler = nullptr;  // failures are read from common.status instead
   common.supernodal = CHOLMOD_SUPERNODAL;
-  if (trailing.empty()) {
-    // The fill-reducing ordering is CHOLMOD's default choice (AMD, METIS when worthwhile).
-    cholesky.analyzePattern(matrix);
-  } else {
-    std::vector<int> ordering = ordering_with_trailing(matrix, trailing, common, body_name);
-    cholesky.analyze_pattern_ordered(matrix, ordering);
-  }
+  std::vector<int> ordering = fill_reducing_ordering(matrix, trailing, common, body_name);
+  cholesky.analyze_pattern_ordered(matrix, ordering);
   if (cholesky.factor() == nullptr || common.status < CHOLMOD_OK) {
     throw std::runtime_error("body '" + body_name + "': CHOLMOD analysis failed (status " +
                              std::to_string(common.status) + ", e.g. out of memory)");

@@ -26,8 +26,8 @@ class CholeskyFactor {
   /// numerically singular (pivot ratio min L_jj^2 / max L_jj^2 < 1e-13, i.e. cond > 1e13);
   /// InputError when it is empty or not square. Solves are not thread-safe (CHOLMOD workspace).
   /// `trailing_unknowns` (indices into the matrix, distinct) are eliminated last: the rest
-  /// in CHOLMOD's fill-reducing order of the matrix without them (AMD or METIS), then these
-  /// in the given order. Empty: CHOLMOD's order of the whole matrix.
+  /// in the fill-reducing order of the matrix without them (fill_reducing_ordering.hpp: AMD or
+  /// METIS on the graph of the nodes), then these in the given order.
   /// `memory_limit_bytes` > 0 bounds the factor: when the symbolic analysis finds that L needs
   /// more (8 bytes per stored entry), ResourceLimitError is thrown before the numerical
   /// factorization allocates it. `observer` (may be empty) is told when the numerical

@@ -1,0 +1,197 @@
+#include "numerics/fill_reducing_ordering.hpp"
+
+#include <suitesparse/cholmod.h>
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+
+namespace robin {
+namespace {
+
+/// Column-compressed pattern of a symmetric n x n matrix: the rows of column j are
+/// rows[start[j] .. start[j+1]), ascending.
+struct SymmetricPattern {
+  std::vector<long> start;
+  std::vector<int> rows;
+};
+
+/// Index of every kept unknown in the leading block (or -1 for a trailing one), checking that
+/// `trailing` holds distinct unknowns of the matrix.
+std::vector<int> leading_indices(int size, const std::vector<int>& trailing,
+                                 const std::string& body_name) {
+  std::vector<int> leading_index(static_cast<std::size_t>(size), 0);
+  for (int unknown : trailing) {
+    if (unknown < 0 || unknown >= size || leading_index[unknown] < 0) {
+      throw std::invalid_argument("body '" + body_name + "': trailing unknown " +
+                                  std::to_string(unknown) + " is out of range or repeated");
+    }
+    leading_index[unknown] = -1;
+  }
+  int count = 0;
+  for (int& index : leading_index) {
+    if (index == 0) index = count++;
+  }
+  return leading_index;
+}
+
+/// Both triangles of the pattern of the leading block (unknowns with leading_index >= 0,
+/// renumbered), built from the lower-triangle entries of `matrix`.
+SymmetricPattern leading_pattern(const SparseMatrix& matrix, const std::vector<int>& leading_index,
+                                 int leading_count) {
+  SymmetricPattern pattern;
+  pattern.start.assign(static_cast<std::size_t>(leading_count) + 1, 0);
+  const auto for_each_entry = [&](auto&& visit) {
+    for (int column = 0; column < matrix.outerSize(); ++column) {
+      const int new_column = leading_index[column];
+      if (new_column < 0) continue;
+      for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
+        const int row = static_cast<int>(entry.row());
+        if (row < column || leading_index[row] < 0) continue;
+        visit(leading_index[row], new_column);
+      }
+    }
+  };
+  for_each_entry([&](int row, int column) {
+    ++pattern.start[column + 1];
+    if (row != column) ++pattern.start[row + 1];
+  });
+  for (int column = 0; column < leading_count; ++column) {
+    pattern.start[column + 1] += pattern.start[column];
+  }
+  pattern.rows.resize(static_cast<std::size_t>(pattern.start.back()));
+  std::vector<long> next(pattern.start.begin(), pattern.start.end() - 1);
+  for_each_entry([&](int row, int column) {
+    pattern.rows[next[column]++] = row;
+    if (row != column) pattern.rows[next[row]++] = column;
+  });
+  for (int column = 0; column < leading_count; ++column) {
+    const auto first = pattern.rows.begin() + pattern.start[column];
+    const auto last = pattern.rows.begin() + pattern.start[column + 1];
+    if (!std::is_sorted(first, last)) std::sort(first, last);
+  }
+  return pattern;
+}
+
+bool same_pattern(const SymmetricPattern& pattern, int left, int right) {
+  const long left_size = pattern.start[left + 1] - pattern.start[left];
+  const long right_size = pattern.start[right + 1] - pattern.start[right];
+  return left_size == right_size && std::equal(pattern.rows.begin() + pattern.start[left],
+                                               pattern.rows.begin() + pattern.start[left + 1],
+                                               pattern.rows.begin() + pattern.start[right]);
+}
+
+/// first[v] .. first[v+1]-1 are the unknowns of supervariable v: maximal runs of consecutive
+/// unknowns with identical patterns.
+std::vector<int> supervariable_starts(const SymmetricPattern& pattern, int size) {
+  std::vector<int> first;
+  for (int unknown = 0; unknown < size; ++unknown) {
+    if (unknown == 0 || !same_pattern(pattern, unknown - 1, unknown)) first.push_back(unknown);
+  }
+  first.push_back(size);
+  return first;
+}
+
+/// The lower triangle of the supervariable graph as a CHOLMOD pattern matrix (stype -1).
+cholmod_sparse* supervariable_graph(const SymmetricPattern& pattern, const std::vector<int>& first,
+                                    cholmod_common& common) {
+  const int count = static_cast<int>(first.size()) - 1;
+  std::vector<int> supervariable(static_cast<std::size_t>(first.back()));
+  for (int v = 0; v < count; ++v) {
+    std::fill(supervariable.begin() + first[v], supervariable.begin() + first[v + 1], v);
+  }
+  std::vector<int> start(static_cast<std::size_t>(count) + 1, 0);
+  std::vector<int> rows;
+  for (int v = 0; v < count; ++v) {
+    const int unknown = first[v];
+    int last = -1;
+    for (long entry = pattern.start[unknown]; entry < pattern.start[unknown + 1]; ++entry) {
+      const int neighbour = supervariable[pattern.rows[entry]];
+      if (neighbour >= v && neighbour != last) rows.push_back(neighbour);
+      last = neighbour;  // rows ascend, so supervariables ascend: duplicates are adjacent
+    }
+    start[v + 1] = static_cast<int>(rows.size());
+  }
+  cholmod_sparse* graph =
+      cholmod_allocate_sparse(count, count, rows.size(), 1, 1, -1, CHOLMOD_PATTERN, &common);
+  if (graph == nullptr) return nullptr;
+  std::memcpy(graph->p, start.data(), start.size() * sizeof(int));
+  std::memcpy(graph->i, rows.data(), rows.size() * sizeof(int));
+  return graph;
+}
+
+/// Fill-reducing order of `graph`: the better of AMD and METIS by the flop count of the
+/// symbolic factorization (CHOLMOD's choice among two methods). Restores common's settings.
+std::vector<int> order_graph(cholmod_sparse* graph, cholmod_common& common,
+                             const std::string& body_name) {
+  const int method_count = common.nmethods;
+  const int first_ordering = common.method[0].ordering;
+  const int second_ordering = common.method[1].ordering;
+  const int supernodal = common.supernodal;
+  common.nmethods = 2;
+  common.method[0].ordering = CHOLMOD_AMD;
+  common.method[1].ordering = CHOLMOD_METIS;
+  common.supernodal = CHOLMOD_SIMPLICIAL;  // only the permutation is wanted
+  cholmod_factor* symbolic = cholmod_analyze(graph, &common);
+  common.nmethods = method_count;
+  common.method[0].ordering = first_ordering;
+  common.method[1].ordering = second_ordering;
+  common.supernodal = supernodal;
+  if (symbolic == nullptr || common.status < CHOLMOD_OK) {
+    if (symbolic != nullptr) cholmod_free_factor(&symbolic, &common);
+    throw std::runtime_error("body '" + body_name + "': CHOLMOD ordering failed (status " +
+                             std::to_string(common.status) + ")");
+  }
+  const auto* permutation = static_cast<const int*>(symbolic->Perm);
+  std::vector<int> order(permutation, permutation + graph->nrow);
+  cholmod_free_factor(&symbolic, &common);
+  return order;
+}
+
+}  // namespace
+
+std::vector<int> fill_reducing_ordering(const SparseMatrix& matrix,
+                                        const std::vector<int>& trailing,
+                                        cholmod_common_struct& common,
+                                        const std::string& body_name) {
+  const int size = static_cast<int>(matrix.rows());
+  const std::vector<int> leading_index = leading_indices(size, trailing, body_name);
+  const int leading_count = size - static_cast<int>(trailing.size());
+  std::vector<int> leading_unknown(static_cast<std::size_t>(leading_count));
+  for (int unknown = 0; unknown < size; ++unknown) {
+    if (leading_index[unknown] >= 0) leading_unknown[leading_index[unknown]] = unknown;
+  }
+  std::vector<int> ordering;
+  ordering.reserve(static_cast<std::size_t>(size));
+  if (leading_count > 0) {
+    std::vector<int> first;
+    cholmod_sparse* graph = nullptr;
+    {
+      const SymmetricPattern pattern = leading_pattern(matrix, leading_index, leading_count);
+      first = supervariable_starts(pattern, leading_count);
+      graph = supervariable_graph(pattern, first, common);
+    }
+    if (graph == nullptr) {
+      throw std::runtime_error("body '" + body_name +
+                               "': CHOLMOD could not allocate the ordering graph (status " +
+                               std::to_string(common.status) + ")");
+    }
+    std::vector<int> order;
+    try {
+      order = order_graph(graph, common, body_name);
+    } catch (...) {
+      cholmod_free_sparse(&graph, &common);
+      throw;
+    }
+    cholmod_free_sparse(&graph, &common);
+    for (int v : order) {
+      for (int unknown = first[v]; unknown < first[v + 1]; ++unknown) {
+        ordering.push_back(leading_unknown[unknown]);
+      }
+    }
+  }
+  ordering.insert(ordering.end(), trailing.begin(), trailing.end());
+  return ordering;
+}
+
+}  // namespace robin
