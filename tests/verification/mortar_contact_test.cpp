@@ -15,6 +15,7 @@
 #include "coupling/in_process_port.hpp"
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
+#include "pressure_error.hpp"
 
 namespace robin {
 namespace {
@@ -28,17 +29,6 @@ double exact_patch_pressure() {
   const double lower = 0.5 * (1.0 - 0.3 * 0.3) / 1000.0;
   const double upper = 0.4 * (1.0 - 0.25 * 0.25) / 400.0;
   return 0.01 / (lower + upper);
-}
-
-/// Largest |lambda_j / m_j - p| / p over the constraints.
-double largest_pressure_error(const ContactPairing& pairing, const Eigen::VectorXd& force,
-                              double pressure) {
-  double error = 0.0;
-  for (std::size_t j = 0; j < pairing.size(); ++j) {
-    const double value = force[static_cast<Eigen::Index>(j)] / pairing.pairs[j].weight;
-    error = std::max(error, std::abs(value - pressure) / pressure);
-  }
-  return error;
 }
 
 MonolithicResult solve_reference(const LocalProblem& problem, double qp_tolerance = 1e-14) {

@@ -24,6 +24,7 @@
 #include "coupling/in_process_port.hpp"
 #include "coupling/local_problem.hpp"
 #include "coupling/monolithic_solver.hpp"
+#include "pressure_error.hpp"
 
 namespace robin {
 namespace {
@@ -112,17 +113,6 @@ TEST(SolidHertz, ContactRadiusAndPeakPressureWithinThreePercentOfHertz) {
 
 double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& reference) {
   return (value - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>();
-}
-
-/// Largest |lambda_j / m_j - p| / p over the rows.
-double largest_pressure_error(const ContactPairing& pairing, const Eigen::VectorXd& force,
-                              double pressure) {
-  double error = 0.0;
-  for (std::size_t j = 0; j < pairing.size(); ++j) {
-    const double value = force[static_cast<Eigen::Index>(j)] / pairing.pairs[j].weight;
-    error = std::max(error, std::abs(value - pressure) / pressure);
-  }
-  return error;
 }
 
 /// The exact pressure of examples/non_matching_solids.toml (uniaxial stress, rollers).
