@@ -1,11 +1,16 @@
 #include "server/mesh_file_reader.hpp"
 
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <csignal>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <stdexcept>
 #include <type_traits>
 #include <vector>
@@ -119,6 +124,55 @@ class MeshDecoder {
   std::size_t position_ = 1;  // after the 'M'
 };
 
+/// Address space the child may add to what it inherited: a fixed part for Gmsh's own start-up,
+/// plus a multiple of the file's size, well above what Gmsh and the conversion need for a file
+/// whose counts are true (a few times its size), far below what a header claiming billions of
+/// nodes in a small file would make Gmsh reserve.
+constexpr std::uint64_t base_allowance_bytes = std::uint64_t{256} << 20;
+constexpr std::uint64_t allowance_per_file_byte = 32;
+
+/// The child's address space now (the first field of /proc/self/statm, in pages), 0 if unknown.
+std::uint64_t address_space_bytes() {
+  const int file = open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
+  if (file < 0) return 0;
+  char text[64] = {};
+  const ssize_t count = read(file, text, sizeof text - 1);
+  close(file);
+  if (count <= 0) return 0;
+  return std::strtoull(text, nullptr, 10) * static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
+}
+
+/// Caps the child's address space (RLIMIT_AS) at what it has plus `allowance`, so that an
+/// allocation the file's counts ask for beyond that fails (std::bad_alloc) instead of taking
+/// the host's memory. An existing lower limit is kept. Returns the allowance in force.
+std::uint64_t limit_address_space(std::uint64_t allowance) {
+  const std::uint64_t current = address_space_bytes();
+  rlimit limit{};
+  if (current == 0 || getrlimit(RLIMIT_AS, &limit) != 0) return 0;
+  const std::uint64_t wanted = current + allowance;
+  if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur <= wanted) return limit.rlim_cur - current;
+  limit.rlim_cur = wanted;
+  if (limit.rlim_max != RLIM_INFINITY && limit.rlim_max < wanted) limit.rlim_cur = limit.rlim_max;
+  setrlimit(RLIMIT_AS, &limit);
+  return limit.rlim_cur - current;
+}
+
+/// Set in the child when operator new found no memory (read_gmsh_mesh turns the exception into
+/// its own error, so the handler records it).
+bool allocation_refused = false;
+
+void refuse_allocation() {
+  allocation_refused = true;
+  std::set_new_handler(nullptr);
+  throw std::bad_alloc();
+}
+
+std::string memory_refusal(std::uint64_t allowance, std::uintmax_t file_bytes) {
+  return "Ethe mesh reader ran out of the memory it is allowed for this file (" +
+         std::to_string(allowance >> 20) + " MiB for " + std::to_string(file_bytes) +
+         " bytes): does a header claim more nodes or elements than the file holds? refused";
+}
+
 /// In the child: reads the mesh and writes the message to `descriptor`; never returns.
 [[noreturn]] void read_in_child(const std::filesystem::path& path, int descriptor) {
   // A crash of the reader ends the child by its signal, which the parent reports (no handler
@@ -126,13 +180,20 @@ class MeshDecoder {
   for (const int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
     std::signal(signal_number, SIG_DFL);
   }
+  std::error_code size_error;
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path, size_error);
+  const std::uint64_t allowance = limit_address_space(
+      base_allowance_bytes + allowance_per_file_byte * (size_error ? 0 : file_bytes));
+  std::set_new_handler(refuse_allocation);
   std::string message;
   try {
     message = encoded_mesh(read_gmsh_mesh(path));
   } catch (const std::exception& error) {
-    message = std::string("E") + error.what();
+    message = allocation_refused ? memory_refusal(allowance, file_bytes)
+                                 : std::string("E") + error.what();
   } catch (...) {
-    message = "Ethe mesh reader failed";
+    message = allocation_refused ? memory_refusal(allowance, file_bytes)
+                                 : std::string("Ethe mesh reader failed");
   }
   for (std::size_t written = 0; written < message.size();) {
     const ssize_t count = write(descriptor, message.data() + written, message.size() - written);

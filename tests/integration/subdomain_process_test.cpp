@@ -843,6 +843,42 @@ TEST(SubdomainProcess, MeshFileThatCrashesGmshIsBadInputAndTheServerGoesOn) {
   EXPECT_EQ(server.process.wait_for_exit(), 0) << server.process.stderr_text();
 }
 
+// A mesh file whose header claims 1.5e9 nodes and holds 12 (tests/data/mesh_square_v41.msh with
+// its $Nodes count raised): Gmsh 4.8 reserves memory for the claimed count (`gmsh -0` on it grew
+// to 22 GB before the kernel killed it). robin-subdomain's reader child may add only a bounded
+// address space to what it inherited, so the request is BAD_INPUT naming the memory refusal,
+// at once, and the server goes on.
+TEST(SubdomainProcess, MeshFileClaimingBillionsOfNodesIsRefusedWithinAMemoryBound) {
+  const AttackFiles files;
+  std::ifstream square(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_v41.msh");
+  std::ofstream claims(files.data / "claims.msh");
+  bool replaced = false;
+  for (std::string line; std::getline(square, line);) {
+    if (line == "9 12 1 12") {  // $Nodes: 9 blocks, 12 nodes, tags 1 to 12
+      line = "9 1500000000 1 12";
+      replaced = true;
+    }
+    claims << line << '\n';
+  }
+  claims.close();
+  ASSERT_TRUE(replaced) << "tests/data/mesh_square_v41.msh changed: its $Nodes header line";
+  ConnectedServer server({"--data-directory", files.data.string()});
+  ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
+  std::uint64_t id = 1;
+  const protocol::Envelope reply = exchange(server.socket, square_path_setup(id++, "claims.msh"));
+  ASSERT_TRUE(reply.has_error()) << reply.DebugString();
+  EXPECT_EQ(reply.error().code(), protocol::BAD_INPUT);
+  EXPECT_NE(reply.error().message().find(
+                "body 'square': SetupBody.mesh_path: the mesh reader ran out of the memory it is "
+                "allowed for this file ("),
+            std::string::npos)
+      << reply.error().message();
+  expect_hello(server.socket, id++);
+  EXPECT_TRUE(exchange(server.socket, square_path_setup(id++, "square.msh")).has_interface());
+  ASSERT_TRUE(exchange(server.socket, shutdown(id)).has_acknowledge());
+  EXPECT_EQ(server.process.wait_for_exit(), 0) << server.process.stderr_text();
+}
+
 /// The virtual memory size of process `pid` in bytes (VmSize of /proc/PID/status; 0 if unknown).
 std::uint64_t virtual_memory_bytes(pid_t pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
