@@ -17,6 +17,7 @@
 #include <iostream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 
 #include "command_line.hpp"
 #include "curve_keys.hpp"
@@ -57,6 +58,15 @@ double default_factor_memory_mebibytes() {
   const long page_size = sysconf(_SC_PAGE_SIZE);
   if (pages <= 0 || page_size <= 0) return 0.0;
   return 0.75 * static_cast<double>(pages) * static_cast<double>(page_size) / 1048576.0;
+}
+
+/// robin-mesh-reader next to this executable (/proc/self/exe), which reads the
+/// SetupBody.mesh_path files; empty when this executable's path cannot be read (a mesh_path
+/// then fails with "cannot run the mesh reader").
+std::filesystem::path mesh_reader_next_to_this_executable() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::filesystem::path() : self.parent_path() / "robin-mesh-reader";
 }
 
 /// A --testing-stage-delay value, "correction=SECONDS" or "correction@ITERATION=SECONDS".
@@ -242,6 +252,7 @@ int main(int argc, char** argv) {
   }
   command_line.server.maximum_dofs = command_line.maximum_dofs;
   command_line.server.maximum_mesh_file_bytes = command_line.maximum_mesh_file_bytes;
+  command_line.server.mesh_reader = mesh_reader_next_to_this_executable();
   command_line.server.maximum_factor_bytes = command_line.maximum_factor_mebibytes * 1048576.0;
   robin::SubdomainServer server(command_line.server);
   try {

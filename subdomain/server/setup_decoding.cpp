@@ -62,7 +62,7 @@ Mesh decode_body_mesh(const protocol::SetupBody& message, const std::string& con
       resolve_data_file(files.data_directory, message.mesh_path(), field);
   check_data_file_size(path, message.mesh_path(), files.maximum_bytes, field);
   try {
-    Mesh mesh = read_mesh_file_in_child(path);
+    Mesh mesh = read_mesh_file_in_child(path, files.reader);
     check_element_validity(mesh, context + ": SetupBody.mesh_path");
     return mesh;
   } catch (const InputError& error) {

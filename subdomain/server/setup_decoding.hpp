@@ -26,10 +26,12 @@ struct DecodedSetup {
 };
 
 /// Where SetupBody.mesh_path may be read: under `data_directory` (empty: nowhere), files of at
-/// most `maximum_bytes` (0: no limit; robin-subdomain --max-mesh-file-size).
+/// most `maximum_bytes` (0: no limit; robin-subdomain --max-mesh-file-size), read by the
+/// executable `reader` (robin-mesh-reader, read_mesh_file_in_child).
 struct MeshFiles {
   std::filesystem::path data_directory;
   std::uintmax_t maximum_bytes = 0;
+  std::filesystem::path reader;
 };
 
 /// Decodes and checks `message`: body name ([A-Za-z0-9_-]+, at most 64), mesh (MeshData,

@@ -495,7 +495,8 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
   begin_stage(SetupStage::mesh, 0);
   const auto mesh_start = Clock::now();
   DecodedSetup setup = decode_setup_body(
-      request.setup_body(), {settings_.data_directory, settings_.maximum_mesh_file_bytes});
+      request.setup_body(),
+      {settings_.data_directory, settings_.maximum_mesh_file_bytes, settings_.mesh_reader});
   const double mesh_seconds = seconds_since(mesh_start);
   setup.body.maximum_dofs = settings_.maximum_dofs;
   setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;

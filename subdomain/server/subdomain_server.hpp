@@ -101,6 +101,9 @@ struct ServerSettings {
   /// The largest mesh file a mesh_path may name, in bytes (--max-mesh-file-size; 0 = none),
   /// checked with stat before the file is read.
   std::uintmax_t maximum_mesh_file_bytes = 0;
+  /// The executable that reads those files (robin-mesh-reader; robin-subdomain's is the one next
+  /// to it): the server itself never runs Gmsh (mesh_file_reader.hpp).
+  std::filesystem::path mesh_reader;
   /// The directory under which FieldsRequest.write_directory may write (--output-root); empty:
   /// every write_directory is refused.
   std::filesystem::path output_root;

@@ -153,6 +153,7 @@ class SeedWriter {
     robin::ServerSettings settings;
     settings.name = "make-corpus";
     settings.data_directory = scratch / "data";
+    settings.mesh_reader = ROBIN_MESH_READER;
     settings.output_root = scratch / "output";
     settings.maximum_dofs = 20000;
     settings.maximum_factor_bytes = 64.0 * 1024 * 1024;

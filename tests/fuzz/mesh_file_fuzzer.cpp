@@ -1,7 +1,7 @@
 // libFuzzer harness: the .msh file reader of robin-subdomain. Every input is written as a Gmsh
 // mesh file, <tmp>/fuzz.msh, and read with robin::read_mesh_file_in_child (what
-// SetupBody.mesh_path goes through: Gmsh's read_gmsh_mesh in a child process, the mesh sent
-// back through a pipe), then checked with robin::check_element_validity as the server does.
+// SetupBody.mesh_path goes through: read_gmsh_mesh in robin-mesh-reader, a child process, the mesh
+// sent back through a pipe), then checked with robin::check_element_validity as the server does.
 // Only robin::InputError (a refused file, with its message) may leave it; any other exception,
 // a crash, a leak or undefined behaviour of this process is a bug. A crash of Gmsh in the child
 // is a refusal ("the mesh reader (Gmsh) crashed ..."): Gmsh 4.8 crashes on some malformed
@@ -69,7 +69,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   }
   try {
-    const robin::Mesh mesh = robin::read_mesh_file_in_child(path);
+    const robin::Mesh mesh = robin::read_mesh_file_in_child(path, ROBIN_MESH_READER);
     robin::check_element_validity(mesh, "fuzz.msh");
   } catch (const robin::InputError&) {
     // A refused file: the expected outcome for most inputs.

@@ -80,6 +80,7 @@ robin::SubdomainServer& fuzzed_server() {
     robin::ServerSettings settings;
     settings.name = "fuzz";
     settings.data_directory = directories.data;
+    settings.mesh_reader = ROBIN_MESH_READER;
     settings.output_root = directories.output;
     settings.maximum_dofs = 20000;
     settings.maximum_factor_bytes = 64.0 * 1024 * 1024;

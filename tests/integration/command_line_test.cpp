@@ -31,8 +31,8 @@ using testing::ProcessOutcome;
 using testing::run_tool;
 using testing::TemporaryDirectory;
 
-const std::vector<std::string> tools{"robin-run", "robin-coordinator", "robin-monolithic",
-                                     "robin-subdomain", "robin-keygen"};
+const std::vector<std::string> tools{"robin-run",       "robin-coordinator", "robin-monolithic",
+                                     "robin-subdomain", "robin-keygen",      "robin-mesh-reader"};
 
 std::string product_version() {
   std::ifstream file(std::filesystem::path(ROBIN_EXAMPLES).parent_path() / "VERSION");

@@ -185,6 +185,7 @@ Eigen::VectorXd sloped_obstacle(const InterfaceDescription& interface) {
 ServerSettings quiet_settings() {
   ServerSettings settings;
   settings.name = "unit test";
+  settings.mesh_reader = ROBIN_MESH_READER;
   return settings;
 }
 
@@ -1212,6 +1213,25 @@ TEST(SubdomainServer, InvertedOrDegenerateCellsAreBadInputNamingTheirTag) {
   EXPECT_NE(message.find("element tag 13 "), std::string::npos) << message;
   EXPECT_NE(message.find("inverted"), std::string::npos) << message;
   expect_hello(server, 7);
+}
+
+// A server whose mesh reader (robin-mesh-reader) cannot be run refuses a mesh_path with an
+// INTERNAL error naming the reader, not the client's file, and goes on serving.
+TEST(SubdomainServer, MeshPathWithoutItsReaderIsAnInternalErrorNamingTheReader) {
+  const TemporaryDirectory data("no-reader");
+  std::filesystem::copy_file(square_msh, data.path() / "square.msh");
+  ServerSettings settings = quiet_settings();
+  settings.data_directory = data.path();
+  settings.mesh_reader = data.path() / "no-such-reader";
+  SubdomainServer server(settings);
+  const protocol::Envelope reply =
+      exchange(server, setup_request(1, square_path_setup("square.msh")));
+  expect_error(reply, protocol::INTERNAL, "awaiting_setup");
+  EXPECT_NE(reply.error().message().find("cannot run the mesh reader '" +
+                                         (data.path() / "no-such-reader").string() + "'"),
+            std::string::npos)
+      << reply.error().message();
+  expect_hello(server, 2);
 }
 
 /// SOLVER_FAILURE naming `what` and the body: an Error, so no NaN or infinity is sent.
