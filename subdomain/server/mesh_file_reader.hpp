@@ -20,8 +20,9 @@ namespace robin {
 /// The mesh of `path` as read_gmsh_mesh reads it, read by the executable `reader`
 /// (robin-mesh-reader) in a child process. Throws InputError with the reader's message when it
 /// refuses the file, "the mesh reader (Gmsh) crashed on this file (signal N, ...): refused" when
-/// the child dies, and std::runtime_error when no child can be started or `reader` cannot be
-/// run.
+/// the child dies, "the mesh reader ran out of the memory it is allowed for this file (...)"
+/// when Gmsh asks for more than 256 MiB plus 32 times the file's size (mesh_reader_main.cpp),
+/// and std::runtime_error when no child can be started or `reader` cannot be run.
 Mesh read_mesh_file_in_child(const std::filesystem::path& path,
                              const std::filesystem::path& reader);
 

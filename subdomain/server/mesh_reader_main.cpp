@@ -5,12 +5,20 @@
 // --version); 2 for a bad command line or when the message cannot be written; a file Gmsh
 // crashes on ends the process by its signal.
 // Only the server runs it, on a file it has already checked (under its --data-directory, at
-// most --max-mesh-file-size bytes).
+// most --max-mesh-file-size bytes). It caps its own address space (RLIMIT_AS) before reading:
+// Gmsh 4.8 reserves memory for the node and element counts a file's header claims, so a small
+// file claiming billions of nodes would otherwise take the host's memory.
 
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
+#include <new>
 #include <string>
 
 #include "command_line.hpp"
@@ -19,15 +27,74 @@
 
 namespace {
 
-/// The message for the file at `path` (a refusal when read_gmsh_mesh throws).
+/// Address space the reader may add to what it has at start: a fixed part for Gmsh's own
+/// work, plus a multiple of the file's size, well above what Gmsh and the conversion need for a
+/// file whose counts are true (a few times its size), far below what a header claiming billions
+/// of nodes in a small file makes Gmsh reserve.
+constexpr std::uint64_t base_allowance_bytes = std::uint64_t{256} << 20;
+constexpr std::uint64_t allowance_per_file_byte = 32;
+
+/// The process's address space now (the first field of /proc/self/statm, in pages), 0 if
+/// unknown.
+std::uint64_t address_space_bytes() {
+  const int file = open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
+  if (file < 0) return 0;
+  char text[64] = {};
+  const ssize_t count = read(file, text, sizeof text - 1);
+  close(file);
+  if (count <= 0) return 0;
+  return std::strtoull(text, nullptr, 10) * static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
+}
+
+/// Caps the address space (RLIMIT_AS) at what the process has plus `allowance`, so that an
+/// allocation beyond it fails (std::bad_alloc) instead of taking the host's memory; an existing
+/// lower limit is kept. Returns the allowance in force (0 when the size cannot be read).
+std::uint64_t limit_address_space(std::uint64_t allowance) {
+  const std::uint64_t current = address_space_bytes();
+  rlimit limit{};
+  if (current == 0 || getrlimit(RLIMIT_AS, &limit) != 0) return 0;
+  const std::uint64_t wanted = current + allowance;
+  if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur <= wanted) return limit.rlim_cur - current;
+  limit.rlim_cur = wanted;
+  if (limit.rlim_max != RLIM_INFINITY && limit.rlim_max < wanted) limit.rlim_cur = limit.rlim_max;
+  setrlimit(RLIMIT_AS, &limit);
+  return limit.rlim_cur - current;
+}
+
+/// Set when operator new found no memory: read_gmsh_mesh turns the exception into its own
+/// error, so the new-handler records it.
+bool allocation_refused = false;
+
+void refuse_allocation() {
+  allocation_refused = true;
+  std::set_new_handler(nullptr);
+  throw std::bad_alloc();
+}
+
+std::string memory_refusal(std::uint64_t allowance, std::uintmax_t file_bytes) {
+  return "the mesh reader ran out of the memory it is allowed for this file (" +
+         std::to_string(allowance >> 20) + " MiB for " + std::to_string(file_bytes) +
+         " bytes): does a header claim more nodes or elements than the file holds? refused";
+}
+
+/// The message for the file at `path` (a refusal when read_gmsh_mesh throws), read within the
+/// memory allowance of that file.
 std::string message_for(const std::string& path) {
+  std::error_code size_error;
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path, size_error);
+  const std::uint64_t allowance = limit_address_space(
+      base_allowance_bytes + allowance_per_file_byte * (size_error ? 0 : file_bytes));
+  std::set_new_handler(refuse_allocation);
+  std::string refusal;
   try {
     return robin::mesh_reader_message(robin::read_gmsh_mesh(path));
   } catch (const std::exception& error) {
-    return robin::mesh_reader_error_message(error.what());
+    refusal = error.what();
   } catch (...) {
-    return robin::mesh_reader_error_message("the mesh reader failed");
+    refusal = "the mesh reader failed";
   }
+  if (allocation_refused) refusal = memory_refusal(allowance, file_bytes);
+  return robin::mesh_reader_error_message(refusal);
 }
 
 /// Writes all of `message` to the standard output; false when it cannot.
