@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/prctl.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -77,6 +78,26 @@ int read_exec_error(int descriptor) {
   return count == static_cast<ssize_t>(sizeof error_number) ? error_number : 0;
 }
 
+/// A descriptor that becomes readable when process `pid` (a child not yet reaped) exits
+/// (pidfd_open, Linux 5.3); -1 when the kernel or the C library has none.
+int open_exit_descriptor(pid_t pid) {
+#ifdef SYS_pidfd_open
+  return static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
+#else
+  (void)pid;
+  return -1;
+#endif
+}
+
+/// Waits up to `milliseconds` for `exit_descriptor` (open_exit_descriptor) to become readable;
+/// false when the wait failed at once (the caller then sleeps instead of spinning). A signal or
+/// the timeout ends the wait early without being an error.
+bool await_exit_event(int exit_descriptor, long milliseconds) {
+  pollfd item{exit_descriptor, POLLIN, 0};
+  const int ready = poll(&item, 1, static_cast<int>(std::min<long>(milliseconds, 60'000)));
+  return ready >= 0 || errno == EINTR;
+}
+
 }  // namespace
 
 ChildProcess::ChildProcess(const ChildProcessOptions& options)
@@ -102,6 +123,7 @@ ChildProcess::ChildProcess(const ChildProcessOptions& options)
   const int exec_error = pid_ > 0 ? read_exec_error(error[0]) : fork_error;
   close(error[0]);
   if (pid_ > 0 && exec_error != 0) reap(0);
+  if (pid_ > 0 && exec_error == 0) exit_descriptor_ = open_exit_descriptor(pid_);
   if (pid_ < 0 || exec_error != 0) {
     close(output_descriptor_);
     output_descriptor_ = -1;
@@ -116,6 +138,7 @@ ChildProcess::~ChildProcess() {
     reap(0);
   }
   if (output_descriptor_ >= 0) close(output_descriptor_);
+  if (exit_descriptor_ >= 0) close(exit_descriptor_);
 }
 
 std::optional<std::string> ChildProcess::read_line(Clock::time_point deadline,
@@ -179,8 +202,12 @@ bool ChildProcess::wait_for_exit(double seconds) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(seconds));
   while (!reap(WNOHANG)) {
-    if (Clock::now() >= deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    const auto remaining =
+        std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now()).count();
+    if (remaining <= 0) return false;
+    if (exit_descriptor_ < 0 || !await_exit_event(exit_descriptor_, remaining)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(std::min<long>(remaining, 10)));
+    }
   }
   return true;
 }

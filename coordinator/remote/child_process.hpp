@@ -69,7 +69,8 @@ class ChildProcess {
   std::string exit_description();
   bool running() { return exit_description().empty(); }
 
-  /// Waits up to `seconds` for the child to exit; true when it has.
+  /// Waits up to `seconds` for the child to exit; true when it has. Woken by the exit itself
+  /// (a pidfd), not by polling, where the kernel has pidfd_open.
   bool wait_for_exit(double seconds);
 
   /// SIGTERM, then SIGKILL when the child is still running after `grace_seconds`; always
@@ -82,6 +83,7 @@ class ChildProcess {
 
   pid_t pid_ = -1;
   int output_descriptor_ = -1;
+  int exit_descriptor_ = -1;  // pidfd of the child, readable once it has exited; -1: none
   bool own_group_ = false;
   std::string pending_output_;
   std::mutex mutex_;  // guards status_ and reaped_
