@@ -448,7 +448,8 @@ RunCheckpoint checkpoint_identity(const CaseDefinition& definition,
 
 int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
                     const std::vector<std::string>& endpoints,
-                    const std::vector<ChannelOptions>& channels, const ServerRestart& restart) {
+                    const std::vector<ChannelOptions>& channels, const ServerRestart& restart,
+                    const std::function<void()>& servers_done) {
   auto log = coordinator_logger();
   const std::size_t body_count = definition.bodies.size();
   if (endpoints.size() != body_count || (!channels.empty() && channels.size() != body_count)) {
@@ -546,6 +547,15 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
       return static_cast<SubdomainPort*>(ports[index].get());
     };
   }
+  bool servers_released = false;
+  // Ends every server's run (once per port) and tells servers_done, the first time only.
+  const auto release_servers = [&] {
+    for (auto& port : ports) {
+      if (port) port->end_run();
+    }
+    if (!servers_released && servers_done) servers_done();
+    servers_released = true;
+  };
   int code = 1;
   try {
     std::vector<SubdomainPort*> run_ports;
@@ -556,6 +566,7 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     const CoupledRunResult result = run_coupled_case(
         observed, run_ports, options, make_observer(log, options, display), continuation);
     display->finish();
+    release_servers();  // the fields are in: the servers can stop while the files are written
     write_coupled_outputs(*results, definition, result);
     code = report_outcome(result, settings, *log);
   } catch (const InputError& error) {  // e.g. unmatched contact nodes: name the case file
@@ -568,9 +579,7 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     code = failure_exit_code(error);
     results->fail(stop_signal() != 0 ? RunFailure::interrupted : RunFailure::failed, error.what());
   }
-  for (auto& port : ports) {
-    if (port) port->end_run();
-  }
+  release_servers();
   return code;
 }
 

@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -118,10 +119,16 @@ std::optional<CaseDefinition> load_case(CoordinatorSettings& settings);
 /// `restart` replaces lost servers (at most settings.max_server_restarts per body); the run
 /// checkpoints every iteration into the output directory and, with settings.resume,
 /// continues from that checkpoint.
+/// `servers_done` (when set) is called once, on this thread, when no request goes to the servers
+/// any more: after a run that produced results, once the fields are in and every server's run is
+/// ended, before the result files are written (so that robin-run can stop its servers
+/// meanwhile); after a failed run, just before returning. It is not called when no run starts
+/// (wrong number of endpoints, unusable output directory).
 int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings& settings,
                     const std::vector<std::string>& endpoints,
                     const std::vector<ChannelOptions>& channels = {},
-                    const ServerRestart& restart = {});
+                    const ServerRestart& restart = {},
+                    const std::function<void()>& servers_done = {});
 
 /// Logs a failure and returns its exit code: 128 + signal once a stop signal was received
 /// (whatever exception the interruption surfaced as), 1 otherwise.

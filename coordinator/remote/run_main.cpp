@@ -17,9 +17,11 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <future>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "remote/coordinator_application.hpp"
@@ -111,8 +113,20 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
                    server.log_file().string());
       return server.endpoint();
     };
-    code = robin::run_coordinator(definition, settings, servers.endpoints(), channels, restart);
-    servers.stop();
+    // Stopped as soon as the coordinator is done with them, while it writes the result files;
+    // the future's destructor waits for the stop also when run_coordinator throws.
+    std::future<void> stopping;
+    const auto stop_in_background = [&servers, &stopping] {
+      try {
+        stopping = std::async(std::launch::async, [&servers] { servers.stop(); });
+      } catch (const std::system_error&) {  // no thread to spare: stop them in this one
+        servers.stop();
+      }
+    };
+    code = robin::run_coordinator(definition, settings, servers.endpoints(), channels, restart,
+                                  stop_in_background);
+    if (stopping.valid()) stopping.get();
+    servers.stop();  // idempotent: stops them here when the run never started
     spdlog::info("servers stopped");
   } catch (const std::exception& error) {
     code = robin::failure_exit_code(error);
