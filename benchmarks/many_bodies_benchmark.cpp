@@ -92,7 +92,9 @@ void run_row(int count, double h, const std::filesystem::path& directory) {
       robin::solve_monolithic(bodies, coupling.problem.graph, coupling.problem.gaps, qp);
   const double monolithic_seconds = seconds_since(monolithic_start);
 
-  for (const std::string acceleration : {"iqn-ils", "aitken", "none"}) {
+  for (const robin::AccelerationMethod acceleration :
+       {robin::AccelerationMethod::iqn_ils, robin::AccelerationMethod::aitken,
+        robin::AccelerationMethod::none}) {
     std::vector<robin::InProcessPort> ports(static_cast<std::size_t>(count));
     std::vector<robin::SubdomainPort*> pointers;
     robin::SolverOptions solver;
@@ -122,9 +124,9 @@ void run_row(int count, double h, const std::filesystem::path& directory) {
                        monolithic.contact_force.lpNorm<Eigen::Infinity>());
     }
     std::printf("| %d | %d | %ld | %s | %s | %zu | %.3f | %.3f | %.1e |\n", count, count - 1,
-                static_cast<long>(coupling.problem.graph.total_rows()), acceleration.c_str(),
-                robin::to_string(result.status).c_str(), result.history.size(), result.wall_seconds,
-                monolithic_seconds, difference);
+                static_cast<long>(coupling.problem.graph.total_rows()),
+                robin::to_string(acceleration).c_str(), robin::to_string(result.status).c_str(),
+                result.history.size(), result.wall_seconds, monolithic_seconds, difference);
     std::fflush(stdout);
   }
 }

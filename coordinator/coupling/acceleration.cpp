@@ -65,10 +65,6 @@ std::unique_ptr<Acceleration> make_quasi_newton(const AccelerationOptions& optio
 }  // namespace
 
 void validate(const AccelerationOptions& options) {
-  if (options.method != "none" && options.method != "aitken" && options.method != "iqn-ils") {
-    throw InputError("acceleration.method must be \"none\", \"aitken\" or \"iqn-ils\", got \"" +
-                     options.method + "\"");
-  }
   if (options.mixing != "full" && options.mixing != "relaxation" && options.mixing != "aitken") {
     throw InputError("acceleration.mixing must be \"full\", \"relaxation\" or \"aitken\", got \"" +
                      options.mixing + "\"");
@@ -95,14 +91,14 @@ std::unique_ptr<Acceleration> make_acceleration(const AccelerationOptions& optio
                                                 const std::vector<int>& block_sizes) {
   validate(options);
   if (block_sizes.empty()) throw std::invalid_argument("make_acceleration: no blocks");
-  if (options.method == "none") {
+  if (options.method == AccelerationMethod::none) {
     std::vector<RelaxationBlock> blocks;
     for (std::size_t block = 0; block < block_sizes.size(); ++block) {
       blocks.push_back(relaxation_block(options, static_cast<int>(block), block_sizes[block]));
     }
     return std::make_unique<FixedRelaxation>(blocks);
   }
-  if (options.method == "aitken") {
+  if (options.method == AccelerationMethod::aitken) {
     const AitkenParameters parameters{options.aitken_initial, options.aitken_minimum,
                                       options.aitken_maximum};
     return per_block(block_sizes, [&](int /*block*/, int size) -> std::unique_ptr<Acceleration> {

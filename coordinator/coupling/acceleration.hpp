@@ -18,13 +18,15 @@
 #include <string>
 #include <vector>
 
+#include "coupling/coupling_choices.hpp"
+
 namespace robin {
 
 struct AccelerationOptions {
   /// "none", "aitken" or "iqn-ils". Default "iqn-ils" (per body, full mixing); with the
   /// "either-sequence" stopping of the Robin loop its iteration count does not grow with the
   /// mesh on the cases of docs/iteration-study.md, which lists the counts of every method.
-  std::string method = "iqn-ils";
+  AccelerationMethod method = AccelerationMethod::iqn_ils;
   /// delta per body: the step of "none", and the first step (and every restart) of "iqn-ils".
   double relaxation1 = 0.5, relaxation2 = 0.5;
   /// "aitken": the first omega of each body, then |omega| is clamped to [minimum, maximum]

@@ -158,11 +158,20 @@ std::optional<double> optional_relaxation(const CheckedTable& table, std::string
   return value;
 }
 
+/// The choice `key` names, when the table has it: one of the texts of coupling_choices.hpp,
+/// which the error lists otherwise.
+template <OptionChoice Choice>
+std::optional<Choice> optional_choice(const CheckedTable& table, std::string_view key) {
+  const std::optional<std::string> text = table.optional_choice(key, choice_texts<Choice>());
+  if (!text) return std::nullopt;
+  return choice_from_text<Choice>(*text).value();
+}
+
 /// The acceleration keys of [coupling]; the ranges are those of validate(AccelerationOptions).
 void read_acceleration(const CheckedTable& table, CouplingOptions& coupling) {
   AccelerationOptions& acceleration = coupling.acceleration;
-  acceleration.method = table.optional_choice("acceleration", {"none", "aitken", "iqn-ils"})
-                            .value_or(acceleration.method);
+  acceleration.method =
+      optional_choice<AccelerationMethod>(table, "acceleration").value_or(acceleration.method);
   coupling.relaxation1 = optional_relaxation(table, "relaxation1");
   coupling.relaxation2 = optional_relaxation(table, "relaxation2");
   acceleration.aitken_initial =
@@ -189,20 +198,17 @@ void read_acceleration(const CheckedTable& table, CouplingOptions& coupling) {
 
 /// The algorithm keys of [coupling] (coupling/coupling_scheme.hpp).
 void read_algorithm(const CheckedTable& table, CouplingOptions& coupling) {
-  coupling.algorithm = table
-                           .optional_choice("algorithm", {"robin", "robin-constant",
-                                                          "dirichlet-neumann", "neumann-neumann"})
-                           .value_or(coupling.algorithm);
+  coupling.algorithm =
+      optional_choice<CouplingAlgorithm>(table, "algorithm").value_or(coupling.algorithm);
   coupling.alpha = number_above(table, "alpha", 0.0, coupling.alpha);
-  if (coupling.algorithm == "robin-constant" && !(coupling.alpha > 0.0)) {
+  if (coupling.algorithm == CouplingAlgorithm::robin_constant && !(coupling.alpha > 0.0)) {
     table.fail("algorithm",
                "\"robin-constant\" needs coupling.alpha > 0 (the constant alpha_S, "
                "length per pressure)");
   }
   coupling.contact_body =
-      table.optional_choice("contact_body", {"1", "2", "auto"}).value_or(coupling.contact_body);
-  coupling.stopping =
-      table.optional_choice("stopping", {"either-sequence", "joint"}).value_or(coupling.stopping);
+      optional_choice<ContactBodyChoice>(table, "contact_body").value_or(coupling.contact_body);
+  coupling.stopping = optional_choice<StoppingRule>(table, "stopping").value_or(coupling.stopping);
 }
 
 void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
@@ -214,7 +220,7 @@ void read_coupling(const CheckedTable& root, CouplingOptions& coupling) {
   }
   coupling.tolerance = number_above(*table, "tolerance", 0.0, coupling.tolerance);
   coupling.max_iterations = integer_at_least(*table, "max_iterations", 1, coupling.max_iterations);
-  coupling.initial_obstacle = table->optional_choice("initial_obstacle", {"gap", "zero"})
+  coupling.initial_obstacle = optional_choice<InitialObstacle>(*table, "initial_obstacle")
                                   .value_or(coupling.initial_obstacle);
   coupling.request_timeout_seconds =
       number_above(*table, "request_timeout", 0.0, coupling.request_timeout_seconds);

@@ -15,6 +15,7 @@
 #include "coupling/case_file_reference.hpp"
 #include "coupling/contact_discretization.hpp"
 #include "coupling/contact_interface.hpp"
+#include "coupling/coupling_choices.hpp"
 #include "numerics/body_definition.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/gmsh_reader.hpp"
@@ -53,15 +54,15 @@ struct BodyCase {
 struct CouplingOptions {
   /// The coupling algorithm (coupling/coupling_scheme.hpp): "robin" (the paper's (Q_m)),
   /// "robin-constant", "dirichlet-neumann" or "neumann-neumann".
-  std::string algorithm = "robin";
+  CouplingAlgorithm algorithm = CouplingAlgorithm::robin;
   /// "robin-constant": the constant alpha_S of paper (6) (length per pressure; > 0).
   double alpha = 0.0;
   /// "dirichlet-neumann": the body that solves the contact problem, "1", "2" or "auto" (the
   /// more compliant body, measured by one correction solve each).
-  std::string contact_body = "auto";
+  ContactBodyChoice contact_body = ContactBodyChoice::automatic;
   /// "either-sequence": stop also when one obstacle sequence's complete state converged
   /// ("robin"); "joint": only when the joint state of both sequences did (the paper's test).
-  std::string stopping = "either-sequence";
+  StoppingRule stopping = StoppingRule::either_sequence;
   double relaxation = 0.5;  // delta of paper (13), for both bodies unless overridden
   std::optional<double> relaxation1, relaxation2;  // per-body deltas (default: relaxation)
   /// Acceleration of the obstacle update (method "iqn-ils", "aitken" or "none"; see
@@ -70,7 +71,7 @@ struct CouplingOptions {
   AccelerationOptions acceleration;
   double tolerance = 1e-8;  // on every scaled residual
   int max_iterations = 200;
-  std::string initial_obstacle = "gap";   // "gap": g^alpha_0 = d; "zero": g^alpha_0 = 0
+  InitialObstacle initial_obstacle = InitialObstacle::gap;  // "gap": g^alpha_0 = d; "zero": 0
   double request_timeout_seconds = 60.0;  // deadline of each interface-sized request
   /// Deadline of the mesh-sized requests (setup: meshing, assembly, factorization and the
   /// interface operator; fields), which grow with the body while the others do not.

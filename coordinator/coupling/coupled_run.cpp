@@ -171,11 +171,11 @@ Eigen::VectorXd predicted_start(const std::vector<std::pair<double, Eigen::Vecto
 /// "robin", "robin-constant" and "dirichlet-neumann" H(x) = d when no gap is negative.
 bool start_is_the_unloaded_fixed_point(const CouplingOptions& options,
                                        const CouplingProblem& problem) {
-  const bool obstacle_scheme = options.algorithm == "robin" ||
-                               options.algorithm == "robin-constant" ||
-                               options.algorithm == "dirichlet-neumann";
-  return obstacle_scheme && options.initial_obstacle == "gap" && problem.gaps.size() > 0 &&
-         problem.gaps.minCoeff() >= 0.0;
+  const bool obstacle_scheme = options.algorithm == CouplingAlgorithm::robin ||
+                               options.algorithm == CouplingAlgorithm::robin_constant ||
+                               options.algorithm == CouplingAlgorithm::dirichlet_neumann;
+  return obstacle_scheme && options.initial_obstacle == InitialObstacle::gap &&
+         problem.gaps.size() > 0 && problem.gaps.minCoeff() >= 0.0;
 }
 
 /// The timings of every body's ports (the replaced ones included).

@@ -4,6 +4,7 @@
 #include <array>
 #include <numeric>
 #include <optional>
+#include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 
@@ -362,7 +363,7 @@ int more_compliant_body(const std::vector<SubdomainPort*>& ports, const Coupling
 /// Throws InputError unless the graph is two bodies with one interface.
 void require_two_bodies(const CouplingOptions& options, const ContactGraph& graph) {
   if (graph.body_count() == 2 && graph.interfaces().size() == 1) return;
-  throw InputError("coupling.algorithm \"" + options.algorithm +
+  throw InputError("coupling.algorithm \"" + to_string(options.algorithm) +
                    "\" couples exactly two bodies with one contact interface; this run has " +
                    std::to_string(graph.body_count()) + " bodies and " +
                    std::to_string(graph.interfaces().size()) +
@@ -412,7 +413,7 @@ std::vector<int> floating_colouring(const CouplingProblem& problem, const Coupli
       }
     }
   }
-  if (options.stopping == "joint") {
+  if (options.stopping == StoppingRule::joint) {
     throw InputError("coupling.stopping \"joint\" with " + named +
                      ": only the obstacle sequence of the floating bodies' colour class is "
                      "defined and the joint state never becomes a solution; use "
@@ -444,10 +445,11 @@ int dirichlet_neumann_contact_body(const CouplingOptions& options,
         "bodies, and the Neumann body must not be (its Neumann solve needs a contact "
         "force that balances its loads); use \"robin\"");
   }
-  const int chosen = options.contact_body == "1"   ? 0
-                     : options.contact_body == "2" ? 1
-                     : floating.empty()            ? more_compliant_body(ports, problem)
-                                                   : floating.front();
+  // contact_body "1" and "2" are 1-based; the body indices here are 0-based.
+  const int chosen = options.contact_body == ContactBodyChoice::first    ? 0
+                     : options.contact_body == ContactBodyChoice::second ? 1
+                     : floating.empty() ? more_compliant_body(ports, problem)
+                                        : floating.front();
   if (!floating.empty() && chosen != floating.front()) {
     throw InputError("coupling.algorithm \"dirichlet-neumann\": body " +
                      std::to_string(floating.front() + 1) +
@@ -543,40 +545,38 @@ std::unique_ptr<CouplingScheme> make_coupling_scheme(const CouplingOptions& opti
                      std::to_string(problem.rigid_modes.size()) + " of " +
                      std::to_string(graph.body_count()) + " bodies");
   }
-  if (options.algorithm == "robin") return make_robin_scheme(options, ports, problem);
-  if (options.algorithm == "robin-constant") {
-    if (!(options.alpha > 0.0)) {
-      throw InputError("coupling.alpha must be > 0 for the algorithm \"robin-constant\"");
+  switch (options.algorithm) {
+    case CouplingAlgorithm::robin:
+      return make_robin_scheme(options, ports, problem);
+    case CouplingAlgorithm::robin_constant:
+      if (!(options.alpha > 0.0)) {
+        throw InputError("coupling.alpha must be > 0 for the algorithm \"robin-constant\"");
+      }
+      if (problem.weights.size() != problem.gaps.size() || (problem.weights.array() <= 0.0).any()) {
+        throw InputError(
+            "the algorithm \"robin-constant\" needs a positive boundary weight per pair");
+      }
+      return std::make_unique<RobinScheme>(ports, problem, options.alpha,
+                                           problem.graph.two_colouring(), -1);
+    case CouplingAlgorithm::dirichlet_neumann: {
+      require_two_bodies(options, graph);
+      const int contact_body = dirichlet_neumann_contact_body(options, ports, problem);
+      return std::make_unique<DirichletNeumannScheme>(ports, problem.gaps, contact_body);
     }
-    if (problem.weights.size() != problem.gaps.size() || (problem.weights.array() <= 0.0).any()) {
-      throw InputError(
-          "the algorithm \"robin-constant\" needs a positive boundary weight per pair");
-    }
-    return std::make_unique<RobinScheme>(ports, problem, options.alpha,
-                                         problem.graph.two_colouring(), -1);
+    case CouplingAlgorithm::neumann_neumann:
+      require_two_bodies(options, graph);
+      if (const std::vector<int> floating = floating_bodies(problem); !floating.empty()) {
+        throw InputError(
+            "coupling.algorithm \"neumann-neumann\" corrects both bodies by Neumann "
+            "solves, which the floating " +
+            describe_bodies(floating) +
+            " does not have (its loads need not balance the force jump); use "
+            "\"robin\" or \"dirichlet-neumann\" with the floating body as contact "
+            "body");
+      }
+      return std::make_unique<NeumannNeumannScheme>(ports, problem.gaps);
   }
-  if (options.algorithm == "dirichlet-neumann") {
-    require_two_bodies(options, graph);
-    const int contact_body = dirichlet_neumann_contact_body(options, ports, problem);
-    return std::make_unique<DirichletNeumannScheme>(ports, problem.gaps, contact_body);
-  }
-  if (options.algorithm == "neumann-neumann") {
-    require_two_bodies(options, graph);
-    if (const std::vector<int> floating = floating_bodies(problem); !floating.empty()) {
-      throw InputError(
-          "coupling.algorithm \"neumann-neumann\" corrects both bodies by Neumann "
-          "solves, which the floating " +
-          describe_bodies(floating) +
-          " does not have (its loads need not balance the force jump); use "
-          "\"robin\" or \"dirichlet-neumann\" with the floating body as contact "
-          "body");
-    }
-    return std::make_unique<NeumannNeumannScheme>(ports, problem.gaps);
-  }
-  throw InputError(
-      "coupling.algorithm must be \"robin\", \"robin-constant\", "
-      "\"dirichlet-neumann\" or \"neumann-neumann\", got \"" +
-      options.algorithm + "\"");
+  throw std::logic_error("make_coupling_scheme: a coupling algorithm outside its enum");
 }
 
 }  // namespace robin

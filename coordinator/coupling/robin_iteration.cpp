@@ -35,7 +35,7 @@ class ProgressMonitor {
 
   /// Returns the status that must stop the run, or nothing; fills `message`.
   std::optional<IterationStatus> check(const IterationRecord& record, std::string& message) {
-    const double value = record.progress(options_.stopping == "either-sequence");
+    const double value = record.progress(options_.stopping == StoppingRule::either_sequence);
     best_history_.push_back(std::min(best(), value));
     if (record.iteration == 1) first_step_ = record.obstacle_step;
     smallest_step_ = std::min(smallest_step_, record.obstacle_step);
@@ -300,7 +300,7 @@ bool accept_converged_state(const IterationRecord& record, const CouplingEvaluat
     result.message = "converged in " + iterations;
     return true;
   }
-  if (options.stopping != "either-sequence") return false;
+  if (options.stopping != StoppingRule::either_sequence) return false;
   for (std::size_t k = 0; k < record.sequences.size(); ++k) {
     if (record.sequences[k].largest() > options.tolerance) continue;
     result.state = evaluation.completions[k];
@@ -550,7 +550,8 @@ RobinResult run_robin_iteration(const std::vector<SubdomainPort*>& ports,
   RobinResult result;
   result.algorithm = scheme->describe();
   Eigen::VectorXd iterate = scheme->initial_iterate(
-      options.initial_obstacle == "zero" ? Eigen::VectorXd::Zero(gaps.size()) : gaps);
+      options.initial_obstacle == InitialObstacle::zero ? Eigen::VectorXd::Zero(gaps.size())
+                                                        : gaps);
   if (initial_iterate != nullptr && resume == nullptr) {
     if (initial_iterate->size() != iterate.size()) {
       throw InputError("the initial iterate of the " + result.algorithm + " iteration has " +

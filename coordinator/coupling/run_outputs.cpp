@@ -26,7 +26,7 @@ void write_history_csv(const std::filesystem::path& path,
   file << std::setprecision(std::numeric_limits<double>::max_digits10);
   write_history_header(file, history_body_count(history));
   file << '\n';
-  const bool either_sequence = options.stopping == "either-sequence";
+  const bool either_sequence = options.stopping == StoppingRule::either_sequence;
   for (const IterationRecord& record : history) {
     write_history_row(file, record, either_sequence, options.tolerance);
     file << '\n';
@@ -99,12 +99,12 @@ nlohmann::json make_summary(const CaseDefinition& definition, const CoupledRunRe
   summary["message"] = iteration.message;
   summary["iterations"] = iteration.history.size();
   summary["algorithm"] = iteration.algorithm;
-  summary["acceleration"] = result.options.acceleration.method;
-  summary["stopping"] = result.options.stopping;
+  summary["acceleration"] = to_string(result.options.acceleration.method);
+  summary["stopping"] = to_string(result.options.stopping);
   summary["completed_by_sequence"] = iteration.completed_by_sequence;
   summary["relaxation"] = result.options.relaxation;
   summary["tolerance"] = result.options.tolerance;
-  summary["initial_obstacle"] = result.options.initial_obstacle;
+  summary["initial_obstacle"] = to_string(result.options.initial_obstacle);
   if (!iteration.history.empty()) {
     summary["final_residuals"] = final_residuals_json(iteration);
     summary["joint_state_residuals"] = residuals_json(iteration.history.back());

@@ -79,7 +79,7 @@ void write_coupled_history(const std::filesystem::path& path, const CoupledRunRe
   if (!result.steps.empty()) bodies = history_body_count(result.steps.front().iteration.history);
   write_history_header(file, bodies);
   file << '\n';
-  const bool either_sequence = result.options.stopping == "either-sequence";
+  const bool either_sequence = result.options.stopping == StoppingRule::either_sequence;
   for (const LoadStepResult& step : result.steps) {
     for (const IterationRecord& record : step.iteration.history) {
       file << step.step << ',' << exact_text(step.factor) << ',';

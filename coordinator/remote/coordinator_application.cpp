@@ -29,6 +29,22 @@ const char* const exit_code_footer =
     "written in these cases); 1 bad input or a server failure; 2 bad command line; 130/143 "
     "stopped by SIGINT/SIGTERM.";
 
+/// The option `name` (TEXT, one of the texts of `order`, as listed in the help and in the
+/// error for another value), stored in `value` as the enum (coupling/coupling_choices.hpp).
+/// `order` empty: every choice, in the case file's order.
+template <OptionChoice Choice>
+void add_choice_option(CLI::App& app, const std::string& name, std::optional<Choice>& value,
+                       const std::string& description, const std::vector<Choice>& order = {}) {
+  std::vector<std::string> texts;
+  for (const Choice choice : order) texts.push_back(to_string(choice));
+  if (order.empty()) texts = choice_texts<Choice>();
+  app.add_option_function<std::string>(
+         name,
+         [&value](const std::string& text) { value = choice_from_text<Choice>(text).value(); },
+         description)
+      ->check(CLI::IsMember(texts));
+}
+
 /// Accepts numbers strictly between `low` and `high` (the case file's ranges).
 CLI::Validator open_interval(double low, double high) {
   return CLI::Validator(
@@ -113,7 +129,7 @@ RunObserver make_observer(const std::shared_ptr<spdlog::logger>& log,
 std::pair<double, std::string> stopping_value(const IterationRecord& record,
                                               const CouplingOptions& options) {
   std::pair<double, std::string> value{record.largest(), "the joint state"};
-  if (options.stopping != "either-sequence") return value;
+  if (options.stopping != StoppingRule::either_sequence) return value;
   for (std::size_t k = 0; k < record.sequences.size(); ++k) {
     if (record.sequences[k].largest() < value.first) {
       value = {record.sequences[k].largest(), "obstacle sequence " + std::to_string(k + 1)};
@@ -162,7 +178,7 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
   const RobinResult& iteration = result.iteration;
   const CouplingOptions& options = result.options;
   const std::string stopping =
-      fmt::format("{} stopping, tolerance {:.0e}", options.stopping, options.tolerance);
+      fmt::format("{} stopping, tolerance {:.0e}", to_string(options.stopping), options.tolerance);
   std::string outcome =
       fmt::format("{} after {} iterations", to_string(iteration.status), iteration.history.size());
   if (iteration.history.empty()) {
@@ -175,7 +191,7 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
           "penetration {:.1e}, complementarity {:.1e}, obstacle change {:.1e}, force error "
           "estimate {:.1e}",
           iteration.completed_by_sequence, accepted->largest(), options.tolerance,
-          options.stopping + " stopping",
+          to_string(options.stopping) + " stopping",
           result.outputs.size() == 2
               ? fmt::format("body {} takes its contact force", 3 - iteration.completed_by_sequence)
               : std::string("the other bodies take their neighbours' contact forces"),
@@ -186,7 +202,7 @@ int report_outcome(const CoupledRunResult& result, const CoordinatorSettings& se
           ": the joint state reached {:.1e} < tolerance {:.0e} ({} stopping); final state: "
           "obstacle change {:.1e}, penetration {:.1e}, force balance {:.1e}, complementarity "
           "{:.1e}, correction {:.1e}",
-          last.largest(), options.tolerance, options.stopping, last.obstacle_change,
+          last.largest(), options.tolerance, to_string(options.stopping), last.obstacle_change,
           last.penetration, last.force_balance, last.complementarity, last.correction);
     }
   } else {
@@ -276,30 +292,27 @@ void add_coordinator_options(CLI::App& app, CoordinatorSettings& settings) {
       ->check(open_interval(0.0, 2.0));
   app.add_option("--relaxation2", settings.relaxation2, "relaxation delta of body 2's obstacle")
       ->check(open_interval(0.0, 2.0));
-  app.add_option("--acceleration", settings.acceleration,
-                 "obstacle update: 'iqn-ils' (quasi-Newton), 'aitken' or 'none' (the "
-                 "paper's fixed relaxation); default from the case file (docs/case-format.md)")
-      ->check(CLI::IsMember({"iqn-ils", "aitken", "none"}));
-  app.add_option("--algorithm", settings.algorithm,
-                 "coupling algorithm: 'robin' (the paper's Steklov-Poincare choice, default), "
-                 "'robin-constant' (needs --alpha), 'dirichlet-neumann' or 'neumann-neumann'")
-      ->check(CLI::IsMember({"robin", "robin-constant", "dirichlet-neumann", "neumann-neumann"}));
+  add_choice_option(
+      app, "--acceleration", settings.acceleration,
+      "obstacle update: 'iqn-ils' (quasi-Newton), 'aitken' or 'none' (the "
+      "paper's fixed relaxation); default from the case file (docs/case-format.md)",
+      {AccelerationMethod::iqn_ils, AccelerationMethod::aitken, AccelerationMethod::none});
+  add_choice_option(app, "--algorithm", settings.algorithm,
+                    "coupling algorithm: 'robin' (the paper's Steklov-Poincare choice, default), "
+                    "'robin-constant' (needs --alpha), 'dirichlet-neumann' or 'neumann-neumann'");
   app.add_option("--alpha", settings.alpha,
                  "'robin-constant': the constant alpha_S (length per pressure)")
       ->check(positive());
-  app.add_option("--contact-body", settings.contact_body,
-                 "'dirichlet-neumann': the body that solves the contact problem: 1, 2 or auto")
-      ->check(CLI::IsMember({"1", "2", "auto"}));
-  app.add_option("--stopping", settings.stopping,
-                 "'either-sequence' (default: stop when one obstacle sequence's complete state "
-                 "converged) or 'joint' (the paper's test on both)")
-      ->check(CLI::IsMember({"either-sequence", "joint"}));
+  add_choice_option(app, "--contact-body", settings.contact_body,
+                    "'dirichlet-neumann': the body that solves the contact problem: 1, 2 or auto");
+  add_choice_option(app, "--stopping", settings.stopping,
+                    "'either-sequence' (default: stop when one obstacle sequence's complete state "
+                    "converged) or 'joint' (the paper's test on both)");
   app.add_option("--tolerance", settings.tolerance, "tolerance on every scaled residual")
       ->check(positive());
   app.add_option("--max-iterations", settings.max_iterations, "iteration limit")->check(positive());
-  app.add_option("--initial-obstacle", settings.initial_obstacle,
-                 "initial obstacles: 'gap' (g0 = d) or 'zero' (g0 = 0)")
-      ->check(CLI::IsMember({"gap", "zero"}));
+  add_choice_option(app, "--initial-obstacle", settings.initial_obstacle,
+                    "initial obstacles: 'gap' (g0 = d) or 'zero' (g0 = 0)");
   app.add_option("--timeout", settings.timeout_seconds,
                  "deadline of each interface-sized request to a server (contact solve, "
                  "correction, handshake), in seconds; default from the case file, 60")

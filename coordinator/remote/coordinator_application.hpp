@@ -39,17 +39,17 @@ struct CoordinatorSettings {
   bool overwrite = false;  // --overwrite: replace an earlier run's results (result_directory.hpp)
   std::optional<double> relaxation;
   std::optional<double> relaxation1, relaxation2;
-  std::optional<std::string> acceleration;  // "iqn-ils", "aitken" or "none"
-  std::optional<std::string> algorithm;     // coupling/coupling_scheme.hpp
-  std::optional<double> alpha;              // "robin-constant"
-  std::optional<std::string> contact_body;  // "dirichlet-neumann": "1", "2" or "auto"
-  std::optional<std::string> stopping;      // "either-sequence" or "joint"
+  std::optional<AccelerationMethod> acceleration;  // "iqn-ils", "aitken" or "none"
+  std::optional<CouplingAlgorithm> algorithm;      // coupling/coupling_scheme.hpp
+  std::optional<double> alpha;                     // "robin-constant"
+  std::optional<ContactBodyChoice> contact_body;   // "dirichlet-neumann": "1", "2" or "auto"
+  std::optional<StoppingRule> stopping;            // "either-sequence" or "joint"
   std::optional<double> tolerance;
   std::optional<int> max_iterations;
-  std::optional<std::string> initial_obstacle;  // "gap" or "zero"
-  std::optional<double> timeout_seconds;        // deadline of each interface-sized request
-  std::optional<double> setup_timeout_seconds;  // deadline of the setup and fields requests
-  double heartbeat_timeout_seconds = 10.0;      // remote_port.hpp; 0: no heartbeat
+  std::optional<InitialObstacle> initial_obstacle;  // "gap" or "zero"
+  std::optional<double> timeout_seconds;            // deadline of each interface-sized request
+  std::optional<double> setup_timeout_seconds;      // deadline of the setup and fields requests
+  double heartbeat_timeout_seconds = 10.0;          // remote_port.hpp; 0: no heartbeat
   std::string log_level = "info";
   bool quiet = false;  // --quiet: the coordinator logs only warnings and errors
   /// --set KEY=VALUE: overrides of case-file keys, in order (coupling/case_file_overrides.hpp).

@@ -10,27 +10,54 @@
 namespace robin {
 namespace {
 
+/// The option as the checkpoint records it: a choice (coupling_choices.hpp) by its text, as
+/// given on the command line.
 template <typename Value>
 void add_if_given(nlohmann::json& options, const char* name, const std::optional<Value>& value) {
-  if (value) options[name] = *value;
+  if (!value) return;
+  if constexpr (OptionChoice<Value>) {
+    options[name] = to_string(*value);
+  } else {
+    options[name] = *value;
+  }
+}
+
+/// The choice the checkpoint's option `name` gives by its text. Throws CheckpointFormatError
+/// when the text is none of the choices.
+template <OptionChoice Choice>
+Choice checkpointed_choice(const std::string& name, const nlohmann::json& value) {
+  const std::string text = value.get<std::string>();
+  if (const std::optional<Choice> choice = choice_from_text<Choice>(text)) return *choice;
+  std::string choices;
+  for (const std::string& choice : choice_texts<Choice>()) {
+    choices += (choices.empty() ? "" : ", ") + choice;
+  }
+  throw CheckpointFormatError("the checkpoint's option " + name + " is '" + text +
+                              "', not one of: " + choices);
 }
 
 /// Sets the option `name` of `settings` from the checkpoint's JSON value.
 void apply_option(CoordinatorSettings& settings, const std::string& name,
                   const nlohmann::json& value) {
   const auto number = [&] { return value.get<double>(); };
-  const auto text = [&] { return value.get<std::string>(); };
   if (name == "--relaxation") settings.relaxation = number();
   if (name == "--relaxation1") settings.relaxation1 = number();
   if (name == "--relaxation2") settings.relaxation2 = number();
-  if (name == "--acceleration") settings.acceleration = text();
-  if (name == "--algorithm") settings.algorithm = text();
+  if (name == "--acceleration") {
+    settings.acceleration = checkpointed_choice<AccelerationMethod>(name, value);
+  }
+  if (name == "--algorithm")
+    settings.algorithm = checkpointed_choice<CouplingAlgorithm>(name, value);
   if (name == "--alpha") settings.alpha = number();
-  if (name == "--contact-body") settings.contact_body = text();
-  if (name == "--stopping") settings.stopping = text();
+  if (name == "--contact-body") {
+    settings.contact_body = checkpointed_choice<ContactBodyChoice>(name, value);
+  }
+  if (name == "--stopping") settings.stopping = checkpointed_choice<StoppingRule>(name, value);
   if (name == "--tolerance") settings.tolerance = number();
   if (name == "--max-iterations") settings.max_iterations = value.get<int>();
-  if (name == "--initial-obstacle") settings.initial_obstacle = text();
+  if (name == "--initial-obstacle") {
+    settings.initial_obstacle = checkpointed_choice<InitialObstacle>(name, value);
+  }
 }
 
 std::string read_text(const std::filesystem::path& path) {

@@ -36,26 +36,29 @@ struct Variant {
 const std::vector<Variant>& variants() {
   static const std::vector<Variant> all{
       {"robin, iqn-ils (default)", [](CouplingOptions&) {}},
-      {"robin, aitken", [](CouplingOptions& o) { o.acceleration.method = "aitken"; }},
+      {"robin, aitken",
+       [](CouplingOptions& o) { o.acceleration.method = AccelerationMethod::aitken; }},
       {"robin, iqn-ils on (g1, g2), joint stopping",
        [](CouplingOptions& o) {
          o.acceleration.per_body = false;
-         o.stopping = "joint";
+         o.stopping = StoppingRule::joint;
        }},
       {"robin, per-body delta (0.9, 0.1)",
        [](CouplingOptions& o) {
-         o.acceleration.method = "none";
+         o.acceleration.method = AccelerationMethod::none;
          o.relaxation1 = 0.9;
          o.relaxation2 = 0.1;
          o.max_iterations = 2000;
        }},
       {"robin-constant, alpha 1e-4",
        [](CouplingOptions& o) {
-         o.algorithm = "robin-constant";
+         o.algorithm = CouplingAlgorithm::robin_constant;
          o.alpha = 1e-4;
        }},
-      {"dirichlet-neumann, auto", [](CouplingOptions& o) { o.algorithm = "dirichlet-neumann"; }},
-      {"neumann-neumann", [](CouplingOptions& o) { o.algorithm = "neumann-neumann"; }},
+      {"dirichlet-neumann, auto",
+       [](CouplingOptions& o) { o.algorithm = CouplingAlgorithm::dirichlet_neumann; }},
+      {"neumann-neumann",
+       [](CouplingOptions& o) { o.algorithm = CouplingAlgorithm::neumann_neumann; }},
   };
   return all;
 }
@@ -120,7 +123,7 @@ TEST(AlgorithmService, TooLargeFixedRelaxationIsReportedAsDiverged) {
   RemotePort body1(server1.endpoint(), definition.bodies[0].definition.name, {});
   RemotePort body2(server2.endpoint(), definition.bodies[1].definition.name, {});
   CouplingOptions options = definition.coupling;
-  options.acceleration.method = "none";
+  options.acceleration.method = AccelerationMethod::none;
   options.relaxation = 1.5;
   options.max_iterations = 500;
   const CoupledRunResult run = run_coupled_case(definition, {&body1, &body2}, options);

@@ -97,7 +97,7 @@ TEST(FixedRelaxation, IsBitForBitThePapersUpdatePerBody) {
   const LinearMap map(0.4 * random_matrix(size1 + size2, size1 + size2, generator),
                       random_vector(size1 + size2, generator));
   AccelerationOptions options;
-  options.method = "none";
+  options.method = AccelerationMethod::none;
   options.relaxation1 = 0.3;
   options.relaxation2 = 0.7;
   const auto acceleration = make_acceleration(options, size1, size2);
@@ -146,7 +146,7 @@ TEST(FixedRelaxation, ConvergesAtTheRatePredictedByTheSpectrum) {
                                      symmetric_with_spectrum(spectrum2, generator)),
                       random_vector(11, generator));
   AccelerationOptions options;
-  options.method = "none";
+  options.method = AccelerationMethod::none;
   options.relaxation1 = 0.5;
   options.relaxation2 = 0.25;
   // The next rates are 0.65 and 0.625: after 60 steps their share is (0.65/0.8)^60 ~ 4e-6.
@@ -371,9 +371,9 @@ TEST(TwoBodies, AitkenConvergesWhereASingleRelaxationDiverges) {
   const int size = 16;
   const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
   AccelerationOptions options;
-  options.method = "none";  // delta = 0.5: |1 - 0.5 (1 + 100 s)| > 1 for body 1
+  options.method = AccelerationMethod::none;  // delta = 0.5: |1 - 0.5 (1 + 100 s)| > 1 for body 1
   EXPECT_GT(two_body_calls(map, size, options, 500), 500);
-  options.method = "aitken";
+  options.method = AccelerationMethod::aitken;
   const int aitken = two_body_calls(map, size, options, 500);
   std::cout << "c = 100: aitken per body needs " << aitken << " iterations to 1e-10\n";
   EXPECT_LE(aitken, 100);
@@ -384,13 +384,13 @@ TEST(TwoBodies, QuasiNewtonNeedsTenTimesFewerIterationsThanTheBestRelaxation) {
   const int size = 16;
   const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
   AccelerationOptions options;
-  options.method = "none";
+  options.method = AccelerationMethod::none;
   const double best = best_single_relaxation(map);
   options.relaxation1 = options.relaxation2 = best;
   const int relaxation = two_body_calls(map, size, options, 20000);
-  options.method = "aitken";
+  options.method = AccelerationMethod::aitken;
   const int aitken = two_body_calls(map, size, options, 20000);
-  options.method = "iqn-ils";
+  options.method = AccelerationMethod::iqn_ils;
   options.mixing = "aitken";  // on this dense random spectrum (full mixing: see the log line)
   options.relaxation1 = options.relaxation2 = 0.5;
   const int per_body = two_body_calls(map, size, options, 20000);
@@ -418,7 +418,7 @@ TEST(TwoBodies, AitkenMixingKeepsAShortHistoryConvergent) {
   const int size = 16;
   const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
   AccelerationOptions options;
-  options.method = "iqn-ils";
+  options.method = AccelerationMethod::iqn_ils;
   for (const int depth : {3, 5}) {
     options.history_depth = depth;
     options.mixing = "aitken";
@@ -466,7 +466,7 @@ TEST(TwoBodies, PerBodyQuasiNewtonIsolatesTheGoodSequenceFromANoisyOne) {
   const int size = 16;
   const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
   AccelerationOptions options;
-  options.method = "iqn-ils";
+  options.method = AccelerationMethod::iqn_ils;
   options.mixing = "aitken";
   const std::vector<double> clean = body1_errors(map, size, options, 0.0, 60);
   const std::vector<double> noisy = body1_errors(map, size, options, 1e-3, 60);
@@ -487,14 +487,15 @@ TEST(TwoBodies, EveryMethodHandlesABodyWithoutPairs) {
   std::mt19937 generator(37);
   const LinearMap map(symmetric_with_spectrum({-0.5, -0.2, 0.3}, generator),
                       random_vector(3, generator));
-  for (const std::string method : {"none", "aitken", "iqn-ils"}) {
+  for (const AccelerationMethod method :
+       {AccelerationMethod::none, AccelerationMethod::aitken, AccelerationMethod::iqn_ils}) {
     for (const bool per_body : {true, false}) {
       AccelerationOptions options;
       options.method = method;
       options.per_body = per_body;
       const auto acceleration = make_acceleration(options, 0, 3);
       // "none" with delta = 0.5 contracts at max |1 - 0.5 (1 - mu)| = 0.75: 1e-10 in 81 steps.
-      EXPECT_LE(calls_to_converge(*acceleration, map, 1e-10, 100), 81) << method;
+      EXPECT_LE(calls_to_converge(*acceleration, map, 1e-10, 100), 81) << to_string(method);
     }
   }
 }
@@ -514,7 +515,6 @@ std::string validation_message(const AccelerationOptions& options) {
 TEST(AccelerationOptions, DefaultsAreValidAndBadValuesNameTheirField) {
   EXPECT_EQ(validation_message(AccelerationOptions{}), "");
   const std::vector<std::pair<std::function<void(AccelerationOptions&)>, std::string>> cases = {
-      {[](AccelerationOptions& o) { o.method = "anderson"; }, "acceleration.method"},
       {[](AccelerationOptions& o) { o.mixing = "half"; }, "acceleration.mixing"},
       {[](AccelerationOptions& o) { o.relaxation1 = 0.0; }, "acceleration.relaxation1"},
       {[](AccelerationOptions& o) { o.relaxation2 = 2.5; }, "acceleration.relaxation2"},

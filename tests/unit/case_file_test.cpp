@@ -203,7 +203,7 @@ TEST(CaseFile, FullCaseReadsEveryKey) {
   EXPECT_EQ(coupling.relaxation, 0.75);
   EXPECT_EQ(coupling.tolerance, 1e-7);
   EXPECT_EQ(coupling.max_iterations, 321);
-  EXPECT_EQ(coupling.initial_obstacle, "zero");
+  EXPECT_EQ(coupling.initial_obstacle, InitialObstacle::zero);
   EXPECT_EQ(coupling.request_timeout_seconds, 12.5);
   EXPECT_EQ(coupling.setup_timeout_seconds, 90.5);
   EXPECT_EQ(coupling.divergence_factor, 500.0);
@@ -301,7 +301,7 @@ TEST(CaseFile, MissingOptionalTablesGiveTheDocumentedDefaults) {
   EXPECT_EQ(definition.coupling.relaxation, 0.5);
   EXPECT_EQ(definition.coupling.tolerance, 1e-8);
   EXPECT_EQ(definition.coupling.max_iterations, 200);
-  EXPECT_EQ(definition.coupling.initial_obstacle, "gap");
+  EXPECT_EQ(definition.coupling.initial_obstacle, InitialObstacle::gap);
   EXPECT_EQ(definition.coupling.request_timeout_seconds, 60.0);
   EXPECT_EQ(definition.coupling.setup_timeout_seconds, 3600.0);
   EXPECT_EQ(definition.coupling.divergence_factor, 1e3);
@@ -326,15 +326,45 @@ TEST(CaseFile, AlgorithmKeys) {
                                     "relaxation = 0.5\nalgorithm = \"robin-constant\"\nalpha = "
                                     "2.5e-5\ncontact_body = \"2\"\nstopping = \"joint\"");
   const CouplingOptions coupling = read_case_file(write_case(text)).coupling;
-  EXPECT_EQ(coupling.algorithm, "robin-constant");
+  EXPECT_EQ(coupling.algorithm, CouplingAlgorithm::robin_constant);
   EXPECT_EQ(coupling.alpha, 2.5e-5);
-  EXPECT_EQ(coupling.contact_body, "2");
-  EXPECT_EQ(coupling.stopping, "joint");
+  EXPECT_EQ(coupling.contact_body, ContactBodyChoice::second);
+  EXPECT_EQ(coupling.stopping, StoppingRule::joint);
   const CouplingOptions defaults = read_case_file(write_case(base_case())).coupling;
-  EXPECT_EQ(defaults.algorithm, "robin");
-  EXPECT_EQ(defaults.contact_body, "auto");
-  EXPECT_EQ(defaults.stopping, "either-sequence");
-  EXPECT_EQ(defaults.acceleration.method, "iqn-ils");
+  EXPECT_EQ(defaults.algorithm, CouplingAlgorithm::robin);
+  EXPECT_EQ(defaults.contact_body, ContactBodyChoice::automatic);
+  EXPECT_EQ(defaults.stopping, StoppingRule::either_sequence);
+  EXPECT_EQ(defaults.acceleration.method, AccelerationMethod::iqn_ils);
+}
+
+/// Every choice converts to the text users write and back; other texts are none of them.
+template <typename Choice>
+void expect_texts(const std::vector<std::pair<Choice, std::string>>& spellings) {
+  std::vector<std::string> texts;
+  for (const auto& [choice, text] : spellings) {
+    EXPECT_EQ(to_string(choice), text);
+    EXPECT_EQ(choice_from_text<Choice>(text), choice) << text;
+    texts.push_back(text);
+  }
+  EXPECT_EQ(choice_texts<Choice>(), texts);
+  EXPECT_FALSE(choice_from_text<Choice>("").has_value());
+  EXPECT_FALSE(choice_from_text<Choice>("Robin").has_value());
+}
+
+TEST(CaseFile, OptionChoicesKeepTheirTexts) {
+  expect_texts<CouplingAlgorithm>({{CouplingAlgorithm::robin, "robin"},
+                                   {CouplingAlgorithm::robin_constant, "robin-constant"},
+                                   {CouplingAlgorithm::dirichlet_neumann, "dirichlet-neumann"},
+                                   {CouplingAlgorithm::neumann_neumann, "neumann-neumann"}});
+  expect_texts<ContactBodyChoice>({{ContactBodyChoice::first, "1"},
+                                   {ContactBodyChoice::second, "2"},
+                                   {ContactBodyChoice::automatic, "auto"}});
+  expect_texts<StoppingRule>(
+      {{StoppingRule::either_sequence, "either-sequence"}, {StoppingRule::joint, "joint"}});
+  expect_texts<InitialObstacle>({{InitialObstacle::gap, "gap"}, {InitialObstacle::zero, "zero"}});
+  expect_texts<AccelerationMethod>({{AccelerationMethod::none, "none"},
+                                    {AccelerationMethod::aitken, "aitken"},
+                                    {AccelerationMethod::iqn_ils, "iqn-ils"}});
 }
 
 TEST(CaseFile, GeoOptionsAndFixComponents) {

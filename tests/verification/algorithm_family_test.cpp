@@ -46,7 +46,7 @@ CoupledRunResult expect_monolithic_answer(const std::string& case_name, Configur
   const CoupledRunResult run = run_coupled_case(definition, {&port1, &port2}, options);
   const RobinResult& state = run.iteration;
   std::printf("%s: %s, acceleration %s: %s after %zu iterations\n", case_name.c_str(),
-              state.algorithm.c_str(), options.acceleration.method.c_str(),
+              state.algorithm.c_str(), to_string(options.acceleration.method).c_str(),
               to_string(state.status).c_str(), state.history.size());
   EXPECT_EQ(state.status, IterationStatus::converged) << state.message;
   if (state.status != IterationStatus::converged) return run;
@@ -66,15 +66,17 @@ const char* const cases[] = {"two_blocks_partial.toml", "asymmetric.toml"};
 
 TEST(AlgorithmFamily, DirichletNeumannWithEitherContactBody) {
   for (const char* case_name : cases) {
-    for (const char* contact_body : {"1", "2", "auto"}) {
+    for (const ContactBodyChoice contact_body :
+         {ContactBodyChoice::first, ContactBodyChoice::second, ContactBodyChoice::automatic}) {
       expect_monolithic_answer(case_name, [&](CouplingOptions& options) {
-        options.algorithm = "dirichlet-neumann";
+        options.algorithm = CouplingAlgorithm::dirichlet_neumann;
         options.contact_body = contact_body;
-        options.acceleration.method = "iqn-ils";
+        options.acceleration.method = AccelerationMethod::iqn_ils;
         // The stiff cantilever of asymmetric.toml as the contact body is the ill-conditioned
         // choice (docs/method.md); the default full mixing does not converge on it, the Aitken
         // mixing does.
-        if (std::string(case_name) == "asymmetric.toml" && std::string(contact_body) == "2") {
+        if (std::string(case_name) == "asymmetric.toml" &&
+            contact_body == ContactBodyChoice::second) {
           options.acceleration.mixing = "aitken";
         }
       });
@@ -85,8 +87,8 @@ TEST(AlgorithmFamily, DirichletNeumannWithEitherContactBody) {
 TEST(AlgorithmFamily, NeumannNeumann) {
   for (const char* case_name : cases) {
     expect_monolithic_answer(case_name, [](CouplingOptions& options) {
-      options.algorithm = "neumann-neumann";
-      options.acceleration.method = "iqn-ils";
+      options.algorithm = CouplingAlgorithm::neumann_neumann;
+      options.acceleration.method = AccelerationMethod::iqn_ils;
     });
   }
 }
@@ -102,8 +104,8 @@ TEST(AlgorithmFamily, RobinWithConstantAlpha) {
       expect_monolithic_answer(
           case_name,
           [&](CouplingOptions& options) {
-            options.algorithm = "robin-constant";
-            options.acceleration.method = "iqn-ils";
+            options.algorithm = CouplingAlgorithm::robin_constant;
+            options.acceleration.method = AccelerationMethod::iqn_ils;
             options.alpha = alpha;
           },
           1e-14);

@@ -158,7 +158,7 @@ void set_up_ports(const Assembly& assembly, Ports& ports) {
   }
 }
 
-RobinResult run_robin(Ports& ports, const std::string& acceleration, double tolerance) {
+RobinResult run_robin(Ports& ports, AccelerationMethod acceleration, double tolerance) {
   CouplingOptions options;
   options.acceleration.method = acceleration;
   options.tolerance = tolerance;
@@ -258,15 +258,16 @@ TEST(FloatingBody, StackOfThreeRobinEqualsTheSeriesSpringsAndTheMonolithicSoluti
   const Assembly stack = uniaxial_stack(stack_youngs, stack_push);
   const MonolithicAssembly reference = solve_monolithic_assembly(stack);
   ASSERT_EQ(reference.result.qp.status, QpStatus::converged);
-  for (const std::string acceleration : {"iqn-ils", "none"}) {
+  for (const AccelerationMethod acceleration :
+       {AccelerationMethod::iqn_ils, AccelerationMethod::none}) {
     Ports ports;
     set_up_ports(stack, ports);
     ASSERT_EQ(ports.problem.rigid_modes, (std::vector<int>{0, 1, 0}));
     // the pressure is checked to 1e-10: the iteration's own tolerance must be below that
     const RobinResult robin = run_robin(ports, acceleration, 1e-11);
     std::printf("stack with a floating middle block, %s: %s after %zu iterations (%s)\n",
-                acceleration.c_str(), to_string(robin.status).c_str(), robin.history.size(),
-                robin.message.c_str());
+                to_string(acceleration).c_str(), to_string(robin.status).c_str(),
+                robin.history.size(), robin.message.c_str());
     ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
     EXPECT_EQ(robin.completed_by_sequence, 1);  // the floating block's sequence
     expect_equals_monolithic(robin, stack.problem, reference.result, 1e-8);
@@ -309,12 +310,14 @@ TEST(FloatingBody, BlockWithBodyForceOnAClampedBlockRobinEqualsMonolithicInEquil
   const double smallest = reference.result.contact_force.minCoeff();
   std::printf("block on block: contact forces from %g to %g (weight %g)\n", smallest, largest,
               weight);
-  for (const std::string acceleration : {"iqn-ils", "aitken"}) {
+  for (const AccelerationMethod acceleration :
+       {AccelerationMethod::iqn_ils, AccelerationMethod::aitken}) {
     Ports ports;
     set_up_ports(assembly, ports);
     const RobinResult robin = run_robin(ports, acceleration, 1e-10);
     std::printf("floating block on a clamped block, %s: %s after %zu iterations\n",
-                acceleration.c_str(), to_string(robin.status).c_str(), robin.history.size());
+                to_string(acceleration).c_str(), to_string(robin.status).c_str(),
+                robin.history.size());
     ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
     expect_equals_monolithic(robin, assembly.problem, reference.result, 1e-8);
     EXPECT_NEAR(robin.state.bodies[1].contact_force.sum(), weight, 1e-9 * weight);
@@ -377,7 +380,7 @@ TEST(FloatingBody, UnsupportedBlockInACupRobinEqualsMonolithicInEquilibrium) {
   EXPECT_LE(std::abs(moment), 1e-11 * scale);
   Ports ports;
   set_up_ports(cup, ports);
-  const RobinResult robin = run_robin(ports, "iqn-ils", 1e-10);
+  const RobinResult robin = run_robin(ports, AccelerationMethod::iqn_ils, 1e-10);
   std::printf("block in a cup, iqn-ils: %s after %zu iterations (%s)\n",
               to_string(robin.status).c_str(), robin.history.size(), robin.algorithm.c_str());
   ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
@@ -445,7 +448,7 @@ TEST(FloatingBody, SchemesThatWouldNeedAFloatingBodysNeumannResponseAreRefused) 
       << scheme_refusal(robin, stack.problem);
   stack.problem.rigid_modes = {0, 1, 0};
   CouplingOptions joint;
-  joint.stopping = "joint";
+  joint.stopping = StoppingRule::joint;
   EXPECT_NE(scheme_refusal(joint, stack.problem).find("stopping \"joint\""), std::string::npos);
   // an odd cycle: a triangle of bodies, one floating
   CouplingProblem triangle = stack.problem;
@@ -455,12 +458,13 @@ TEST(FloatingBody, SchemesThatWouldNeedAFloatingBodysNeumannResponseAreRefused) 
 
   const Assembly pair = block_on_block(Eigen::Vector3d(0.0, -10.0, 0.0), true);
   CouplingOptions dirichlet_neumann;
-  dirichlet_neumann.algorithm = "dirichlet-neumann";
-  dirichlet_neumann.contact_body = "1";  // the clamped block: the floating one would be Neumann
+  dirichlet_neumann.algorithm = CouplingAlgorithm::dirichlet_neumann;
+  dirichlet_neumann.contact_body =
+      ContactBodyChoice::first;  // the clamped block: the floating one would be Neumann
   EXPECT_NE(scheme_refusal(dirichlet_neumann, pair.problem).find("must be the contact body"),
             std::string::npos);
   CouplingOptions neumann_neumann;
-  neumann_neumann.algorithm = "neumann-neumann";
+  neumann_neumann.algorithm = CouplingAlgorithm::neumann_neumann;
   EXPECT_NE(scheme_refusal(neumann_neumann, pair.problem).find("floating body 2"),
             std::string::npos)
       << scheme_refusal(neumann_neumann, pair.problem);
@@ -473,7 +477,8 @@ TEST(FloatingBody, DirichletNeumannWithTheFloatingContactBodyEqualsMonolithic) {
   Ports ports;
   set_up_ports(assembly, ports);
   CouplingOptions options;
-  options.algorithm = "dirichlet-neumann";  // contact body "auto": the floating one
+  options.algorithm =
+      CouplingAlgorithm::dirichlet_neumann;  // contact body "auto": the floating one
   options.tolerance = 1e-10;
   options.max_iterations = 300;
   const RobinResult result =
@@ -491,9 +496,9 @@ TEST(FloatingBody, RobinConstantRunsWithAFloatingBody) {
   Ports ports;
   set_up_ports(assembly, ports);
   CouplingOptions options;
-  options.algorithm = "robin-constant";
+  options.algorithm = CouplingAlgorithm::robin_constant;
   options.alpha = 1e-4;  // below h / E (docs/method.md, "The algorithm family")
-  options.stopping = "joint";
+  options.stopping = StoppingRule::joint;
   options.tolerance = 1e-9;
   options.max_iterations = 2000;
   const RobinResult result =

@@ -100,9 +100,9 @@ TEST_P(HertzStepsTest, StepsEqualFreshMonolithicSolvesAndWarmStartsSaveIteration
   CaseDefinition definition = example("hertz_steps.toml");
   definition.solver.qp.relative_tolerance = 1e-14;
   if (plain) {
-    definition.coupling.acceleration.method = "none";
+    definition.coupling.acceleration.method = AccelerationMethod::none;
     definition.coupling.relaxation = 0.5;
-    definition.coupling.stopping = "joint";
+    definition.coupling.stopping = StoppingRule::joint;
   }
   const std::vector<double> factors = definition.loading.factors;
   ASSERT_EQ(factors, (std::vector<double>{0.25, 0.5, 0.75, 1.0}));

@@ -103,7 +103,7 @@ MonolithicRow solve_monolithic_row(const Row& row) {
   return reference;
 }
 
-RobinResult run_row(const Row& row, const std::string& acceleration) {
+RobinResult run_row(const Row& row, AccelerationMethod acceleration) {
   std::vector<InProcessPort> ports(row.definitions.size());
   std::vector<SubdomainPort*> pointers;
   SolverOptions solver;
@@ -141,10 +141,12 @@ TEST(ManyBodies, RowOfThreeBlocksEqualsTheMonolithicContactGraphSolution) {
   const Row row = make_row(1000.0);
   const MonolithicRow reference = solve_monolithic_row(row);
   ASSERT_EQ(reference.result.qp.status, QpStatus::converged);
-  for (const std::string acceleration : {"iqn-ils", "none"}) {
+  for (const AccelerationMethod acceleration :
+       {AccelerationMethod::iqn_ils, AccelerationMethod::none}) {
     const RobinResult robin = run_row(row, acceleration);
-    std::printf("row of three blocks, %s: %s after %zu iterations (%s)\n", acceleration.c_str(),
-                to_string(robin.status).c_str(), robin.history.size(), robin.message.c_str());
+    std::printf("row of three blocks, %s: %s after %zu iterations (%s)\n",
+                to_string(acceleration).c_str(), to_string(robin.status).c_str(),
+                robin.history.size(), robin.message.c_str());
     ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
     expect_equals_monolithic(robin, row, reference.result);
   }
@@ -190,7 +192,7 @@ TEST(ManyBodies, MonolithicReferenceSatisfiesSignoriniFromTheDisplacementFields)
 
 TEST(ManyBodies, EqualBlocksCarryMirrorSymmetricForcesOnBothInterfaces) {
   const Row row = make_row(1000.0);
-  const RobinResult robin = run_row(row, "iqn-ils");
+  const RobinResult robin = run_row(row, AccelerationMethod::iqn_ils);
   ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
   // The middle block's rows: interface 0's (its left edge), then interface 1's (its right edge).
   const Eigen::VectorXd& middle = robin.state.bodies[1].contact_force;
@@ -214,7 +216,7 @@ TEST(ManyBodies, StiffMiddleBlockStillEqualsTheMonolithicSolution) {
   const Row row = make_row(100000.0);
   const MonolithicRow reference = solve_monolithic_row(row);
   ASSERT_EQ(reference.result.qp.status, QpStatus::converged);
-  const RobinResult robin = run_row(row, "iqn-ils");
+  const RobinResult robin = run_row(row, AccelerationMethod::iqn_ils);
   std::printf("row with a middle block 100 times stiffer: %s after %zu iterations (%s)\n",
               to_string(robin.status).c_str(), robin.history.size(), robin.message.c_str());
   ASSERT_EQ(robin.status, IterationStatus::converged) << robin.message;
@@ -247,11 +249,13 @@ TEST(ManyBodies, SymmetricPairWhoseInterfaceDoesNotMoveConverges) {
   ASSERT_GT(force, 0.0);
   // The interface stays put: its motion is round-off next to the blocks' shortening (1e-3).
   EXPECT_LT(reference.result.normal_traces[0].lpNorm<Eigen::Infinity>(), 1e-12);
-  for (const std::string acceleration : {"iqn-ils", "aitken", "none"}) {
+  for (const AccelerationMethod acceleration :
+       {AccelerationMethod::iqn_ils, AccelerationMethod::aitken, AccelerationMethod::none}) {
     const RobinResult robin = run_row(row, acceleration);
-    std::printf("symmetric pair, %s: %s after %zu iterations\n", acceleration.c_str(),
+    std::printf("symmetric pair, %s: %s after %zu iterations\n", to_string(acceleration).c_str(),
                 to_string(robin.status).c_str(), robin.history.size());
-    ASSERT_EQ(robin.status, IterationStatus::converged) << acceleration << ": " << robin.message;
+    ASSERT_EQ(robin.status, IterationStatus::converged)
+        << to_string(acceleration) << ": " << robin.message;
     for (int body = 0; body < 2; ++body) {
       EXPECT_LE(
           relative_difference(robin.state.bodies[static_cast<std::size_t>(body)].contact_force,
@@ -266,12 +270,13 @@ TEST(ManyBodies, TwoBodyAlgorithmsRefuseAGraphOfThree) {
   std::vector<InProcessPort> ports(3);
   std::vector<SubdomainPort*> pointers;
   for (InProcessPort& port : ports) pointers.push_back(&port);
-  for (const std::string algorithm : {"dirichlet-neumann", "neumann-neumann"}) {
+  for (const CouplingAlgorithm algorithm :
+       {CouplingAlgorithm::dirichlet_neumann, CouplingAlgorithm::neumann_neumann}) {
     CouplingOptions options;
     options.algorithm = algorithm;
     try {
       make_coupling_scheme(options, pointers, row.problem);
-      ADD_FAILURE() << algorithm << " accepted three bodies";
+      ADD_FAILURE() << to_string(algorithm) << " accepted three bodies";
     } catch (const InputError& error) {
       EXPECT_NE(std::string(error.what()).find("exactly two bodies"), std::string::npos)
           << error.what();

@@ -45,7 +45,7 @@ double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& 
 /// Runs the case with `method` ("none": the paper's plain relaxation with `relaxation` and its
 /// joint stopping test) and compares with the monolithic reference; returns the iteration count.
 std::size_t expect_matches_monolithic(const CaseDefinition& definition,
-                                      const std::string& case_name, const std::string& method,
+                                      const std::string& case_name, AccelerationMethod method,
                                       double relaxation, double tolerance = 1e-9,
                                       double reference_qp_tolerance = 0.0) {
   CouplingOptions options = definition.coupling;
@@ -53,15 +53,15 @@ std::size_t expect_matches_monolithic(const CaseDefinition& definition,
   options.relaxation = relaxation;
   options.tolerance = tolerance;
   options.max_iterations = 5000;
-  if (method == "none") options.stopping = "joint";
+  if (method == AccelerationMethod::none) options.stopping = StoppingRule::joint;
   const CoupledRunResult robin = run_in_process(definition, options);
-  std::printf("%s: %s, delta = %.3g: %s after %zu iterations\n", case_name.c_str(), method.c_str(),
-              relaxation, to_string(robin.iteration.status).c_str(),
+  std::printf("%s: %s, delta = %.3g: %s after %zu iterations\n", case_name.c_str(),
+              to_string(method).c_str(), relaxation, to_string(robin.iteration.status).c_str(),
               robin.iteration.history.size());
   const std::size_t iterations = robin.iteration.history.size();
   EXPECT_EQ(robin.iteration.status, IterationStatus::converged) << robin.iteration.message;
   if (robin.iteration.status != IterationStatus::converged) return iterations;
-  if (options.stopping == "joint") {
+  if (options.stopping == StoppingRule::joint) {
     EXPECT_EQ(robin.iteration.completed_by_sequence, 0);
   }
 
@@ -101,24 +101,24 @@ std::size_t expect_matches_monolithic(const CaseDefinition& definition,
   return iterations;
 }
 
-std::size_t expect_matches_monolithic(const std::string& case_name, const std::string& method,
+std::size_t expect_matches_monolithic(const std::string& case_name, AccelerationMethod method,
                                       double relaxation, double tolerance = 1e-9) {
   return expect_matches_monolithic(example(case_name), case_name, method, relaxation, tolerance);
 }
 
 // The paper's plain relaxation.
 TEST(RobinVersusMonolithic, SymmetricBlocks) {
-  expect_matches_monolithic("two_blocks.toml", "none", 0.5);
+  expect_matches_monolithic("two_blocks.toml", AccelerationMethod::none, 0.5);
 }
 
 TEST(RobinVersusMonolithic, PartialContactBlocks) {
-  expect_matches_monolithic("two_blocks_partial.toml", "none", 0.5);
+  expect_matches_monolithic("two_blocks_partial.toml", AccelerationMethod::none, 0.5);
 }
 
 TEST(RobinVersusMonolithic, AsymmetricCantileverOnBlock) {
   // The bending cantilever is far more compliant than the block on smooth modes, so one shared
   // delta must be small (see docs/method.md).
-  expect_matches_monolithic("asymmetric.toml", "none", 0.02);
+  expect_matches_monolithic("asymmetric.toml", AccelerationMethod::none, 0.02);
 }
 
 TEST(RobinIteration, PlainRelaxationIterationCounts) {
@@ -128,9 +128,9 @@ TEST(RobinIteration, PlainRelaxationIterationCounts) {
   for (const std::string name : {"two_blocks.toml", "two_blocks_partial.toml", "asymmetric.toml"}) {
     const CaseDefinition definition = example(name);
     CouplingOptions options = definition.coupling;
-    options.acceleration.method = "none";
+    options.acceleration.method = AccelerationMethod::none;
     options.relaxation = 0.5;
-    options.stopping = "joint";  // the paper's test
+    options.stopping = StoppingRule::joint;  // the paper's test
     options.max_iterations = 1000;
     const CoupledRunResult robin = run_in_process(definition, options);
     std::printf("plain relaxation delta = 0.5 on %s: %s, %zu iterations (%s)\n", name.c_str(),
@@ -147,7 +147,7 @@ TEST(RobinIteration, PlainRelaxationIterationCounts) {
 }
 
 TEST(RobinVersusMonolithic, Hertz) {
-  expect_matches_monolithic("hertz.toml", "none", 0.5);
+  expect_matches_monolithic("hertz.toml", AccelerationMethod::none, 0.5);
 }
 
 // The accelerated methods reach the same answer; the default (Aitken per body) needs far fewer
@@ -155,9 +155,9 @@ TEST(RobinVersusMonolithic, Hertz) {
 TEST(RobinVersusMonolithic, AcceleratedMethodsOnEveryCase) {
   for (const std::string name :
        {"two_blocks.toml", "two_blocks_partial.toml", "asymmetric.toml", "hertz.toml"}) {
-    expect_matches_monolithic(name, "aitken", 0.5);
+    expect_matches_monolithic(name, AccelerationMethod::aitken, 0.5);
     // IQN-ILS stalls near 1e-9 on the asymmetric pair (secant columns of QP noise): 1e-8 here.
-    expect_matches_monolithic(name, "iqn-ils", 0.5, 1e-8);
+    expect_matches_monolithic(name, AccelerationMethod::iqn_ils, 0.5, 1e-8);
   }
 }
 
@@ -168,14 +168,16 @@ TEST(RobinVersusMonolithic, AcceleratedMethodsOnEveryCase) {
 TEST(RobinVersusMonolithic, AitkenOnTheAsymmetricPairAtHOverEightStopsNearTheAnswer) {
   CaseDefinition definition = example("asymmetric.toml");
   for (BodyCase& body : definition.bodies) body.mesh_options.size /= 8.0;
-  expect_matches_monolithic(definition, "asymmetric.toml at h/8", "aitken", 0.5, 1e-8, 1e-14);
+  expect_matches_monolithic(definition, "asymmetric.toml at h/8", AccelerationMethod::aitken, 0.5,
+                            1e-8, 1e-14);
 }
 
 TEST(RobinVersusMonolithic, DefaultMethodBeatsTheBestFixedDeltaTenfoldOnTheAsymmetricPair) {
   const AccelerationOptions defaults;  // named: see case_file_overrides_test.cpp
-  const std::string default_method = defaults.method;
+  const AccelerationMethod default_method = defaults.method;
   const std::size_t accelerated = expect_matches_monolithic("asymmetric.toml", default_method, 0.5);
-  const std::size_t plain = expect_matches_monolithic("asymmetric.toml", "none", 0.02);
+  const std::size_t plain =
+      expect_matches_monolithic("asymmetric.toml", AccelerationMethod::none, 0.02);
   EXPECT_LE(10 * accelerated, plain);
 }
 
@@ -184,7 +186,7 @@ TEST(RobinIteration, TooLargeRelaxationIsReportedAsDiverging) {
   // iteration, so delta = 1.5 doubles it every iteration.
   const CaseDefinition definition = example("two_blocks.toml");
   CouplingOptions options = definition.coupling;
-  options.acceleration.method = "none";
+  options.acceleration.method = AccelerationMethod::none;
   options.relaxation = 1.5;
   options.max_iterations = 200;
   const CoupledRunResult robin = run_in_process(definition, options);
