@@ -1,5 +1,7 @@
 #include "numerics/body_solver.hpp"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -18,6 +20,15 @@ std::string format_load_factor(double factor) {
   std::ostringstream text;
   text << factor;
   return text.str();
+}
+
+/// Gives the pages of freed heap memory back to the system (glibc keeps them otherwise, in the
+/// middle of its arenas), so that they do not count again beside the factor about to be
+/// allocated. Elsewhere nothing.
+void release_free_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -245,10 +256,9 @@ void BodySolver::assemble() {
         "': the Dirichlet conditions leave a rigid motion free (translation or rotation); "
         "fix u_x and u_y on a boundary segment, or enough components on several boundaries");
   }
-  full_stiffness_ = assemble_stiffness(mesh, definition_.material);
+  SparseMatrix reduced_stiffness = assemble_reduced_stiffness();
   full_load_ = assemble_external_load(definition_);
-  const SparseMatrix reduced_stiffness = dofs_->reduce_matrix(full_stiffness_);
-  reduced_load_ = dofs_->reduce_load(full_stiffness_, full_load_);
+  reduced_load_ = dofs_->reduce_load(prescribed_stiffness_, full_load_);
   for (std::size_t k = 0; k < definition_.contact_boundaries.size(); ++k) {
     const Eigen::VectorXd weights =
         robin::boundary_weights(mesh, mesh.boundary(definition_.contact_boundaries[k]));
@@ -265,14 +275,27 @@ void BodySolver::assemble() {
   Eigen::MatrixXd kernel = options_.rigid_motions == RigidMotions::refuse
                                ? Eigen::MatrixXd(dofs_->free_count(), 0)
                                : rigid_body_modes(mesh, *dofs_);
-  factor_ = std::make_unique<GeneralizedInverse>(reduced_stiffness, std::move(kernel), name(),
-                                                 trailing_unknowns(), options_.maximum_factor_bytes,
-                                                 options_.observer);
+  factor_ = std::make_unique<GeneralizedInverse>(
+      std::move(reduced_stiffness), std::move(kernel), name(), trailing_unknowns(),
+      options_.maximum_factor_bytes, factorization_observer());
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
   rigid_amplitudes_ = Eigen::VectorXd::Zero(rigid_mode_count());
   // the ordering as the factor measured it; the rest (numerical factorization, K^{-1} f) here
   timings_.ordering_seconds = factor_->ordering_seconds();
   timings_.factorization_seconds = seconds_since(start) - timings_.ordering_seconds;
+}
+
+SparseMatrix BodySolver::assemble_reduced_stiffness() {
+  const SparseMatrix stiffness = assemble_stiffness(definition_.mesh, definition_.material);
+  prescribed_stiffness_ = dofs_->prescribed_part(stiffness);
+  return dofs_->reduce_matrix_lower(stiffness);
+}
+
+SetupObserver BodySolver::factorization_observer() const {
+  return [observer = options_.observer](SetupStage stage) {
+    if (stage == SetupStage::factorization) release_free_memory();
+    if (observer) observer(stage);
+  };
 }
 
 std::vector<int> BodySolver::trailing_unknowns() const {
@@ -284,7 +307,8 @@ std::vector<int> BodySolver::trailing_unknowns() const {
       if (!dofs_->is_prescribed(dof)) unknowns.push_back(dofs_->free_index(dof));
     }
   }
-  if (static_cast<long>(unknowns.size()) > long{definition_.mesh.dimension} * options_.dense_limit) {
+  if (static_cast<long>(unknowns.size()) >
+      long{definition_.mesh.dimension} * options_.dense_limit) {
     unknowns.clear();
   }
   return unknowns;
@@ -440,7 +464,7 @@ void BodySolver::replace_loads(BodyDefinition definition, const BodySolverOption
   definition_ = std::move(definition);
   dofs_ = std::make_unique<DofMap>(prescribed_dofs(definition_));
   full_load_ = assemble_external_load(definition_);
-  reduced_load_ = dofs_->reduce_load(full_stiffness_, full_load_);
+  reduced_load_ = dofs_->reduce_load(prescribed_stiffness_, full_load_);
   timings_.assembly_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f with the kept factor
@@ -562,7 +586,8 @@ Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force,
 }
 
 Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& displacement) const {
-  Eigen::VectorXd reaction = full_stiffness_ * displacement - load_factor_ * full_load_;
+  // (K u)_p = K_p: u: the prescribed part holds the whole of every prescribed row
+  Eigen::VectorXd reaction = prescribed_stiffness_ * displacement - load_factor_ * full_load_;
   for (int dof = 0; dof < dofs_->total_count(); ++dof) {
     if (!dofs_->is_prescribed(dof)) reaction[dof] = 0.0;
   }

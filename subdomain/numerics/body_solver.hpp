@@ -76,8 +76,8 @@ struct BodySolverOptions {
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
   int dense_limit = 3000;
   /// Eliminate the free dofs of the contact boundaries last in the Cholesky factor (when there
-  /// are at most dimension x dense_limit of them), so a dense F comes from the factor's trailing block in
-  /// O(m^2 n_c) instead of n_c solves with the whole factor (see numerics/cholesky.hpp).
+  /// are at most dimension x dense_limit of them), so a dense F comes from the factor's trailing
+  /// block in O(m^2 n_c) instead of n_c solves with the whole factor (see numerics/cholesky.hpp).
   bool contact_unknowns_last = true;
   /// Limits checked before the work starts (0 = none): the body's degrees of freedom (2 or 3 per
   /// node, before assembly) and the memory of its Cholesky factor (from the symbolic
@@ -227,9 +227,9 @@ class BodySolver {
   /// correction solve (one product with F). Throws SingularBodyError for a floating body.
   Eigen::VectorXd solve_neumann(const Eigen::VectorXd& contact_force) const;
 
-  /// Full displacement (mesh.dimension per node, prescribed values included) under contact forces lambda:
-  /// u_f = K^+ (t f - B' lambda) + R alpha, alpha the rigid amplitudes of the last contact solve
-  /// (none without rigid motions).
+  /// Full displacement (mesh.dimension per node, prescribed values included) under contact forces
+  /// lambda: u_f = K^+ (t f - B' lambda) + R alpha, alpha the rigid amplitudes of the last contact
+  /// solve (none without rigid motions).
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force) const;
   /// The same with given rigid amplitudes alpha (k values), e.g. the monolithic reference's.
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force,
@@ -247,6 +247,12 @@ class BodySolver {
 
  private:
   void assemble();
+  /// Assembles K, keeps its prescribed part (DofMap::prescribed_part: the reduced load and the
+  /// reactions read nothing else) and returns the lower triangle of K_ff, freeing K.
+  SparseMatrix assemble_reduced_stiffness();
+  /// options_.observer, with the freed heap memory given back to the system (malloc_trim)
+  /// when the numerical factorization begins.
+  SetupObserver factorization_observer() const;
   /// At least one contact boundary, each a boundary of the mesh, none named twice (InputError).
   void check_contact_boundaries() const;
   void report(SetupStage stage) const;
@@ -266,7 +272,7 @@ class BodySolver {
   BodySolverOptions options_;
   BodyTimings timings_;
   std::unique_ptr<DofMap> dofs_;
-  SparseMatrix full_stiffness_;
+  SparseMatrix prescribed_stiffness_;  // K's entries in a prescribed row or column
   Eigen::VectorXd full_load_;
   Eigen::VectorXd reduced_load_;
   std::unique_ptr<GeneralizedInverse> factor_;  // K^{-1}, or K^+ for a floating body

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 #include "numerics/errors.hpp"
 #include "numerics/fill_reducing_ordering.hpp"
@@ -49,6 +50,37 @@ class SupernodalCholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eige
     m_info = Eigen::Success;
     m_analysisIsOk = true;
     m_factorizationIsOk = false;
+  }
+
+  /// factorize(matrix), freeing `matrix` as soon as CHOLMOD holds its own permuted copy, so the
+  /// two are not resident beside L. The steps of cholmod_factorize_p for a supernodal factor of
+  /// a lower-stored matrix (final_asis, no shift): S = tril(P A P') by two transposes (S = A
+  /// for the natural order), then cholmod_super_numeric; the same S, hence the same L.
+  void factorize_releasing(SparseMatrix& matrix) {
+    cholmod_common& common = cholmod();
+    cholmod_factor* factor = m_cholmodFactor;
+    common.status = CHOLMOD_OK;
+    cholmod_sparse* permuted = nullptr;
+    if (factor->ordering != CHOLMOD_NATURAL) {
+      cholmod_sparse view =
+          Eigen::viewAsCholmod(std::as_const(matrix).selfadjointView<Eigen::Lower>());
+      cholmod_sparse* upper = cholmod_ptranspose(&view, 2, static_cast<int*>(factor->Perm), nullptr,
+                                                 0, &common);  // triu(P A P')
+      SparseMatrix().swap(matrix);  // frees it (Eigen's assignment would keep the storage)
+      if (upper != nullptr) permuted = cholmod_ptranspose(upper, 2, nullptr, nullptr, 0, &common);
+      cholmod_free_sparse(&upper, &common);
+    }
+    if (common.status == CHOLMOD_OK) {
+      cholmod_sparse view =
+          Eigen::viewAsCholmod(std::as_const(matrix).selfadjointView<Eigen::Lower>());
+      double no_shift[2] = {0.0, 0.0};
+      cholmod_super_numeric(permuted != nullptr ? permuted : &view, nullptr, no_shift, factor,
+                            &common);
+    }
+    cholmod_free_sparse(&permuted, &common);
+    SparseMatrix().swap(matrix);
+    m_info = factor->minor == factor->n ? Eigen::Success : Eigen::NumericalIssue;
+    m_factorizationIsOk = true;
   }
 };
 
@@ -128,14 +160,14 @@ struct CholeskyFactor::Implementation {
   double ordering_seconds = 0.0;
   double factorization_seconds = 0.0;
 
-  void factorize(const SparseMatrix& matrix, const std::vector<int>& trailing,
+  void factorize(SparseMatrix& matrix, const std::vector<int>& trailing,
                  const SetupObserver& observer);
   void check_memory_estimate();
   void check_pivots() const;
   void locate_trailing(const std::vector<int>& trailing);
 };
 
-void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
+void CholeskyFactor::Implementation::factorize(SparseMatrix& matrix,
                                                const std::vector<int>& trailing,
                                                const SetupObserver& observer) {
   auto start = std::chrono::steady_clock::now();
@@ -153,7 +185,7 @@ void CholeskyFactor::Implementation::factorize(const SparseMatrix& matrix,
   ordering_seconds = seconds_since(start);
   if (observer) observer(SetupStage::factorization);
   start = std::chrono::steady_clock::now();
-  cholesky.factorize(matrix);
+  cholesky.factorize_releasing(matrix);
   const cholmod_factor& factor = *cholesky.factor();
   if (common.status < CHOLMOD_OK) {
     throw std::runtime_error("body '" + body_name + "': CHOLMOD factorization failed (status " +
@@ -220,6 +252,12 @@ void CholeskyFactor::Implementation::check_pivots() const {
 }
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
+                               const std::vector<int>& trailing_unknowns, double memory_limit_bytes,
+                               const SetupObserver& observer)
+    : CholeskyFactor(SparseMatrix(matrix), body_name, trailing_unknowns, memory_limit_bytes,
+                     observer) {}
+
+CholeskyFactor::CholeskyFactor(SparseMatrix&& matrix, const std::string& body_name,
                                const std::vector<int>& trailing_unknowns, double memory_limit_bytes,
                                const SetupObserver& observer)
     : implementation_(std::make_unique<Implementation>()) {

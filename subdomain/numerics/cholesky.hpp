@@ -35,6 +35,11 @@ class CholeskyFactor {
   CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
                  const std::vector<int>& trailing_unknowns = {}, double memory_limit_bytes = 0.0,
                  const SetupObserver& observer = {});
+  /// The same, taking the matrix: it is freed (left empty) during the numerical factorization,
+  /// once CHOLMOD has its own permuted copy, so that the two are not resident beside L.
+  CholeskyFactor(SparseMatrix&& matrix, const std::string& body_name,
+                 const std::vector<int>& trailing_unknowns = {}, double memory_limit_bytes = 0.0,
+                 const SetupObserver& observer = {});
   ~CholeskyFactor();
   CholeskyFactor(const CholeskyFactor&) = delete;
   CholeskyFactor& operator=(const CholeskyFactor&) = delete;

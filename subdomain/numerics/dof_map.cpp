@@ -21,23 +21,54 @@ DofMap::DofMap(std::vector<std::optional<double>> prescribed)
   }
 }
 
-SparseMatrix DofMap::reduce_matrix(const SparseMatrix& full) const {
+template <typename Keep>
+SparseMatrix DofMap::select_entries(const SparseMatrix& full, const std::vector<int>& index,
+                                    int size, Keep keep) const {
   if (full.rows() != total_count() || full.cols() != total_count()) {
-    throw std::invalid_argument("DofMap::reduce_matrix: matrix size differs from the dof count");
+    throw std::invalid_argument("DofMap: matrix size differs from the dof count");
   }
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(full.nonZeros()));
+  // Two passes over full's columns (ascending, rows ascending in each): the counts, then the
+  // entries, so the result is built in place, its rows ascending since `index` is.
+  SparseMatrix selected(size, size);
+  int* column_starts = selected.outerIndexPtr();
+  long count = 0;
   for (int column = 0; column < full.outerSize(); ++column) {
-    const int free_column = free_index_[column];
-    if (free_column < 0) continue;
+    if (index[column] < 0) continue;
+    column_starts[index[column]] = static_cast<int>(count);
     for (SparseMatrix::InnerIterator entry(full, column); entry; ++entry) {
-      const int free_row = free_index_[entry.row()];
-      if (free_row >= 0) triplets.emplace_back(free_row, free_column, entry.value());
+      if (index[entry.row()] >= 0 && keep(static_cast<int>(entry.row()), column)) ++count;
     }
   }
-  SparseMatrix reduced(free_count_, free_count_);
-  reduced.setFromTriplets(triplets.begin(), triplets.end());
-  return reduced;
+  column_starts[size] = static_cast<int>(count);
+  selected.resizeNonZeros(count);
+  long position = 0;
+  for (int column = 0; column < full.outerSize(); ++column) {
+    if (index[column] < 0) continue;
+    for (SparseMatrix::InnerIterator entry(full, column); entry; ++entry) {
+      const int row = static_cast<int>(entry.row());
+      if (index[row] < 0 || !keep(row, column)) continue;
+      selected.innerIndexPtr()[position] = index[row];
+      selected.valuePtr()[position++] = entry.value();
+    }
+  }
+  return selected;
+}
+
+SparseMatrix DofMap::reduce_matrix(const SparseMatrix& full) const {
+  return select_entries(full, free_index_, free_count_, [](int, int) { return true; });
+}
+
+SparseMatrix DofMap::reduce_matrix_lower(const SparseMatrix& full) const {
+  return select_entries(full, free_index_, free_count_,
+                        [](int row, int column) { return row >= column; });
+}
+
+SparseMatrix DofMap::prescribed_part(const SparseMatrix& full) const {
+  std::vector<int> identity(prescribed_.size());
+  for (std::size_t dof = 0; dof < identity.size(); ++dof) identity[dof] = static_cast<int>(dof);
+  return select_entries(full, identity, total_count(), [this](int row, int column) {
+    return is_prescribed(row) || is_prescribed(column);
+  });
 }
 
 Eigen::VectorXd DofMap::reduce_load(const SparseMatrix& full,
@@ -73,7 +104,9 @@ Eigen::VectorXd DofMap::restrict(const Eigen::VectorXd& full) const {
   return free_values;
 }
 
-int rigid_mode_count(int dimension) { return dimension == 3 ? 6 : 3; }
+int rigid_mode_count(int dimension) {
+  return dimension == 3 ? 6 : 3;
+}
 
 Eigen::VectorXd rigid_mode_row(const Mesh& mesh, int dof, const Eigen::Vector3d& centre,
                                double scale) {
@@ -105,7 +138,9 @@ std::pair<Eigen::Vector3d, double> centre_and_scale(const Mesh& mesh) {
   return {centre, scale};
 }
 
-int mode_count(const Mesh& mesh) { return rigid_mode_count(mesh.dimension); }
+int mode_count(const Mesh& mesh) {
+  return rigid_mode_count(mesh.dimension);
+}
 
 /// Eigen decomposition of the Gram matrix Q_p'Q_p of the rigid modes on the prescribed dofs
 /// (eigenvalues ascending).

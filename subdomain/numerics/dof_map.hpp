@@ -26,6 +26,12 @@ class DofMap {
 
   /// Free-free block of K and the reduced load f_f - K_fp u_p.
   SparseMatrix reduce_matrix(const SparseMatrix& full) const;
+  /// The lower triangle of the free-free block (all that a Cholesky factor reads).
+  SparseMatrix reduce_matrix_lower(const SparseMatrix& full) const;
+  /// The entries of K in a prescribed row or column (zero elsewhere): with it instead of K,
+  /// reduce_load gives the same f_f - K_fp u_p and (K u)_p = K_p: u is the same at prescribed
+  /// rows, each sum taken in the same order (the free-free entries only add u_p's zeros).
+  SparseMatrix prescribed_part(const SparseMatrix& full) const;
   Eigen::VectorXd reduce_load(const SparseMatrix& full, const Eigen::VectorXd& full_load) const;
   /// Full field from free values plus the prescribed values.
   Eigen::VectorXd expand(const Eigen::VectorXd& free_values) const;
@@ -33,6 +39,12 @@ class DofMap {
   Eigen::VectorXd restrict(const Eigen::VectorXd& full) const;
 
  private:
+  /// The entries (row, column) of `full` that `keep` accepts, renumbered by `index` (-1: a
+  /// dropped row or column; ascending among the kept ones), in a size x size matrix.
+  template <typename Keep>
+  SparseMatrix select_entries(const SparseMatrix& full, const std::vector<int>& index, int size,
+                              Keep keep) const;
+
   std::vector<std::optional<double>> prescribed_;
   std::vector<int> free_index_;
   Eigen::VectorXd prescribed_values_;

@@ -2,7 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
@@ -132,35 +134,125 @@ Eigen::MatrixXd element_stiffness(const ElementGeometry& geometry, const Eigen::
   return element_stiffness<6>(geometry, Eigen::Matrix<double, 6, 6>(c));
 }
 
+/// The node graph of a mesh: node c shares an element with the nodes
+/// neighbours[offsets[c]] .. neighbours[offsets[c+1] - 1] (itself included), ascending.
+struct NodeGraph {
+  std::vector<long> offsets;
+  std::vector<int> neighbours;
+  int degree(int node) const { return static_cast<int>(offsets[node + 1] - offsets[node]); }
+};
+
+NodeGraph node_graph(const Mesh& mesh) {
+  const int node_count = static_cast<int>(mesh.node_count());
+  // The elements of every node (incidences by block and element), counted then filled.
+  std::vector<long> incidence_offsets(static_cast<std::size_t>(node_count) + 1, 0);
+  for (const ElementBlock& block : mesh.blocks) {
+    for (const int node : block.connectivity) ++incidence_offsets[node + 1];
+  }
+  for (int node = 0; node < node_count; ++node) {
+    incidence_offsets[node + 1] += incidence_offsets[node];
+  }
+  std::vector<std::pair<int, std::size_t>> incidences(
+      static_cast<std::size_t>(incidence_offsets[node_count]));
+  std::vector<long> filled(incidence_offsets.begin(), incidence_offsets.end() - 1);
+  for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
+    const ElementBlock& block = mesh.blocks[b];
+    const std::size_t count = static_cast<std::size_t>(nodes_per_element(block.type));
+    for (std::size_t k = 0; k < block.connectivity.size(); ++k) {
+      incidences[filled[block.connectivity[k]]++] = {static_cast<int>(b), k / count};
+    }
+  }
+  NodeGraph graph;
+  graph.offsets.assign(static_cast<std::size_t>(node_count) + 1, 0);
+  std::vector<int> marked_by(static_cast<std::size_t>(node_count), -1);
+  for (int node = 0; node < node_count; ++node) {
+    const std::size_t first = graph.neighbours.size();
+    for (long k = incidence_offsets[node]; k < incidence_offsets[node + 1]; ++k) {
+      const ElementBlock& block = mesh.blocks[incidences[k].first];
+      const std::size_t count = static_cast<std::size_t>(nodes_per_element(block.type));
+      for (std::size_t i = 0; i < count; ++i) {
+        const int other = block.connectivity[incidences[k].second * count + i];
+        if (marked_by[other] == node) continue;
+        marked_by[other] = node;
+        graph.neighbours.push_back(other);
+      }
+    }
+    std::sort(graph.neighbours.begin() + static_cast<std::ptrdiff_t>(first),
+              graph.neighbours.end());
+    graph.offsets[node + 1] = static_cast<long>(graph.neighbours.size());
+  }
+  return graph;
+}
+
+/// The pattern of K with zero values: column d c + b holds the rows d r + a of every neighbour
+/// r of node c and every component a, ascending (r major), so node c's d columns start at
+/// d^2 offsets[c] and have d degree(c) entries each.
+SparseMatrix stiffness_pattern(const NodeGraph& graph, int dimension) {
+  const int node_count = static_cast<int>(graph.offsets.size()) - 1;
+  const long entry_count = long{dimension} * dimension * graph.offsets[node_count];
+  if (entry_count > std::numeric_limits<int>::max()) {
+    throw std::length_error("assemble_stiffness: more than 2^31 - 1 stiffness entries");
+  }
+  SparseMatrix pattern(dimension * node_count, dimension * node_count);
+  pattern.resizeNonZeros(entry_count);
+  int* column_starts = pattern.outerIndexPtr();
+  int* rows = pattern.innerIndexPtr();
+  long entry = 0;
+  for (int node = 0; node < node_count; ++node) {
+    for (int component = 0; component < dimension; ++component) {
+      column_starts[dimension * node + component] = static_cast<int>(entry);
+      for (long k = graph.offsets[node]; k < graph.offsets[node + 1]; ++k) {
+        for (int row_component = 0; row_component < dimension; ++row_component) {
+          rows[entry++] = dimension * graph.neighbours[k] + row_component;
+        }
+      }
+    }
+  }
+  column_starts[dimension * node_count] = static_cast<int>(entry);
+  std::fill(pattern.valuePtr(), pattern.valuePtr() + entry_count, 0.0);
+  return pattern;
+}
+
+/// The position in stiffness_pattern's values of K(d row_node, d column_node): the first
+/// column of column_node, at row_node's place among its neighbours.
+long entry_offset(const NodeGraph& graph, int dimension, int row_node, int column_node) {
+  const int* first = graph.neighbours.data() + graph.offsets[column_node];
+  const int* last = graph.neighbours.data() + graph.offsets[column_node + 1];
+  const long place = std::lower_bound(first, last, row_node) - first;
+  return long{dimension} * dimension * graph.offsets[column_node] + long{dimension} * place;
+}
+
 }  // namespace
 
 SparseMatrix assemble_stiffness(const Mesh& mesh, const Material& material) {
   check_material_dimension(mesh, material);
   const int dimension = mesh.dimension;
-  std::vector<Eigen::Triplet<double>> triplets;
-  std::size_t reserve = 0;
-  for (const ElementBlock& block : mesh.blocks) {
-    const std::size_t size = dimension * nodes_per_element(block.type);
-    reserve += block.element_count() * size * size;
-  }
-  triplets.reserve(reserve);
+  const NodeGraph graph = node_graph(mesh);
+  SparseMatrix stiffness = stiffness_pattern(graph, dimension);
+  double* values = stiffness.valuePtr();
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
     const ElementBlock& block = mesh.blocks[b];
     const int count = nodes_per_element(block.type);
+    std::vector<long> starts(static_cast<std::size_t>(count * count));
     for (std::size_t e = 0; e < block.element_count(); ++e) {
       const Eigen::MatrixXd local = element_stiffness({mesh, b, e}, material.stiffness);
       const int* nodes = &block.connectivity[e * count];
+      for (int column = 0; column < count; ++column) {
+        for (int row = 0; row < count; ++row) {
+          starts[row * count + column] = entry_offset(graph, dimension, nodes[row], nodes[column]);
+        }
+      }
+      // K(d r + a, d c + b) += K_e(d i + a, d j + b) for element nodes r = nodes[i], c = nodes[j],
+      // in the order of i, a, j, b: every entry sums its elements' terms in element order.
       for (int i = 0; i < dimension * count; ++i) {
         for (int j = 0; j < dimension * count; ++j) {
-          triplets.emplace_back(dimension * nodes[i / dimension] + i % dimension,
-                                dimension * nodes[j / dimension] + j % dimension, local(i, j));
+          const long start = starts[(i / dimension) * count + j / dimension];
+          const long column_length = long{dimension} * graph.degree(nodes[j / dimension]);
+          values[start + (j % dimension) * column_length + i % dimension] += local(i, j);
         }
       }
     }
   }
-  const int size = mesh.dof_count();
-  SparseMatrix stiffness(size, size);
-  stiffness.setFromTriplets(triplets.begin(), triplets.end());
   return stiffness;
 }
 
@@ -191,7 +283,8 @@ Eigen::VectorXd assemble_boundary_traction(const Mesh& mesh, const BoundaryGroup
   Eigen::VectorXd load = Eigen::VectorXd::Zero(mesh.dof_count());
   const NodeElementMap adjacency(mesh);
   const int count = nodes_per_facet(group.type);
-  const std::vector<QuadraturePoint> rule = facet_quadrature(group.type, facet_load_degree(group.type));
+  const std::vector<QuadraturePoint> rule =
+      facet_quadrature(group.type, facet_load_degree(group.type));
   for (std::size_t e = 0; e < group.facet_count(); ++e) {
     const FacetGeometry facet(mesh, group, e, adjacency);
     for (const QuadraturePoint& point : rule) {
@@ -233,7 +326,8 @@ Eigen::VectorXd boundary_weights(const Mesh& mesh, const BoundaryGroup& group) {
     }
     return weights;
   }
-  const std::vector<QuadraturePoint> rule = facet_quadrature(group.type, facet_load_degree(group.type));
+  const std::vector<QuadraturePoint> rule =
+      facet_quadrature(group.type, facet_load_degree(group.type));
   for (std::size_t e = 0; e < group.facet_count(); ++e) {
     const FacetGeometry facet(mesh, group, e);
     for (const QuadraturePoint& point : rule) {

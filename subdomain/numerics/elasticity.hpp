@@ -17,7 +17,8 @@ namespace robin {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using VectorField = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 
-/// Global stiffness K (d n x d n, symmetric) assembled from element triplets. Throws
+/// Global stiffness K (d n x d n, symmetric) assembled element by element into its pattern (the
+/// node pairs that share an element), each entry summing its terms in element order. Throws
 /// InputError when the material is not of the mesh's dimension.
 SparseMatrix assemble_stiffness(const Mesh& mesh, const Material& material);
 

@@ -43,9 +43,16 @@ GeneralizedInverse::GeneralizedInverse(const SparseMatrix& stiffness, Eigen::Mat
                                        const std::string& body_name,
                                        const std::vector<int>& trailing_unknowns,
                                        double memory_limit_bytes, const SetupObserver& observer)
+    : GeneralizedInverse(SparseMatrix(stiffness), std::move(kernel), body_name, trailing_unknowns,
+                         memory_limit_bytes, observer) {}
+
+GeneralizedInverse::GeneralizedInverse(SparseMatrix&& stiffness, Eigen::MatrixXd kernel,
+                                       const std::string& body_name,
+                                       const std::vector<int>& trailing_unknowns,
+                                       double memory_limit_bytes, const SetupObserver& observer)
     : size_(static_cast<int>(stiffness.rows())), kernel_(std::move(kernel)) {
   if (kernel_.cols() == 0) {
-    factor_ = std::make_unique<CholeskyFactor>(stiffness, body_name, trailing_unknowns,
+    factor_ = std::make_unique<CholeskyFactor>(std::move(stiffness), body_name, trailing_unknowns,
                                                memory_limit_bytes, observer);
     return;
   }
@@ -65,9 +72,10 @@ GeneralizedInverse::GeneralizedInverse(const SparseMatrix& stiffness, Eigen::Mat
       kept_trailing.push_back(kept_index_[static_cast<std::size_t>(unknown)]);
     }
   }
-  factor_ =
-      std::make_unique<CholeskyFactor>(kept_block(stiffness, kept_index_, kept_count), body_name,
-                                       kept_trailing, memory_limit_bytes, observer);
+  SparseMatrix kept = kept_block(stiffness, kept_index_, kept_count);
+  SparseMatrix().swap(stiffness);  // only K_rr is factorized
+  factor_ = std::make_unique<CholeskyFactor>(std::move(kept), body_name, kept_trailing,
+                                             memory_limit_bytes, observer);
 }
 
 Eigen::VectorXd GeneralizedInverse::restrict_to_kept(const Eigen::VectorXd& values) const {

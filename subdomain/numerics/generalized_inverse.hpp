@@ -37,6 +37,10 @@ class GeneralizedInverse {
   GeneralizedInverse(const SparseMatrix& stiffness, Eigen::MatrixXd kernel,
                      const std::string& body_name, const std::vector<int>& trailing_unknowns,
                      double memory_limit_bytes, const SetupObserver& observer);
+  /// The same, taking K: it is freed (left empty) during the factorization (cholesky.hpp).
+  GeneralizedInverse(SparseMatrix&& stiffness, Eigen::MatrixXd kernel, const std::string& body_name,
+                     const std::vector<int>& trailing_unknowns, double memory_limit_bytes,
+                     const SetupObserver& observer);
 
   int size() const { return size_; }
   /// k, the dimension of the kernel.

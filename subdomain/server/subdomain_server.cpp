@@ -388,7 +388,7 @@ void SubdomainServer::check_version(const protocol::Envelope& request) const {
   }
 }
 
-void SubdomainServer::dispatch(const protocol::Envelope& request, protocol::Envelope& reply,
+void SubdomainServer::dispatch(protocol::Envelope& request, protocol::Envelope& reply,
                                RequestRecord& record) {
   using Envelope = protocol::Envelope;
   switch (request.content_case()) {
@@ -475,7 +475,7 @@ void SubdomainServer::on_hello(protocol::Envelope& reply) {
   hello.set_state(to_string(state_));
 }
 
-void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol::Envelope& reply,
+void SubdomainServer::on_setup_body(protocol::Envelope& request, protocol::Envelope& reply,
                                     RequestRecord& record) {
   // A SetupBody starts a new run, whatever its outcome (and whose the body was); the previous
   // body's factor serves it when the stiffness is the same, and is freed before a new one is
@@ -498,6 +498,8 @@ void SubdomainServer::on_setup_body(const protocol::Envelope& request, protocol:
       request.setup_body(),
       {settings_.data_directory, settings_.maximum_mesh_file_bytes, settings_.mesh_reader});
   const double mesh_seconds = seconds_since(mesh_start);
+  // The body holds its own copy of the mesh: the request's is freed before the assembly.
+  request.mutable_setup_body()->clear_mesh();
   setup.body.maximum_dofs = settings_.maximum_dofs;
   setup.body.maximum_factor_bytes = settings_.maximum_factor_bytes;
   const long dof_count = static_cast<long>(setup.definition.mesh.dof_count());

@@ -162,15 +162,13 @@ class SubdomainServer {
  private:
   struct RequestRecord;
 
-  void dispatch(const protocol::Envelope& request, protocol::Envelope& reply,
-                RequestRecord& record);
+  void dispatch(protocol::Envelope& request, protocol::Envelope& reply, RequestRecord& record);
   void check_version(const protocol::Envelope& request) const;
   void require_state(ServerState minimum, const std::string& request_type) const;
   /// Throws WRONG_STATE when `request` names another run than the body's (see above).
   void require_same_run(const protocol::Envelope& request, const std::string& request_type) const;
   void on_hello(protocol::Envelope& reply);
-  void on_setup_body(const protocol::Envelope& request, protocol::Envelope& reply,
-                     RequestRecord& record);
+  void on_setup_body(protocol::Envelope& request, protocol::Envelope& reply, RequestRecord& record);
   void on_assign_contact(const protocol::Envelope& request, protocol::Envelope& reply);
   void on_contact_solve(const protocol::Envelope& request, protocol::Envelope& reply,
                         RequestRecord& record);

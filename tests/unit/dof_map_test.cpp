@@ -45,6 +45,28 @@ TEST_F(SmallSystem, ReducedMatrixAndLoadByHand) {
   EXPECT_EQ(load, Eigen::Vector2d(2.0, 4.0));
 }
 
+TEST_F(SmallSystem, LowerTriangleOfTheReducedMatrix) {
+  // A non-symmetric K shows which triangle is taken: K_ff = rows/columns {0, 2}.
+  Eigen::Matrix4d dense = dense_;
+  dense(2, 0) = -0.5;
+  const SparseMatrix reduced = dofs_.reduce_matrix_lower(from_dense(dense));
+  EXPECT_EQ(reduced.nonZeros(), 3);
+  EXPECT_EQ(Eigen::MatrixXd(reduced), Eigen::Matrix2d({{4.0, 0.0}, {-0.5, 4.0}}));
+}
+
+TEST_F(SmallSystem, PrescribedPartGivesTheSameLoadAndReactions) {
+  // Every entry in row or column 1 or 3 is kept; the free-free entries (0, 0), (2, 2) are not.
+  const SparseMatrix part = dofs_.prescribed_part(stiffness_);
+  EXPECT_EQ(part.nonZeros(), stiffness_.nonZeros() - 2);
+  const Eigen::Vector4d load(1.0, 2.0, 3.0, 4.0);
+  EXPECT_EQ(dofs_.reduce_load(part, load), dofs_.reduce_load(stiffness_, load));
+  const Eigen::Vector4d displacement(0.5, 2.0, 1.0, -1.0);
+  const Eigen::Vector4d full = stiffness_ * displacement;
+  const Eigen::Vector4d from_part = part * displacement;
+  EXPECT_EQ(from_part(1), full(1));
+  EXPECT_EQ(from_part(3), full(3));
+}
+
 TEST_F(SmallSystem, ExpandAndRestrictRoundTrip) {
   EXPECT_EQ(dofs_.expand(Eigen::Vector2d(0.5, 1.0)), Eigen::Vector4d(0.5, 2.0, 1.0, -1.0));
   EXPECT_EQ(dofs_.restrict(Eigen::Vector4d(10.0, 20.0, 30.0, 40.0)), Eigen::Vector2d(10.0, 30.0));
