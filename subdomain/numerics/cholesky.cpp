@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -167,6 +168,12 @@ struct CholeskyFactor::Implementation {
   void locate_trailing(const std::vector<int>& trailing);
 };
 
+/// CHOLMOD reports an allocation it could not make as a status, not an exception: rethrown as
+/// std::bad_alloc, so that callers handle it as any other exhausted memory.
+void throw_if_out_of_memory(const cholmod_common& common) {
+  if (common.status == CHOLMOD_OUT_OF_MEMORY) throw std::bad_alloc();
+}
+
 void CholeskyFactor::Implementation::factorize(SparseMatrix& matrix,
                                                const std::vector<int>& trailing,
                                                const SetupObserver& observer) {
@@ -178,6 +185,7 @@ void CholeskyFactor::Implementation::factorize(SparseMatrix& matrix,
   std::vector<int> ordering = fill_reducing_ordering(matrix, trailing, common, body_name);
   cholesky.analyze_pattern_ordered(matrix, ordering);
   if (cholesky.factor() == nullptr || common.status < CHOLMOD_OK) {
+    throw_if_out_of_memory(common);
     throw std::runtime_error("body '" + body_name + "': CHOLMOD analysis failed (status " +
                              std::to_string(common.status) + ", e.g. out of memory)");
   }
@@ -188,6 +196,7 @@ void CholeskyFactor::Implementation::factorize(SparseMatrix& matrix,
   cholesky.factorize_releasing(matrix);
   const cholmod_factor& factor = *cholesky.factor();
   if (common.status < CHOLMOD_OK) {
+    throw_if_out_of_memory(common);
     throw std::runtime_error("body '" + body_name + "': CHOLMOD factorization failed (status " +
                              std::to_string(common.status) + ", e.g. out of memory)");
   }

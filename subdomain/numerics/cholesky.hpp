@@ -24,7 +24,8 @@ class CholeskyFactor {
   /// Factorizes the symmetric positive definite `matrix` (only its lower triangle is read).
   /// Throws SingularBodyError naming `body_name` when the matrix is not positive definite or
   /// numerically singular (pivot ratio min L_jj^2 / max L_jj^2 < 1e-13, i.e. cond > 1e13);
-  /// InputError when it is empty or not square. Solves are not thread-safe (CHOLMOD workspace).
+  /// InputError when it is empty or not square; std::bad_alloc when CHOLMOD runs out of memory.
+  /// Solves are not thread-safe (CHOLMOD workspace).
   /// `trailing_unknowns` (indices into the matrix, distinct) are eliminated last: the rest
   /// in the fill-reducing order of the matrix without them (fill_reducing_ordering.hpp: AMD or
   /// METIS on the graph of the nodes), then these in the given order.

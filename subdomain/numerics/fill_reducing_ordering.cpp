@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <new>
 #include <stdexcept>
 
 namespace robin {
@@ -139,6 +140,7 @@ std::vector<int> order_graph(cholmod_sparse* graph, cholmod_common& common,
   common.supernodal = supernodal;
   if (symbolic == nullptr || common.status < CHOLMOD_OK) {
     if (symbolic != nullptr) cholmod_free_factor(&symbolic, &common);
+    if (common.status == CHOLMOD_OUT_OF_MEMORY) throw std::bad_alloc();
     throw std::runtime_error("body '" + body_name + "': CHOLMOD ordering failed (status " +
                              std::to_string(common.status) + ")");
   }
@@ -172,6 +174,7 @@ std::vector<int> fill_reducing_ordering(const SparseMatrix& matrix,
       graph = supervariable_graph(pattern, first, common);
     }
     if (graph == nullptr) {
+      if (common.status == CHOLMOD_OUT_OF_MEMORY) throw std::bad_alloc();
       throw std::runtime_error("body '" + body_name +
                                "': CHOLMOD could not allocate the ordering graph (status " +
                                std::to_string(common.status) + ")");

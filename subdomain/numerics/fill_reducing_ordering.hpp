@@ -28,7 +28,8 @@ namespace robin {
 /// then `trailing`, in the given order. Supervariables are found among consecutive unknowns
 /// (the components of a node are numbered together). `common` is CHOLMOD's workspace; its
 /// ordering settings are restored on return. Throws std::invalid_argument naming `body_name`
-/// when a trailing unknown is out of range or repeated, std::runtime_error when CHOLMOD fails.
+/// when a trailing unknown is out of range or repeated, std::bad_alloc when CHOLMOD runs out of
+/// memory, std::runtime_error when it fails otherwise.
 std::vector<int> fill_reducing_ordering(const SparseMatrix& matrix,
                                         const std::vector<int>& trailing,
                                         cholmod_common_struct& common,

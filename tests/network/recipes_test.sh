@@ -213,8 +213,8 @@ check_systemd_unit() {
 library_owners() {
   local tools=() libraries=() resolved=() index
   declare -A owner
-  mapfile -t tools < <(grep -o '/src/build/bin/robin-[a-z]*' deploy/Dockerfile | sed 's|.*/||' | sort -u)
-  [ ${#tools[@]} -eq 5 ] || { echo "expected 5 executables in deploy/Dockerfile: ${tools[*]}"; return 1; }
+  mapfile -t tools < <(grep -o '/src/build/bin/robin-[a-z-]*' deploy/Dockerfile | sed 's|.*/||' | sort -u)
+  [ ${#tools[@]} -eq 6 ] || { echo "expected 6 executables in deploy/Dockerfile: ${tools[*]}"; return 1; }
   for index in "${!tools[@]}"; do ldd "$binary_directory/${tools[index]}" || return 1; done |
     awk '$3 ~ /^\// { print $3 }' | sort -u > "$work/libraries"
   mapfile -t libraries < "$work/libraries"
