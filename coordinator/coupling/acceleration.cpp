@@ -32,12 +32,6 @@ std::unique_ptr<Acceleration> per_block(const std::vector<int>& sizes, MakeBlock
   return std::make_unique<BlockwiseAcceleration>(sizes, std::move(parts));
 }
 
-QuasiNewtonMixing parse_mixing(const std::string& mixing) {
-  if (mixing == "full") return QuasiNewtonMixing::full;
-  if (mixing == "relaxation") return QuasiNewtonMixing::relaxation;
-  return QuasiNewtonMixing::aitken;
-}
-
 /// delta of block `block`: relaxation1 for the first, relaxation2 for the second and every
 /// further block (the bodies of a contact graph beyond the second).
 RelaxationBlock relaxation_block(const AccelerationOptions& options, int block, int size) {
@@ -47,7 +41,7 @@ RelaxationBlock relaxation_block(const AccelerationOptions& options, int block, 
 std::unique_ptr<Acceleration> make_quasi_newton(const AccelerationOptions& options,
                                                 const std::vector<int>& sizes) {
   const QuasiNewtonParameters parameters{options.history_depth,    options.filter_threshold,
-                                         options.safeguard_growth, parse_mixing(options.mixing),
+                                         options.safeguard_growth, options.mixing,
                                          options.aitken_minimum,   options.aitken_maximum};
   if (!options.per_body) {
     std::vector<RelaxationBlock> blocks;
@@ -65,10 +59,6 @@ std::unique_ptr<Acceleration> make_quasi_newton(const AccelerationOptions& optio
 }  // namespace
 
 void validate(const AccelerationOptions& options) {
-  if (options.mixing != "full" && options.mixing != "relaxation" && options.mixing != "aitken") {
-    throw InputError("acceleration.mixing must be \"full\", \"relaxation\" or \"aitken\", got \"" +
-                     options.mixing + "\"");
-  }
   // The relaxation range of the plain iteration (case file: coupling.relaxation).
   require(options.relaxation1 > 0.0 && options.relaxation1 < 2.0, "relaxation1", "in (0, 2)",
           options.relaxation1);

@@ -40,8 +40,8 @@ struct AccelerationOptions {
   double safeguard_growth = 2.0;
   /// "iqn-ils": how the least-squares point x^ and its predicted image h^ are mixed,
   /// x_{k+1} = (1 - beta) x^ + beta h^ per body (acceleration_quasi_newton.hpp):
-  /// "full" (beta = 1, classical IQN-ILS; the default), "relaxation" (beta = relaxation1/2) or
-  /// "aitken" (beta = the secant estimate of the newest column, |beta| in [aitken_minimum,
+  /// full (beta = 1, classical IQN-ILS; the default), relaxation (beta = relaxation1/2) or
+  /// aitken (beta = the secant estimate of the newest column, |beta| in [aitken_minimum,
   /// aitken_maximum]). With "either-sequence" stopping only the well-conditioned obstacle
   /// sequence must converge; for it "full" leaves the modes outside the secant space multiplied
   /// by about -F^b (F^a)^-1, small, while the secant estimate of "aitken" follows the few
@@ -50,7 +50,7 @@ struct AccelerationOptions {
   /// (docs/iteration-study.md, "IQN-ILS mixing on the asymmetric pair"). "aitken" keeps a
   /// truncated history of a badly conditioned sequence convergent where "full" may not
   /// (tests/unit/acceleration_test.cpp).
-  std::string mixing = "full";
+  QuasiNewtonMixing mixing = QuasiNewtonMixing::full;
   /// "iqn-ils": an independent IQN-ILS on each body's block (true), or one on (g^1, g^2).
   /// Per body is the default: the blocks are independent maps, and an ill-conditioned block
   /// then cannot hold back the other (tests/unit/acceleration_test.cpp measures both).

@@ -42,8 +42,6 @@
 
 namespace robin {
 
-enum class QuasiNewtonMixing { full, relaxation, aitken };
-
 struct QuasiNewtonParameters {
   int history_depth = 10;
   double filter_threshold = 1e-10;

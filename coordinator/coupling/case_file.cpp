@@ -187,8 +187,8 @@ void read_acceleration(const CheckedTable& table, CouplingOptions& coupling) {
   acceleration.safeguard_growth =
       number_above(table, "safeguard_growth", 1.0, acceleration.safeguard_growth);
   acceleration.per_body = table.optional_boolean("per_body").value_or(acceleration.per_body);
-  acceleration.mixing = table.optional_choice("mixing", {"full", "relaxation", "aitken"})
-                            .value_or(acceleration.mixing);
+  acceleration.mixing =
+      optional_choice<QuasiNewtonMixing>(table, "mixing").value_or(acceleration.mixing);
   try {
     validate(effective_acceleration(coupling));
   } catch (const InputError& error) {

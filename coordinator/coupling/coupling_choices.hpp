@@ -27,6 +27,9 @@ enum class InitialObstacle { gap, zero };
 /// inverse least squares.
 enum class AccelerationMethod { none, aitken, iqn_ils };
 
+/// How IQN-ILS mixes its least-squares point and predicted image (acceleration.hpp, `mixing`).
+enum class QuasiNewtonMixing { full, relaxation, aitken };
+
 /// Each choice of `Choice` with its text, in the order the case file's messages list them.
 template <typename Choice>
 struct ChoiceSpellings;
@@ -72,6 +75,15 @@ struct ChoiceSpellings<AccelerationMethod> {
       {AccelerationMethod::none, "none"},
       {AccelerationMethod::aitken, "aitken"},
       {AccelerationMethod::iqn_ils, "iqn-ils"},
+  }};
+};
+
+template <>
+struct ChoiceSpellings<QuasiNewtonMixing> {
+  static constexpr std::array<std::pair<QuasiNewtonMixing, std::string_view>, 3> entries{{
+      {QuasiNewtonMixing::full, "full"},
+      {QuasiNewtonMixing::relaxation, "relaxation"},
+      {QuasiNewtonMixing::aitken, "aitken"},
   }};
 };
 

@@ -391,12 +391,12 @@ TEST(TwoBodies, QuasiNewtonNeedsTenTimesFewerIterationsThanTheBestRelaxation) {
   options.method = AccelerationMethod::aitken;
   const int aitken = two_body_calls(map, size, options, 20000);
   options.method = AccelerationMethod::iqn_ils;
-  options.mixing = "aitken";  // on this dense random spectrum (full mixing: see the log line)
+  options.mixing = QuasiNewtonMixing::aitken;  // on this dense random spectrum (full mixing: see the log line)
   options.relaxation1 = options.relaxation2 = 0.5;
   const int per_body = two_body_calls(map, size, options, 20000);
   options.per_body = false;
   const int joint = two_body_calls(map, size, options, 20000);
-  options.mixing = "full";
+  options.mixing = QuasiNewtonMixing::full;
   const int joint_full = two_body_calls(map, size, options, 20000);
   options.per_body = true;
   const int per_body_full = two_body_calls(map, size, options, 20000);
@@ -421,9 +421,9 @@ TEST(TwoBodies, AitkenMixingKeepsAShortHistoryConvergent) {
   options.method = AccelerationMethod::iqn_ils;
   for (const int depth : {3, 5}) {
     options.history_depth = depth;
-    options.mixing = "aitken";
+    options.mixing = QuasiNewtonMixing::aitken;
     const int aitken = two_body_calls(map, size, options, 500);
-    options.mixing = "full";
+    options.mixing = QuasiNewtonMixing::full;
     const int full = two_body_calls(map, size, options, 500);
     std::cout << "c = 100, history depth " << depth << ": aitken mixing " << aitken
               << " iterations, full mixing " << (full > 500 ? "not in 500" : std::to_string(full))
@@ -467,7 +467,7 @@ TEST(TwoBodies, PerBodyQuasiNewtonIsolatesTheGoodSequenceFromANoisyOne) {
   const LinearMap map = two_bodies(size, 100.0, 2.0, generator);
   AccelerationOptions options;
   options.method = AccelerationMethod::iqn_ils;
-  options.mixing = "aitken";
+  options.mixing = QuasiNewtonMixing::aitken;
   const std::vector<double> clean = body1_errors(map, size, options, 0.0, 60);
   const std::vector<double> noisy = body1_errors(map, size, options, 1e-3, 60);
   EXPECT_EQ(clean, noisy);
@@ -515,7 +515,6 @@ std::string validation_message(const AccelerationOptions& options) {
 TEST(AccelerationOptions, DefaultsAreValidAndBadValuesNameTheirField) {
   EXPECT_EQ(validation_message(AccelerationOptions{}), "");
   const std::vector<std::pair<std::function<void(AccelerationOptions&)>, std::string>> cases = {
-      {[](AccelerationOptions& o) { o.mixing = "half"; }, "acceleration.mixing"},
       {[](AccelerationOptions& o) { o.relaxation1 = 0.0; }, "acceleration.relaxation1"},
       {[](AccelerationOptions& o) { o.relaxation2 = 2.5; }, "acceleration.relaxation2"},
       {[](AccelerationOptions& o) { o.relaxation2 = std::nan(""); }, "acceleration.relaxation2"},

@@ -365,6 +365,9 @@ TEST(CaseFile, OptionChoicesKeepTheirTexts) {
   expect_texts<AccelerationMethod>({{AccelerationMethod::none, "none"},
                                     {AccelerationMethod::aitken, "aitken"},
                                     {AccelerationMethod::iqn_ils, "iqn-ils"}});
+  expect_texts<QuasiNewtonMixing>({{QuasiNewtonMixing::full, "full"},
+                                   {QuasiNewtonMixing::relaxation, "relaxation"},
+                                   {QuasiNewtonMixing::aitken, "aitken"}});
 }
 
 TEST(CaseFile, GeoOptionsAndFixComponents) {
@@ -778,6 +781,12 @@ std::vector<ErrorCase> error_cases() {
        "alpha",
        1,
        {"case.toml:{line}: coupling.alpha: must be > 0"}},
+      {"UnknownMixing",
+       "relaxation = 0.5",
+       "mixing = \"half\"",
+       "mixing",
+       1,
+       {"case.toml:{line}: coupling.mixing: 'half' is not one of: full, relaxation, aitken"}},
       {"UnknownContactBody",
        "relaxation = 0.5",
        "contact_body = \"3\"",

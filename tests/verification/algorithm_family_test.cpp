@@ -77,7 +77,7 @@ TEST(AlgorithmFamily, DirichletNeumannWithEitherContactBody) {
         // mixing does.
         if (std::string(case_name) == "asymmetric.toml" &&
             contact_body == ContactBodyChoice::second) {
-          options.acceleration.mixing = "aitken";
+          options.acceleration.mixing = QuasiNewtonMixing::aitken;
         }
       });
     }
