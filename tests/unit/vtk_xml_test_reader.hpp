@@ -32,9 +32,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 
-#include <unistd.h>
+#include "../test_files.hpp"
 
 namespace robin::test {
 
@@ -189,28 +188,7 @@ inline const nlohmann::json& find_array(const nlohmann::json& section, const std
   throw std::runtime_error("no DataArray named " + name);
 }
 
-/// A fresh empty directory under the system temporary directory (named after the test and the
-/// process id, so concurrent runs do not collide), removed on destruction.
-class TemporaryDirectory {
- public:
-  explicit TemporaryDirectory(const std::string& stem) {
-    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            (stem + "_" + (test ? std::string(test->name()) : std::string("global")) + "_" +
-             std::to_string(::getpid()));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TemporaryDirectory() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  TemporaryDirectory(const TemporaryDirectory&) = delete;
-  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+/// The tests' scratch directory (test_files.hpp).
+using robin::testing::TemporaryDirectory;
 
 }  // namespace robin::test
