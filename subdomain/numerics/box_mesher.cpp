@@ -12,9 +12,7 @@ namespace {
 /// The grid of (cells + 1) nodes per direction, x fastest.
 struct Grid {
   Eigen::Vector3i cells;
-  int node(int i, int j, int k) const {
-    return i + (cells.x() + 1) * (j + (cells.y() + 1) * k);
-  }
+  int node(int i, int j, int k) const { return i + (cells.x() + 1) * (j + (cells.y() + 1) * k); }
   int node(const Eigen::Vector3i& at) const { return node(at.x(), at.y(), at.z()); }
 };
 
@@ -26,7 +24,8 @@ std::vector<std::array<Eigen::Vector3i, 4>> kuhn_tetrahedra() {
   do {
     std::array<Eigen::Vector3i, 4> path;
     path[0] = Eigen::Vector3i::Zero();
-    for (int step = 0; step < 3; ++step) path[step + 1] = path[step] + Eigen::Vector3i::Unit(axes[step]);
+    for (int step = 0; step < 3; ++step)
+      path[step + 1] = path[step] + Eigen::Vector3i::Unit(axes[step]);
     tetrahedra.push_back(path);
   } while (std::next_permutation(axes.begin(), axes.end()));
   return tetrahedra;
@@ -93,7 +92,8 @@ void add_midside_nodes(Mesh& mesh) {
   for (std::size_t e = 0; e < block.element_count(); ++e) {
     const int* corners = &block.connectivity[4 * e];
     quadratic.insert(quadratic.end(), corners, corners + 4);
-    for (const auto& [a, b] : tetrahedron_edges) quadratic.push_back(midside(corners[a], corners[b]));
+    for (const auto& [a, b] : tetrahedron_edges)
+      quadratic.push_back(midside(corners[a], corners[b]));
   }
   block = {ElementType::tetrahedron10, std::move(quadratic), {}};
   for (auto& [name, group] : mesh.boundaries) {
@@ -137,8 +137,14 @@ Mesh make_box_mesh(const Eigen::Vector3d& low, const Eigen::Vector3d& high,
       for (int i = 0; i < cells.x(); ++i) {
         const Eigen::Vector3i corner(i, j, k);
         if (hexahedra) {
-          for (const auto& [x, y, z] : {std::array{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                                        {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}) {
+          for (const auto& [x, y, z] : {std::array{0, 0, 0},
+                                        {1, 0, 0},
+                                        {1, 1, 0},
+                                        {0, 1, 0},
+                                        {0, 0, 1},
+                                        {1, 0, 1},
+                                        {1, 1, 1},
+                                        {0, 1, 1}}) {
             block.connectivity.push_back(grid.node(corner + Eigen::Vector3i(x, y, z)));
           }
           continue;
@@ -155,7 +161,7 @@ Mesh make_box_mesh(const Eigen::Vector3d& low, const Eigen::Vector3d& high,
   mesh.blocks.push_back(std::move(block));
   const FacetType face = hexahedra ? FacetType::quadrilateral4 : FacetType::triangle3;
   const std::pair<const char*, std::pair<int, bool>> sides[] = {
-      {"left", {0, false}}, {"right", {0, true}}, {"front", {1, false}},
+      {"left", {0, false}}, {"right", {0, true}},   {"front", {1, false}},
       {"back", {1, true}},  {"bottom", {2, false}}, {"top", {2, true}}};
   for (const auto& [name, side] : sides) {
     mesh.boundaries[name] = {face, side_faces(grid, side.first, side.second, !hexahedra)};

@@ -78,10 +78,10 @@ void check_row(const ContactOperator& contact, int row, const std::vector<int>& 
           " is not a node of the contact boundary (see InterfaceDescription.node_ids)");
     }
     if (contact.components[k] < 0 || contact.components[k] >= dimension) {
-      throw InputError(context + ": AssignContact.components" + entry + " = " +
-                       std::to_string(contact.components[k]) +
-                       (dimension == 3 ? ", expected 0 (x), 1 (y) or 2 (z)"
-                                       : ", expected 0 (x) or 1 (y)"));
+      throw InputError(
+          context + ": AssignContact.components" + entry + " = " +
+          std::to_string(contact.components[k]) +
+          (dimension == 3 ? ", expected 0 (x), 1 (y) or 2 (z)" : ", expected 0 (x) or 1 (y)"));
     }
     if (!std::isfinite(contact.values[k])) {
       throw InputError(context + ": AssignContact.values" + entry + " is not a finite number");

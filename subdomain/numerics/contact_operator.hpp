@@ -44,8 +44,8 @@ ContactOperator node_to_node_operator(const std::vector<int>& nodes,
 
 /// Checks the structure of `contact` against the body's contact nodes (sorted ascending):
 /// offsets start at 0, do not decrease and end at the entry count; no empty row; every node a
-/// contact node; components 0 .. dimension - 1; finite values; distinct (node, component) pairs in a row;
-/// one finite weight m_j > 0 per row. Throws InputError "<context>: <field> ..." naming the
+/// contact node; components 0 .. dimension - 1; finite values; distinct (node, component) pairs in
+/// a row; one finite weight m_j > 0 per row. Throws InputError "<context>: <field> ..." naming the
 /// first problem (the field names are those of the protocol's AssignContact).
 void check_contact_operator(const ContactOperator& contact, const std::vector<int>& contact_nodes,
                             int dimension, const std::string& context);

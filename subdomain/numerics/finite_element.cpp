@@ -123,8 +123,8 @@ std::vector<QuadraturePoint> collapsed_tetrahedron_rule(int degree) {
         const double u = 0.5 * (along_u.reference.x() + 1.0);
         const double v = 0.5 * (along_v.reference.x() + 1.0);
         const double w = 0.5 * (along_w.reference.x() + 1.0);
-        const double weight = 0.125 * along_u.weight * along_v.weight * along_w.weight *
-                              (1.0 - v) * (1.0 - w) * (1.0 - w);
+        const double weight = 0.125 * along_u.weight * along_v.weight * along_w.weight * (1.0 - v) *
+                              (1.0 - w) * (1.0 - w);
         rule.push_back({Eigen::Vector3d(u * (1.0 - v) * (1.0 - w), v * (1.0 - w), w), weight});
       }
     }
@@ -463,7 +463,9 @@ std::optional<NodeElementMap::ElementIndex> NodeElementMap::element_with(
     const ElementBlock& block = mesh_->blocks[candidate.first];
     const int count = nodes_per_element(block.type);
     const auto begin = block.connectivity.begin() + candidate.second * count;
-    const auto contains = [&](int node) { return std::find(begin, begin + count, node) != begin + count; };
+    const auto contains = [&](int node) {
+      return std::find(begin, begin + count, node) != begin + count;
+    };
     if (std::all_of(nodes.begin() + 1, nodes.end(), contains)) return candidate;
   }
   return std::nullopt;
@@ -539,7 +541,8 @@ FacetGeometry::FacetGeometry(const Mesh& mesh, const BoundaryGroup& group, std::
   for (int i = 0; i < corner_count; ++i) centroid += mesh.nodes[nodes[i]];
   centroid /= corner_count;
   Eigen::Vector3d middle = Eigen::Vector3d::Zero();
-  for (const int corner : corners) middle += mesh.nodes[corner] / static_cast<double>(corners.size());
+  for (const int corner : corners)
+    middle += mesh.nodes[corner] / static_cast<double>(corners.size());
   orientation_ = 1.0;
   const FacetPoint at_centre = evaluate(facet_centre(type_));
   orientation_ = at_centre.outward_normal.dot(middle - centroid) >= 0.0 ? 1.0 : -1.0;

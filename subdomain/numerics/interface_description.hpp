@@ -45,7 +45,8 @@ struct InterfaceDescription {
   std::vector<std::size_t> node_tags;        // the nodes' tags in the mesh file (for messages)
   std::vector<Eigen::Vector3d> coordinates;  // reference positions (z = 0 in 2D)
   std::vector<Eigen::Vector3d> normals;      // unit outward normals from the geometry
-  std::vector<double> weights;  // m_i = int_{contact boundaries} phi_i ds (length in 2D, area in 3D)
+  std::vector<double>
+      weights;  // m_i = int_{contact boundaries} phi_i ds (length in 2D, area in 3D)
   /// Per node, which of u_x, u_y, u_z a Dirichlet condition prescribes (u_z: false in 2D).
   std::vector<std::array<bool, 3>> fixed;
   /// One per contact boundary, in the order of BodyDefinition::contact_boundaries.

@@ -18,7 +18,9 @@ class DenseOperator final : public LinearOperator {
  public:
   explicit DenseOperator(Eigen::MatrixXd matrix) : matrix_(std::move(matrix)) {}
   int size() const override { return static_cast<int>(matrix_.rows()); }
-  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override { y.noalias() = matrix_ * x; }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
+    y.noalias() = matrix_ * x;
+  }
   const Eigen::MatrixXd& matrix() const { return matrix_; }
 
  private:

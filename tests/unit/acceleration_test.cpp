@@ -391,7 +391,8 @@ TEST(TwoBodies, QuasiNewtonNeedsTenTimesFewerIterationsThanTheBestRelaxation) {
   options.method = AccelerationMethod::aitken;
   const int aitken = two_body_calls(map, size, options, 20000);
   options.method = AccelerationMethod::iqn_ils;
-  options.mixing = QuasiNewtonMixing::aitken;  // on this dense random spectrum (full mixing: see the log line)
+  options.mixing =
+      QuasiNewtonMixing::aitken;  // on this dense random spectrum (full mixing: see the log line)
   options.relaxation1 = options.relaxation2 = 0.5;
   const int per_body = two_body_calls(map, size, options, 20000);
   options.per_body = false;

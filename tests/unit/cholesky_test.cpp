@@ -157,7 +157,8 @@ SparseMatrix random_trace(int rows, int size, const std::vector<int>& columns, u
   std::uniform_real_distribution<double> value(-1.0, 1.0);
   std::vector<Eigen::Triplet<double>> entries;
   for (int row = 0; row < rows; ++row) {
-    for (int k = 0; k < 2; ++k) entries.emplace_back(row, columns[pick(generator)], value(generator));
+    for (int k = 0; k < 2; ++k)
+      entries.emplace_back(row, columns[pick(generator)], value(generator));
   }
   SparseMatrix trace(rows, size);
   trace.setFromTriplets(entries.begin(), entries.end());

@@ -21,16 +21,16 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <sstream>
-#include <unistd.h>
 #include <numeric>
 #include <random>
+#include <sstream>
 
 #include "numerics/body_solver.hpp"
 #include "numerics/box_mesher.hpp"
@@ -48,7 +48,9 @@ const std::filesystem::path data_directory = ROBIN_TEST_DATA;
 const ElementType solid_types[] = {ElementType::tetrahedron4, ElementType::tetrahedron10,
                                    ElementType::hexahedron8};
 
-double factorial(int n) { return n <= 1 ? 1.0 : n * factorial(n - 1); }
+double factorial(int n) {
+  return n <= 1 ? 1.0 : n * factorial(n - 1);
+}
 
 TEST(SolidElements, ShapeFunctionsInterpolateTheirNodes) {
   for (const ElementType type : solid_types) {
@@ -97,8 +99,8 @@ TEST(SolidElements, QuadratureIntegratesMonomialsExactly) {
           hexahedron_sum += point.weight * std::pow(point.reference.x(), a) *
                             std::pow(point.reference.y(), b) * std::pow(point.reference.z(), c);
         }
-        const double tetrahedron_exact = factorial(a) * factorial(b) * factorial(c) /
-                                         factorial(a + b + c + 3);
+        const double tetrahedron_exact =
+            factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
         // int_{-1}^{1} x^n dx = 2 / (n + 1) for even n, 0 for odd n.
         const auto line = [](int n) { return n % 2 == 1 ? 0.0 : 2.0 / (n + 1); };
         EXPECT_NEAR(tetrahedron_sum, tetrahedron_exact, 1e-15)
@@ -127,8 +129,8 @@ TEST(SolidElements, BoxMeshesHaveTheBoxVolumeSideAreasAndOutwardNormals) {
   const Eigen::Vector3d low(-0.5, 0.25, 1.0), high(1.5, 1.0, 1.6);
   const Eigen::Vector3d size = high - low;
   const std::map<std::string, Eigen::Vector3d> outward = {
-      {"left", -Eigen::Vector3d::UnitX()},  {"right", Eigen::Vector3d::UnitX()},
-      {"front", -Eigen::Vector3d::UnitY()}, {"back", Eigen::Vector3d::UnitY()},
+      {"left", -Eigen::Vector3d::UnitX()},   {"right", Eigen::Vector3d::UnitX()},
+      {"front", -Eigen::Vector3d::UnitY()},  {"back", Eigen::Vector3d::UnitY()},
       {"bottom", -Eigen::Vector3d::UnitZ()}, {"top", Eigen::Vector3d::UnitZ()}};
   for (const ElementType type : solid_types) {
     const Mesh mesh = make_box_mesh(low, high, {3, 2, 4}, type);
@@ -137,8 +139,8 @@ TEST(SolidElements, BoxMeshesHaveTheBoxVolumeSideAreasAndOutwardNormals) {
     for (const auto& [name, normal] : outward) {
       const BoundaryGroup& group = mesh.boundary(name);
       const int axis = normal.cwiseAbs().maxCoeff() == std::abs(normal.x()) ? 0
-                       : std::abs(normal.y()) == 1.0                          ? 1
-                                                                              : 2;
+                       : std::abs(normal.y()) == 1.0                        ? 1
+                                                                            : 2;
       EXPECT_NEAR(boundary_weights(mesh, group).sum(), size.prod() / size[axis], 1e-13)
           << to_string(type) << " " << name;
       for (const Eigen::Vector3d& node_normal : boundary_node_normals(mesh, group)) {
@@ -185,10 +187,10 @@ std::vector<Material> patch_materials() {
 }
 
 /// Solves K_ff u_f = f_f - K_fp u_p with u = field on the nodes of the `fixed` boundaries.
-Eigen::VectorXd solve_with_prescribed(const Mesh& mesh, const Material& material,
-                                      const std::vector<std::string>& fixed,
-                                      const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& field,
-                                      const Eigen::VectorXd& load) {
+Eigen::VectorXd solve_with_prescribed(
+    const Mesh& mesh, const Material& material, const std::vector<std::string>& fixed,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& field,
+    const Eigen::VectorXd& load) {
   std::vector<std::optional<double>> prescribed(static_cast<std::size_t>(mesh.dof_count()));
   for (const std::string& name : fixed) {
     for (const int node : mesh.boundary(name).nodes()) {
@@ -207,8 +209,7 @@ void expect_affine(const Mesh& mesh, const Material& material, const AffineField
                    const Eigen::VectorXd& displacement, const std::string& label) {
   double error = 0.0;
   for (std::size_t node = 0; node < mesh.node_count(); ++node) {
-    error = std::max(error,
-                     (displacement.segment<3>(3 * node) - field(mesh.nodes[node])).norm());
+    error = std::max(error, (displacement.segment<3>(3 * node) - field(mesh.nodes[node])).norm());
   }
   EXPECT_LT(error, 1e-12) << label;
   const StressField stress = recover_stress(mesh, material, displacement);
@@ -234,9 +235,9 @@ TEST(SolidPatchTest, DirichletPatchIsExactForEveryElementAndMaterial) {
       mesh = make_box_mesh({0.0, 0.0, 0.0}, {1.0, 0.7, 0.5}, {3, 3, 2}, type);
     }
     for (const Material& material : patch_materials()) {
-      const Eigen::VectorXd displacement = solve_with_prescribed(
-          mesh, material, {"left", "right", "front", "back", "bottom", "top"}, field,
-          Eigen::VectorXd::Zero(mesh.dof_count()));
+      const Eigen::VectorXd displacement =
+          solve_with_prescribed(mesh, material, {"left", "right", "front", "back", "bottom", "top"},
+                                field, Eigen::VectorXd::Zero(mesh.dof_count()));
       expect_affine(mesh, material, field, displacement,
                     to_string(type) + (material.stiffness(0, 1) == material.stiffness(0, 2)
                                            ? " isotropic"
@@ -276,7 +277,8 @@ Eigen::Vector3d manufactured_displacement(const Eigen::Vector3d& x) {
 /// b = -div(C eps(u)): with H_ijl = d_j d_l u_i = -k_ij k_il sin(k_i . x), the derivative of the
 /// Voigt strain along x_l is the Voigt form of sym(H_..l) (shears doubled), sigma's derivative
 /// C times it, and (div sigma)_i = sum_l d_l sigma_il.
-Eigen::Vector3d manufactured_body_force(const Eigen::MatrixXd& stiffness, const Eigen::Vector3d& x) {
+Eigen::Vector3d manufactured_body_force(const Eigen::MatrixXd& stiffness,
+                                        const Eigen::Vector3d& x) {
   const Eigen::Vector3d sines = (wave_vectors * x).array().sin().matrix();
   Eigen::Vector3d divergence = Eigen::Vector3d::Zero();
   for (int l = 0; l < 3; ++l) {
@@ -302,9 +304,9 @@ TEST(SolidManufacturedSolution, ConvergesAtTheInterpolationRate) {
   const Material material =
       make_voigt_material(anisotropic_stiffness(), PlaneModel::plane_strain, "anisotropic");
   const std::vector<std::string> all = {"left", "right", "front", "back", "bottom", "top"};
-  const std::vector<std::pair<ElementType, double>> expected = {
-      {ElementType::tetrahedron4, 2.0}, {ElementType::hexahedron8, 2.0},
-      {ElementType::tetrahedron10, 3.0}};
+  const std::vector<std::pair<ElementType, double>> expected = {{ElementType::tetrahedron4, 2.0},
+                                                                {ElementType::hexahedron8, 2.0},
+                                                                {ElementType::tetrahedron10, 3.0}};
   for (const auto& [type, rate] : expected) {
     std::vector<double> errors;
     const std::vector<int> divisions = {2, 4, 8};
@@ -329,7 +331,8 @@ TEST(SolidManufacturedSolution, ConvergesAtTheInterpolationRate) {
 TEST(SolidRigidMotions, AnUnsupportedBodyHasSixSpanningTheKernelOfK) {
   for (const ElementType type : solid_types) {
     const Mesh mesh = make_box_mesh({0.0, 0.0, 0.0}, {2.0, 1.0, 0.5}, {2, 2, 1}, type);
-    const DofMap free_body(std::vector<std::optional<double>>(static_cast<std::size_t>(mesh.dof_count())));
+    const DofMap free_body(
+        std::vector<std::optional<double>>(static_cast<std::size_t>(mesh.dof_count())));
     EXPECT_FALSE(removes_rigid_motions(mesh, free_body));
     const Eigen::MatrixXd modes = rigid_body_modes(mesh, free_body);
     ASSERT_EQ(modes.cols(), 6) << to_string(type);
@@ -354,13 +357,12 @@ TEST(SolidRigidMotions, AnUnsupportedBodyHasSixSpanningTheKernelOfK) {
 TEST(SolidGmshMeshes, TetrahedraAndHexahedraFromAGeoPassThePatchTest) {
   const AffineField field;
   const Material material = make_isotropic_solid_material(3.0, 0.2, "material");
-  for (const auto& [order, recombine, type] :
-       {std::tuple{1, false, ElementType::tetrahedron4},
-        std::tuple{2, false, ElementType::tetrahedron10},
-        std::tuple{1, true, ElementType::hexahedron8}}) {
-    const Mesh mesh =
-        read_gmsh_mesh(data_directory / (recombine ? "solid_block_hexahedra.geo" : "solid_block.geo"),
-                       {0.35, order, recombine});
+  for (const auto& [order, recombine, type] : {std::tuple{1, false, ElementType::tetrahedron4},
+                                               std::tuple{2, false, ElementType::tetrahedron10},
+                                               std::tuple{1, true, ElementType::hexahedron8}}) {
+    const Mesh mesh = read_gmsh_mesh(
+        data_directory / (recombine ? "solid_block_hexahedra.geo" : "solid_block.geo"),
+        {0.35, order, recombine});
     ASSERT_EQ(mesh.dimension, 3);
     ASSERT_EQ(mesh.blocks.size(), 1u);
     EXPECT_EQ(mesh.blocks.front().type, type);
@@ -376,9 +378,9 @@ TEST(SolidGmshMeshes, TetrahedraAndHexahedraFromAGeoPassThePatchTest) {
     for (const Eigen::Vector3d& normal : boundary_node_normals(mesh, mesh.boundary("left"))) {
       EXPECT_LT((normal + Eigen::Vector3d::UnitX()).norm(), 1e-12) << to_string(type);
     }
-    const Eigen::VectorXd displacement = solve_with_prescribed(
-        mesh, material, {"left", "right", "front", "back", "bottom", "top"}, field,
-        Eigen::VectorXd::Zero(mesh.dof_count()));
+    const Eigen::VectorXd displacement =
+        solve_with_prescribed(mesh, material, {"left", "right", "front", "back", "bottom", "top"},
+                              field, Eigen::VectorXd::Zero(mesh.dof_count()));
     expect_affine(mesh, material, field, displacement, "Gmsh " + to_string(type));
   }
 }
@@ -408,8 +410,8 @@ TEST(SolidContact, FloatingBlockOnARigidPlaneCarriesTheUniformPressure) {
     // Node-to-node rows against the rigid plane z = 0: u . n <= 0 with n = (0, 0, -1).
     solver.assign_contact(
         node_to_node_operator(interface.node_ids, interface.normals, interface.weights));
-    const ContactSolveResult result =
-        solver.solve_contact(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface.node_ids.size())));
+    const ContactSolveResult result = solver.solve_contact(
+        Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface.node_ids.size())));
     ASSERT_EQ(result.status, QpStatus::converged) << to_string(type) << ": " << result.message;
     for (std::size_t i = 0; i < interface.node_ids.size(); ++i) {
       EXPECT_NEAR(interface.normals[i].z(), -1.0, 1e-14);
@@ -433,7 +435,8 @@ TEST(SolidContact, FloatingBlockOnARigidPlaneCarriesTheUniformPressure) {
       const Eigen::Vector3d& x = body.mesh.nodes[node];
       const Eigen::Vector3d exact(poisson * pressure * x.x() / young,
                                   poisson * pressure * x.y() / young, -pressure * x.z() / young);
-      EXPECT_LT((displacement.segment<3>(3 * static_cast<Eigen::Index>(node)) - exact).norm(), 1e-9 * pressure / young)
+      EXPECT_LT((displacement.segment<3>(3 * static_cast<Eigen::Index>(node)) - exact).norm(),
+                1e-9 * pressure / young)
           << to_string(type) << " node " << node;
     }
   }
@@ -453,10 +456,10 @@ std::vector<double> ascii_array(const std::string& text, const std::string& name
 TEST(SolidOutput, QuadraticTetrahedraAreWrittenInVtkNodeOrder) {
   // VTK_QUADRATIC_TETRA (24): corners 0-3, then the midside nodes of edges 01, 12, 20, 03, 13, 23
   // (VTK's documentation of vtkQuadraticTetra), whatever order Gmsh uses.
-  const Mesh mesh = make_box_mesh({0.0, 0.0, 0.0}, {1.0, 2.0, 3.0}, {1, 1, 1},
-                                  ElementType::tetrahedron10);
-  const std::filesystem::path path =
-      std::filesystem::temp_directory_path() / ("solid_output_" + std::to_string(::getpid()) + ".vtu");
+  const Mesh mesh =
+      make_box_mesh({0.0, 0.0, 0.0}, {1.0, 2.0, 3.0}, {1, 1, 1}, ElementType::tetrahedron10);
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("solid_output_" + std::to_string(::getpid()) + ".vtu");
   write_vtu(path, mesh, {}, {}, {VtuEncoding::ascii, false});
   std::ifstream file(path);
   const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
@@ -477,7 +480,8 @@ TEST(SolidOutput, QuadraticTetrahedraAreWrittenInVtkNodeOrder) {
     for (int edge = 0; edge < 6; ++edge) {
       const Eigen::Vector3d middle =
           0.5 * (point(nodes[vtk_edges[edge][0]]) + point(nodes[vtk_edges[edge][1]]));
-      EXPECT_LT((point(nodes[4 + edge]) - middle).norm(), 1e-12) << "cell " << cell << " edge " << edge;
+      EXPECT_LT((point(nodes[4 + edge]) - middle).norm(), 1e-12)
+          << "cell " << cell << " edge " << edge;
     }
   }
 }
