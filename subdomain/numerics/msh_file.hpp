@@ -1,0 +1,39 @@
+#pragma once
+// Gmsh's MSH file format read without Gmsh: versions 2.2 and 4.1, ASCII and binary.
+//
+// Sections read: $MeshFormat, $PhysicalNames, $Entities (4.1: the physical tags of the points,
+// curves, surfaces and volumes), $Nodes and $Elements; every other section ($Periodic,
+// $NodeData, $PartitionedEntities, ...) is skipped up to its $End marker. Binary files must
+// have been written on a little-endian machine (the endianness word 1 of $MeshFormat) with
+// 8-byte sizes and reals (data-size 8).
+//
+// The mesh is the one Gmsh's API gives for the same file (read_gmsh_mesh's contract,
+// gmsh_reader.hpp): a model with a volume entity is a solid body, otherwise a plane body whose
+// nodes lie in z = 0; the body's elements are those of the physical groups of its dimension
+// (every element of that dimension when there is none), each physical group of one dimension
+// less is a named boundary (its tag when it has no name), nodes no element uses are left out,
+// node indices follow ascending node tags and elements are oriented positively.
+//
+// The file is untrusted. Every count is checked against the bytes left in the file before
+// anything is allocated for it: an item needs at least a fixed number of bytes (a node 8 in
+// ASCII, 4 + 3 x 8 or 8 + 3 x 8 in binary), so a header claiming more items than the rest of the
+// file can hold is refused at once, and what is allocated stays within a small multiple of the
+// file's size. Every tag and index is checked. Errors are InputError messages
+// "mesh file 'NAME' line L: ..." (ASCII) or "mesh file 'NAME' byte B: ..." (binary data), or
+// "mesh file 'NAME': ..." for a problem of the mesh as a whole.
+
+#include <filesystem>
+#include <string>
+
+#include "numerics/mesh.hpp"
+
+namespace robin {
+
+/// The mesh in the MSH file `path`; messages name the file `name` (its path when empty).
+/// Throws InputError when the file cannot be read or is refused.
+Mesh read_msh_file(const std::filesystem::path& path, const std::string& name = "");
+
+/// The mesh in `bytes`, the contents of an MSH file called `name` in messages.
+Mesh parse_msh_file(const std::string& bytes, const std::string& name);
+
+}  // namespace robin
