@@ -1,9 +1,11 @@
 #pragma once
-// Reads meshes through the Gmsh C++ API. Supported inputs:
-//  - .msh (format 4.1 and 2.2): read as is;
-//  - .geo: meshed on the fly in its dimension. When `size` > 0 the Gmsh variable `h` is
-//    set to it before the script is parsed (like `gmsh -setnumber h SIZE`); a .geo
-//    declares `DefineConstant[ h = 0.1 ];` to use it.
+// Reads Gmsh meshes. Supported inputs:
+//  - .msh (format 4.1 and 2.2, ASCII or binary): read as is by read_msh_file (msh_file.hpp),
+//    without Gmsh;
+//  - .geo: meshed on the fly in its dimension by Gmsh in robin-mesh-reader, a child process
+//    (the tools do not link libgmsh), which writes a binary MSH 4.1 file read_msh_file reads.
+//    When `size` > 0 the Gmsh variable `h` is set to it before the script is parsed (like
+//    `gmsh -setnumber h SIZE`); a .geo declares `DefineConstant[ h = 0.1 ];` to use it.
 // A model with a volume is a solid body (Mesh::dimension 3): the elements of every 3D physical
 // group are read (4- and 10-node tetrahedra, 8-node hexahedra) and every 2D physical group
 // becomes a named boundary of faces (3- and 6-node triangles, 4-node quadrilaterals). A model
@@ -49,14 +51,18 @@ struct MeshReadObserver {
   std::function<void()> waiting;
 };
 
-/// Reads several mesh files at once, each as read_gmsh_mesh reads it. Gmsh holds one model per
-/// process, so each .geo is meshed in a child process of its own, all concurrently; a child
-/// writes its mesh as binary MSH 4.1 into a private temporary directory, which this process
-/// reads (a .msh is read directly) as soon as that child has ended. Only the user's own files
-/// belong here: a .geo is a program. Throws InputError naming the file for the first request
-/// that fails (in the order the failures are seen), after every child has ended.
+/// Reads several mesh files at once, each as read_gmsh_mesh reads it. Each .geo is meshed by
+/// robin-mesh-reader (mesh_reader_executable) in a child process of its own, all concurrently;
+/// a child writes its mesh as binary MSH 4.1 into a private temporary directory, which this
+/// process reads (a .msh is read directly) as soon as that child has ended. Only the user's own
+/// files belong here: a .geo is a program. Throws InputError naming the file for the first
+/// request that fails (in the order the failures are seen), after every child has ended.
 std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
                                    const MeshReadObserver& observer = {});
+
+/// The robin-mesh-reader that meshes .geo files: the one next to the running executable (the
+/// tools are installed together), else the one of the build tree (tests and benchmarks).
+std::filesystem::path mesh_reader_executable();
 
 /// How a .geo script refers to a variable, read from its text (comments and strings skipped).
 enum class GeoVariableUse {

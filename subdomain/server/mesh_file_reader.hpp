@@ -1,14 +1,12 @@
 #pragma once
-// The server's reader of SetupBody.mesh_path files: robin-mesh-reader (mesh_reader_main.cpp),
-// run in a child process, reads the file with Gmsh and sends the mesh back through a pipe, so
-// that a file Gmsh crashes on costs a BAD_INPUT, not the server. Gmsh 4.8 dies of a
-// segmentation fault on malformed MSH 2.2 files (found by tests/fuzz/mesh_file_fuzzer.cpp: a
-// $Nodes section one node longer than its count); the files come from the operator's data
-// directory, but one bad file must not stop the server for every client. The child also keeps
-// Gmsh's memory out of the server, and Gmsh out of the server's process altogether:
-// robin-subdomain does not link libgmsh, whose dependencies (OpenCASCADE, FLTK, X11: about 120
-// shared libraries, all bound at load time) cost every process that links it about 0.15 s of
-// start-up, paid for each server of each robin-run.
+// The server's reader of SetupBody.mesh_path .geo files: robin-mesh-reader (mesh_reader_main.cpp),
+// run in a child process, meshes the script with Gmsh and sends the mesh back through a pipe,
+// so that a script Gmsh crashes on costs a BAD_INPUT, not the server, Gmsh's memory stays out of
+// the server (capped by RLIMIT_AS in the child), and robin-subdomain does not link libgmsh,
+// whose dependencies (OpenCASCADE, FLTK, X11: about 120 shared libraries, all bound at load
+// time) cost every process that links it about 0.15 s of start-up. A mesh_path .msh file is read
+// in the server's own process by the native reader (msh_file.hpp), whose allocations are bounded
+// by the file's size; the child still reads one when given it (robin-mesh-reader FILE).
 
 #include <filesystem>
 #include <string>

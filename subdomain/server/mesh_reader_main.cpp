@@ -1,13 +1,18 @@
-// robin-mesh-reader FILE: robin-subdomain's reader of SetupBody.mesh_path files
-// (mesh_file_reader.hpp), not a tool of its own. Reads FILE with read_gmsh_mesh and writes one
-// message on its standard output: mesh_reader_message (the mesh) or mesh_reader_error_message
-// (why the file is refused). Exit codes: 0 after writing the message (and after --help and
-// --version); 2 for a bad command line or when the message cannot be written; a file Gmsh
-// crashes on ends the process by its signal.
-// Only the server runs it, on a file it has already checked (under its --data-directory, at
-// most --max-mesh-file-size bytes). It caps its own address space (RLIMIT_AS) before reading:
-// Gmsh 4.8 reserves memory for the node and element counts a file's header claims, so a small
-// file claiming billions of nodes would otherwise take the host's memory.
+// robin-mesh-reader: the only executable that links libgmsh; the tools run it, it is not a tool
+// of its own. Two modes:
+//  - robin-mesh-reader --mesh-geo GEO --output OUT [--size H] [--element-order K] [--recombine]:
+//    meshes the .geo script GEO with Gmsh (mesh_geo_file) and writes binary MSH 4.1 to OUT, for
+//    read_gmsh_meshes (gmsh_reader.hpp) of robin-run, robin-coordinator, robin-monolithic, ...
+//    On failure it writes the error message on its standard output and exits with 1.
+//  - robin-mesh-reader FILE: robin-subdomain's reader of a SetupBody.mesh_path .geo file
+//    (mesh_file_reader.hpp). Reads FILE with read_gmsh_mesh and writes one message on its
+//    standard output: mesh_reader_message (the mesh) or mesh_reader_error_message (why the file
+//    is refused); exits with 0 after writing it. Only the server runs it, on a file it has
+//    already checked (under its --data-directory, at most --max-mesh-file-size bytes). It caps
+//    its own address space (RLIMIT_AS) before reading, which the meshing process it starts
+//    inherits: Gmsh's memory is not bounded by the script's size.
+// Exit codes: 2 for a bad command line or when the message cannot be written; a crash of Gmsh
+// ends the process by its signal.
 
 #include <fcntl.h>
 #include <sys/resource.h>
@@ -15,6 +20,7 @@
 
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -22,15 +28,14 @@
 #include <string>
 
 #include "command_line.hpp"
+#include "gmsh/geo_mesher.hpp"
 #include "numerics/gmsh_reader.hpp"
 #include "server/mesh_file_reader.hpp"
 
 namespace {
 
 /// Address space the reader may add to what it has at start: a fixed part for Gmsh's own
-/// work, plus a multiple of the file's size, well above what Gmsh and the conversion need for a
-/// file whose counts are true (a few times its size), far below what a header claiming billions
-/// of nodes in a small file makes Gmsh reserve.
+/// work, plus a multiple of the file's size.
 constexpr std::uint64_t base_allowance_bytes = std::uint64_t{256} << 20;
 constexpr std::uint64_t allowance_per_file_byte = 32;
 
@@ -108,16 +113,48 @@ bool write_all(const std::string& message) {
   return true;
 }
 
+/// Meshes `geo` into `output`; returns the exit status (1 with the message on standard output
+/// when Gmsh refuses the script).
+int mesh_geo(const std::string& geo, const robin::MeshReadOptions& options,
+             const std::string& output) {
+  std::string message;
+  try {
+    robin::mesh_geo_file(geo, options, output);
+    return 0;
+  } catch (const std::exception& error) {
+    message = error.what();
+  } catch (...) {
+    message = "mesh file '" + geo + "': meshing failed";
+  }
+  return write_all(message) ? 1 : 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "robin-mesh-reader: reads a mesh file with Gmsh for robin-subdomain (SetupBody.mesh_path) "
-      "and writes it on standard output; run by the server, not by hand"};
-  std::string file;
-  app.add_option("file", file, "the mesh file (.msh or .geo)")->required();
+      "robin-mesh-reader: meshes a .geo script with Gmsh for the tools (--mesh-geo), or reads a "
+      "mesh file for robin-subdomain (SetupBody.mesh_path) and writes it on standard output; "
+      "run by the tools, not by hand"};
+  std::string file, geo, output;
+  robin::MeshReadOptions options;
+  app.add_option("file", file, "the mesh file (.msh or .geo) to send to robin-subdomain");
+  auto* geo_option = app.add_option("--mesh-geo", geo, "the .geo script to mesh into --output");
+  auto* output_option =
+      app.add_option("--output", output, "the binary MSH 4.1 file --mesh-geo writes");
+  app.add_option("--size", options.size, "the value of the .geo variable h (0: the script's)");
+  app.add_option("--element-order", options.element_order, "1 or 2");
+  app.add_flag("--recombine", options.recombine, "generate quadrilaterals (Mesh.RecombineAll)");
+  geo_option->needs(output_option);
+  output_option->needs(geo_option);
+  geo_option->excludes("file");
   robin::add_version_option(app, "robin-mesh-reader");
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
+  if (!geo.empty()) _exit(mesh_geo(geo, options, output));
+  if (file.empty()) {
+    std::fputs("robin-mesh-reader: give FILE or --mesh-geo GEO --output OUT\n", stderr);
+    return 2;
+  }
   const bool written = write_all(message_for(file));
   // As in the forked reader before this executable: nothing runs after the message is out (no
   // exit handlers, no teardown of Gmsh's static state, no sanitizer's leak check of Gmsh), so a

@@ -9,6 +9,7 @@
 #include "mesh_codec.hpp"
 #include "numerics/errors.hpp"
 #include "numerics/mesh_validity.hpp"
+#include "numerics/msh_file.hpp"
 #include "server/file_access.hpp"
 #include "server/mesh_file_reader.hpp"
 
@@ -47,10 +48,20 @@ std::string decode_body_name(const std::string& name) {
   return name;
 }
 
+/// Whether `path` names an MSH file (.msh, any case), which the server reads itself.
+bool is_msh_file(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".msh";
+}
+
 /// The mesh from `mesh` (MeshData) or, when absent, `mesh_path` under the data directory (not
-/// read when larger than the limit). A reader error is rethrown with the body and field
-/// prepended. Nothing received is run: a MeshData is data, and a mesh_path names a file the
-/// server's operator put in the data directory.
+/// read when larger than the limit). A .msh file is read in this process by the native reader,
+/// whose allocations are bounded by the file's size (msh_file.hpp); a .geo file is meshed by
+/// Gmsh in robin-mesh-reader, a child process with a memory cap (read_mesh_file_in_child). A reader
+/// error is rethrown with the body and field prepended. Nothing received is run: a MeshData is
+/// data, and a mesh_path names a file the server's operator put in the data directory.
 Mesh decode_body_mesh(const protocol::SetupBody& message, const std::string& context,
                       const MeshFiles& files) {
   if (message.has_mesh()) return decode_mesh(message.mesh(), context);
@@ -62,7 +73,8 @@ Mesh decode_body_mesh(const protocol::SetupBody& message, const std::string& con
       resolve_data_file(files.data_directory, message.mesh_path(), field);
   check_data_file_size(path, message.mesh_path(), files.maximum_bytes, field);
   try {
-    Mesh mesh = read_mesh_file_in_child(path, files.reader);
+    Mesh mesh = is_msh_file(path) ? read_msh_file(path, message.mesh_path())
+                                  : read_mesh_file_in_child(path, files.reader);
     check_element_validity(mesh, context + ": SetupBody.mesh_path");
     return mesh;
   } catch (const InputError& error) {

@@ -825,8 +825,9 @@ TEST(SubdomainProcess, MeshFileAboveTheSizeLimitIsRefusedUnread) {
 
 // A mesh file that crashes Gmsh 4.8 (tests/data/mesh_gmsh_crash_v22.msh: its $Nodes section says
 // 11 nodes and lists 12; `gmsh -0` dies of SIGSEGV on it, found by tests/fuzz/mesh_file_fuzzer)
-// in the data directory: robin-subdomain reads mesh files in a child process, so the request
-// is BAD_INPUT naming the crash and the server goes on: Hello, and square.msh is read as before.
+// in the data directory: robin-subdomain reads .msh files with the native reader (msh_file.hpp),
+// which finds a twelfth node where $EndNodes belongs (line 24), so the request is BAD_INPUT
+// naming the line, and the server goes on: Hello, and square.msh is read as before.
 TEST(SubdomainProcess, MeshFileThatCrashesGmshIsBadInputAndTheServerGoesOn) {
   const AttackFiles files;
   std::filesystem::copy_file(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_gmsh_crash_v22.msh",
@@ -835,8 +836,8 @@ TEST(SubdomainProcess, MeshFileThatCrashesGmshIsBadInputAndTheServerGoesOn) {
   ASSERT_FALSE(server.endpoint.empty()) << server.process.stderr_text();
   std::uint64_t id = 1;
   expect_error(exchange(server.socket, square_path_setup(id++, "crash.msh")), protocol::BAD_INPUT,
-               "body 'square': SetupBody.mesh_path: the mesh reader (Gmsh) crashed on this file "
-               "(signal 11, Segmentation fault): refused");
+               "body 'square': SetupBody.mesh_path: mesh file 'crash.msh' line 24: expected "
+               "$EndNodes, found '12'");
   expect_hello(server.socket, id++);
   EXPECT_TRUE(exchange(server.socket, square_path_setup(id++, "square.msh")).has_interface());
   ASSERT_TRUE(exchange(server.socket, shutdown(id)).has_acknowledge());
@@ -845,9 +846,9 @@ TEST(SubdomainProcess, MeshFileThatCrashesGmshIsBadInputAndTheServerGoesOn) {
 
 // A mesh file whose header claims 1.5e9 nodes and holds 12 (tests/data/mesh_square_v41.msh with
 // its $Nodes count raised): Gmsh 4.8 reserves memory for the claimed count (`gmsh -0` on it grew
-// to 22 GB before the kernel killed it). robin-subdomain's reader child may add only a bounded
-// address space to what it inherited, so the request is BAD_INPUT naming the memory refusal,
-// at once, and the server goes on.
+// to 22 GB before the kernel killed it). robin-subdomain's native reader (msh_file.hpp) checks
+// the count against the bytes left in the file before allocating anything for it, so the
+// request is BAD_INPUT naming the line and the count, at once, and the server goes on.
 TEST(SubdomainProcess, MeshFileClaimingBillionsOfNodesIsRefusedWithinAMemoryBound) {
   const AttackFiles files;
   std::ifstream square(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square_v41.msh");
@@ -869,8 +870,8 @@ TEST(SubdomainProcess, MeshFileClaimingBillionsOfNodesIsRefusedWithinAMemoryBoun
   ASSERT_TRUE(reply.has_error()) << reply.DebugString();
   EXPECT_EQ(reply.error().code(), protocol::BAD_INPUT);
   EXPECT_NE(reply.error().message().find(
-                "body 'square': SetupBody.mesh_path: the mesh reader ran out of the memory it is "
-                "allowed for this file ("),
+                "body 'square': SetupBody.mesh_path: mesh file 'claims.msh' line 25: $Nodes "
+                "declares 1500000000 nodes but the file has "),
             std::string::npos)
       << reply.error().message();
   expect_hello(server.socket, id++);
