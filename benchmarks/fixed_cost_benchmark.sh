@@ -2,7 +2,9 @@
 # The fixed costs of robin-run against robin-monolithic at small sizes (issue 16 item 2): the
 # wall time of whole runs, measured around the process, of the partial-contact two-block case
 # (examples/two_blocks_partial.toml at h = 0.033, 8948 DOFs, made as profile_benchmark.sh makes
-# it) and of the 3D Hertz case (examples/hertz_3d.toml at h = 0.05, 8658 DOFs). Each build
+# it) and of the 3D Hertz case (examples/hertz_3d.toml at h = 0.05, 8658 DOFs), and, when the
+# gmsh command is installed, of the two-block case on .msh files (block_lower/upper.geo meshed by
+# `gmsh -2 -format msh22` at h = 0.033 beforehand: the run reads meshes, meshes nothing). Each build
 # directory given is one variant (e.g. before and after a change); the runs are interleaved
 # (variant by variant, tool by tool, RUNS rounds) so that a changing machine load spreads over
 # every column. Prints the median and every time of each (case, variant, tool).
@@ -39,8 +41,21 @@ seconds() {
   echo "$start $end" | awk '{printf "%.3f", $2 - $1}'
 }
 
-for case_file in "$(make_case examples/two_blocks_partial.toml 0.033)" \
-                 "$(make_case examples/hertz_3d.toml 0.05)"; do
+# make_msh_case SIZE: examples/two_blocks_partial.toml on .msh files meshed by gmsh at SIZE.
+make_msh_case() {
+  local case_file="$work/two_blocks_partial_msh_$1.toml" body
+  for body in lower upper; do
+    gmsh -2 -setnumber h "$1" -format msh22 "examples/meshes/block_$body.geo" \
+      -o "$work/block_${body}_$1.msh" > /dev/null
+  done
+  sed -e "s|^mesh = \"meshes/block_\(.*\)\.geo\"|mesh = \"$work/block_\1_$1.msh\"|" \
+      -e '/^mesh_size = /d' examples/two_blocks_partial.toml > "$case_file"
+  echo "$case_file"
+}
+
+cases=("$(make_case examples/two_blocks_partial.toml 0.033)" "$(make_case examples/hertz_3d.toml 0.05)")
+if command -v gmsh > /dev/null; then cases+=("$(make_msh_case 0.033)"); fi
+for case_file in "${cases[@]}"; do
   declare -A times=()
   for _ in $(seq "$runs"); do
     for build in "${builds[@]}"; do

@@ -737,22 +737,61 @@ void collect_boundaries(const MshModel& model, const std::string& name, int dime
   }
 }
 
-/// Node tag -> compact index, for the nodes used by the body's elements and facets, in
-/// ascending tag order.
-std::unordered_map<std::size_t, int> compact_nodes(const BodyElements& body) {
-  std::vector<std::size_t> used;
-  for (const auto& [type, domain] : body.domain) {
-    used.insert(used.end(), domain.node_tags.begin(), domain.node_tags.end());
+/// Node tag -> compact index of a set of tags, in ascending tag order: a table when the largest
+/// tag is at most 4 times the file's node count (plus 1024), so that it stays within a multiple
+/// of the file's size, a hash map otherwise.
+class NodeIndex {
+ public:
+  /// The tags `for_each_tag(visit)` visits (repeats allowed); `file_nodes` is the file's count.
+  template <typename ForEachTag>
+  NodeIndex(ForEachTag&& for_each_tag, std::size_t file_nodes) {
+    std::size_t largest = 0;
+    for_each_tag([&](std::size_t tag) { largest = std::max(largest, tag); });
+    if (largest <= 4 * file_nodes + 1024) {
+      table_.assign(largest + 1, -1);
+      for_each_tag([&](std::size_t tag) { table_[tag] = 0; });
+      for (std::size_t tag = 0; tag < table_.size(); ++tag) {
+        if (table_[tag] < 0) continue;
+        table_[tag] = static_cast<int>(tags_.size());
+        tags_.push_back(tag);
+      }
+      return;
+    }
+    for_each_tag([&](std::size_t tag) { tags_.push_back(tag); });
+    std::sort(tags_.begin(), tags_.end());
+    tags_.erase(std::unique(tags_.begin(), tags_.end()), tags_.end());
+    hashed_ = true;
+    map_.reserve(tags_.size());
+    for (std::size_t i = 0; i < tags_.size(); ++i) map_.emplace(tags_[i], static_cast<int>(i));
   }
-  for (const auto& [boundary, facets] : body.facets) {
-    used.insert(used.end(), facets.second.begin(), facets.second.end());
+  /// The compact index of `tag`; -1 when it is not in the set.
+  int find(std::size_t tag) const {
+    if (!hashed_) return tag < table_.size() ? table_[tag] : -1;
+    const auto found = map_.find(tag);
+    return found == map_.end() ? -1 : found->second;
   }
-  std::sort(used.begin(), used.end());
-  used.erase(std::unique(used.begin(), used.end()), used.end());
-  std::unordered_map<std::size_t, int> index;
-  index.reserve(used.size());
-  for (std::size_t i = 0; i < used.size(); ++i) index.emplace(used[i], static_cast<int>(i));
-  return index;
+  /// The tags, ascending.
+  const std::vector<std::size_t>& tags() const { return tags_; }
+  std::size_t size() const { return tags_.size(); }
+
+ private:
+  std::vector<int> table_;
+  std::unordered_map<std::size_t, int> map_;
+  std::vector<std::size_t> tags_;
+  bool hashed_ = false;
+};
+
+/// The nodes the body's elements and facets use.
+NodeIndex compact_nodes(const BodyElements& body, std::size_t file_nodes) {
+  const auto for_each_tag = [&](auto&& visit) {
+    for (const auto& [type, domain] : body.domain) {
+      for (const std::size_t tag : domain.node_tags) visit(tag);
+    }
+    for (const auto& [boundary, facets] : body.facets) {
+      for (const std::size_t tag : facets.second) visit(tag);
+    }
+  };
+  return NodeIndex(for_each_tag, file_nodes);
 }
 
 /// The largest |coordinate| of the nodes Gmsh keeps: every node of a 4.1 file, the nodes some
@@ -763,29 +802,31 @@ double model_extent(const MshModel& model) {
     for (const double value : model.coordinates) extent = std::max(extent, std::abs(value));
     return extent;
   }
-  std::unordered_map<std::size_t, char> used;
-  for (const auto& [key, lists] : model.elements) {
-    for (const auto& [type, list] : lists) {
-      for (const std::size_t tag : list.node_tags) used.emplace(tag, 0);
+  const auto for_each_tag = [&](auto&& visit) {
+    for (const auto& [key, lists] : model.elements) {
+      for (const auto& [type, list] : lists) {
+        for (const std::size_t tag : list.node_tags) visit(tag);
+      }
     }
-  }
+  };
+  const NodeIndex used(for_each_tag, model.node_tags.size());
   for (std::size_t k = 0; k < model.node_tags.size(); ++k) {
-    if (used.count(model.node_tags[k]) == 0) continue;
+    if (used.find(model.node_tags[k]) < 0) continue;
     for (int c = 0; c < 3; ++c) extent = std::max(extent, std::abs(model.coordinates[3 * k + c]));
   }
   return extent;
 }
 
-void fill_nodes(const MshModel& model, const std::string& name,
-                const std::unordered_map<std::size_t, int>& index, Mesh& mesh) {
+void fill_nodes(const MshModel& model, const std::string& name, const NodeIndex& index,
+                Mesh& mesh) {
   mesh.nodes.assign(index.size(), Eigen::Vector3d::Zero());
   mesh.node_tags.assign(index.size(), 0);
   const double extent = mesh.dimension == 2 ? model_extent(model) : 0.0;
   for (std::size_t k = 0; k < model.node_tags.size(); ++k) {
     const std::size_t tag = model.node_tags[k];
-    const auto found = index.find(tag);
-    if (found == index.end()) continue;
-    if (mesh.node_tags[found->second] != 0) {
+    const int position = index.find(tag);
+    if (position < 0) continue;
+    if (mesh.node_tags[position] != 0) {
       throw InputError(name + ": node tag " + std::to_string(tag) + " is defined twice");
     }
     const double* xyz = &model.coordinates[3 * k];
@@ -794,10 +835,11 @@ void fill_nodes(const MshModel& model, const std::string& name,
                        " has z = " + std::to_string(xyz[2]) +
                        ": a mesh without volumes is a plane body and must lie in the z = 0 plane");
     }
-    mesh.nodes[found->second] = {xyz[0], xyz[1], mesh.dimension == 2 ? 0.0 : xyz[2]};
-    mesh.node_tags[found->second] = tag;
+    mesh.nodes[position] = {xyz[0], xyz[1], mesh.dimension == 2 ? 0.0 : xyz[2]};
+    mesh.node_tags[position] = tag;
   }
-  for (const auto& [tag, position] : index) {
+  for (std::size_t position = 0; position < index.size(); ++position) {
+    const std::size_t tag = index.tags()[position];
     if (mesh.node_tags[position] == 0) {
       throw InputError(name + ": an element uses node tag " + std::to_string(tag) +
                        ", which $Nodes does not define");
@@ -805,11 +847,11 @@ void fill_nodes(const MshModel& model, const std::string& name,
   }
 }
 
-std::vector<int> to_indices(const std::vector<std::size_t>& tags,
-                            const std::unordered_map<std::size_t, int>& index) {
+/// The compact indices of `tags`, every one of which is in `index`.
+std::vector<int> to_indices(const std::vector<std::size_t>& tags, const NodeIndex& index) {
   std::vector<int> indices(tags.size());
   std::transform(tags.begin(), tags.end(), indices.begin(),
-                 [&](std::size_t tag) { return index.at(tag); });
+                 [&](std::size_t tag) { return index.find(tag); });
   return indices;
 }
 
@@ -902,7 +944,7 @@ Mesh body_mesh(const MshModel& model, const std::string& name) {
   BodyElements body;
   collect_domain(model, name, dimension, body);
   collect_boundaries(model, name, dimension, body);
-  const std::unordered_map<std::size_t, int> index = compact_nodes(body);
+  const NodeIndex index = compact_nodes(body, model.node_tags.size());
   Mesh mesh;
   mesh.dimension = dimension;
   fill_nodes(model, name, index, mesh);
