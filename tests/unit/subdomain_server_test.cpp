@@ -1215,23 +1215,27 @@ TEST(SubdomainServer, InvertedOrDegenerateCellsAreBadInputNamingTheirTag) {
   expect_hello(server, 7);
 }
 
-// A server whose mesh reader (robin-mesh-reader) cannot be run refuses a mesh_path with an
-// INTERNAL error naming the reader, not the client's file, and goes on serving.
+// A server whose mesh reader (robin-mesh-reader) cannot be run refuses a .geo mesh_path (which
+// only the reader meshes) with an INTERNAL error naming the reader, not the client's file, and
+// goes on serving; a .msh mesh_path needs no reader (the server reads it itself, msh_file.hpp).
 TEST(SubdomainServer, MeshPathWithoutItsReaderIsAnInternalErrorNamingTheReader) {
   const TemporaryDirectory data("no-reader");
   std::filesystem::copy_file(square_msh, data.path() / "square.msh");
+  std::filesystem::copy_file(std::filesystem::path(ROBIN_TEST_DATA) / "mesh_square.geo",
+                             data.path() / "square.geo");
   ServerSettings settings = quiet_settings();
   settings.data_directory = data.path();
   settings.mesh_reader = data.path() / "no-such-reader";
   SubdomainServer server(settings);
   const protocol::Envelope reply =
-      exchange(server, setup_request(1, square_path_setup("square.msh")));
+      exchange(server, setup_request(1, square_path_setup("square.geo")));
   expect_error(reply, protocol::INTERNAL, "awaiting_setup");
   EXPECT_NE(reply.error().message().find("cannot run the mesh reader '" +
                                          (data.path() / "no-such-reader").string() + "'"),
             std::string::npos)
       << reply.error().message();
   expect_hello(server, 2);
+  EXPECT_TRUE(exchange(server, setup_request(3, square_path_setup("square.msh"))).has_interface());
 }
 
 /// SOLVER_FAILURE naming `what` and the body: an Error, so no NaN or infinity is sent.
