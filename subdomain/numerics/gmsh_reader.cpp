@@ -67,26 +67,36 @@ void check_request(const std::filesystem::path& path, const MeshReadOptions& opt
 /// execute").
 constexpr int cannot_execute_status = 126;
 
-/// A .geo being meshed by robin-mesh-reader in a child process: its pid, the pipe that carries
-/// its error message (its standard output) and the file it writes.
-struct MeshingChild {
+/// Where the meshing process writes the mesh of request `k`.
+std::filesystem::path meshing_output(const std::filesystem::path& directory, std::size_t k) {
+  return directory / ("body" + std::to_string(k) + ".msh");
+}
+
+/// robin-mesh-reader meshing the .geo files of one read_gmsh_meshes call (mesh_reader_main.cpp,
+/// --mesh-geo-batch): one process, which loads libgmsh once and forks a meshing child per file,
+/// all concurrently, and reports each file as its child ends on its standard output: a line
+/// "REQUEST LENGTH" then LENGTH bytes of error message (0: the mesh is written).
+struct MeshingProcess {
   pid_t pid = -1;
-  int error_pipe = -1;
-  std::filesystem::path output;
+  int reports = -1;  // the read end of its standard output
 };
 
-/// The command line of robin-mesh-reader meshing `request` into `output`.
-std::vector<std::string> meshing_command(const std::filesystem::path& reader,
-                                         const MeshFileRequest& request,
-                                         const std::filesystem::path& output) {
-  std::ostringstream size;
-  size.precision(17);
-  size << request.options.size;
-  std::vector<std::string> words = {
-      reader.string(), "--mesh-geo",      request.path.string(),
-      "--output",      output.string(),   "--size",
-      size.str(),      "--element-order", std::to_string(request.options.element_order)};
-  if (request.options.recombine) words.emplace_back("--recombine");
+/// The command line of robin-mesh-reader meshing `geo_requests` (indices into `requests`), each
+/// into directory/bodyK.msh: --mesh-geo-batch, then per file its request index, .geo path,
+/// output path, size, element order and recombination (0 or 1).
+std::vector<std::string> meshing_command(const std::vector<MeshFileRequest>& requests,
+                                         const std::vector<std::size_t>& geo_requests,
+                                         const std::filesystem::path& directory) {
+  std::vector<std::string> words = {mesh_reader_executable().string(), "--mesh-geo-batch"};
+  for (const std::size_t k : geo_requests) {
+    std::ostringstream size;
+    size.precision(17);
+    size << requests[k].options.size;
+    words.insert(words.end(), {std::to_string(k), requests[k].path.string(),
+                               meshing_output(directory, k).string(), size.str(),
+                               std::to_string(requests[k].options.element_order),
+                               requests[k].options.recombine ? "1" : "0"});
+  }
   return words;
 }
 
@@ -106,9 +116,7 @@ std::vector<std::string> meshing_command(const std::filesystem::path& reader,
   _exit(cannot_execute_status);
 }
 
-MeshingChild start_meshing_child(const MeshFileRequest& request,
-                                 const std::filesystem::path& output) {
-  std::vector<std::string> words = meshing_command(mesh_reader_executable(), request, output);
+MeshingProcess start_meshing_process(std::vector<std::string> words) {
   std::vector<char*> argv;
   for (std::string& word : words) argv.push_back(word.data());
   argv.push_back(nullptr);
@@ -123,57 +131,73 @@ MeshingChild start_meshing_child(const MeshFileRequest& request,
   }
   if (pid == 0) run_in_child(argv.data(), pipe_ends[1]);
   close(pipe_ends[1]);
-  return {pid, pipe_ends[0], output};
+  return {pid, pipe_ends[0]};
 }
 
-/// Waits for `child`; returns its error message ("" when it succeeded).
-std::string finish_meshing_child(const MeshingChild& child, const MeshFileRequest& request) {
-  std::string message;
-  char buffer[4096];
-  for (ssize_t count; (count = read(child.error_pipe, buffer, sizeof buffer)) != 0;) {
-    if (count < 0 && errno == EINTR) continue;
-    if (count < 0) break;
-    message.append(buffer, static_cast<std::size_t>(count));
+/// The reports of a MeshingProcess as they arrive: each request index with its error message
+/// ("" when its mesh is written).
+class MeshingReports {
+ public:
+  explicit MeshingReports(int descriptor) : descriptor_(descriptor) {}
+
+  /// The next report; std::nullopt when the process's output has ended. Calls `waiting` (when
+  /// set) about once a second meanwhile.
+  std::optional<std::pair<std::size_t, std::string>> next(const std::function<void()>& waiting) {
+    for (;;) {
+      if (auto report = parse()) return report;
+      if (ended_) return std::nullopt;
+      pollfd descriptor{descriptor_, POLLIN, 0};
+      const int ready = poll(&descriptor, 1, 1000);
+      if (ready == 0 && waiting) waiting();
+      if (ready <= 0) continue;
+      char buffer[4096];
+      const ssize_t count = read(descriptor_, buffer, sizeof buffer);
+      if (count < 0 && errno == EINTR) continue;
+      if (count <= 0) ended_ = true;
+      if (count > 0) bytes_.append(buffer, static_cast<std::size_t>(count));
+    }
   }
-  close(child.error_pipe);
+
+ private:
+  /// A complete report at the front of the bytes received, removed from them.
+  std::optional<std::pair<std::size_t, std::string>> parse() {
+    const std::size_t line_end = bytes_.find('\n');
+    if (line_end == std::string::npos) return std::nullopt;
+    std::size_t request = 0, length = 0;
+    std::istringstream header(bytes_.substr(0, line_end));
+    if (!(header >> request >> length)) {
+      ended_ = true;  // not a report: the process is not the reader this build expects
+      bytes_.clear();
+      return std::nullopt;
+    }
+    if (bytes_.size() - line_end - 1 < length) return std::nullopt;
+    std::string message = bytes_.substr(line_end + 1, length);
+    bytes_.erase(0, line_end + 1 + length);
+    return std::make_pair(request, std::move(message));
+  }
+
+  int descriptor_;
+  std::string bytes_;
+  bool ended_ = false;
+};
+
+/// Waits for the meshing process; "" when it exited with 0, else why it failed.
+std::string finish_meshing_process(const MeshingProcess& process) {
+  close(process.reports);
   int status = 0;
-  while (waitpid(child.pid, &status, 0) < 0 && errno == EINTR) {
+  while (waitpid(process.pid, &status, 0) < 0 && errno == EINTR) {
   }
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
-  if (!message.empty()) return message;
   if (WIFEXITED(status) && WEXITSTATUS(status) == cannot_execute_status) {
-    return file_label(request.path) + ": cannot run the mesh reader '" +
-           mesh_reader_executable().string() +
+    return "cannot run the mesh reader '" + mesh_reader_executable().string() +
            "', which meshes .geo files (robin-mesh-reader, installed next to the tools)";
   }
-  return file_label(request.path) + ": the meshing process " +
+  return "the meshing process " +
          (WIFSIGNALED(status) ? "was killed by signal " + std::to_string(WTERMSIG(status))
-                              : "failed");
+                              : "failed (exit status " + std::to_string(WEXITSTATUS(status)) + ")");
 }
 
 using Clock = std::chrono::steady_clock;
-
-/// Blocks until one of the children `pending` (indices into `children`) has written to or
-/// closed its error pipe (it is ending) and returns its index; the first on a poll error.
-/// Calls `waiting` (when set) about once a second meanwhile.
-std::size_t next_ended_child(const std::vector<std::optional<MeshingChild>>& children,
-                             const std::vector<std::size_t>& pending,
-                             const std::function<void()>& waiting) {
-  std::vector<pollfd> pipes;
-  for (const std::size_t k : pending) pipes.push_back({children[k]->error_pipe, POLLIN, 0});
-  for (;;) {
-    const int ready = poll(pipes.data(), pipes.size(), 1000);
-    if (ready == 0) {
-      if (waiting) waiting();
-      continue;
-    }
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready < 0) return pending.front();
-    for (std::size_t i = 0; i < pipes.size(); ++i) {
-      if (pipes[i].revents != 0) return pending[i];
-    }
-  }
-}
 
 /// A private directory for the meshes of the children, removed on destruction.
 class PrivateDirectory {
@@ -220,26 +244,19 @@ Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& op
 std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
                                    const MeshReadObserver& observer) {
   std::vector<Mesh> meshes(requests.size());
-  std::vector<std::optional<MeshingChild>> children(requests.size());
-  std::vector<Clock::time_point> started(requests.size());
-  const PrivateDirectory directory;
+  std::vector<bool> meshed(requests.size(), false);
+  std::vector<std::size_t> geo_requests;
   for (std::size_t k = 0; k < requests.size(); ++k) {
     if (lower_extension(requests[k].path) != ".geo") continue;
     check_request(requests[k].path, requests[k].options);
-    children[k] =
-        start_meshing_child(requests[k], directory.path() / ("body" + std::to_string(k) + ".msh"));
-    started[k] = Clock::now();
-    if (observer.started) observer.started(k);
+    geo_requests.push_back(k);
   }
+  std::vector<Clock::time_point> started(requests.size());
+  const PrivateDirectory directory;
   std::string first_error;
-  const auto read = [&](std::size_t k) {
+  const auto read = [&](std::size_t k, const std::filesystem::path& path) {
     try {
-      if (children[k]) {
-        meshes[k] = read_msh_file(children[k]->output, requests[k].path.string());
-      } else {
-        check_request(requests[k].path, requests[k].options);
-        meshes[k] = read_msh_file(requests[k].path);
-      }
+      meshes[k] = read_msh_file(path, requests[k].path.string());
     } catch (const InputError& error) {
       if (first_error.empty()) first_error = error.what();
       return;
@@ -250,23 +267,41 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
                         std::chrono::duration<double>(Clock::now() - started[k]).count());
     }
   };
-  // each child's mesh is read as soon as it ends, in the order they end
-  std::vector<std::size_t> pending;
-  for (std::size_t k = 0; k < requests.size(); ++k) {
-    if (children[k]) pending.push_back(k);
-  }
-  while (!pending.empty()) {
-    const std::size_t k = next_ended_child(children, pending, observer.waiting);
-    pending.erase(std::find(pending.begin(), pending.end(), k));
-    const std::string error = finish_meshing_child(*children[k], requests[k]);
-    if (!error.empty() && first_error.empty()) first_error = error;
-    if (error.empty() && first_error.empty()) read(k);
+  if (!geo_requests.empty()) {
+    const MeshingProcess process =
+        start_meshing_process(meshing_command(requests, geo_requests, directory.path()));
+    for (const std::size_t k : geo_requests) {
+      started[k] = Clock::now();
+      if (observer.started) observer.started(k);
+    }
+    // each .geo's mesh is read as soon as its child has ended, in the order they end
+    MeshingReports reports(process.reports);
+    while (const auto report = reports.next(observer.waiting)) {
+      const auto [k, error] = *report;
+      if (k >= requests.size() || meshed[k]) continue;
+      meshed[k] = true;
+      if (!error.empty() && first_error.empty()) first_error = error;
+      if (error.empty() && first_error.empty()) read(k, meshing_output(directory.path(), k));
+    }
+    const std::string process_error = finish_meshing_process(process);
+    for (const std::size_t k : geo_requests) {
+      if (meshed[k] || !first_error.empty()) continue;
+      first_error =
+          file_label(requests[k].path) + ": " +
+          (process_error.empty() ? "the meshing process ended without its mesh" : process_error);
+    }
   }
   for (std::size_t k = 0; k < requests.size() && first_error.empty(); ++k) {
-    if (children[k]) continue;
+    if (lower_extension(requests[k].path) == ".geo") continue;
     started[k] = Clock::now();
     if (observer.started) observer.started(k);
-    read(k);
+    try {
+      check_request(requests[k].path, requests[k].options);
+    } catch (const InputError& error) {
+      first_error = error.what();
+      break;
+    }
+    read(k, requests[k].path);
   }
   if (!first_error.empty()) throw InputError(first_error);
   return meshes;
