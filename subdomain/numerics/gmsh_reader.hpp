@@ -2,8 +2,9 @@
 // Reads Gmsh meshes. Supported inputs:
 //  - .msh (format 4.1 and 2.2, ASCII or binary): read as is by read_msh_file (msh_file.hpp),
 //    without Gmsh;
-//  - .geo: meshed on the fly in its dimension by Gmsh in robin-mesh-reader, a child process
-//    (the tools do not link libgmsh), which writes a binary MSH 4.1 file read_msh_file reads.
+//  - .geo: meshed on the fly in its dimension by Gmsh under robin-mesh-reader, in a child
+//    process (the tools do not link libgmsh), which writes a binary MSH 4.1 file read_msh_file
+//    reads.
 //    When `size` > 0 the Gmsh variable `h` is set to it before the script is parsed (like
 //    `gmsh -setnumber h SIZE`); a .geo declares `DefineConstant[ h = 0.1 ];` to use it.
 // A model with a volume is a solid body (Mesh::dimension 3): the elements of every 3D physical
@@ -51,10 +52,11 @@ struct MeshReadObserver {
   std::function<void()> waiting;
 };
 
-/// Reads several mesh files at once, each as read_gmsh_mesh reads it. Each .geo is meshed by
-/// robin-mesh-reader (mesh_reader_executable) in a child process of its own, all concurrently;
-/// a child writes its mesh as binary MSH 4.1 into a private temporary directory, which this
-/// process reads (a .msh is read directly) as soon as that child has ended. Only the user's own
+/// Reads several mesh files at once, each as read_gmsh_mesh reads it. The .geo files are meshed
+/// by one robin-mesh-reader process (mesh_reader_executable, --mesh-geo-batch), which loads
+/// libgmsh once and meshes each file in a child process of its own, all concurrently; a child
+/// writes its mesh as binary MSH 4.1 into a private temporary directory, which this process
+/// reads (a .msh is read directly) as soon as that child has ended. Only the user's own
 /// files belong here: a .geo is a program. Throws InputError naming the file for the first
 /// request that fails (in the order the failures are seen), after every child has ended.
 std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
