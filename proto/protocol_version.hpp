@@ -15,7 +15,9 @@ inline constexpr unsigned protocol_major = 2;
 /// three-dimensional (solid) bodies: MeshData.dimension 3 with tetrahedra and hexahedra (CellType
 /// TETRAHEDRON4, TETRAHEDRON10, HEXAHEDRON8) and triangular or quadrilateral boundary faces, 6x6
 /// Voigt materials, 3 components per node in every vector, Dirichlet.z, FieldsReply.dimension; a
-/// plane body's messages are those of 2.3.
-inline constexpr unsigned protocol_minor = 4;
+/// plane body's messages are those of 2.3. 2.5: FieldsRequest.omit_fields_from_reply (a server
+/// that wrote the body's file sends a reply without mesh and fields) and peak_resident_bytes in
+/// InterfaceDescription, Acknowledge and FieldsReply.
+inline constexpr unsigned protocol_minor = 5;
 
 }  // namespace robin::protocol

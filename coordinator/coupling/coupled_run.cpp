@@ -13,6 +13,7 @@
 #include "coupling/interface_outputs.hpp"
 #include "coupling/iteration_checkpoint.hpp"
 #include "coupling/local_problem.hpp"
+#include "coupling/step_outputs.hpp"
 
 namespace robin {
 namespace {
@@ -227,11 +228,28 @@ RobinResult recoverable_iteration(RecoverablePorts& ports, const CouplingProblem
   return result;
 }
 
+/// Where the fields of load step `step` of `count` go (0: a run without load steps): see
+/// RunContinuation::server_write_directory.
+FieldsDestination fields_destination(const RunContinuation& continuation,
+                                     const GraphCoupling& coupling, int step, std::size_t count) {
+  FieldsDestination destination;
+  if (continuation.server_write_directory.empty()) return destination;
+  destination.write_directory = continuation.server_write_directory;
+  if (step > 0) destination.write_directory /= step_directory(step, count);
+  destination.omit_fields = true;
+  for (const ContactPairing& pairing : coupling.pairings) {
+    if (!pairing.excluded_pairs.empty()) destination.omit_fields = false;
+  }
+  return destination;
+}
+
 /// Every body's fields for the iteration's contact forces.
-std::vector<BodyOutput> collect_fields(RecoverablePorts& ports, const RobinResult& iteration) {
+std::vector<BodyOutput> collect_fields(RecoverablePorts& ports, const RobinResult& iteration,
+                                       const FieldsDestination& destination) {
   return ports.run([&] {
     return on_every_port(ports.ports(), [&](SubdomainPort& port, int alpha) {
-      return port.fields(iteration.state.bodies[static_cast<std::size_t>(alpha)].contact_force);
+      return port.fields(iteration.state.bodies[static_cast<std::size_t>(alpha)].contact_force,
+                         destination);
     });
   });
 }
@@ -355,7 +373,9 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
     report_stage(observer, "collecting the fields of " + every_body(ports) + " (load step " +
                                std::to_string(step.step) + ")");
     const auto fields_start = Clock::now();
-    step.outputs = collect_fields(ports, step.iteration);
+    step.outputs = collect_fields(
+        ports, step.iteration,
+        fields_destination(continuation, result.coupling, step.step, loading.factors.size()));
     result.profile.fields_seconds += seconds_since(fields_start);
     result.iteration = step.iteration;
     result.outputs = step.outputs;
@@ -429,7 +449,8 @@ void run_single_solve(RecoverablePorts& recoverable, const CouplingOptions& opti
   result.iteration_port_timings = differences(port_timings(recoverable), before);
   report_stage(observer, "collecting the fields of " + every_body(recoverable));
   const auto fields_start = Clock::now();
-  result.outputs = collect_fields(recoverable, result.iteration);
+  result.outputs = collect_fields(recoverable, result.iteration,
+                                  fields_destination(continuation, result.coupling, 0, 0));
   result.profile.fields_seconds = seconds_since(fields_start);
   result.excluded_clearance = excluded_clearance(result);
 }

@@ -81,6 +81,12 @@ struct RunContinuation {
   std::function<void(const LoadStepCheckpoint&)> step_completed;
   /// Replaces lost servers (port_recovery.hpp); empty: a lost server fails the run.
   ServerReplacement replacement;
+  /// Not empty: every body's server writes its fields file itself into this directory, relative
+  /// to the servers' output root (robin-run's local servers: the result directory's staging
+  /// area), a load step's into steps/step_NNN of it (step_outputs.hpp), and leaves the mesh and
+  /// fields out of its reply unless a contact pair is excluded (whose clearance needs the
+  /// displacements). Empty: the fields come back and the coordinator writes the files.
+  std::filesystem::path server_write_directory;
 };
 
 /// Observer of the run's stages ("setup", "pairing", iteration records) for progress lines.

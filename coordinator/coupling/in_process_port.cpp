@@ -81,7 +81,9 @@ void InProcessPort::set_load_factor(double factor) {
   }
 }
 
-BodyOutput InProcessPort::fields(const Eigen::VectorXd& contact_force) {
+/// The body lives here: there is no server to write its file, the coordinator writes it.
+BodyOutput InProcessPort::fields(const Eigen::VectorXd& contact_force,
+                                 const FieldsDestination& /*destination*/) {
   const auto start = std::chrono::steady_clock::now();
   BodyOutput output = make_body_output(body(), contact_force);
   profile_.stages[SetupStage::fields] =

@@ -21,7 +21,8 @@ class InProcessPort final : public SubdomainPort {
   void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;
   CorrectionSolveResult finish_neumann_solve() override;
   void set_load_factor(double factor) override;
-  BodyOutput fields(const Eigen::VectorXd& contact_force) override;
+  BodyOutput fields(const Eigen::VectorXd& contact_force,
+                    const FieldsDestination& destination) override;
   void end_run() noexcept override;
   const PortTimings& timings() const override { return timings_; }
   const BodyProfile& profile() const override { return profile_; }

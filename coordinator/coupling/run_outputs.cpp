@@ -154,7 +154,7 @@ void write_coupled_outputs(ResultDirectory& results, const CaseDefinition& defin
   const std::filesystem::path& directory = results.staging();
   std::vector<std::string> files;
   for (const BodyOutput& output : result.outputs) {
-    files.push_back(write_body_output(directory, output));
+    files.push_back(place_body_output(directory, output));
   }
   write_solution_pvd(directory, files);
   const RobinResult& iteration = result.iteration;

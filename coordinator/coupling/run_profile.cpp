@@ -41,6 +41,9 @@ nlohmann::json body_profile_json(const BodyProfile& profile, const std::string& 
     body[key_of(stage)] =
         found == profile.stages.end() ? nlohmann::json(nullptr) : nlohmann::json(found->second);
   }
+  body["peak_resident_bytes"] = profile.peak_resident_bytes
+                                    ? nlohmann::json(*profile.peak_resident_bytes)
+                                    : nlohmann::json(nullptr);
   return body;
 }
 

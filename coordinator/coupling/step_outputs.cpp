@@ -145,7 +145,7 @@ void write_coupled_step_outputs(const std::filesystem::path& directory,
     std::filesystem::create_directories(step_path);
     files.emplace_back();
     for (const BodyOutput& output : step.outputs) {
-      files.back().push_back(write_body_output(step_path, output));
+      files.back().push_back(place_body_output(step_path, output));
     }
     const RobinResult& iteration = step.iteration;
     if (has_interface_state(result.coupling, iteration.state)) {

@@ -9,6 +9,8 @@
 // PortError (naming the server, the body and the step) on failure, including deadlines.
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -51,6 +53,20 @@ struct BodyProfile {
   /// Moving the SetupBody request and its reply: encoding the body, plus the round trip less
   /// setup_seconds. Zero in process.
   std::optional<double> transfer_seconds;
+  /// The process's peak resident set size in bytes, from the latest reply that reported it
+  /// (protocol 2.5: setup, contact assignment, fields); absent when none did (an older server,
+  /// in process).
+  std::optional<std::uint64_t> peak_resident_bytes;
+};
+
+/// Where a body's fields file goes. By default the port returns the whole mesh and fields and
+/// the coordinator writes the file; with `write_directory` the body's server writes
+/// <body>.vtu there itself (FieldsRequest.write_directory: relative to the server's output
+/// root) and returns its name in BodyOutput::written_file, and with `omit_fields` too its reply
+/// leaves the mesh and fields out (protocol 2.5; an older server sends them anyway).
+struct FieldsDestination {
+  std::filesystem::path write_directory;
+  bool omit_fields = false;
 };
 
 class SubdomainPort {
@@ -78,7 +94,10 @@ class SubdomainPort {
   /// and F; later solves and fields answer for the new loads. Valid after setup(). Throws
   /// PortError, also for a server of protocol 2.0 (naming the server and both versions).
   virtual void set_load_factor(double factor) = 0;
-  virtual BodyOutput fields(const Eigen::VectorXd& contact_force) = 0;
+  /// The body's fields for contact forces lambda (see FieldsDestination; a port that cannot
+  /// have its body's file written elsewhere ignores `destination` and returns everything).
+  virtual BodyOutput fields(const Eigen::VectorXd& contact_force,
+                            const FieldsDestination& destination) = 0;
   /// Ends the run (the server stays up for the next one). Must not throw.
   virtual void end_run() noexcept = 0;
   /// Forgets a request started but not finished (its reply, if any, is discarded), so that the

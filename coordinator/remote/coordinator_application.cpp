@@ -522,6 +522,9 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
   continuation.step_completed = [&](const LoadStepCheckpoint& step) {
     checkpoint.steps.push_back(step);
   };
+  if (settings.servers_write_fields) {
+    continuation.server_write_directory = results->staging().filename();
+  }
   std::vector<int> restarts(body_count, 0);
   nlohmann::json restart_records = nlohmann::json::array();
   if (restart.lost && restart.restart && settings.max_server_restarts > 0) {

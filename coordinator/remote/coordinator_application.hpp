@@ -68,6 +68,12 @@ struct CoordinatorSettings {
   /// How the bodies' meshing and setup progress is shown (progress_display.hpp); null: plain
   /// log lines.
   std::shared_ptr<ProgressDisplay> display;
+  /// robin-run's local robin-subdomain servers, started with --output-root = the output
+  /// directory: each writes its body's .vtu into the run's staging area itself, in parallel, and
+  /// replies without the fields (RunContinuation::server_write_directory). False: the coordinator
+  /// writes every file (servers given by endpoint, or started elsewhere or from another
+  /// executable).
+  bool servers_write_fields = false;
 };
 
 /// How run_coordinator replaces the server of a body that was lost mid-run (robin-run:

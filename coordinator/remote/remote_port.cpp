@@ -55,6 +55,12 @@ void record_stage_times(const StageTimes& stage_times, std::map<SetupStage, doub
   }
 }
 
+/// A reply's peak_resident_bytes (protocol 2.5) into the profile; 0 (not reported) keeps the
+/// value of an earlier reply.
+void record_peak_resident(std::uint64_t bytes, BodyProfile& profile) {
+  if (bytes > 0) profile.peak_resident_bytes = bytes;
+}
+
 template <typename Values>
 void append(const Eigen::VectorXd& vector, Values& values) {
   values.Add(vector.data(), vector.data() + vector.size());
@@ -240,6 +246,7 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
 void RemotePort::record_setup_profile(const protocol::InterfaceDescription& reply, double seconds) {
   profile_ = BodyProfile{};
   record_stage_times(reply.stage_times(), profile_.stages);
+  record_peak_resident(reply.peak_resident_bytes(), profile_);
   const double server_seconds = reply.request_seconds();
   if (std::isfinite(server_seconds) && server_seconds > 0.0) {
     profile_.setup_seconds = server_seconds;
@@ -253,6 +260,7 @@ void RemotePort::assign_contact(const ContactOperator& contact) {
   const Envelope reply = watched_exchange(request, "contact assignment",
                                           options_.request_timeout_seconds, Envelope::kAcknowledge);
   record_stage_times(reply.acknowledge().stage_times(), profile_.stages);
+  record_peak_resident(reply.acknowledge().peak_resident_bytes(), profile_);
   contact_size_ = contact.row_count();
 }
 
@@ -354,17 +362,45 @@ void RemotePort::set_load_factor(double factor) {
   }
 }
 
-BodyOutput RemotePort::fields(const Eigen::VectorXd& contact_force) {
+BodyOutput RemotePort::fields(const Eigen::VectorXd& contact_force,
+                              const FieldsDestination& destination) {
   Envelope request;
-  append(contact_force, *request.mutable_fields()->mutable_contact_force());
+  protocol::FieldsRequest& message = *request.mutable_fields();
+  append(contact_force, *message.mutable_contact_force());
+  if (!destination.write_directory.empty()) {
+    message.set_write_directory(destination.write_directory.generic_string());
+    message.set_omit_fields_from_reply(destination.omit_fields);
+  }
   const Envelope reply =
       watched_exchange(request, "fields", options_.setup_timeout_seconds, Envelope::kFieldsReply);
-  record_stage_times(reply.fields_reply().stage_times(), profile_.stages);
+  const protocol::FieldsReply& fields = reply.fields_reply();
+  record_stage_times(fields.stage_times(), profile_.stages);
+  record_peak_resident(fields.peak_resident_bytes(), profile_);
   try {
-    return decode_fields(reply.fields_reply(), body_label_);
+    BodyOutput output = decode_fields(fields, body_label_);
+    if (!destination.write_directory.empty()) output.written_file = written_file_name(fields);
+    return output;
   } catch (const MalformedReply& malformed) {
     fail("fields", std::string("malformed reply: ") + malformed.what());
   }
+}
+
+/// The name of the file the server wrote for FieldsRequest.write_directory: "<body>.vtu".
+/// Without one (a server that did not write it) the coordinator writes the file from the
+/// reply's fields, which must then be there.
+std::string RemotePort::written_file_name(const protocol::FieldsReply& reply) const {
+  const std::string expected = body_label_ + ".vtu";
+  if (reply.written_file().empty()) {
+    if (reply.node_coordinates().empty()) {
+      throw MalformedReply("neither written_file nor the fields: the body's file is nowhere");
+    }
+    return "";
+  }
+  if (std::filesystem::path(reply.written_file()).filename() != expected) {
+    throw MalformedReply("written_file '" + reply.written_file() + "' is not the body's '" +
+                         expected + "'");
+  }
+  return expected;
 }
 
 void RemotePort::end_run() noexcept {

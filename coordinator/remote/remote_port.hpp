@@ -57,7 +57,8 @@
 
 namespace robin::protocol {
 class InterfaceDescription;
-}
+class FieldsReply;
+}  // namespace robin::protocol
 
 namespace robin {
 
@@ -99,7 +100,8 @@ class RemotePort final : public SubdomainPort {
   /// protocol 2.0, this coordinator speaks 2.1; a case with [loading] steps needs
   /// SetLoadFactor (protocol 2.1): ...".
   void set_load_factor(double factor) override;
-  BodyOutput fields(const Eigen::VectorXd& contact_force) override;
+  BodyOutput fields(const Eigen::VectorXd& contact_force,
+                    const FieldsDestination& destination) override;
   void end_run() noexcept override;
   void abandon_request() noexcept override;
   const PortTimings& timings() const override;
@@ -131,6 +133,7 @@ class RemotePort final : public SubdomainPort {
   /// exchange() with the heartbeat watching the server meanwhile (when it offers "status").
   protocol::Envelope watched_exchange(protocol::Envelope& request, const std::string& step,
                                       double timeout_seconds, int expected_content);
+  std::string written_file_name(const protocol::FieldsReply& reply) const;
   [[noreturn]] void fail(const std::string& step, const std::string& problem) const;
   void update_byte_counts();
   void record_setup_profile(const protocol::InterfaceDescription& reply, double seconds);

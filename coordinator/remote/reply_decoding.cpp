@@ -159,6 +159,8 @@ std::map<std::string, BoundaryGroup> decode_boundaries(const protocol::FieldsRep
 std::vector<ElementBlock> decode_blocks(const protocol::FieldsReply& message, long node_count,
                                         int dimension) {
   const long block_count = message.cell_types_size();
+  // no mesh at all: the reply of a server that wrote the file itself (protocol 2.5)
+  if (block_count == 0 && message.cell_offsets().empty()) return {};
   expect_size(message.cell_offsets(), block_count + 1, "cell_offsets");
   std::vector<ElementBlock> blocks;
   for (long b = 0; b < block_count; ++b) {

@@ -42,7 +42,9 @@ CorrectionSolveResult decode_neumann_result(const protocol::NeumannSolveResult& 
 /// VTK cell types 5, 22, 9 in 2D and 10, 24, 12 in 3D, the quadratic tetrahedra's nodes back in
 /// Gmsh's order, and the named boundaries when the reply has them) and fields. A 6-component stress
 /// field gets the component names XX, YY, ZZ, XY, YZ, XZ, a 3-component one (older servers) xx, yy,
-/// xy. Throws MalformedReply for a size, index, cell type or boundary name that does not fit.
+/// xy. A reply without mesh and fields (no nodes, cell types or offsets: protocol 2.5,
+/// FieldsRequest.omit_fields_from_reply) gives an empty mesh and no fields, with the resultants.
+/// Throws MalformedReply for a size, index, cell type or boundary name that does not fit.
 BodyOutput decode_fields(const protocol::FieldsReply& message, const std::string& body_name);
 
 /// The element type of a VTK cell type number (5, 22 or 9; 10, 24 or 12 for the solid elements);

@@ -69,9 +69,16 @@ std::vector<robin::ServerLaunchOptions> placed(const robin::ServerLaunchOptions&
   return options;
 }
 
+/// Whether the servers are this build's robin-subdomain on this machine, sharing the output
+/// directory with the coordinator: no --server-command, --server-listen or --server-executable
+/// (a server elsewhere, or another implementation, gets its files written by the coordinator).
+bool writes_own_files(const ServerPlacement& placement) {
+  return placement.commands.empty() && placement.listens.empty() && placement.executables.empty();
+}
+
 /// Starts the servers, runs the case against them and stops them; returns the exit code.
 int run_with_local_servers(const robin::CaseDefinition& definition,
-                           const robin::CoordinatorSettings& settings, bool curve,
+                           robin::CoordinatorSettings settings, bool curve,
                            const ServerPlacement& placement) {
   robin::ServerLaunchOptions launch;
   launch.log_directory = settings.output_directory / "logs";
@@ -87,6 +94,13 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
                    keys->client_keys().server_public_key);
     }
     launch.executable = robin::sibling_executable("robin-subdomain");
+    if (writes_own_files(placement)) {
+      // the servers write their bodies' files into the output directory (FieldsRequest.
+      // write_directory), as the coordinator would, each in parallel with the others
+      launch.extra_arguments.push_back("--output-root");
+      launch.extra_arguments.push_back(
+          std::filesystem::absolute(settings.output_directory).string());
+    }
     robin::LocalServers servers(robin::body_names(definition),
                                 placed(launch, placement, definition.bodies.size()));
     servers.await_listening(robin::throw_if_stop_requested);
@@ -123,6 +137,7 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
         servers.stop();
       }
     };
+    settings.servers_write_fields = writes_own_files(placement);
     code = robin::run_coordinator(definition, settings, servers.endpoints(), channels, restart,
                                   stop_in_background);
     if (stopping.valid()) stopping.get();

@@ -99,6 +99,10 @@ BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& conta
   return output;
 }
 
+std::string place_body_output(const std::filesystem::path& directory, const BodyOutput& output) {
+  return output.written_file.empty() ? write_body_output(directory, output) : output.written_file;
+}
+
 std::string write_body_output(const std::filesystem::path& directory, const BodyOutput& output) {
   const std::string file_name = output.body_name + ".vtu";
   if (output.body_name.empty() || std::filesystem::path(output.body_name).has_parent_path()) {

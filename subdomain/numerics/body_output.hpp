@@ -21,7 +21,15 @@ struct BodyOutput {
   std::vector<OutputField> cell_fields;
   Eigen::Vector3d reaction_resultant = Eigen::Vector3d::Zero();  // sum of reactions (z = 0 in 2D)
   Eigen::Vector3d applied_force = Eigen::Vector3d::Zero();       // body forces + tractions
+  /// The file's name, "<body_name>.vtu", when the body's server wrote it itself
+  /// (FieldsReply.written_file); the mesh and fields may then be empty (protocol 2.5,
+  /// FieldsRequest.omit_fields_from_reply). Empty: the coordinator writes the file.
+  std::string written_file;
 };
+
+/// The body's file name in its result directory: `written_file` when its server wrote it
+/// there, otherwise the file write_body_output writes into `directory`.
+std::string place_body_output(const std::filesystem::path& directory, const BodyOutput& output);
 
 /// The stress field's component names in ParaView's symmetric-tensor order: XX, YY, ZZ, XY, YZ,
 /// XZ. The stress of a plane problem has YZ = XZ = 0 and ZZ = nu (XX + YY) for an isotropic

@@ -113,6 +113,11 @@ void encode_fields(const BodyOutput& output, protocol::FieldsReply& message) {
   }
   for (const OutputField& field : output.cell_fields)
     encode_field(field, *message.add_cell_fields());
+  encode_resultants(output, message);
+}
+
+void encode_resultants(const BodyOutput& output, protocol::FieldsReply& message) {
+  if (output.mesh.dimension == 3) message.set_dimension(3);  // absent (2) for a plane body
   add_vector(output.reaction_resultant, output.mesh.dimension,
              *message.mutable_reaction_resultant());
   add_vector(output.applied_force, output.mesh.dimension, *message.mutable_applied_force());

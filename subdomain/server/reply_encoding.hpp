@@ -28,6 +28,11 @@ protocol::SolveStatus to_protocol(QpStatus status);
 /// as node indices, for the line cells of the output).
 void encode_fields(const BodyOutput& output, protocol::FieldsReply& message);
 
+/// Only the reaction resultant, the applied force and the dimension (3 for a solid body, absent
+/// for a plane one): the reply of a server that wrote the fields file itself (protocol 2.5,
+/// FieldsRequest.omit_fields_from_reply).
+void encode_resultants(const BodyOutput& output, protocol::FieldsReply& message);
+
 /// A repeated double field as a vector.
 Eigen::VectorXd to_vector(const google::protobuf::RepeatedField<double>& values);
 

@@ -15,6 +15,7 @@
 #include "server/file_access.hpp"
 #include "server/reply_encoding.hpp"
 #include "server/request_error.hpp"
+#include "server/resident_memory.hpp"
 #include "server/server_logging.hpp"
 #include "server/setup_decoding.hpp"
 
@@ -166,6 +167,18 @@ std::string write_fields_file(const std::filesystem::path& directory, const Body
     throw RequestError(protocol::INVALID_ARGUMENT,
                        "FieldsRequest.write_directory: cannot write the fields of body '" +
                            output.body_name + "' to '" + directory.string() + "': " + error.what());
+  }
+}
+
+/// Refuses fields with a NaN or an infinity (SOLVER_FAILURE naming the field and the body).
+void require_finite_fields(const BodyOutput& output, const std::string& body_name) {
+  for (const auto* fields : {&output.point_fields, &output.cell_fields}) {
+    const std::string kind = fields == &output.point_fields ? "point" : "cell";
+    for (const OutputField& field : *fields) {
+      require_finite(Eigen::Map<const Eigen::VectorXd>(
+                         field.values.data(), static_cast<Eigen::Index>(field.values.size())),
+                     "FieldsReply " + kind + " field '" + field.name + "'", body_name);
+    }
   }
 }
 
@@ -527,6 +540,7 @@ void SubdomainServer::on_setup_body(protocol::Envelope& request, protocol::Envel
     add_stage_time(stage_times, SetupStage::factorization, timings.factorization_seconds);
     description.set_request_seconds(seconds_since(record.start));
   }
+  if (settings_.protocol_minor >= 5) description.set_peak_resident_bytes(peak_resident_bytes());
   interface_nodes_ = interface.node_ids;
   qp_parameters_ = setup.qp;
   body_ = std::move(body);
@@ -558,6 +572,9 @@ void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
   if (settings_.protocol_minor >= 2) {
     add_stage_time(*reply.mutable_acknowledge()->mutable_stage_times(),
                    SetupStage::interface_operator, body_->timings().interface_seconds);
+  }
+  if (settings_.protocol_minor >= 5) {
+    reply.mutable_acknowledge()->set_peak_resident_bytes(peak_resident_bytes());
   }
 }
 
@@ -639,36 +656,46 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
   const protocol::FieldsRequest& message = request.fields();
   require_same_run(request, "FieldsRequest");
   require_state(ServerState::ready, "FieldsRequest");
+  // Since 2.5: a reply without mesh and fields, for a file the server writes itself.
+  const bool omit_fields = settings_.protocol_minor >= 5 && message.omit_fields_from_reply();
+  if (omit_fields && message.write_directory().empty()) {
+    throw RequestError(protocol::INVALID_ARGUMENT,
+                       "body '" + body_->name() +
+                           "': FieldsRequest.omit_fields_from_reply is set without "
+                           "write_directory: the fields would go nowhere");
+  }
   begin_stage(SetupStage::fields, 0);
   const auto start = Clock::now();
   const Eigen::VectorXd contact_force = checked_vector(
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
-  const BodyOutput output = make_body_output(*body_, contact_force);
-  for (const OutputField& field : output.point_fields) {
-    require_finite(Eigen::Map<const Eigen::VectorXd>(
-                       field.values.data(), static_cast<Eigen::Index>(field.values.size())),
-                   "FieldsReply point field '" + field.name + "'", body_->name());
-  }
-  for (const OutputField& field : output.cell_fields) {
-    require_finite(Eigen::Map<const Eigen::VectorXd>(
-                       field.values.data(), static_cast<Eigen::Index>(field.values.size())),
-                   "FieldsReply cell field '" + field.name + "'", body_->name());
-  }
-  std::filesystem::path directory;
-  if (!message.write_directory().empty()) {
-    try {
-      directory = resolve_output_directory(settings_.output_root, message.write_directory(),
-                                           "FieldsRequest.write_directory");
-    } catch (const InputError& error) {
-      throw RequestError(protocol::INVALID_ARGUMENT,
-                         "body '" + body_->name() + "': " + error.what());
-    }
-  }
+  const std::filesystem::path directory = fields_directory(message.write_directory());
   protocol::FieldsReply& fields = *reply.mutable_fields_reply();
-  encode_fields(output, fields);
-  if (!directory.empty()) fields.set_written_file(write_fields_file(directory, output));
+  {
+    const BodyOutput output = make_body_output(*body_, contact_force);
+    require_finite_fields(output, body_->name());
+    // the file first: its buffers are freed before the reply's copy of the fields is made
+    if (!directory.empty()) fields.set_written_file(write_fields_file(directory, output));
+    if (omit_fields) {
+      encode_resultants(output, fields);
+    } else {
+      encode_fields(output, fields);
+    }
+  }  // the fields are freed before the reply is serialized
   if (settings_.protocol_minor >= 2) {
     add_stage_time(*fields.mutable_stage_times(), SetupStage::fields, seconds_since(start));
+  }
+  if (settings_.protocol_minor >= 5) fields.set_peak_resident_bytes(peak_resident_bytes());
+}
+
+/// The directory of FieldsRequest.write_directory under the output root (created); empty when
+/// none was asked for. A refused directory is an INVALID_ARGUMENT naming the body.
+std::filesystem::path SubdomainServer::fields_directory(const std::string& requested) const {
+  if (requested.empty()) return {};
+  try {
+    return resolve_output_directory(settings_.output_root, requested,
+                                    "FieldsRequest.write_directory");
+  } catch (const InputError& error) {
+    throw RequestError(protocol::INVALID_ARGUMENT, "body '" + body_->name() + "': " + error.what());
   }
 }
 

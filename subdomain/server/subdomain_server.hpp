@@ -180,6 +180,7 @@ class SubdomainServer {
   /// correction_delay_* say (testing only; nothing when they are 0).
   void delay_for_testing(unsigned iteration) const;
   void on_fields(const protocol::Envelope& request, protocol::Envelope& reply);
+  std::filesystem::path fields_directory(const std::string& requested) const;
   void on_set_load_factor(const protocol::Envelope& request, protocol::Envelope& reply,
                           RequestRecord& record);
   /// Whether the optional capability `name` is announced and served.

@@ -184,7 +184,7 @@ TEST(NeumannSolveRemote, ServerWithoutTheCapabilityServesRobinButRefusesTheNeuma
         << message;
   }
   // Nothing was sent: the port has no request in flight and the server still serves.
-  const BodyOutput output = body1.fields(force);
+  const BodyOutput output = body1.fields(force, {});
   EXPECT_EQ(output.mesh.nodes.size(), reference.outputs[0].mesh.nodes.size());
   body2.start_neumann_solve(remote.iteration.state.bodies[1].contact_force, 7);
   const CorrectionSolveResult neumann = body2.finish_neumann_solve();

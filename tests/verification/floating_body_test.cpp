@@ -275,7 +275,7 @@ TEST(FloatingBody, StackOfThreeRobinEqualsTheSeriesSpringsAndTheMonolithicSoluti
                             stack.problem);
     std::vector<BodyOutput> outputs;
     for (std::size_t body = 0; body < 3; ++body) {
-      outputs.push_back(ports.ports[body].fields(robin.state.bodies[body].contact_force));
+      outputs.push_back(ports.ports[body].fields(robin.state.bodies[body].contact_force, {}));
     }
     expect_exact_fields(outputs);
   }
