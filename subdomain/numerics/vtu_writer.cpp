@@ -10,8 +10,11 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <stdexcept>
+#include <string_view>
 #include <unordered_map>
 #include <variant>
 
@@ -175,6 +178,11 @@ DataArray field_array(const OutputField& field, std::size_t count,
           std::move(values)};
 }
 
+/// The attributes of a field's array (as field_array writes it), without its values.
+DataArray attributes_of(const OutputField& field) {
+  return {"Float64", field.name, written_components(field.components), field.component_names, {}};
+}
+
 /// Key of a facet by its corner nodes, whatever their order: the sorted corners, -1 padded.
 using FacetKey = std::array<int, 4>;
 
@@ -238,21 +246,36 @@ std::vector<int> vtk_node_order(const ElementBlock& block) {
   return nodes;
 }
 
-/// Points, connectivity, offsets (end of each cell in connectivity) and types: area elements
-/// block after block, then (with boundary cells) the boundary edges in name order.
-std::vector<DataArray> geometry_arrays(const Mesh& mesh, bool boundary_cells) {
+/// The points (x, y, z per node).
+DataArray points_array(const Mesh& mesh) {
   std::vector<double> points;
   points.reserve(3 * mesh.node_count());
   for (const Eigen::Vector3d& node : mesh.nodes)
     points.insert(points.end(), {node.x(), node.y(), node.z()});
+  return {"Float64", "Points", 3, {}, std::move(points)};
+}
+
+/// Which array of the Cells section.
+enum class CellArray { connectivity, offsets, types };
+
+/// One array of the cells: connectivity, offsets (end of each cell in connectivity) or types,
+/// over the area elements block after block, then (with boundary cells) the boundary facets in
+/// name order.
+DataArray cell_array(const Mesh& mesh, bool boundary_cells, CellArray which) {
   std::vector<std::int64_t> connectivity, offsets;
   std::vector<std::uint8_t> types;
+  std::int64_t end = 0;
   const auto add_cells = [&](const std::vector<int>& nodes, int per_cell, int type) {
     for (std::size_t k = 0; k < nodes.size(); k += static_cast<std::size_t>(per_cell)) {
-      connectivity.insert(connectivity.end(), nodes.begin() + static_cast<std::ptrdiff_t>(k),
-                          nodes.begin() + static_cast<std::ptrdiff_t>(k) + per_cell);
-      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
-      types.push_back(static_cast<std::uint8_t>(type));
+      end += per_cell;
+      if (which == CellArray::connectivity) {
+        connectivity.insert(connectivity.end(), nodes.begin() + static_cast<std::ptrdiff_t>(k),
+                            nodes.begin() + static_cast<std::ptrdiff_t>(k) + per_cell);
+      } else if (which == CellArray::offsets) {
+        offsets.push_back(end);
+      } else {
+        types.push_back(static_cast<std::uint8_t>(type));
+      }
     }
   };
   for (const ElementBlock& block : mesh.blocks) {
@@ -263,30 +286,33 @@ std::vector<DataArray> geometry_arrays(const Mesh& mesh, bool boundary_cells) {
       add_cells(group.connectivity, nodes_per_facet(group.type), vtk_cell_type(group.type));
     }
   }
-  std::vector<DataArray> arrays;
-  arrays.push_back({"Float64", "Points", 3, {}, std::move(points)});
-  arrays.push_back({"Int64", "connectivity", 1, {}, std::move(connectivity)});
-  arrays.push_back({"Int64", "offsets", 1, {}, std::move(offsets)});
-  arrays.push_back({"UInt8", "types", 1, {}, std::move(types)});
-  return arrays;
+  switch (which) {
+    case CellArray::connectivity:
+      return {"Int64", "connectivity", 1, {}, std::move(connectivity)};
+    case CellArray::offsets:
+      return {"Int64", "offsets", 1, {}, std::move(offsets)};
+    case CellArray::types:
+      break;
+  }
+  return {"UInt8", "types", 1, {}, std::move(types)};
 }
 
-/// The array's values as bytes in the machine's byte order (strings: each followed by '\0').
-std::vector<unsigned char> to_bytes(const DataArray& array) {
+/// The array's values as bytes in the machine's byte order: a view of its own storage, or for
+/// strings (each followed by '\0') of `storage`.
+std::string_view value_bytes(const DataArray& array, std::string& storage) {
   return std::visit(
-      [](const auto& values) {
+      [&storage](const auto& values) {
         using Value = typename std::decay_t<decltype(values)>::value_type;
-        std::vector<unsigned char> bytes;
         if constexpr (std::is_same_v<Value, std::string>) {
           for (const std::string& text : values) {
-            bytes.insert(bytes.end(), text.begin(), text.end());
-            bytes.push_back(0);
+            storage += text;
+            storage.push_back('\0');
           }
+          return std::string_view(storage);
         } else {
-          bytes.resize(values.size() * sizeof(Value));
-          if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
+          return std::string_view(reinterpret_cast<const char*>(values.data()),
+                                  values.size() * sizeof(Value));
         }
-        return bytes;
       },
       array.values);
 }
@@ -295,34 +321,6 @@ void append_header_word(std::string& blob, std::uint64_t word) {
   std::array<char, sizeof word> bytes;
   std::memcpy(bytes.data(), &word, sizeof word);
   blob.append(bytes.data(), bytes.size());
-}
-
-/// The appended-data record of `bytes` in vtkZLibDataCompressor's layout (see the header).
-std::string compressed_record(const std::vector<unsigned char>& bytes,
-                              const std::filesystem::path& path) {
-  const std::size_t full_blocks = bytes.size() / compression_block_size;
-  const std::size_t last_block = bytes.size() % compression_block_size;
-  const std::size_t block_count = full_blocks + (last_block != 0 ? 1 : 0);
-  std::string data;
-  std::vector<std::uint64_t> compressed_sizes;
-  std::vector<Bytef> buffer(compressBound(compression_block_size));
-  for (std::size_t block = 0; block < block_count; ++block) {
-    const std::size_t begin = block * compression_block_size;
-    const std::size_t size = std::min(compression_block_size, bytes.size() - begin);
-    uLongf compressed_size = static_cast<uLongf>(buffer.size());
-    if (compress2(buffer.data(), &compressed_size, bytes.data() + begin, static_cast<uLong>(size),
-                  compression_level) != Z_OK) {
-      throw std::runtime_error("cannot write '" + path.string() + "': zlib compression failed");
-    }
-    data.append(reinterpret_cast<const char*>(buffer.data()), compressed_size);
-    compressed_sizes.push_back(compressed_size);
-  }
-  std::string record;
-  append_header_word(record, block_count);
-  append_header_word(record, compression_block_size);
-  append_header_word(record, last_block);
-  for (std::uint64_t size : compressed_sizes) append_header_word(record, size);
-  return record + data;
 }
 
 /// Writes the array's values as text: numbers separated by spaces; a string as the codes of
@@ -351,13 +349,22 @@ void write_ascii_values(std::ofstream& out, const DataArray& array) {
       array.values);
 }
 
-/// Writes DataArray elements; in binary mode their records are added to `appended`.
+/// Width reserved for an offset in the XML (a uint64 has at most 20 digits) and its closing quote.
+constexpr std::size_t offset_width = 21;
+
+/// Writes the DataArray elements as they come. ASCII: each with its values. Binary: each with
+/// room for its offset into the appended data; finish() then makes the arrays again one at a
+/// time, streams their compressed records after the XML and writes every offset into its room
+/// ("123" followed by spaces up to the element's end). So only one array's values and record are
+/// in memory at a time, never the whole appended block.
 class ArrayWriter {
  public:
   ArrayWriter(std::ofstream& out, VtuEncoding encoding, const std::filesystem::path& path)
       : out_(out), encoding_(encoding), path_(path) {}
 
-  void write(const DataArray& array) {
+  /// `array` holds the attributes (and a string array's values); `make` makes its values when
+  /// they are written (called once, after the XML in binary mode).
+  void write(const DataArray& array, std::function<DataArray()> make) {
     out_ << "        <DataArray type=\"" << array.type << "\" Name=\"" << escape_xml(array.name)
          << '"';
     if (const auto* strings = std::get_if<std::vector<std::string>>(&array.values)) {
@@ -370,22 +377,125 @@ class ArrayWriter {
     }
     if (encoding_ == VtuEncoding::ascii) {
       out_ << " format=\"ascii\">";
-      write_ascii_values(out_, array);
+      write_ascii_values(out_, make());
       out_ << "</DataArray>\n";
       return;
     }
-    out_ << " format=\"appended\" offset=\"" << appended_.size() << "\"/>\n";
-    appended_ += compressed_record(to_bytes(array), path_);
+    out_ << " format=\"appended\" offset=\"";
+    pending_.push_back({out_.tellp(), std::move(make)});
+    out_ << std::string(offset_width, ' ') << "/>\n";
   }
 
-  const std::string& appended() const { return appended_; }
+  /// A small array whose values are at hand.
+  void write(DataArray array) {
+    auto values = std::make_shared<DataArray>(std::move(array));
+    write(*values, [values] { return std::move(*values); });
+  }
+
+  /// Binary: the appended data (every record, in the order of the elements), then the offsets.
+  void finish() {
+    if (encoding_ == VtuEncoding::ascii) return;
+    out_ << "  <AppendedData encoding=\"raw\">\n   _";
+    std::uint64_t offset = 0;
+    std::vector<std::uint64_t> offsets;
+    for (PendingArray& pending : pending_) {
+      offsets.push_back(offset);
+      std::string storage;
+      const DataArray array = pending.make();
+      offset += write_compressed_record(value_bytes(array, storage));
+      pending.make = nullptr;
+    }
+    out_ << "\n  </AppendedData>\n"
+         << "</VTKFile>\n";
+    for (std::size_t k = 0; k < pending_.size(); ++k) {
+      out_.seekp(pending_[k].position);
+      out_ << offsets[k] << '"';
+    }
+    out_.seekp(0, std::ios::end);
+  }
 
  private:
+  struct PendingArray {
+    std::streampos position;  // of the offset's room
+    std::function<DataArray()> make;
+  };
+
+  /// Writes the appended-data record of `bytes` in vtkZLibDataCompressor's layout (see the
+  /// header); returns its size in bytes.
+  std::uint64_t write_compressed_record(std::string_view bytes) {
+    const std::size_t full_blocks = bytes.size() / compression_block_size;
+    const std::size_t last_block = bytes.size() % compression_block_size;
+    const std::size_t block_count = full_blocks + (last_block != 0 ? 1 : 0);
+    std::string data;
+    std::string header;
+    append_header_word(header, block_count);
+    append_header_word(header, compression_block_size);
+    append_header_word(header, last_block);
+    std::vector<Bytef> buffer(compressBound(compression_block_size));
+    for (std::size_t block = 0; block < block_count; ++block) {
+      const std::size_t begin = block * compression_block_size;
+      const std::size_t size = std::min(compression_block_size, bytes.size() - begin);
+      uLongf compressed_size = static_cast<uLongf>(buffer.size());
+      if (compress2(buffer.data(), &compressed_size,
+                    reinterpret_cast<const Bytef*>(bytes.data()) + begin, static_cast<uLong>(size),
+                    compression_level) != Z_OK) {
+        throw std::runtime_error("cannot write '" + path_.string() + "': zlib compression failed");
+      }
+      data.append(reinterpret_cast<const char*>(buffer.data()), compressed_size);
+      append_header_word(header, compressed_size);
+    }
+    out_.write(header.data(), static_cast<std::streamsize>(header.size()));
+    out_.write(data.data(), static_cast<std::streamsize>(data.size()));
+    return header.size() + data.size();
+  }
+
   std::ofstream& out_;
   VtuEncoding encoding_;
   const std::filesystem::path& path_;
-  std::string appended_;
+  std::vector<PendingArray> pending_;
 };
+
+/// The Piece element: its PointData, CellData (with boundary_id when `boundary_cells`), Points
+/// and Cells.
+void write_piece(std::ofstream& out, ArrayWriter& writer, const Mesh& mesh,
+                 const std::vector<OutputField>& point_fields,
+                 const std::vector<OutputField>& cell_fields,
+                 const std::vector<std::int64_t>& adjacent, std::vector<std::int32_t> boundary_id,
+                 bool boundary_cells) {
+  const std::size_t node_count = mesh.node_count();
+  const std::size_t element_count = mesh.element_count();
+  out << "    <Piece NumberOfPoints=\"" << node_count << "\" NumberOfCells=\"" << boundary_id.size()
+      << "\">\n"
+      << "      <PointData>\n";
+  for (const OutputField& field : point_fields) {
+    writer.write(attributes_of(field),
+                 [&field, node_count] { return field_array(field, node_count); });
+  }
+  out << "      </PointData>\n"
+      << "      <CellData>\n";
+  for (const OutputField& field : cell_fields) {
+    writer.write(attributes_of(field), [&field, element_count, &adjacent] {
+      return field_array(field, element_count, adjacent);
+    });
+  }
+  if (boundary_cells) writer.write({"Int32", "boundary_id", 1, {}, std::move(boundary_id)});
+  out << "      </CellData>\n"
+      << "      <Points>\n";
+  writer.write({"Float64", "Points", 3, {}, {}}, [&mesh] { return points_array(mesh); });
+  out << "      </Points>\n"
+      << "      <Cells>\n";
+  writer.write({"Int64", "connectivity", 1, {}, {}}, [&mesh, boundary_cells] {
+    return cell_array(mesh, boundary_cells, CellArray::connectivity);
+  });
+  writer.write({"Int64", "offsets", 1, {}, {}}, [&mesh, boundary_cells] {
+    return cell_array(mesh, boundary_cells, CellArray::offsets);
+  });
+  writer.write({"UInt8", "types", 1, {}, {}}, [&mesh, boundary_cells] {
+    return cell_array(mesh, boundary_cells, CellArray::types);
+  });
+  out << "      </Cells>\n"
+      << "    </Piece>\n";
+}
 
 }  // namespace
 
@@ -458,32 +568,14 @@ void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
     writer.write({"String", "boundary_names", 1, {}, boundary_names});
     out << "    </FieldData>\n";
   }
-  out << "    <Piece NumberOfPoints=\"" << node_count << "\" NumberOfCells=\"" << boundary_id.size()
-      << "\">\n"
-      << "      <PointData>\n";
-  for (const OutputField& field : point_fields) writer.write(field_array(field, node_count));
-  out << "      </PointData>\n"
-      << "      <CellData>\n";
-  for (const OutputField& field : cell_fields) {
-    writer.write(field_array(field, element_count, adjacent));
-  }
-  if (options.boundary_cells) writer.write({"Int32", "boundary_id", 1, {}, boundary_id});
-  out << "      </CellData>\n";
-  std::vector<DataArray> geometry = geometry_arrays(mesh, options.boundary_cells);
-  out << "      <Points>\n";
-  writer.write(geometry[0]);
-  out << "      </Points>\n"
-      << "      <Cells>\n";
-  for (std::size_t k = 1; k < geometry.size(); ++k) writer.write(geometry[k]);
-  out << "      </Cells>\n"
-      << "    </Piece>\n"
-      << "  </UnstructuredGrid>\n";
+  write_piece(out, writer, mesh, point_fields, cell_fields, adjacent, std::move(boundary_id),
+              options.boundary_cells);
+  out << "  </UnstructuredGrid>\n";
   if (binary) {
-    out << "  <AppendedData encoding=\"raw\">\n   _";
-    out.write(writer.appended().data(), static_cast<std::streamsize>(writer.appended().size()));
-    out << "\n  </AppendedData>\n";
+    writer.finish();
+  } else {
+    out << "</VTKFile>\n";
   }
-  out << "</VTKFile>\n";
   finish_writing(out, path);
 }
 

@@ -5,7 +5,10 @@
 // array is binary in the appended-data section (encoding "raw"), compressed with zlib as
 // vtkZLibDataCompressor writes it: per array, the UInt64 header [number of blocks, uncompressed
 // block size (32768 bytes), uncompressed size of the last block (0 when it is full), compressed
-// size of each block], then the zlib streams of the blocks. VtuEncoding::ascii writes every
+// size of each block], then the zlib streams of the blocks. The arrays are made and compressed
+// one at a time while the appended data is written (never the whole block in memory), and their
+// offsets written afterwards into room left in the XML: `offset="N"` is followed by spaces up to
+// a fixed width before the element's `/>`. VtuEncoding::ascii writes every
 // array inline as text instead, each real number as the shortest decimal that reads back to the
 // same double. Either way the values read back are the doubles given here, bit for bit.
 //
