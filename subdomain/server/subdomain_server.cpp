@@ -550,6 +550,10 @@ void SubdomainServer::on_setup_body(protocol::Envelope& request, protocol::Envel
                    std::to_string(body_->free_dof_count()) + " free dofs, " +
                    std::to_string(interface_nodes_.size()) + " contact boundary nodes";
   if (reuse) record.outcome += ", factorization of the previous run reused";
+  if (const std::uint64_t peak = peak_resident_bytes(); peak > 0) {
+    record.outcome +=
+        fmt::format(", peak resident {:.0f} MiB", static_cast<double>(peak) / 1048576.0);
+  }
   if (!run_id_.empty()) record.outcome += ", run " + run_id_;
 }
 
