@@ -5,7 +5,8 @@
 //    coordinator's stages, which run one after the other, sum to at most the wall time this
 //    test measured around the robin-run process;
 //  - robin-coordinator against a server playing protocol 2.1 (no stage times) and the Python
-//    server (no separate ordering): what was not reported is null, what was is a number;
+//    server (no separate ordering, no peak resident size: protocol 2.4): what was not reported
+//    is null, what was is a number;
 //  - robin-monolithic writes the same keys, its bodies' server-only stages null, its bodies'
 //    setups (one after the other) within its setup stage.
 // No time is compared with a fixed threshold.
@@ -122,8 +123,10 @@ TEST(RunProfile, WhatAServerDidNotReportIsNull) {
   ASSERT_EQ(profile["bodies"].size(), 2u);
   const json& old = profile["bodies"][0];
   for (const std::string& key : body_stages) expect_not_reported(old, key);
+  expect_not_reported(old, "peak_resident_bytes");  // protocol 2.5
   const json& python = profile["bodies"][1];
   expect_not_reported(python, "ordering");  // SuperLU orders and factorizes in one call
+  expect_not_reported(python, "peak_resident_bytes");
   double setup = 0.0;
   for (const char* key : {"mesh", "assembly", "factorization"}) {
     setup += seconds_of(python, key);
@@ -153,7 +156,9 @@ TEST(RunProfile, RobinMonolithicWritesTheSameKeys) {
   ASSERT_EQ(profile["bodies"].size(), 2u);
   double setups = 0.0;
   for (const json& body : profile["bodies"]) {
-    for (const char* key : {"mesh", "transfer", "fields"}) expect_not_reported(body, key);
+    for (const char* key : {"mesh", "transfer", "fields", "peak_resident_bytes"}) {
+      expect_not_reported(body, key);
+    }
     double stages = 0.0;
     for (const char* key : {"assembly", "ordering", "factorization"}) {
       stages += seconds_of(body, key);

@@ -1045,6 +1045,69 @@ std::set<std::string> listing(const std::filesystem::path& directory) {
   return names;
 }
 
+// Protocol 2.5: FieldsRequest.omit_fields_from_reply. With write_directory the server writes
+// the same file as for a full reply (the bytes of out/lower.vtu and full/lower.vtu are equal)
+// and replies with the resultants of the full reply and no mesh or fields; without
+// write_directory it is INVALID_ARGUMENT. A server playing protocol 2.4 ignores it (a full
+// reply) and reports no peak_resident_bytes; a 2.5 server reports a positive one.
+TEST(SubdomainServer, OmitFieldsFromReplyKeepsTheFileAndTheResultantsOnly) {
+  const TemporaryDirectory root("output");
+  ServerSettings settings = quiet_settings();
+  settings.output_root = root.path();
+  const std::unique_ptr<SubdomainServer> server = ready_server(settings);
+  const protocol::Envelope full = exchange(*server, fields_request(3, "full"));
+  ASSERT_TRUE(full.has_fields_reply()) << full.DebugString();
+  EXPECT_GT(full.fields_reply().node_coordinates_size(), 0);
+  EXPECT_GT(full.fields_reply().peak_resident_bytes(), 0u);
+  protocol::Envelope request = fields_request(4, "out");
+  request.mutable_fields()->set_omit_fields_from_reply(true);
+  const protocol::Envelope reply = exchange(*server, request);
+  ASSERT_TRUE(reply.has_fields_reply()) << reply.DebugString();
+  const protocol::FieldsReply& small = reply.fields_reply();
+  EXPECT_EQ(small.node_coordinates_size() + small.node_tags_size() + small.cell_types_size() +
+                small.cell_offsets_size() + small.connectivity_size() + small.point_fields_size() +
+                small.cell_fields_size() + small.boundaries_size(),
+            0);
+  EXPECT_EQ(
+      std::vector<double>(small.reaction_resultant().begin(), small.reaction_resultant().end()),
+      std::vector<double>(full.fields_reply().reaction_resultant().begin(),
+                          full.fields_reply().reaction_resultant().end()));
+  EXPECT_EQ(std::vector<double>(small.applied_force().begin(), small.applied_force().end()),
+            std::vector<double>(full.fields_reply().applied_force().begin(),
+                                full.fields_reply().applied_force().end()));
+  EXPECT_EQ(small.written_file(),
+            (std::filesystem::canonical(root.path()) / "out/lower.vtu").string());
+  EXPECT_EQ(small.stage_times_size(), 1);
+  EXPECT_GT(small.peak_resident_bytes(), 0u);
+  EXPECT_EQ(file_text(root.path() / "out/lower.vtu"), file_text(root.path() / "full/lower.vtu"));
+  request = fields_request(5, "");
+  request.mutable_fields()->set_omit_fields_from_reply(true);
+  expect_error(exchange(*server, request), protocol::INVALID_ARGUMENT, "ready");
+
+  settings.protocol_minor = 4;
+  SubdomainServer older(settings);
+  const auto handle = [&older](const protocol::Envelope& envelope) {
+    protocol::Envelope answer;
+    EXPECT_TRUE(answer.ParseFromString(older.handle(envelope.SerializeAsString())));
+    EXPECT_EQ(answer.version().minor(), 4u);
+    return answer;
+  };
+  const protocol::Envelope setup = handle(setup_request(6, lower_block_setup()));
+  ASSERT_TRUE(setup.has_interface()) << setup.DebugString();
+  EXPECT_EQ(setup.interface().peak_resident_bytes(), 0u);
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  const protocol::Envelope acknowledge = handle(assign_all_request(7, interface));
+  ASSERT_TRUE(acknowledge.has_acknowledge()) << acknowledge.DebugString();
+  EXPECT_EQ(acknowledge.acknowledge().peak_resident_bytes(), 0u);
+  request = fields_request(8, "older");
+  request.mutable_fields()->set_omit_fields_from_reply(true);
+  const protocol::Envelope older_reply = handle(request);
+  ASSERT_TRUE(older_reply.has_fields_reply()) << older_reply.DebugString();
+  EXPECT_EQ(older_reply.fields_reply().node_coordinates_size(),
+            full.fields_reply().node_coordinates_size());
+  EXPECT_EQ(older_reply.fields_reply().peak_resident_bytes(), 0u);
+}
+
 // Issue 11 (c), writes through write_directory. Under the output root, out/lower.vtu is a
 // symbolic link to an existing file outside the root: FieldsRequest replaces the link by the
 // VTU file and leaves the outside file unchanged. A write_directory that is absolute, contains
