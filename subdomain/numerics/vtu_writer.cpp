@@ -355,8 +355,8 @@ constexpr std::size_t offset_width = 21;
 /// Writes the DataArray elements as they come. ASCII: each with its values. Binary: each with
 /// room for its offset into the appended data; finish() then makes the arrays again one at a
 /// time, streams their compressed records after the XML and writes every offset into its room
-/// ("123" followed by spaces up to the element's end). So only one array's values and record are
-/// in memory at a time, never the whole appended block.
+/// ("123" followed by spaces up to the element's end). So only one array's values are in memory
+/// at a time, and one compressed block, never the whole appended block.
 class ArrayWriter {
  public:
   ArrayWriter(std::ofstream& out, VtuEncoding encoding, const std::filesystem::path& path)
@@ -421,16 +421,21 @@ class ArrayWriter {
   };
 
   /// Writes the appended-data record of `bytes` in vtkZLibDataCompressor's layout (see the
-  /// header); returns its size in bytes.
+  /// header), each block as it is compressed, its size written afterwards into the record's
+  /// header; returns the record's size in bytes.
   std::uint64_t write_compressed_record(std::string_view bytes) {
     const std::size_t full_blocks = bytes.size() / compression_block_size;
     const std::size_t last_block = bytes.size() % compression_block_size;
     const std::size_t block_count = full_blocks + (last_block != 0 ? 1 : 0);
-    std::string data;
     std::string header;
     append_header_word(header, block_count);
     append_header_word(header, compression_block_size);
     append_header_word(header, last_block);
+    const std::streampos sizes_position = out_.tellp() + std::streamoff(header.size());
+    header.append(block_count * sizeof(std::uint64_t), '\0');  // the sizes, written below
+    out_.write(header.data(), static_cast<std::streamsize>(header.size()));
+    std::string sizes;
+    std::uint64_t record_size = header.size();
     std::vector<Bytef> buffer(compressBound(compression_block_size));
     for (std::size_t block = 0; block < block_count; ++block) {
       const std::size_t begin = block * compression_block_size;
@@ -441,12 +446,15 @@ class ArrayWriter {
                     compression_level) != Z_OK) {
         throw std::runtime_error("cannot write '" + path_.string() + "': zlib compression failed");
       }
-      data.append(reinterpret_cast<const char*>(buffer.data()), compressed_size);
-      append_header_word(header, compressed_size);
+      out_.write(reinterpret_cast<const char*>(buffer.data()),
+                 static_cast<std::streamsize>(compressed_size));
+      append_header_word(sizes, compressed_size);
+      record_size += compressed_size;
     }
-    out_.write(header.data(), static_cast<std::streamsize>(header.size()));
-    out_.write(data.data(), static_cast<std::streamsize>(data.size()));
-    return header.size() + data.size();
+    out_.seekp(sizes_position);
+    out_.write(sizes.data(), static_cast<std::streamsize>(sizes.size()));
+    out_.seekp(0, std::ios::end);
+    return record_size;
   }
 
   std::ofstream& out_;
