@@ -2,7 +2,9 @@
 // The one-command launcher: starts one robin-subdomain server per body (found next to this
 // executable) on tcp://127.0.0.1 with ephemeral ports, logs of the servers in
 // DIR/logs/server-<body>.log, runs the coordinator against them and stops them. SIGINT/SIGTERM stop
-// everything cleanly.
+// everything cleanly. These servers get --output-root DIR and write their bodies' .vtu files
+// themselves, in parallel (FieldsRequest.write_directory, docs/outputs.md); with any --server-*
+// option below the coordinator writes them.
 // --curve encrypts the local connections with CurveZMQ, with keys made for this run only
 // (curve_options.hpp); without it the loopback connections are not encrypted.
 // Servers on other hosts: --server-command "ssh HOST" (or "srun -N1 -n1 ...", "ip netns exec
