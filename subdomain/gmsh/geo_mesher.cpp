@@ -85,16 +85,6 @@ int model_dimension() {
 
 }  // namespace
 
-#if defined(__SANITIZE_ADDRESS__)
-/// LeakSanitizer hook: Gmsh 4.8 itself leaks a few bytes per script (parser strings,
-/// quadrilateral recombination); those leaks are not ours to fix. GCC's sanitizer runtime is a
-/// shared library (libasan.so) that finds this hook through the dynamic symbol table: it stays
-/// visible although the build hides our symbols (CMAKE_CXX_VISIBILITY_PRESET, CMakeLists.txt).
-extern "C" __attribute__((visibility("default"))) const char* __lsan_default_suppressions() {
-  return "leak:libgmsh.so\n";
-}
-#endif
-
 void mesh_geo_file(const std::filesystem::path& geo, const MeshReadOptions& options,
                    const std::filesystem::path& output) {
   const std::string name = "mesh file '" + geo.string() + "'";
