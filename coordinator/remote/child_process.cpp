@@ -31,10 +31,38 @@ std::vector<std::string> command_line(const ChildProcessOptions& options) {
   return words;
 }
 
+/// The child's environment, "NAME=value" words: the parent's, with options.environment's
+/// variables replacing or added to it. Built before fork (the child must not allocate).
+std::vector<std::string> child_environment(const ChildProcessOptions& options) {
+  std::vector<std::string> words;
+  const auto overridden = [&options](const std::string& word) {
+    return std::any_of(options.environment.begin(), options.environment.end(),
+                       [&word](const auto& variable) {
+                         return word.size() > variable.first.size() &&
+                                word.compare(0, variable.first.size(), variable.first) == 0 &&
+                                word[variable.first.size()] == '=';
+                       });
+  };
+  for (char** variable = environ; variable != nullptr && *variable != nullptr; ++variable) {
+    if (!overridden(*variable)) words.emplace_back(*variable);
+  }
+  for (const auto& [name, value] : options.environment) words.push_back(name + "=" + value);
+  return words;
+}
+
+/// Pointers to `words` followed by the null pointer that ends an argv or envp array.
+std::vector<char*> null_terminated(std::vector<std::string>& words) {
+  std::vector<char*> pointers;
+  for (std::string& word : words) pointers.push_back(word.data());
+  pointers.push_back(nullptr);
+  return pointers;
+}
+
 /// Everything between fork and exec: only async-signal-safe calls. Never returns; on failure
 /// the errno of the failed call is written to `error_descriptor`.
-[[noreturn]] void become_child(const ChildProcessOptions& options, char* const* argv, pid_t parent,
-                               int output_descriptor, int log_descriptor, int error_descriptor) {
+[[noreturn]] void become_child(const ChildProcessOptions& options, char* const* argv,
+                               char* const* environment, pid_t parent, int output_descriptor,
+                               int log_descriptor, int error_descriptor) {
   if (options.new_process_group) setpgid(0, 0);
   prctl(PR_SET_PDEATHSIG, options.parent_death_signal);
   if (getppid() != parent) _exit(127);  // the parent died before prctl took effect
@@ -48,9 +76,9 @@ std::vector<std::string> command_line(const ChildProcessOptions& options) {
     _exit(127);
   }
   if (options.command_prefix.empty()) {
-    execv(argv[0], argv);
+    execve(argv[0], argv, environment);
   } else {
-    execvp(argv[0], argv);
+    execvpe(argv[0], argv, environment);
   }
   const int error_number = errno;
   [[maybe_unused]] auto written = write(error_descriptor, &error_number, sizeof error_number);
@@ -103,9 +131,9 @@ bool await_exit_event(int exit_descriptor, long milliseconds) {
 ChildProcess::ChildProcess(const ChildProcessOptions& options)
     : own_group_(options.new_process_group) {
   std::vector<std::string> words = command_line(options);
-  std::vector<char*> argv;
-  for (std::string& word : words) argv.push_back(word.data());
-  argv.push_back(nullptr);
+  const std::vector<char*> argv = null_terminated(words);
+  std::vector<std::string> environment_words = child_environment(options);
+  const std::vector<char*> environment = null_terminated(environment_words);
   const int log_descriptor = open_log_file(options.log_file);
   int output[2], error[2];
   if (pipe2(output, O_CLOEXEC) != 0 || pipe2(error, O_CLOEXEC) != 0) {
@@ -114,7 +142,10 @@ ChildProcess::ChildProcess(const ChildProcessOptions& options)
   }
   const pid_t parent = getpid();
   pid_ = fork();
-  if (pid_ == 0) become_child(options, argv.data(), parent, output[1], log_descriptor, error[1]);
+  if (pid_ == 0) {
+    become_child(options, argv.data(), environment.data(), parent, output[1], log_descriptor,
+                 error[1]);
+  }
   const int fork_error = errno;
   close(output[1]);
   close(error[1]);

@@ -22,6 +22,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace robin {
@@ -32,6 +33,9 @@ struct ChildProcessOptions {
   /// Standard error is appended to this file (created if needed); empty: inherited.
   std::filesystem::path log_file;
   std::vector<std::string> command_prefix;  // see the file comment; empty: run `executable`
+  /// Variables (name, value) set in the child's environment on top of the parent's: a name
+  /// the parent has is replaced, every other variable of the parent is passed on.
+  std::vector<std::pair<std::string, std::string>> environment;
   int parent_death_signal = SIGTERM;
   /// The child leads its own process group, so that a terminal's Ctrl-C reaches only the
   /// parent, which then stops the child in order (and signals reach the whole group).

@@ -12,13 +12,21 @@
 // --server-executable its path there; each is given once for every server or once per body
 // (body order). The prefix must pass the server's standard output through (its "listening on
 // ENDPOINT" line gives the endpoint the coordinator connects to) and forward SIGTERM.
+// Threads: the servers' factorizations run on a multithreaded BLAS (and OpenMP). Servers on
+// this machine share its processors, max(1, processors / local servers) threads each
+// (OPENBLAS_NUM_THREADS, OMP_NUM_THREADS in their environment), unless robin-run's own
+// environment sets those variables; --threads-per-server N gives every server N.
 // A server that dies mid-run is restarted (--max-server-restarts times per body, default 2):
 // its body is set up again and the run carries on from its last checkpoint.
 // Exit codes: coordinator_application.hpp.
 
+#include <sched.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <future>
 #include <optional>
 #include <sstream>
@@ -38,7 +46,40 @@ struct ServerPlacement {
   std::vector<std::string> commands;  // command prefixes, split at spaces
   std::vector<std::string> listens;   // bind endpoints
   std::vector<std::string> executables;
+  int threads_per_server = 0;  // --threads-per-server; 0: shared out among the local servers
 };
+
+/// The environment variables that set the thread counts of the BLAS (OpenBLAS) and OpenMP
+/// libraries under the servers' factorizations.
+constexpr std::array<const char*, 2> thread_variables = {"OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"};
+
+/// The processors this process may run on (its affinity mask), at least 1.
+int available_processors() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return 1;
+  return std::max(1, CPU_COUNT(&set));
+}
+
+/// Sets each server's thread variables: `threads_per_server` when given; otherwise, for the
+/// servers started on this machine (no command prefix), an equal share of its processors,
+/// for each variable that robin-run's own environment does not set.
+void set_server_threads(std::vector<robin::ServerLaunchOptions>& options, int threads_per_server) {
+  const auto local = [](const robin::ServerLaunchOptions& server) {
+    return server.command_prefix.empty();
+  };
+  const long local_count = std::count_if(options.begin(), options.end(), local);
+  for (robin::ServerLaunchOptions& server : options) {
+    if (threads_per_server == 0 && !local(server)) continue;
+    const int threads = threads_per_server > 0
+                            ? threads_per_server
+                            : std::max(1, available_processors() / static_cast<int>(local_count));
+    for (const char* variable : thread_variables) {
+      if (threads_per_server == 0 && std::getenv(variable) != nullptr) continue;
+      server.environment.emplace_back(variable, std::to_string(threads));
+    }
+  }
+}
 
 /// Splits a command prefix at runs of spaces ("ssh -p 2222 node1").
 std::vector<std::string> split_words(const std::string& text) {
@@ -103,8 +144,10 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
       launch.extra_arguments.push_back(
           std::filesystem::absolute(settings.output_directory).string());
     }
-    robin::LocalServers servers(robin::body_names(definition),
-                                placed(launch, placement, definition.bodies.size()));
+    std::vector<robin::ServerLaunchOptions> options =
+        placed(launch, placement, definition.bodies.size());
+    set_server_threads(options, placement.threads_per_server);
+    robin::LocalServers servers(robin::body_names(definition), options);
     servers.await_listening(robin::throw_if_stop_requested);
     if (keys) keys->remove_files();  // read by the servers; the coordinator's are in memory
     std::vector<robin::ChannelOptions> channels(servers.size());
@@ -178,6 +221,12 @@ int main(int argc, char** argv) {
                  "robin-subdomain's path where the servers run (default: next to robin-run); "
                  "once or per body")
       ->type_name("PATH");
+  app.add_option("--threads-per-server", placement.threads_per_server,
+                 "BLAS and OpenMP threads of every server (OPENBLAS_NUM_THREADS, "
+                 "OMP_NUM_THREADS); default: this machine's processors shared out among the "
+                 "servers started on it, unless those variables are set in this environment")
+      ->type_name("N")
+      ->check(CLI::Range(1, 4096));
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
   // --quiet quietens this terminal; the servers' log files keep --log-level.
   settings.display = std::make_shared<robin::ProgressDisplay>(

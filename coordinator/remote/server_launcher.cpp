@@ -61,6 +61,7 @@ SubdomainServer::SubdomainServer(const std::string& body, const ServerLaunchOpti
                          options.extra_arguments.end());
   child.log_file = log_file_;
   child.command_prefix = options.command_prefix;
+  child.environment = options.environment;
   try {
     process_ = std::make_unique<ChildProcess>(child);
   } catch (const std::exception& error) {

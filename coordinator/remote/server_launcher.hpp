@@ -31,6 +31,8 @@ struct ServerLaunchOptions {
   double grace_seconds = 3.0;                // before SIGTERM, and again before SIGKILL
   std::vector<std::string> extra_arguments;  // appended to the server's command line
   std::vector<std::string> command_prefix;   // see child_process.hpp; empty: run directly
+  /// Set in the server's environment on top of the launcher's (ChildProcessOptions).
+  std::vector<std::pair<std::string, std::string>> environment;
   /// The coordinator's keys for the Shutdown request when the servers use CurveZMQ (their
   /// --curve-secret-key and --curve-allow in extra_arguments).
   std::optional<CurveClientKeys> curve_client;

@@ -12,12 +12,15 @@
 //  - a contact QP tolerance far looser than the coupling tolerance makes robin-run stop with
 //    exit 5 and "stagnated", still writing its result files;
 //  - command-line options override the case file's [coupling] table (seen in summary.json),
-//    and --timeout 0 is rejected with exit 2.
+//    and --timeout 0 is rejected with exit 2;
+//  - robin-run's local servers get an equal share of the processors as their BLAS and OpenMP
+//    thread counts, unless robin-run's environment sets them; --threads-per-server wins.
 // The tests that must not hang run robin-run with a real deadline (run_robin_run).
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <sched.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
@@ -248,14 +251,17 @@ nlohmann::json read_summary(const std::filesystem::path& directory) {
   return file.good() ? nlohmann::json::parse(file) : nlohmann::json::object();
 }
 
-/// Runs build/bin/robin-run `arguments` and kills it unless it exits within `timeout_seconds`
-/// (run_tool's deadline only starts once the tool has closed its standard output), a failure.
-/// Prints the exit and the measured time.
-ProcessOutcome run_robin_run(const std::vector<std::string>& arguments,
-                             const std::filesystem::path& directory, double timeout_seconds) {
+/// Runs build/bin/robin-run `arguments` (with `environment` added to this process's) and kills it
+/// unless it exits within `timeout_seconds` (run_tool's deadline only starts once the tool has
+/// closed its standard output), a failure. Prints the exit and the measured time.
+ProcessOutcome run_robin_run(
+    const std::vector<std::string>& arguments, const std::filesystem::path& directory,
+    double timeout_seconds,
+    const std::vector<std::pair<std::string, std::string>>& environment = {}) {
   ChildProcessOptions options;
   options.executable = testing::tool("robin-run");
   options.arguments = arguments;
+  options.environment = environment;
   options.log_file = directory / "robin-run.stderr";
   const auto start = std::chrono::steady_clock::now();
   const auto deadline = start + std::chrono::duration_cast<ChildProcess::Clock::duration>(
@@ -454,6 +460,60 @@ TEST(RobinRunCommandLine, ZeroTimeoutIsRejected) {
   EXPECT_NE(outcome.errors.find("must be a finite number > 0"), std::string::npos)
       << outcome.errors;
   EXPECT_FALSE(std::filesystem::exists(output));
+}
+
+// ---- Threads of the servers -----------------------------------------------------------------
+
+/// What each server of a robin-run on examples/two_blocks.toml had in its environment of
+/// OPENBLAS_NUM_THREADS and OMP_NUM_THREADS ("NAME=value" lines, sorted): --server-executable is
+/// a script that writes those lines into a file of its own and then execs robin-subdomain.
+std::vector<std::string> server_thread_settings(
+    const std::vector<std::string>& options,
+    const std::vector<std::pair<std::string, std::string>>& environment) {
+  const TemporaryDirectory directory("robin-run-threads");
+  const std::filesystem::path script = write_script(
+      directory.path(), "server.sh",
+      "env | grep -E '^(OPENBLAS|OMP)_NUM_THREADS=' | sort > '" + directory.path().string() +
+          "/environment-'$$\nexec '" + testing::tool("robin-subdomain").string() + "' \"$@\"\n");
+  std::vector<std::string> arguments = {example("two_blocks.toml").string(), "--output",
+                                        (directory.path() / "out").string(), "--server-executable",
+                                        script.string()};
+  arguments.insert(arguments.end(), options.begin(), options.end());
+  const ProcessOutcome outcome = run_robin_run(arguments, directory.path(), 120.0, environment);
+  EXPECT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
+  std::vector<std::string> settings;
+  for (const auto& entry : std::filesystem::directory_iterator(directory.path())) {
+    if (entry.path().filename().string().rfind("environment-", 0) == 0) {
+      settings.push_back(read_text(entry.path()));
+    }
+  }
+  return settings;
+}
+
+/// `variable`'s value in this process's environment, or `otherwise` when it is not set.
+std::string environment_value(const char* variable, const std::string& otherwise) {
+  const char* value = std::getenv(variable);
+  return value != nullptr ? value : otherwise;
+}
+
+TEST(RobinRunThreads, LocalServersShareTheProcessorsUnlessTheEnvironmentSetsThreads) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  ASSERT_EQ(sched_getaffinity(0, sizeof set, &set), 0);
+  const std::string share = std::to_string(std::max(1, CPU_COUNT(&set) / 2));  // two servers
+  // OPENBLAS_NUM_THREADS set for robin-run is passed on; OMP_NUM_THREADS, unless this test's
+  // own environment has it, is the share.
+  const std::string expected = "OMP_NUM_THREADS=" + environment_value("OMP_NUM_THREADS", share) +
+                               "\nOPENBLAS_NUM_THREADS=5\n";
+  const std::vector<std::string> settings =
+      server_thread_settings({}, {{"OPENBLAS_NUM_THREADS", "5"}});
+  EXPECT_EQ(settings, std::vector<std::string>(2, expected));
+}
+
+TEST(RobinRunThreads, ThreadsPerServerOverridesTheEnvironment) {
+  const std::vector<std::string> settings = server_thread_settings(
+      {"--threads-per-server", "3"}, {{"OPENBLAS_NUM_THREADS", "5"}, {"OMP_NUM_THREADS", "7"}});
+  EXPECT_EQ(settings, std::vector<std::string>(2, "OMP_NUM_THREADS=3\nOPENBLAS_NUM_THREADS=3\n"));
 }
 
 }  // namespace
