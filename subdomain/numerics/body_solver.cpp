@@ -300,16 +300,15 @@ SetupObserver BodySolver::factorization_observer() const {
 
 std::vector<int> BodySolver::trailing_unknowns() const {
   std::vector<int> unknowns;
-  if (!options_.contact_unknowns_last) return unknowns;
-  for (int node : contact_nodes()) {
+  const std::vector<int> nodes = contact_nodes();
+  // the contact rows are not known before AssignContact: the contact nodes stand for them
+  if (!options_.contact_unknowns_last || !dense_interface_operator(static_cast<long>(nodes.size())))
+    return unknowns;
+  for (int node : nodes) {
     const int dimension = definition_.mesh.dimension;
     for (int dof = dimension * node; dof < dimension * (node + 1); ++dof) {
       if (!dofs_->is_prescribed(dof)) unknowns.push_back(dofs_->free_index(dof));
     }
-  }
-  if (static_cast<long>(unknowns.size()) >
-      long{definition_.mesh.dimension} * options_.dense_limit) {
-    unknowns.clear();
   }
   return unknowns;
 }
@@ -481,10 +480,7 @@ void BodySolver::build_interface_operator() {
   const double dense_bytes = 8.0 * contact_size() * static_cast<double>(contact_size());
   const bool dense_fits =
       options_.maximum_factor_bytes <= 0.0 || dense_bytes <= options_.maximum_factor_bytes;
-  const bool dense =
-      dense_fits && (options_.interface_operator == InterfaceOperatorKind::dense ||
-                     (options_.interface_operator == InterfaceOperatorKind::automatic &&
-                      contact_size() <= options_.dense_limit));
+  const bool dense = dense_fits && dense_interface_operator(contact_size());
   if (dense && factor_->has_trailing_block()) {
     compliance_ = std::make_unique<DenseOperator>(factor_->trailing_congruence(trace_));
   } else if (dense) {
@@ -492,6 +488,12 @@ void BodySolver::build_interface_operator() {
   } else {
     compliance_ = std::make_unique<FactorComplianceOperator>(trace_, *factor_);
   }
+}
+
+bool BodySolver::dense_interface_operator(long contact_count) const {
+  return options_.interface_operator == InterfaceOperatorKind::dense ||
+         (options_.interface_operator == InterfaceOperatorKind::automatic &&
+          contact_count <= options_.dense_limit);
 }
 
 void BodySolver::reset_warm_start() {

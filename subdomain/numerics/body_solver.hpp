@@ -60,7 +60,7 @@
 namespace robin {
 
 enum class InterfaceOperatorKind {
-  automatic,  // dense when the contact size is at most dense_limit
+  automatic,  // dense when the contact size is at most dense_limit, otherwise factor
   dense,      // F assembled once by blocked multi-right-hand-side solves; products cost O(n_c^2)
   factor,     // F applied through the factor: one solve (two triangular solves) per product
 };
@@ -74,10 +74,15 @@ enum class RigidMotions {
 struct BodySolverOptions {
   RigidMotions rigid_motions = RigidMotions::refuse;
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
-  int dense_limit = 3000;
-  /// Eliminate the free dofs of the contact boundaries last in the Cholesky factor (when there
-  /// are at most dimension x dense_limit of them), so a dense F comes from the factor's trailing
-  /// block in O(m^2 n_c) instead of n_c solves with the whole factor (see numerics/cholesky.hpp).
+  /// The automatic choice's limit on contact nodes. A dense F costs 8 n_c^2 bytes, and with the
+  /// contact dofs last a dense trailing block of (d n_c)^2 / 2 entries in L; a solid body whose
+  /// contact face has n_c nodes has a factor of far more entries than both, and applying F
+  /// through such a factor streams all of L for every product of the contact solver.
+  int dense_limit = 8000;
+  /// Eliminate the free dofs of the contact boundaries last in the Cholesky factor when F will
+  /// be dense (dense_interface_operator for the number of contact nodes), so a dense F comes
+  /// from the factor's trailing block in O(m^2 n_c) instead of n_c solves with the whole factor
+  /// (see numerics/cholesky.hpp).
   bool contact_unknowns_last = true;
   /// Limits checked before the work starts (0 = none): the body's degrees of freedom (2 or 3 per
   /// node, before assembly) and the memory of its Cholesky factor (from the symbolic
@@ -257,6 +262,9 @@ class BodySolver {
   void check_contact_boundaries() const;
   void report(SetupStage stage) const;
   void build_interface_operator();
+  /// Whether F is assembled densely for `contact_count` contact rows (before the memory check
+  /// of build_interface_operator): `dense`, or `automatic` with at most dense_limit rows.
+  bool dense_interface_operator(long contact_count) const;
   /// e = B K^{-1} f + B u_p at load factor 1 and at the current one, for the assigned B.
   void update_free_trace();
   /// Free dofs of the contact boundaries' nodes, to be eliminated last (empty when disabled).

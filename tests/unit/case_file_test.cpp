@@ -296,7 +296,7 @@ TEST(CaseFile, MissingOptionalTablesGiveTheDocumentedDefaults) {
   EXPECT_EQ(definition.solver.qp.relative_tolerance, 1e-12);
   EXPECT_EQ(definition.solver.qp.max_iterations, 20000);
   EXPECT_EQ(definition.solver.body.interface_operator, InterfaceOperatorKind::automatic);
-  EXPECT_EQ(definition.solver.body.dense_limit, 3000);
+  EXPECT_EQ(definition.solver.body.dense_limit, 8000);
   EXPECT_EQ(definition.solver.pairing_tolerance, 1e-6);
   EXPECT_EQ(definition.coupling.relaxation, 0.5);
   EXPECT_EQ(definition.coupling.tolerance, 1e-8);
