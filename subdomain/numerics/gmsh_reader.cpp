@@ -1,6 +1,5 @@
 #include "numerics/gmsh_reader.hpp"
 
-#include <fcntl.h>
 #include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,7 +9,6 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -21,6 +19,7 @@
 #include <system_error>
 
 #include "numerics/errors.hpp"
+#include "numerics/helper_process.hpp"
 #include "numerics/msh_file.hpp"
 
 namespace robin {
@@ -63,10 +62,6 @@ void check_request(const std::filesystem::path& path, const MeshReadOptions& opt
   }
 }
 
-/// The exit status of a child that could not run the mesh reader (the shell's "cannot
-/// execute").
-constexpr int cannot_execute_status = 126;
-
 /// Where the meshing process writes the mesh of request `k`.
 std::filesystem::path meshing_output(const std::filesystem::path& directory, std::size_t k) {
   return directory / ("body" + std::to_string(k) + ".msh");
@@ -75,11 +70,9 @@ std::filesystem::path meshing_output(const std::filesystem::path& directory, std
 /// robin-mesh-reader meshing the .geo files of one read_gmsh_meshes call (mesh_reader_main.cpp,
 /// --mesh-geo-batch): one process, which loads libgmsh once and forks a meshing child per file,
 /// all concurrently, and reports each file as its child ends on its standard output: a line
-/// "REQUEST LENGTH" then LENGTH bytes of error message (0: the mesh is written).
-struct MeshingProcess {
-  pid_t pid = -1;
-  int reports = -1;  // the read end of its standard output
-};
+/// "REQUEST LENGTH" then LENGTH bytes of error message (0: the mesh is written), read from its
+/// HelperProcess::output.
+using MeshingProcess = HelperProcess;
 
 /// The command line of robin-mesh-reader meshing `geo_requests` (indices into `requests`), each
 /// into directory/bodyK.msh: --mesh-geo-batch, then per file its request index, .geo path,
@@ -100,38 +93,12 @@ std::vector<std::string> meshing_command(const std::vector<MeshFileRequest>& req
   return words;
 }
 
-/// In the child, between fork and exec (async-signal-safe calls only): runs `argv` with its
-/// standard output on `descriptor`, with the default signal dispositions and no signal
-/// blocked; never returns.
-[[noreturn]] void run_in_child(char* const* argv, int descriptor) {
-  struct sigaction default_action {};
-  default_action.sa_handler = SIG_DFL;
-  for (const int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGINT, SIGTERM}) {
-    sigaction(signal_number, &default_action, nullptr);
-  }
-  sigset_t no_signals;
-  sigemptyset(&no_signals);
-  sigprocmask(SIG_SETMASK, &no_signals, nullptr);
-  if (dup2(descriptor, STDOUT_FILENO) >= 0) execv(argv[0], argv);
-  _exit(cannot_execute_status);
-}
-
 MeshingProcess start_meshing_process(std::vector<std::string> words) {
   std::vector<char*> argv;
   for (std::string& word : words) argv.push_back(word.data());
   argv.push_back(nullptr);
-  int pipe_ends[2];
-  if (pipe2(pipe_ends, O_CLOEXEC) != 0)
-    throw std::runtime_error("cannot create a pipe for meshing");
-  const pid_t pid = fork();
-  if (pid < 0) {
-    close(pipe_ends[0]);
-    close(pipe_ends[1]);
-    throw std::runtime_error("cannot start a meshing process (fork failed)");
-  }
-  if (pid == 0) run_in_child(argv.data(), pipe_ends[1]);
-  close(pipe_ends[1]);
-  return {pid, pipe_ends[0]};
+  return start_helper_process(argv.data(), "cannot create a pipe for meshing",
+                              "cannot start a meshing process (fork failed)");
 }
 
 /// The reports of a MeshingProcess as they arrive: each request index with its error message
@@ -183,7 +150,7 @@ class MeshingReports {
 
 /// Waits for the meshing process; "" when it exited with 0, else why it failed.
 std::string finish_meshing_process(const MeshingProcess& process) {
-  close(process.reports);
+  close(process.output);
   int status = 0;
   while (waitpid(process.pid, &status, 0) < 0 && errno == EINTR) {
   }
@@ -275,7 +242,7 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
       if (observer.started) observer.started(k);
     }
     // each .geo's mesh is read as soon as its child has ended, in the order they end
-    MeshingReports reports(process.reports);
+    MeshingReports reports(process.output);
     while (const auto report = reports.next(observer.waiting)) {
       const auto [k, error] = *report;
       if (k >= requests.size() || meshed[k]) continue;

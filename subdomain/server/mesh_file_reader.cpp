@@ -1,17 +1,16 @@
 #include "server/mesh_file_reader.hpp"
 
-#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <csignal>
 #include <cstring>
 #include <stdexcept>
 #include <type_traits>
 #include <vector>
 
 #include "numerics/errors.hpp"
+#include "numerics/helper_process.hpp"
 
 namespace robin {
 namespace {
@@ -95,26 +94,6 @@ class MeshDecoder {
   std::size_t position_ = 1;  // after the 'M'
 };
 
-/// The exit status of a child that could not run the reader (the shell's "cannot execute").
-constexpr int cannot_execute_status = 126;
-
-/// In the child, between fork and exec (async-signal-safe calls only): runs `argv` (the reader
-/// and the file) with its standard output on `descriptor`; never returns.
-[[noreturn]] void run_reader_in_child(char* const* argv, int descriptor) {
-  // A crash of the reader ends the child by its signal, which the parent reports: no handler
-  // or mask inherited from the server (such as a sanitizer's) survives into the reader.
-  struct sigaction default_action {};
-  default_action.sa_handler = SIG_DFL;
-  for (const int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
-    sigaction(signal_number, &default_action, nullptr);
-  }
-  sigset_t no_signals;
-  sigemptyset(&no_signals);
-  sigprocmask(SIG_SETMASK, &no_signals, nullptr);
-  if (dup2(descriptor, STDOUT_FILENO) >= 0) execv(argv[0], argv);
-  _exit(cannot_execute_status);
-}
-
 /// Everything the child wrote, then its exit status.
 std::pair<std::string, int> collect(pid_t child, int descriptor) {
   std::string bytes;
@@ -165,19 +144,10 @@ Mesh read_mesh_file_in_child(const std::filesystem::path& path,
                              const std::filesystem::path& reader) {
   std::string reader_word = reader.string(), path_word = path.string();
   char* const argv[] = {reader_word.data(), path_word.data(), nullptr};  // before the fork
-  int pipe_ends[2];
-  if (pipe2(pipe_ends, O_CLOEXEC) != 0) {
-    throw std::runtime_error("cannot create a pipe to read a mesh file");
-  }
-  const pid_t child = fork();
-  if (child < 0) {
-    close(pipe_ends[0]);
-    close(pipe_ends[1]);
-    throw std::runtime_error("cannot start a process to read a mesh file (fork failed)");
-  }
-  if (child == 0) run_reader_in_child(argv, pipe_ends[1]);
-  close(pipe_ends[1]);
-  const auto [bytes, status] = collect(child, pipe_ends[0]);
+  const HelperProcess child =
+      start_helper_process(argv, "cannot create a pipe to read a mesh file",
+                           "cannot start a process to read a mesh file (fork failed)");
+  const auto [bytes, status] = collect(child.pid, child.output);
   if (WIFSIGNALED(status)) {
     throw InputError("the mesh reader (Gmsh) crashed on this file (signal " +
                      std::to_string(WTERMSIG(status)) + ", " + strsignal(WTERMSIG(status)) +
