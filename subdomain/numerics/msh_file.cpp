@@ -882,13 +882,10 @@ double signed_measure(const Mesh& mesh, ElementType type, const int* nodes) {
   return jacobian.determinant();
 }
 
-/// Orients every element positively (counter-clockwise in 2D, a positive Jacobian in 3D),
-/// entity by entity: Gmsh meshes each surface or volume consistently, so the sign of the
-/// entity's total signed measure gives its orientation, and a negatively oriented entity has
-/// every element reversed. An element whose sign differs from its entity's is inverted (a
-/// folded or tangled mesh) and refused, naming its tag.
-void orient_positively(const std::string& name, Mesh& mesh, ElementBlock& block,
-                       const std::vector<int>& entities) {
+}  // namespace
+
+void orient_elements_positively(const std::string& name, const Mesh& mesh, ElementBlock& block,
+                                const std::vector<int>& entities) {
   // Reverse the orientation: the corner order (midside nodes follow their edges); a
   // tetrahedron swaps corners 1 and 2, a hexahedron its faces' corner order.
   static const std::map<ElementType, std::vector<int>> reversed = {
@@ -924,6 +921,8 @@ void orient_positively(const std::string& name, Mesh& mesh, ElementBlock& block,
   }
 }
 
+namespace {
+
 bool has_physical_group(const MshModel& model) {
   for (const auto& entities : model.entities) {
     for (const auto& [entity, physicals] : entities) {
@@ -950,7 +949,7 @@ Mesh body_mesh(const MshModel& model, const std::string& name) {
   fill_nodes(model, name, index, mesh);
   for (auto& [type, domain] : body.domain) {
     ElementBlock block{type, to_indices(domain.node_tags, index), std::move(domain.element_tags)};
-    orient_positively(name, mesh, block, domain.entities);
+    orient_elements_positively(name, mesh, block, domain.entities);
     mesh.blocks.push_back(std::move(block));
   }
   for (const auto& [boundary, facets] : body.facets) {

@@ -24,6 +24,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "numerics/mesh.hpp"
 
@@ -35,5 +36,18 @@ Mesh read_msh_file(const std::filesystem::path& path, const std::string& name = 
 
 /// The mesh in `bytes`, the contents of an MSH file called `name` in messages.
 Mesh parse_msh_file(const std::string& bytes, const std::string& name);
+
+/// Orients the elements of `block` (its connectivity indexes `mesh`'s nodes) positively
+/// (counter-clockwise in 2D, a positive Jacobian in 3D), entity by entity: `entities` holds the
+/// Gmsh entity (surface or volume tag) of each element. Gmsh meshes each surface or volume
+/// consistently, so the sign of the entity's total signed measure gives its orientation, and a
+/// negatively oriented entity has every element reversed. An element whose sign differs from
+/// its entity's is inverted (a folded or tangled mesh) and refused, naming its tag: throws
+/// InputError "NAME: element tag T (TYPE at node tag N) has zero area" (zero volume), or "...
+/// is inverted against the other elements of surface E (a folded or tangled mesh)" (volume E).
+/// Both the native reader and the tests' reference reader through Gmsh's API
+/// (tests/unit/gmsh_api_reader.cpp) orient their elements with it.
+void orient_elements_positively(const std::string& name, const Mesh& mesh, ElementBlock& block,
+                                const std::vector<int>& entities);
 
 }  // namespace robin

@@ -1,13 +1,13 @@
 // The reference against which tests/unit/msh_file_test.cpp checks the native MSH reader: a .msh
 // file read through Gmsh's own C++ API and turned into a Mesh by the code robin used before the
-// native reader (gmsh_reader.cpp until 2026-11-27), kept here unchanged in substance. Test code
-// only: it links libgmsh.
+// native reader (gmsh_reader.cpp until 2026-11-27), kept here unchanged in substance, but for the
+// orientation of the elements: both readers call orient_elements_positively (msh_file.hpp), so
+// the comparison checks what each reader extracts. Test code only: it links libgmsh.
 
 #include "gmsh_api_reader.hpp"
 
 #include <gmsh.h>
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <map>
 #include <optional>
@@ -17,7 +17,7 @@
 #include <unordered_map>
 
 #include "numerics/errors.hpp"
-#include "numerics/finite_element.hpp"
+#include "numerics/msh_file.hpp"
 
 namespace robin {
 
@@ -263,75 +263,6 @@ std::vector<int> to_indices(const std::vector<std::size_t>& tags,
   return indices;
 }
 
-/// Twice the signed area of the element's corner polygon (positive when counter-clockwise).
-double twice_signed_area(const Mesh& mesh, ElementType type, const int* nodes) {
-  const int corners = type == ElementType::quadrilateral4 ? 4 : 3;
-  double sum = 0.0;
-  for (int i = 0; i < corners; ++i) {
-    const Eigen::Vector3d& a = mesh.nodes[nodes[i]];
-    const Eigen::Vector3d& b = mesh.nodes[nodes[(i + 1) % corners]];
-    sum += a.x() * b.y() - b.x() * a.y();
-  }
-  return sum;
-}
-
-/// The element's signed measure: in 2D twice the signed area of its corner polygon (positive
-/// when counter-clockwise), in 3D det(dx/dxi) at the reference centroid (positive when the
-/// element has Gmsh's orientation).
-double signed_measure(const Mesh& mesh, ElementType type, const int* nodes) {
-  if (element_dimension(type) == 2) return twice_signed_area(mesh, type, nodes);
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
-  shape_functions(type, reference_centroid(type), values, gradients);
-  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < nodes_per_element(type); ++i) {
-    jacobian += mesh.nodes[nodes[i]] * gradients.row(i);
-  }
-  return jacobian.determinant();
-}
-
-/// Orients every element positively (counter-clockwise in 2D, a positive Jacobian in 3D), entity
-/// by entity: Gmsh meshes each surface or volume consistently, so the sign of the entity's total
-/// signed measure gives its orientation, and a negatively oriented entity has every element
-/// reversed. An element whose sign differs from its entity's is inverted (a folded or tangled
-/// mesh) and refused, naming its tag.
-void orient_positively(const ErrorSource& source, Mesh& mesh, ElementBlock& block,
-                       const std::vector<int>& entities) {
-  // Reverse the orientation: the corner order (midside nodes follow their edges); a
-  // tetrahedron swaps corners 1 and 2, a hexahedron its faces' corner order.
-  static const std::map<ElementType, std::vector<int>> reversed = {
-      {ElementType::triangle3, {0, 2, 1}},
-      {ElementType::triangle6, {0, 2, 1, 5, 4, 3}},
-      {ElementType::quadrilateral4, {0, 3, 2, 1}},
-      {ElementType::tetrahedron4, {0, 2, 1, 3}},
-      {ElementType::tetrahedron10, {0, 2, 1, 3, 6, 5, 4, 7, 9, 8}},
-      {ElementType::hexahedron8, {0, 3, 2, 1, 4, 7, 6, 5}}};
-  const int count = nodes_per_element(block.type);
-  std::map<int, double> entity_measure;
-  for (std::size_t e = 0; e < block.element_count(); ++e) {
-    entity_measure[entities[e]] += signed_measure(mesh, block.type, &block.connectivity[e * count]);
-  }
-  const std::vector<int>& order = reversed.at(block.type);
-  const bool solid = element_dimension(block.type) == 3;
-  for (std::size_t e = 0; e < block.element_count(); ++e) {
-    int* nodes = &block.connectivity[e * count];
-    const double measure = signed_measure(mesh, block.type, nodes);
-    const double orientation = entity_measure[entities[e]] < 0.0 ? -1.0 : 1.0;
-    if (measure * orientation <= 0.0) {
-      throw source.error(block.element_label(e) + " (" + to_string(block.type) + " at node tag " +
-                         std::to_string(mesh.node_tags[nodes[0]]) + ") " +
-                         (measure == 0.0
-                              ? (solid ? "has zero volume" : "has zero area")
-                              : "is inverted against the other elements of " +
-                                    std::string(solid ? "volume " : "surface ") +
-                                    std::to_string(entities[e]) + " (a folded or tangled mesh)"));
-    }
-    if (orientation > 0.0) continue;
-    const std::vector<int> original(nodes, nodes + count);
-    for (int i = 0; i < count; ++i) nodes[i] = original[order[i]];
-  }
-}
-
 Mesh extract_mesh(const ErrorSource& source) {
   gmsh::vectorpair groups;
   gmsh::model::getPhysicalGroups(groups);
@@ -350,7 +281,7 @@ Mesh extract_mesh(const ErrorSource& source) {
   fill_nodes(source, index, mesh);
   for (const auto& [type, domain] : elements.domain) {
     ElementBlock block{type, to_indices(domain.node_tags, index), domain.element_tags};
-    orient_positively(source, mesh, block, domain.entities);
+    orient_elements_positively(source.name, mesh, block, domain.entities);
     mesh.blocks.push_back(std::move(block));
   }
   for (const auto& [name, facets] : elements.facets) {
