@@ -89,27 +89,47 @@ int written_components(int components) {
   return components == 2 ? 3 : components;
 }
 
-void check_field(const OutputField& field, std::size_t count, const char* location,
-                 const std::filesystem::path& path) {
-  const std::string where =
-      std::string(location) + " field '" + field.name + "' of '" + path.string() + "'";
+/// "<location> field '<name>' of '<path>'", the start of a message about a field.
+std::string field_description(const std::string& name, const char* location,
+                              const std::filesystem::path& path) {
+  return std::string(location) + " field '" + name + "' of '" + path.string() + "'";
+}
+
+/// Refuses an empty name, fewer than one component or more component names than components.
+void check_field_attributes(const FieldSource& field, const char* location,
+                            const std::filesystem::path& path) {
   if (field.name.empty()) {
     throw std::runtime_error(std::string("a ") + location + " field of '" + path.string() +
                              "' has an empty name");
   }
+  const std::string where = field_description(field.name, location, path);
   if (field.components < 1) {
     throw std::runtime_error(where + ": components must be at least 1, got " +
                              std::to_string(field.components));
   }
-  const std::size_t expected = count * static_cast<std::size_t>(field.components);
-  if (field.values.size() != expected) {
-    throw std::runtime_error(where + ": expected " + std::to_string(expected) + " values (" +
-                             std::to_string(field.components) + " x " + std::to_string(count) +
-                             "), got " + std::to_string(field.values.size()));
-  }
   if (field.component_names.size() > static_cast<std::size_t>(field.components)) {
     throw std::runtime_error(where + ": more component names than components");
   }
+}
+
+/// Refuses a field whose number of values is not components x count.
+void check_value_count(const FieldSource& field, std::size_t value_count, std::size_t count,
+                       const char* location, const std::filesystem::path& path) {
+  const std::size_t expected = count * static_cast<std::size_t>(field.components);
+  if (value_count != expected) {
+    throw std::runtime_error(field_description(field.name, location, path) + ": expected " +
+                             std::to_string(expected) + " values (" +
+                             std::to_string(field.components) + " x " + std::to_string(count) +
+                             "), got " + std::to_string(value_count));
+  }
+}
+
+/// The source of a field whose values are at hand (appends a copy of them).
+FieldSource source_of(const OutputField& field) {
+  return {field.name, field.components, field.component_names,
+          [&field](std::vector<double>& values) {
+            values.insert(values.end(), field.values.begin(), field.values.end());
+          }};
 }
 
 void check_connectivity(const std::vector<int>& connectivity, int nodes_per_cell,
@@ -152,34 +172,51 @@ struct DataArray {
       values;
 };
 
-/// The values of `field` for `count` items followed by `extra` items copied from the items
-/// `source[j]` (NaN where source[j] is -1), with 2 components padded to 3.
-DataArray field_array(const OutputField& field, std::size_t count,
-                      const std::vector<std::int64_t>& source = {}) {
-  const auto components = static_cast<std::size_t>(field.components);
-  const auto written = static_cast<std::size_t>(written_components(field.components));
-  std::vector<double> values((count + source.size()) * written, 0.0);
-  const auto copy_item = [&](std::size_t from, std::size_t to) {
-    for (std::size_t c = 0; c < components; ++c) {
-      values[to * written + c] = field.values[from * components + c];
-    }
-  };
-  for (std::size_t k = 0; k < count; ++k) copy_item(k, k);
-  for (std::size_t j = 0; j < source.size(); ++j) {
-    if (source[j] >= 0) {
-      copy_item(static_cast<std::size_t>(source[j]), count + j);
-    } else {
-      for (std::size_t c = 0; c < written; ++c) {
-        values[(count + j) * written + c] = std::numeric_limits<double>::quiet_NaN();
-      }
+/// Makes `values` (`count` items of `components` values) the array as written, in place: 2
+/// components padded to 3 (the third zero), then one item per entry of `source`, a copy of
+/// item source[j] (NaN where source[j] is -1).
+void lay_out_items(std::vector<double>& values, std::size_t count, int components,
+                   const std::vector<std::int64_t>& source) {
+  const auto given = static_cast<std::size_t>(components);
+  const auto written = static_cast<std::size_t>(written_components(components));
+  values.resize((count + source.size()) * written, 0.0);
+  if (written != given) {  // from the last item down, so that no item is overwritten unread
+    for (std::size_t k = count; k-- > 0;) {
+      for (std::size_t c = given; c-- > 0;) values[k * written + c] = values[k * given + c];
+      for (std::size_t c = given; c < written; ++c) values[k * written + c] = 0.0;
     }
   }
-  return {"Float64", field.name, static_cast<int>(written), field.component_names,
-          std::move(values)};
+  for (std::size_t j = 0; j < source.size(); ++j) {
+    for (std::size_t c = 0; c < written; ++c) {
+      values[(count + j) * written + c] =
+          source[j] >= 0 ? values[static_cast<std::size_t>(source[j]) * written + c]
+                         : std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+}
+
+/// Where a field goes: its location ("point" or "cell"), its item count, the items copied
+/// after them (cell fields on boundary facets: adjacent_elements) and the file, for messages.
+struct FieldPlace {
+  const char* location;
+  std::size_t count;
+  const std::vector<std::int64_t>& source;
+  const std::filesystem::path& path;
+};
+
+/// The array of `field` as written (lay_out_items), its values made by the field's source.
+DataArray field_array(const FieldSource& field, const FieldPlace& place) {
+  const int written = written_components(field.components);
+  std::vector<double> values;
+  values.reserve((place.count + place.source.size()) * static_cast<std::size_t>(written));
+  field.append_values(values);
+  check_value_count(field, values.size(), place.count, place.location, place.path);
+  lay_out_items(values, place.count, field.components, place.source);
+  return {"Float64", field.name, written, field.component_names, std::move(values)};
 }
 
 /// The attributes of a field's array (as field_array writes it), without its values.
-DataArray attributes_of(const OutputField& field) {
+DataArray attributes_of(const FieldSource& field) {
   return {"Float64", field.name, written_components(field.components), field.component_names, {}};
 }
 
@@ -208,10 +245,24 @@ struct FacetKeyHash {
   }
 };
 
-/// For every facet of every boundary (name order), the flat index of an element that has it as
-/// a side (matched by its corner nodes), -1 when none has.
-std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
-  std::unordered_map<FacetKey, std::int64_t, FacetKeyHash> element_of_side;
+using FacetElements = std::unordered_map<FacetKey, std::int64_t, FacetKeyHash>;
+
+/// The keys of the facets of every boundary (name order), facet after facet.
+std::vector<FacetKey> boundary_facet_keys(const Mesh& mesh) {
+  std::vector<FacetKey> keys;
+  for (const auto& [name, group] : mesh.boundaries) {
+    const auto nodes = static_cast<std::size_t>(nodes_per_facet(group.type));
+    const int corners = facet_corner_count(group.type);
+    for (std::size_t k = 0; k < group.facet_count(); ++k) {
+      keys.push_back(facet_key(&group.connectivity[k * nodes], corners));
+    }
+  }
+  return keys;
+}
+
+/// Sets each facet of `elements` still without an element (-1) to the flat index of the first
+/// element, in the element order of mesh.blocks, that has it as a side.
+void find_first_elements(const Mesh& mesh, FacetElements& elements) {
   std::int64_t flat = 0;
   for (const ElementBlock& block : mesh.blocks) {
     const int nodes = nodes_per_element(block.type);
@@ -221,29 +272,36 @@ std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
       for (const std::vector<int>& side : sides) {
         int corners[4];
         for (std::size_t a = 0; a < side.size(); ++a) corners[a] = element[side[a]];
-        element_of_side.emplace(facet_key(corners, static_cast<int>(side.size())), flat);
+        const auto found = elements.find(facet_key(corners, static_cast<int>(side.size())));
+        if (found != elements.end() && found->second < 0) found->second = flat;
       }
     }
   }
+}
+
+/// For every facet of every boundary (name order), the flat index of the first element that has
+/// it as a side (matched by its corner nodes), -1 when none has. Only the boundary facets are
+/// kept in a table, not the sides of every element.
+std::vector<std::int64_t> adjacent_elements(const Mesh& mesh) {
+  const std::vector<FacetKey> keys = boundary_facet_keys(mesh);
+  FacetElements elements;
+  for (const FacetKey& key : keys) elements.emplace(key, -1);
+  find_first_elements(mesh, elements);
   std::vector<std::int64_t> adjacent;
-  for (const auto& [name, group] : mesh.boundaries) {
-    const auto nodes = static_cast<std::size_t>(nodes_per_facet(group.type));
-    const int corners = facet_corner_count(group.type);
-    for (std::size_t k = 0; k < group.facet_count(); ++k) {
-      const auto found = element_of_side.find(facet_key(&group.connectivity[k * nodes], corners));
-      adjacent.push_back(found == element_of_side.end() ? -1 : found->second);
-    }
-  }
+  adjacent.reserve(keys.size());
+  for (const FacetKey& key : keys) adjacent.push_back(elements.at(key));
   return adjacent;
 }
 
-/// An element's nodes in VTK's order: Gmsh's, except the quadratic tetrahedron, whose last two
-/// midside nodes (Gmsh: on edges 3-2 and 3-1) VTK numbers the other way (edges 1-3, 2-3).
-std::vector<int> vtk_node_order(const ElementBlock& block) {
-  if (block.type != ElementType::tetrahedron10) return block.connectivity;
-  std::vector<int> nodes = block.connectivity;
-  for (std::size_t k = 0; k + 10 <= nodes.size(); k += 10) std::swap(nodes[k + 8], nodes[k + 9]);
-  return nodes;
+/// VTK's type number of the quadratic tetrahedron.
+constexpr int quadratic_tetrahedron_type = 24;
+
+/// Puts the quadratic tetrahedron at the end of `connectivity` into VTK's node order: Gmsh's,
+/// except the last two midside nodes (Gmsh: on edges 3-2 and 3-1), which VTK numbers the other
+/// way (edges 1-3, 2-3).
+void to_vtk_node_order(std::vector<std::int64_t>& connectivity) {
+  const std::size_t size = connectivity.size();
+  std::swap(connectivity[size - 2], connectivity[size - 1]);
 }
 
 /// The points (x, y, z per node).
@@ -271,6 +329,7 @@ DataArray cell_array(const Mesh& mesh, bool boundary_cells, CellArray which) {
       if (which == CellArray::connectivity) {
         connectivity.insert(connectivity.end(), nodes.begin() + static_cast<std::ptrdiff_t>(k),
                             nodes.begin() + static_cast<std::ptrdiff_t>(k) + per_cell);
+        if (type == quadratic_tetrahedron_type) to_vtk_node_order(connectivity);
       } else if (which == CellArray::offsets) {
         offsets.push_back(end);
       } else {
@@ -279,7 +338,7 @@ DataArray cell_array(const Mesh& mesh, bool boundary_cells, CellArray which) {
     }
   };
   for (const ElementBlock& block : mesh.blocks) {
-    add_cells(vtk_node_order(block), nodes_per_element(block.type), vtk_cell_type(block.type));
+    add_cells(block.connectivity, nodes_per_element(block.type), vtk_cell_type(block.type));
   }
   if (boundary_cells) {
     for (const auto& [name, group] : mesh.boundaries) {
@@ -466,25 +525,23 @@ class ArrayWriter {
 /// The Piece element: its PointData, CellData (with boundary_id when `boundary_cells`), Points
 /// and Cells.
 void write_piece(std::ofstream& out, ArrayWriter& writer, const Mesh& mesh,
-                 const std::vector<OutputField>& point_fields,
-                 const std::vector<OutputField>& cell_fields,
+                 const std::vector<FieldSource>& point_fields,
+                 const std::vector<FieldSource>& cell_fields,
                  const std::vector<std::int64_t>& adjacent, std::vector<std::int32_t> boundary_id,
-                 bool boundary_cells) {
-  const std::size_t node_count = mesh.node_count();
-  const std::size_t element_count = mesh.element_count();
-  out << "    <Piece NumberOfPoints=\"" << node_count << "\" NumberOfCells=\"" << boundary_id.size()
-      << "\">\n"
+                 bool boundary_cells, const std::filesystem::path& path) {
+  static const std::vector<std::int64_t> no_items;
+  const FieldPlace points{"point", mesh.node_count(), no_items, path};
+  const FieldPlace cells{"cell", mesh.element_count(), adjacent, path};
+  out << "    <Piece NumberOfPoints=\"" << points.count << "\" NumberOfCells=\""
+      << boundary_id.size() << "\">\n"
       << "      <PointData>\n";
-  for (const OutputField& field : point_fields) {
-    writer.write(attributes_of(field),
-                 [&field, node_count] { return field_array(field, node_count); });
+  for (const FieldSource& field : point_fields) {
+    writer.write(attributes_of(field), [&field, points] { return field_array(field, points); });
   }
   out << "      </PointData>\n"
       << "      <CellData>\n";
-  for (const OutputField& field : cell_fields) {
-    writer.write(attributes_of(field), [&field, element_count, &adjacent] {
-      return field_array(field, element_count, adjacent);
-    });
+  for (const FieldSource& field : cell_fields) {
+    writer.write(attributes_of(field), [&field, cells] { return field_array(field, cells); });
   }
   if (boundary_cells) writer.write({"Int32", "boundary_id", 1, {}, std::move(boundary_id)});
   out << "      </CellData>\n"
@@ -541,18 +598,15 @@ int vtk_cell_type(FacetType type) {
   throw std::invalid_argument("vtk_cell_type: unknown facet type");
 }
 
-void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
-               const std::vector<OutputField>& point_fields,
-               const std::vector<OutputField>& cell_fields, const VtuOptions& options) {
-  const std::size_t node_count = mesh.node_count();
-  const std::size_t element_count = mesh.element_count();
-  check_mesh(mesh, options.boundary_cells, path);
-  for (const OutputField& field : point_fields) check_field(field, node_count, "point", path);
-  for (const OutputField& field : cell_fields) check_field(field, element_count, "cell", path);
+namespace {
 
+/// write_streamed_vtu once the mesh and every field's attributes are checked.
+void write_checked_vtu(const std::filesystem::path& path, const Mesh& mesh,
+                       const std::vector<FieldSource>& point_fields,
+                       const std::vector<FieldSource>& cell_fields, const VtuOptions& options) {
   const std::vector<std::int64_t> adjacent =
       options.boundary_cells ? adjacent_elements(mesh) : std::vector<std::int64_t>{};
-  std::vector<std::int32_t> boundary_id(element_count, 0);
+  std::vector<std::int32_t> boundary_id(mesh.element_count(), 0);
   std::vector<std::string> boundary_names;
   if (options.boundary_cells) {
     for (const auto& [name, group] : mesh.boundaries) {
@@ -577,7 +631,7 @@ void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
     out << "    </FieldData>\n";
   }
   write_piece(out, writer, mesh, point_fields, cell_fields, adjacent, std::move(boundary_id),
-              options.boundary_cells);
+              options.boundary_cells, path);
   out << "  </UnstructuredGrid>\n";
   if (binary) {
     writer.finish();
@@ -585,6 +639,41 @@ void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
     out << "</VTKFile>\n";
   }
   finish_writing(out, path);
+}
+
+std::vector<FieldSource> sources_of(const std::vector<OutputField>& fields) {
+  std::vector<FieldSource> sources;
+  sources.reserve(fields.size());
+  for (const OutputField& field : fields) sources.push_back(source_of(field));
+  return sources;
+}
+
+}  // namespace
+
+void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
+               const std::vector<OutputField>& point_fields,
+               const std::vector<OutputField>& cell_fields, const VtuOptions& options) {
+  check_mesh(mesh, options.boundary_cells, path);
+  const std::vector<FieldSource> points = sources_of(point_fields);
+  const std::vector<FieldSource> cells = sources_of(cell_fields);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    check_field_attributes(points[k], "point", path);
+    check_value_count(points[k], point_fields[k].values.size(), mesh.node_count(), "point", path);
+  }
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    check_field_attributes(cells[k], "cell", path);
+    check_value_count(cells[k], cell_fields[k].values.size(), mesh.element_count(), "cell", path);
+  }
+  write_checked_vtu(path, mesh, points, cells, options);
+}
+
+void write_streamed_vtu(const std::filesystem::path& path, const Mesh& mesh,
+                        const std::vector<FieldSource>& point_fields,
+                        const std::vector<FieldSource>& cell_fields, const VtuOptions& options) {
+  check_mesh(mesh, options.boundary_cells, path);
+  for (const FieldSource& field : point_fields) check_field_attributes(field, "point", path);
+  for (const FieldSource& field : cell_fields) check_field_attributes(field, "cell", path);
+  write_checked_vtu(path, mesh, point_fields, cell_fields, options);
 }
 
 void write_pvd(const std::filesystem::path& path, const std::vector<std::string>& datasets) {

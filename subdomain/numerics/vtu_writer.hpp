@@ -38,6 +38,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,18 @@ struct OutputField {
   /// Optional names of the components (ParaView ComponentName attributes), e.g. "XX", "YY",
   /// "ZZ", "XY", "YZ", "XZ"; empty for none, otherwise at most `components` entries.
   std::vector<std::string> component_names = {};
+};
+
+/// A field whose values are made when the writer comes to it, so that only one field's values
+/// are in memory at a time.
+struct FieldSource {
+  std::string name;
+  int components = 1;
+  /// As OutputField::component_names.
+  std::vector<std::string> component_names = {};
+  /// Appends `components` values per node (or per element), node-major, to `values`: empty, with
+  /// room reserved for the array as written (so that appending does not reallocate).
+  std::function<void(std::vector<double>& values)> append_values;
 };
 
 /// How the arrays of a .vtu are stored.
@@ -82,6 +95,18 @@ int vtk_cell_type(FacetType type);
 void write_vtu(const std::filesystem::path& path, const Mesh& mesh,
                const std::vector<OutputField>& point_fields,
                const std::vector<OutputField>& cell_fields, const VtuOptions& options = {});
+
+/// write_vtu with fields made one at a time: each source's append_values is called once, when
+/// its array is written (binary: after the XML, in the order of the arrays in the file; point
+/// fields before cell fields). The file is the one write_vtu writes of OutputFields holding the
+/// same values. A source with a malformed name or component count is reported before the file
+/// is opened, one with the wrong number of values when it is written, as write_vtu reports them;
+/// an exception from append_values propagates. Either way the file is then left unfinished (the
+/// caller removes it).
+void write_streamed_vtu(const std::filesystem::path& path, const Mesh& mesh,
+                        const std::vector<FieldSource>& point_fields,
+                        const std::vector<FieldSource>& cell_fields,
+                        const VtuOptions& options = {});
 
 /// Writes a .pvd collection referencing `datasets` (paths relative to the .pvd), one part each
 /// (part = index, timestep 0). Throws std::runtime_error naming the path when it cannot be

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <numbers>
 
@@ -444,6 +446,100 @@ TEST(VtuWriter, CompressedArraysSpanSeveralBlocksAndAreSmallerThanText) {
   EXPECT_EQ(values, json(field.values));
   EXPECT_EQ(vtk["point_data"]["sine"]["values"], json(field.values));
   EXPECT_EQ(find_array(independent["Cells"], "connectivity")["values"], vtk["connectivity"]);
+}
+
+std::string file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// The source of `field`, appending its values and recording its name in `calls`.
+FieldSource recorded_source(const OutputField& field, std::vector<std::string>& calls) {
+  return {field.name, field.components, field.component_names,
+          [&field, &calls](std::vector<double>& values) {
+            calls.push_back(field.name);
+            values.insert(values.end(), field.values.begin(), field.values.end());
+          }};
+}
+
+TEST_P(VtuEncodings, StreamedFieldsWriteTheFileOfTheFieldsAtHand) {
+  const TemporaryDirectory directory("vtu_writer");
+  const QuadraticCase data;  // with its boundary edges as cells
+  OutputField vector_field{"v", 2, {}}, cell_vector{"w", 2, {}, {"a", "b"}};
+  for (std::size_t k = 0; k < data.mesh.node_count(); ++k) {
+    vector_field.values.insert(vector_field.values.end(), {0.5 * k, -1.0 * k});
+  }
+  for (std::size_t e = 0; e < data.mesh.element_count(); ++e) {
+    cell_vector.values.insert(cell_vector.values.end(), {1.0 + e, 2.0 - e});
+  }
+  const auto at_hand = directory.path() / "at_hand.vtu";
+  const auto streamed = directory.path() / "streamed.vtu";
+  const VtuOptions options{.encoding = GetParam()};
+  write_vtu(at_hand, data.mesh, {data.point_field, vector_field}, {data.cell_field, cell_vector},
+            options);
+  std::vector<std::string> calls;
+  write_streamed_vtu(
+      streamed, data.mesh,
+      {recorded_source(data.point_field, calls), recorded_source(vector_field, calls)},
+      {recorded_source(data.cell_field, calls), recorded_source(cell_vector, calls)}, options);
+  EXPECT_EQ(calls, std::vector<std::string>({"f", "v", "cell", "w"}));
+  const std::string bytes = file_bytes(at_hand);
+  ASSERT_GT(bytes.size(), 1000u);
+  EXPECT_TRUE(bytes == file_bytes(streamed));
+  // the two-component fields padded to three, the cell field copied to the boundary edges
+  const json piece = read_vtk_xml(streamed)["pieces"][0];
+  const json& v = find_array(piece["PointData"], "v")["values"];
+  ASSERT_EQ(v.size(), 3 * data.mesh.node_count());
+  EXPECT_EQ(v[3 * 5].get<double>(), 2.5);
+  EXPECT_EQ(v[3 * 5 + 1].get<double>(), -5.0);
+  EXPECT_EQ(v[3 * 5 + 2].get<double>(), 0.0);
+  const json& w = find_array(piece["CellData"], "w")["values"];
+  const json& cell = find_array(piece["CellData"], "cell")["values"];
+  ASSERT_EQ(w.size(), 3u * 38u);
+  for (std::size_t edge = 24; edge < 38; ++edge) {
+    const double element = cell[edge].get<double>();
+    EXPECT_EQ(w[3 * edge].get<double>(), 1.0 + element) << "edge " << edge;
+    EXPECT_EQ(w[3 * edge + 1].get<double>(), 2.0 - element) << "edge " << edge;
+    EXPECT_EQ(w[3 * edge + 2].get<double>(), 0.0) << "edge " << edge;
+  }
+}
+
+TEST(VtuWriter, StreamedFieldOfTheWrongSizeIsRejectedNamingFieldAndPath) {
+  const TemporaryDirectory directory("vtu_writer");
+  const Mesh mesh = make_mixed_mesh();  // 10 nodes, 4 cells
+  const auto path = directory.path() / "bad.vtu";
+  const auto values_of_size = [](std::size_t size) {
+    return [size](std::vector<double>& values) { values.resize(size, 1.0); };
+  };
+  expect_error_naming(
+      [&] {
+        write_streamed_vtu(path, mesh, {{"pressure", 1, {}, values_of_size(9)}}, {});
+      },
+      {"pressure", path.string(), "10", "9"});
+  expect_error_naming(
+      [&] {
+        write_streamed_vtu(path, mesh, {}, {{"cell_stress", 3, {}, values_of_size(4)}});
+      },
+      {"cell_stress", path.string(), "12"});
+  expect_error_naming(
+      [&] {
+        write_streamed_vtu(path, mesh, {{"nothing", 0, {}, values_of_size(0)}}, {});
+      },
+      {"nothing", path.string()});
+}
+
+TEST(VtuWriter, FacetOfTwoElementsTakesTheFirstElementsCellValues) {
+  const TemporaryDirectory directory("vtu_writer");
+  Mesh mesh = make_mixed_mesh();  // triangles 0 (0, 1, 2) and 1 (0, 2, 3) share the edge 0-2
+  mesh.boundaries["diagonal"] = {FacetType::line2, {2, 0}};
+  mesh.boundaries["loose"] = {FacetType::line2, {0, 4}};  // a side of no element
+  const auto path = directory.path() / "shared.vtu";
+  write_vtu(path, mesh, {}, {{"index", 1, {10.0, 20.0, 30.0, 40.0}}});
+  const json piece = read_vtk_xml(path)["pieces"][0];
+  const json& index = find_array(piece["CellData"], "index")["values"];
+  ASSERT_EQ(index.size(), 6u);
+  EXPECT_EQ(index[4].get<double>(), 10.0);
+  EXPECT_TRUE(index[5].is_null()) << "NaN on a side of no element, got " << index[5];
 }
 
 }  // namespace
