@@ -1,5 +1,6 @@
 #include "numerics/body_output.hpp"
 
+#include <functional>
 #include <stdexcept>
 
 #include <sys/stat.h>
@@ -7,6 +8,7 @@
 #include <cstdlib>
 
 #include "numerics/elasticity.hpp"
+#include "numerics/finite_element.hpp"
 
 namespace robin {
 namespace {
@@ -55,6 +57,279 @@ Eigen::Vector3d resultant(const Eigen::VectorXd& nodal_vectors, int dimension) {
   return total;
 }
 
+/// Strain-displacement matrix B of an element at a point from its shape functions' gradients
+/// (one row per node): the convention of recover_stress (numerics/elasticity.hpp), in 2D
+/// strain (e_xx, e_yy, 2 e_xy) = B u_e, in 3D (e_xx, e_yy, e_zz, 2 e_yz, 2 e_xz, 2 e_xy), with
+/// u_e = (u_x0, u_y0, [u_z0,] u_x1, ...).
+Eigen::MatrixXd strain_matrix(const Eigen::MatrixXd& gradients) {
+  const Eigen::Index count = gradients.rows();
+  const Eigen::Index dimension = gradients.cols();
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(dimension == 2 ? 3 : 6, dimension * count);
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const double dx = gradients(i, 0), dy = gradients(i, 1);
+    if (dimension == 2) {
+      b(0, 2 * i) = dx;
+      b(1, 2 * i + 1) = dy;
+      b(2, 2 * i) = dy;
+      b(2, 2 * i + 1) = dx;
+      continue;
+    }
+    const double dz = gradients(i, 2);
+    b(0, 3 * i) = dx;
+    b(1, 3 * i + 1) = dy;
+    b(2, 3 * i + 2) = dz;
+    b(3, 3 * i + 1) = dz;  // 2 e_yz = du_y/dz + du_z/dy
+    b(3, 3 * i + 2) = dy;
+    b(4, 3 * i) = dz;  // 2 e_xz = du_x/dz + du_z/dx
+    b(4, 3 * i + 2) = dx;
+    b(5, 3 * i) = dy;  // 2 e_xy = du_x/dy + du_y/dx
+    b(5, 3 * i + 1) = dx;
+  }
+  return b;
+}
+
+/// The displacements of one element's nodes, node after node.
+Eigen::VectorXd nodal_values(const Mesh& mesh, const ElementGeometry& geometry,
+                             const Eigen::VectorXd& displacement) {
+  const int dimension = mesh.dimension;
+  Eigen::VectorXd local(dimension * geometry.node_count());
+  for (int i = 0; i < geometry.node_count(); ++i) {
+    local.segment(dimension * i, dimension) =
+        displacement.segment(dimension * geometry.node(i), dimension);
+  }
+  return local;
+}
+
+/// The Voigt stress s = C B u_e of elements, evaluated as recover_stress evaluates it: the
+/// same values bit for bit, one element at a time.
+class ElementStress {
+ public:
+  ElementStress(const Mesh& mesh, const Material& material, const Eigen::VectorXd& displacement)
+      : mesh_(mesh), material_(material), displacement_(displacement) {}
+
+  /// Calls visit(block, geometry, stress_at) for every element in the order of mesh.blocks;
+  /// stress_at(reference point) is the element's stress there.
+  template <class Visit>
+  void for_each_element(Visit&& visit) const {
+    for (std::size_t b = 0; b < mesh_.blocks.size(); ++b) {
+      for (std::size_t e = 0; e < mesh_.blocks[b].element_count(); ++e) {
+        const ElementGeometry geometry(mesh_, b, e);
+        const Eigen::VectorXd local = nodal_values(mesh_, geometry, displacement_);
+        const auto stress_at = [&](const Eigen::Vector3d& reference) -> Eigen::VectorXd {
+          return material_.stiffness *
+                 (strain_matrix(geometry.evaluate(reference).gradients) * local);
+        };
+        visit(mesh_.blocks[b], geometry, stress_at);
+      }
+    }
+  }
+
+ private:
+  const Mesh& mesh_;
+  const Material& material_;
+  const Eigen::VectorXd& displacement_;
+};
+
+/// Voigt stress per node (columns): the average over the elements touching the node of the
+/// element's stress at the node, as recover_stress's nodal_stress.
+Eigen::MatrixXd nodal_stresses(const Mesh& mesh, const Material& material,
+                               const Eigen::VectorXd& displacement) {
+  Eigen::MatrixXd nodal =
+      Eigen::MatrixXd::Zero(material.voigt_size(), static_cast<Eigen::Index>(mesh.node_count()));
+  Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
+  const ElementBlock* references_block = nullptr;
+  std::vector<Eigen::Vector3d> references;  // the reference nodes of references_block's type
+  ElementStress(mesh, material, displacement)
+      .for_each_element(
+          [&](const ElementBlock& block, const ElementGeometry& geometry, const auto& stress_at) {
+            if (&block != references_block) {
+              references = reference_nodes(block.type);
+              references_block = &block;
+            }
+            for (int i = 0; i < geometry.node_count(); ++i) {
+              nodal.col(geometry.node(i)) += stress_at(references[i]);
+              touching(geometry.node(i)) += 1.0;
+            }
+          });
+  for (Eigen::Index node = 0; node < touching.size(); ++node) {
+    if (touching(node) > 0.0) nodal.col(node) /= touching(node);
+  }
+  return nodal;
+}
+
+/// Appends the stress tensor of every column of Voigt stresses (6 values each, ParaView's
+/// order) to `tensors` and its von Mises stress to `von_mises_values`.
+void append_stress_tensors(const Material& material, const Eigen::MatrixXd& stresses,
+                           std::vector<double>& tensors, std::vector<double>& von_mises_values) {
+  for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
+    const StressTensor tensor = stress_tensor(material, Eigen::VectorXd(stresses.col(k)));
+    tensors.insert(tensors.end(), tensor.data(), tensor.data() + 6);
+    von_mises_values.push_back(von_mises(tensor));
+  }
+}
+
+/// Appends, per element at its centroid, the stress tensor (6 values, ParaView's order) to
+/// `tensors` and its von Mises stress to `von_mises_values`.
+void append_element_stresses(const Mesh& mesh, const Material& material,
+                             const Eigen::VectorXd& displacement, std::vector<double>& tensors,
+                             std::vector<double>& von_mises_values) {
+  ElementStress(mesh, material, displacement)
+      .for_each_element(
+          [&](const ElementBlock& block, const ElementGeometry&, const auto& stress_at) {
+            const StressTensor tensor =
+                stress_tensor(material, stress_at(reference_centroid(block.type)));
+            tensors.insert(tensors.end(), tensor.data(), tensor.data() + 6);
+            von_mises_values.push_back(von_mises(tensor));
+          });
+}
+
+/// Moves `from` into the end of `values` and frees it.
+void append_and_free(std::vector<double>& from, std::vector<double>& values) {
+  values.insert(values.end(), from.begin(), from.end());
+  std::vector<double>().swap(from);
+}
+
+/// Appends a vector's values.
+void append_vector(const Eigen::VectorXd& vector, std::vector<double>& values) {
+  values.insert(values.end(), vector.data(), vector.data() + vector.size());
+}
+
+/// The fields of a body made one at a time while its file is written (write_streamed_vtu):
+/// what several fields share (the displacement, the contact forces, the reactions) is made
+/// once; the stresses are evaluated element by element as each stress field is written, their
+/// von Mises values kept for the von_mises field that follows.
+class StreamedFields {
+ public:
+  StreamedFields(const BodySolver& body, const Eigen::VectorXd& contact_force, FieldCheck check)
+      : body_(body),
+        material_(body.definition().material),
+        displacement_(body.displacement(contact_force, body.rigid_amplitudes())),
+        force_field_(body.contact_force_field(contact_force)),
+        reaction_(body.reactions(displacement_)),
+        check_(std::move(check)) {}
+
+  const Eigen::VectorXd& reaction() const { return reaction_; }
+
+  std::vector<FieldSource> point_sources() {
+    const int dimension = body_.mesh().dimension;
+    return {source("point", "displacement", dimension, &StreamedFields::append_displacement),
+            source("point", "stress", 6, &StreamedFields::append_nodal_stress,
+                   stress_tensor_components()),
+            source("point", "von_mises", 1, &StreamedFields::append_nodal_von_mises),
+            source("point", "contact_pressure", 1, &StreamedFields::append_contact_pressure),
+            source("point", "contact_force", dimension, &StreamedFields::append_contact_force),
+            source("point", "reaction", dimension, &StreamedFields::append_reaction)};
+  }
+
+  std::vector<FieldSource> cell_sources() {
+    return {source("cell", "stress", 6, &StreamedFields::append_element_stress,
+                   stress_tensor_components()),
+            source("cell", "von_mises", 1, &StreamedFields::append_element_von_mises)};
+  }
+
+ private:
+  using Append = void (StreamedFields::*)(std::vector<double>& values);
+
+  /// The source of a field whose values `append` makes, given to check_ (when set) once made.
+  FieldSource source(const char* location, const std::string& name, int components, Append append,
+                     const std::vector<std::string>& component_names = {}) {
+    return {name, components, component_names,
+            [this, location, name, append](std::vector<double>& values) {
+              (this->*append)(values);
+              if (check_) check_(location, name, values);
+            }};
+  }
+
+  void append_displacement(std::vector<double>& values) { append_vector(displacement_, values); }
+  void append_contact_force(std::vector<double>& values) { append_vector(force_field_, values); }
+  void append_reaction(std::vector<double>& values) { append_vector(reaction_, values); }
+
+  void append_contact_pressure(std::vector<double>& values) {
+    const std::vector<double> pressure = nodal_contact_pressure(body_, force_field_);
+    values.insert(values.end(), pressure.begin(), pressure.end());
+  }
+
+  void append_nodal_stress(std::vector<double>& values) {
+    const Eigen::MatrixXd nodal = nodal_stresses(body_.mesh(), material_, displacement_);
+    nodal_von_mises_.clear();
+    nodal_von_mises_.reserve(static_cast<std::size_t>(nodal.cols()));
+    append_stress_tensors(material_, nodal, values, nodal_von_mises_);
+  }
+
+  void append_nodal_von_mises(std::vector<double>& values) {
+    if (nodal_von_mises_.size() != body_.mesh().node_count()) {  // not made with the stress
+      std::vector<double> tensors;
+      append_nodal_stress(tensors);
+    }
+    append_and_free(nodal_von_mises_, values);
+  }
+
+  void append_element_stress(std::vector<double>& values) {
+    element_von_mises_.clear();
+    element_von_mises_.reserve(body_.mesh().element_count());
+    append_element_stresses(body_.mesh(), material_, displacement_, values, element_von_mises_);
+  }
+
+  void append_element_von_mises(std::vector<double>& values) {
+    if (element_von_mises_.size() != body_.mesh().element_count()) {  // not made with the stress
+      std::vector<double> tensors;
+      append_element_stress(tensors);
+    }
+    append_and_free(element_von_mises_, values);
+  }
+
+  const BodySolver& body_;
+  const Material& material_;
+  const Eigen::VectorXd displacement_;
+  const Eigen::VectorXd force_field_;  // -B' lambda per node
+  const Eigen::VectorXd reaction_;
+  const FieldCheck check_;
+  std::vector<double> nodal_von_mises_;    // made with the nodal stress tensors
+  std::vector<double> element_von_mises_;  // made with the element stress tensors
+};
+
+/// Refuses contact forces of the wrong size (std::invalid_argument naming the body).
+void check_contact_force_size(const BodySolver& body, const Eigen::VectorXd& contact_force) {
+  if (contact_force.size() != body.contact_size()) {
+    throw std::invalid_argument(
+        "body '" + body.name() + "': " + std::to_string(contact_force.size()) +
+        " contact forces for " + std::to_string(body.contact_size()) + " contact constraints");
+  }
+}
+
+/// Writes <directory>/<body_name>.vtu with `write` (given the path of a fresh temporary file in
+/// `directory`, renamed into place once written, removed if `write` throws); returns the file's
+/// name.
+std::string write_into_place(const std::filesystem::path& directory, const std::string& body_name,
+                             const std::function<void(const std::string& temporary)>& write) {
+  const std::string file_name = body_name + ".vtu";
+  if (body_name.empty() || std::filesystem::path(body_name).has_parent_path()) {
+    throw std::runtime_error("cannot write '" + (directory / file_name).string() +
+                             "': body name '" + body_name + "' is not usable as a file name");
+  }
+  std::filesystem::create_directories(directory);
+  // A fresh temporary file (mkstemp: O_EXCL, so never through an existing link), renamed into
+  // place: a symbolic link at the target is replaced, not followed, and a reader never sees a
+  // half-written file. mkstemp creates the file for its owner only; a result file is made
+  // readable by everyone (0644, as the Python server writes it).
+  std::string temporary = (directory / ("." + file_name + ".XXXXXX")).string();
+  const int descriptor = mkstemp(temporary.data());
+  if (descriptor < 0) {
+    throw std::runtime_error("cannot create a temporary file in '" + directory.string() + "'");
+  }
+  fchmod(descriptor, S_IRUSR | S_IWUSR | S_IRGRP | S_IROTH);
+  close(descriptor);
+  try {
+    write(temporary);
+    std::filesystem::rename(temporary, directory / file_name);
+  } catch (...) {
+    std::error_code error;
+    std::filesystem::remove(temporary, error);
+    throw;
+  }
+  return file_name;
+}
+
 }  // namespace
 
 const std::vector<std::string>& stress_tensor_components() {
@@ -68,11 +343,7 @@ BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& conta
 
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force,
                             const Eigen::VectorXd& rigid_amplitudes) {
-  if (contact_force.size() != body.contact_size()) {
-    throw std::invalid_argument(
-        "body '" + body.name() + "': " + std::to_string(contact_force.size()) +
-        " contact forces for " + std::to_string(body.contact_size()) + " contact constraints");
-  }
+  check_contact_force_size(body, contact_force);
   const Material& material = body.definition().material;
   const Eigen::VectorXd displacement = body.displacement(contact_force, rigid_amplitudes);
   const StressField stress = recover_stress(body.mesh(), material, displacement);
@@ -104,33 +375,24 @@ std::string place_body_output(const std::filesystem::path& directory, const Body
 }
 
 std::string write_body_output(const std::filesystem::path& directory, const BodyOutput& output) {
-  const std::string file_name = output.body_name + ".vtu";
-  if (output.body_name.empty() || std::filesystem::path(output.body_name).has_parent_path()) {
-    throw std::runtime_error("cannot write '" + (directory / file_name).string() +
-                             "': body name '" + output.body_name +
-                             "' is not usable as a file name");
-  }
-  std::filesystem::create_directories(directory);
-  // A fresh temporary file (mkstemp: O_EXCL, so never through an existing link), renamed into
-  // place: a symbolic link at the target is replaced, not followed, and a reader never sees a
-  // half-written file. mkstemp creates the file for its owner only; a result file is made
-  // readable by everyone (0644, as the Python server writes it).
-  std::string temporary = (directory / ("." + file_name + ".XXXXXX")).string();
-  const int descriptor = mkstemp(temporary.data());
-  if (descriptor < 0) {
-    throw std::runtime_error("cannot create a temporary file in '" + directory.string() + "'");
-  }
-  fchmod(descriptor, S_IRUSR | S_IWUSR | S_IRGRP | S_IROTH);
-  close(descriptor);
-  try {
+  return write_into_place(directory, output.body_name, [&output](const std::string& temporary) {
     write_vtu(temporary, output.mesh, output.point_fields, output.cell_fields);
-    std::filesystem::rename(temporary, directory / file_name);
-  } catch (...) {
-    std::error_code error;
-    std::filesystem::remove(temporary, error);
-    throw;
-  }
-  return file_name;
+  });
+}
+
+BodyOutput write_body_fields(const std::filesystem::path& directory, const BodySolver& body,
+                             const Eigen::VectorXd& contact_force, const FieldCheck& check) {
+  check_contact_force_size(body, contact_force);
+  StreamedFields fields(body, contact_force, check);
+  BodyOutput output;
+  output.body_name = body.name();
+  output.mesh.dimension = body.mesh().dimension;
+  output.reaction_resultant = resultant(fields.reaction(), body.mesh().dimension);
+  output.applied_force = body.applied_force();
+  output.written_file = write_into_place(directory, body.name(), [&](const std::string& temporary) {
+    write_streamed_vtu(temporary, body.mesh(), fields.point_sources(), fields.cell_sources());
+  });
+  return output;
 }
 
 }  // namespace robin

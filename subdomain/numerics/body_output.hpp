@@ -3,6 +3,8 @@
 // Mirrors FieldsReply of proto/robin.proto.
 
 #include <Eigen/Core>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "numerics/body_solver.hpp"
@@ -48,5 +50,20 @@ BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& conta
 /// Writes <directory>/<body_name>.vtu (numerics/vtu_writer.hpp: binary zlib-compressed, with the
 /// mesh's named boundaries as line cells); returns the file name.
 std::string write_body_output(const std::filesystem::path& directory, const BodyOutput& output);
+
+/// Looks at a field's values before they are written: its location ("point" or "cell"), its
+/// name and its values (components per node or element, as OutputField::values); throws to
+/// abandon the file.
+using FieldCheck = std::function<void(const std::string& location, const std::string& name,
+                                      const std::vector<double>& values)>;
+
+/// Writes <directory>/<body_name>.vtu: the file write_body_output writes of
+/// make_body_output(body, contact_force), byte for byte, made from the body's own mesh (not a
+/// copy) with one field's values in memory at a time, each given to `check` (when set) before
+/// it is written. Returns the output without its mesh and fields: body_name, mesh.dimension, the
+/// resultants and written_file (the file's name). Throws as write_body_output does, and what
+/// `check` throws; the file is then not left behind.
+BodyOutput write_body_fields(const std::filesystem::path& directory, const BodySolver& body,
+                             const Eigen::VectorXd& contact_force, const FieldCheck& check = {});
 
 }  // namespace robin
