@@ -1,5 +1,6 @@
 #include "server/subdomain_server.hpp"
 
+#include <malloc.h>
 #include <spdlog/spdlog.h>
 #include <algorithm>
 #include <chrono>
@@ -180,6 +181,42 @@ void require_finite_fields(const BodyOutput& output, const std::string& body_nam
                      "FieldsReply " + kind + " field '" + field.name + "'", body_name);
     }
   }
+}
+
+/// Writes <directory>/<body>.vtu one field at a time (write_body_fields), a field with a NaN or
+/// an infinity refused as require_finite_fields refuses it; returns the output without mesh and
+/// fields, written_file the path written. An unusable directory is an INVALID_ARGUMENT.
+BodyOutput write_streamed_fields_file(const std::filesystem::path& directory,
+                                      const BodySolver& body,
+                                      const Eigen::VectorXd& contact_force) {
+  const FieldCheck check = [&body](const std::string& location, const std::string& name,
+                                   const std::vector<double>& values) {
+    require_finite(
+        Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())),
+        "FieldsReply " + location + " field '" + name + "'", body.name());
+  };
+  try {
+    BodyOutput output = write_body_fields(directory, body, contact_force, check);
+    output.written_file = (directory / output.written_file).string();
+    return output;
+  } catch (const RequestError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& error) {
+    throw RequestError(protocol::INVALID_ARGUMENT,
+                       "FieldsRequest.write_directory: cannot write the fields of body '" +
+                           body.name() + "' to '" + directory.string() + "': " + error.what());
+  }
+}
+
+/// Gives the pages of freed heap memory back to the system (glibc keeps them otherwise, in the
+/// middle of its arenas), so that they do not count again beside the fields about to be made.
+/// Elsewhere nothing.
+void release_free_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
 }
 
 /// The INTERNAL message of a request that could not allocate its memory (std::bad_alloc; the
@@ -674,16 +711,17 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
   const std::filesystem::path directory = fields_directory(message.write_directory());
   protocol::FieldsReply& fields = *reply.mutable_fields_reply();
-  {
+  release_free_memory();
+  if (omit_fields) {  // the file made field by field, from the body's own mesh
+    const BodyOutput output = write_streamed_fields_file(directory, *body_, contact_force);
+    fields.set_written_file(output.written_file);
+    encode_resultants(output, fields);
+  } else {
     const BodyOutput output = make_body_output(*body_, contact_force);
     require_finite_fields(output, body_->name());
     // the file first: its buffers are freed before the reply's copy of the fields is made
     if (!directory.empty()) fields.set_written_file(write_fields_file(directory, output));
-    if (omit_fields) {
-      encode_resultants(output, fields);
-    } else {
-      encode_fields(output, fields);
-    }
+    encode_fields(output, fields);
   }  // the fields are freed before the reply is serialized
   if (settings_.protocol_minor >= 2) {
     add_stage_time(*fields.mutable_stage_times(), SetupStage::fields, seconds_since(start));
