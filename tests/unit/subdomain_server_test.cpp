@@ -1359,6 +1359,50 @@ TEST(SubdomainServer, NonFiniteResultsAreSolverFailureNamingTheBody) {
   EXPECT_TRUE(exchange(server, fields).has_fields_reply());
 }
 
+/// A FieldsRequest for the two contact rows of the test below, forces `force`, the file written
+/// into `directory` and left out of the reply (protocol 2.5).
+protocol::Envelope written_fields_request(std::uint64_t id, double force,
+                                          const std::string& directory) {
+  protocol::Envelope fields = request(id);
+  fields.mutable_fields()->add_contact_force(force);
+  fields.mutable_fields()->add_contact_force(force);
+  fields.mutable_fields()->set_write_directory(directory);
+  fields.mutable_fields()->set_omit_fields_from_reply(true);
+  return fields;
+}
+
+// The file a server writes field by field (omit_fields_from_reply): forces near 1e300 on rows
+// of coefficient 1e10 overflow the nodal contact force field, a SOLVER_FAILURE as for a full
+// reply, and no file (or temporary file) is left behind; the server stays ready and writes the
+// same file again for every later FieldsRequest (nothing of the body is released).
+TEST(SubdomainServer, FieldsWrittenByTheServerRefuseNonFiniteValuesAndRepeat) {
+  const TemporaryDirectory root("output");
+  ServerSettings settings = quiet_settings();
+  settings.output_root = root.path();
+  SubdomainServer server(settings);
+  const InterfaceDescription interface = BodySolver(lower_block_definition()).contact_boundary();
+  ASSERT_TRUE(exchange(server, setup_request(1, lower_block_setup())).has_interface());
+  ContactOperator contact;
+  for (int row = 0; row < 2; ++row) {
+    contact.add_entry(interface.node_ids[10], 1, 1e10);
+    contact.finish_row(0.1);
+  }
+  ASSERT_TRUE(exchange(server, assign_request(2, contact)).has_acknowledge());
+  expect_solver_failure(exchange(server, written_fields_request(3, 1e300, "overflow")),
+                        "FieldsReply point field");
+  const std::filesystem::path overflow = root.path() / "overflow";
+  EXPECT_TRUE(!std::filesystem::exists(overflow) || listing(overflow).empty());
+  EXPECT_EQ(server.state(), ServerState::ready);
+  std::uint64_t id = 4;
+  for (const char* directory : {"first", "second"}) {
+    const protocol::Envelope reply = exchange(server, written_fields_request(id++, 1.0, directory));
+    ASSERT_TRUE(reply.has_fields_reply()) << reply.DebugString();
+  }
+  const std::string first = file_text(root.path() / "first/lower.vtu");
+  EXPECT_GT(first.size(), 1000u);
+  EXPECT_TRUE(first == file_text(root.path() / "second/lower.vtu"));
+}
+
 // Issue 11 (g) through the server: AssignContact rows that combine two nodes,
 // 0.5 u_y(a) + 0.5 u_y(b) for neighbouring contact nodes, give the correction and the Neumann
 // solve of a BodySolver built in this process with the same operator.
