@@ -30,7 +30,7 @@ int cell_degree(FacetType nonmortar, FacetType mortar) {
 }
 
 struct FacePoint {
-  Eigen::VectorXd values;            // shape functions at the point
+  ShapeValues values;                // shape functions at the point
   Eigen::Vector3d position;          // x(r, s)
   Eigen::Vector3d along_r, along_s;  // dx/dr, dx/ds
 };
@@ -61,7 +61,7 @@ class Face {
 
   FacePoint evaluate(const Eigen::Vector2d& reference) const {
     FacePoint point;
-    Eigen::MatrixXd gradients;
+    ShapeGradients gradients;
     shape_functions(parametrization_, Eigen::Vector3d(reference.x(), reference.y(), 0.0),
                     point.values, gradients);
     point.position.setZero();
@@ -77,7 +77,7 @@ class Face {
 
   /// The normal field: the shape-function interpolation of the averaged nodal normals,
   /// normalized.
-  Eigen::Vector3d normal_field(const Eigen::VectorXd& values) const {
+  Eigen::Vector3d normal_field(const ShapeValues& values) const {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     for (int a = 0; a < count_; ++a) {
       normal += values[a] * surface_->normals[static_cast<std::size_t>(node(a))];
@@ -313,8 +313,8 @@ void integrate_polygon(const NonmortarFace& nonmortar, const Face& other, const 
       const Eigen::Vector3d area_normal = at.along_r.cross(at.along_s);
       const double measure =
           gauss.weight * twice_area * area_normal.norm() / std::abs(area_normal.dot(auxiliary));
-      const Eigen::VectorXd standard = nonmortar.transformation * at.values;
-      const Eigen::VectorXd dual = nonmortar.dual * at.values;
+      const ShapeValues standard = nonmortar.transformation * at.values;
+      const ShapeValues dual = nonmortar.dual * at.values;
       sums.covered += measure * standard;
       sums.dual_gap += (measure * distance) * dual;
       sums.standard_gap += (measure * distance) * standard;
@@ -421,8 +421,8 @@ Eigen::MatrixXd face_mass_matrix(FacetType type, const std::vector<Eigen::Vector
   const int count = nodes_per_facet(type);
   Eigen::MatrixXd mass = Eigen::MatrixXd::Zero(count, count);
   for (const QuadraturePoint& gauss : element_quadrature(parametrization, face_degree)) {
-    Eigen::VectorXd values;
-    Eigen::MatrixXd gradients;
+    ShapeValues values;
+    ShapeGradients gradients;
     shape_functions(parametrization, gauss.reference, values, gradients);
     Eigen::Vector3d along_r = Eigen::Vector3d::Zero(), along_s = Eigen::Vector3d::Zero();
     for (int a = 0; a < count; ++a) {

@@ -56,14 +56,14 @@ struct Side {
 };
 
 struct SegmentPoint {
-  Eigen::VectorXd values;  // shape functions at the point
+  ShapeValues values;  // shape functions at the point
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
   Eigen::Vector2d tangent = Eigen::Vector2d::Zero();  // dx/dxi
 };
 
 SegmentPoint evaluate(const Side& side, int segment, double reference) {
   SegmentPoint point;
-  Eigen::VectorXd derivatives;
+  ShapeValues derivatives;
   edge_shape_functions(side.segment_type(), reference, point.values, derivatives);
   for (int a = 0; a < side.nodes_per_segment(); ++a) {
     point.position += point.values[a] * side.coordinates(side.node(segment, a));
@@ -74,7 +74,7 @@ SegmentPoint evaluate(const Side& side, int segment, double reference) {
 
 /// The non-mortar normal field: the shape-function interpolation of the averaged nodal
 /// normals, normalised.
-Eigen::Vector2d normal_field(const Side& side, int segment, const Eigen::VectorXd& values) {
+Eigen::Vector2d normal_field(const Side& side, int segment, const ShapeValues& values) {
   Eigen::Vector2d normal = Eigen::Vector2d::Zero();
   for (int a = 0; a < side.nodes_per_segment(); ++a) {
     normal += values[a] * side.normal(side.node(segment, a));
@@ -245,7 +245,7 @@ void integrate_overlap(const Side& nonmortar, int segment, const Eigen::MatrixXd
     double distance = (target.position - at.position).dot(normal);
     if (gap != nullptr) distance += (*gap)(at.position.x(), at.position.y());
     const double measure = 0.5 * gauss.weight * (high - low) * at.tangent.norm();
-    const Eigen::VectorXd dual_values = dual * at.values;
+    const ShapeValues dual_values = dual * at.values;
     for (int a = 0; a < count; ++a) {
       FaceRowIntegrals& row = coupling.rows[static_cast<std::size_t>(nonmortar.node(segment, a))];
       row.covered += measure * at.values[a];

@@ -1,8 +1,8 @@
 #include "numerics/elasticity.hpp"
 
 #include <Eigen/Geometry>
-#include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -43,47 +43,40 @@ int facet_load_degree(FacetType type) {
   return type == FacetType::line3 || type == FacetType::triangle6 ? 6 : 4;
 }
 
-/// Strain-displacement matrix B (Voigt size x d n) with u_e = (u_x0, u_y0, [u_z0,] u_x1, ...):
-/// in 2D strain (e_xx, e_yy, 2 e_xy) = B u_e, in 3D (e_xx, e_yy, e_zz, 2 e_yz, 2 e_xz, 2 e_xy).
-Eigen::MatrixXd strain_displacement(const Eigen::MatrixXd& gradients) {
-  const Eigen::Index count = gradients.rows();
-  const Eigen::Index dimension = gradients.cols();
-  if (dimension == 2) {
-    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(3, 2 * count);
-    for (Eigen::Index i = 0; i < count; ++i) {
-      b(0, 2 * i) = gradients(i, 0);
-      b(1, 2 * i + 1) = gradients(i, 1);
-      b(2, 2 * i) = gradients(i, 1);
-      b(2, 2 * i + 1) = gradients(i, 0);
+/// The Voigt strain components as coordinate pairs (a, b): a normal strain e_aa = du_a/dx_a
+/// when a = b, an engineering shear strain 2 e_ab = du_a/dx_b + du_b/dx_a otherwise. In 2D
+/// (e_xx, e_yy, 2 e_xy), in 3D (e_xx, e_yy, e_zz, 2 e_yz, 2 e_xz, 2 e_xy) (material.hpp).
+constexpr int plane_voigt_pairs[3][2] = {{0, 0}, {1, 1}, {0, 1}};
+constexpr int solid_voigt_pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}};
+
+/// Strain-displacement matrix B (Voigt size x d n) of the physical gradients dN/dx (n x d):
+/// strain = B u_e with u_e = (u_x0, u_y0, [u_z0,] u_x1, ...).
+void strain_displacement(const ShapeGradients& gradients, StrainDisplacement& b) {
+  const int count = static_cast<int>(gradients.rows());
+  const int dimension = static_cast<int>(gradients.cols());
+  const int voigt_size = dimension == 2 ? 3 : 6;
+  const int(*pairs)[2] = dimension == 2 ? plane_voigt_pairs : solid_voigt_pairs;
+  b.setZero(voigt_size, dimension * count);
+  for (int row = 0; row < voigt_size; ++row) {
+    const int a = pairs[row][0];
+    const int c = pairs[row][1];
+    for (int i = 0; i < count; ++i) {
+      b(row, dimension * i + a) = gradients(i, c);
+      if (a != c) b(row, dimension * i + c) = gradients(i, a);
     }
-    return b;
   }
-  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(6, 3 * count);
-  for (Eigen::Index i = 0; i < count; ++i) {
-    const double dx = gradients(i, 0), dy = gradients(i, 1), dz = gradients(i, 2);
-    b(0, 3 * i) = dx;
-    b(1, 3 * i + 1) = dy;
-    b(2, 3 * i + 2) = dz;
-    b(3, 3 * i + 1) = dz;  // 2 e_yz = du_y/dz + du_z/dy
-    b(3, 3 * i + 2) = dy;
-    b(4, 3 * i) = dz;  // 2 e_xz = du_x/dz + du_z/dx
-    b(4, 3 * i + 2) = dx;
-    b(5, 3 * i) = dy;  // 2 e_xy = du_x/dy + du_y/dx
-    b(5, 3 * i + 1) = dx;
-  }
-  return b;
 }
 
-Eigen::VectorXd element_displacement(const Mesh& mesh, const ElementBlock& block,
-                                     std::size_t element, const Eigen::VectorXd& displacement) {
+/// The element's nodal displacements u_e (d n) gathered from the global vector.
+void element_displacement(const Mesh& mesh, const ElementBlock& block, std::size_t element,
+                          const Eigen::VectorXd& displacement, ElementVector& local) {
   const int count = nodes_per_element(block.type);
   const int dimension = mesh.dimension;
-  Eigen::VectorXd local(dimension * count);
+  local.resize(dimension * count);
   for (int i = 0; i < count; ++i) {
     const int node = block.connectivity[element * count + i];
     local.segment(dimension * i, dimension) = displacement.segment(dimension * node, dimension);
   }
-  return local;
 }
 
 void check_displacement_size(const Mesh& mesh, const Eigen::VectorXd& displacement,
@@ -111,27 +104,22 @@ void add_nodal(Eigen::VectorXd& load, int dimension, int node, const Eigen::Vect
   load.segment(dimension * node, dimension) += value.head(dimension);
 }
 
-/// K_e = sum over the rule of B^T C B |J| w, with C of fixed size (3 x 3 or 6 x 6: the products
-/// then have a fixed evaluation order, whatever the dimension).
+/// K_e = sum over `rule` (the element type's stiffness rule, tabulated) of B^T C B |J| w, with C
+/// of fixed size (3 x 3 or 6 x 6: the products then have a fixed evaluation order, whatever the
+/// dimension).
 template <int VoigtSize>
-Eigen::MatrixXd element_stiffness(const ElementGeometry& geometry,
-                                  const Eigen::Matrix<double, VoigtSize, VoigtSize>& c) {
-  const int count = geometry.node_count();
-  const int size = element_dimension(geometry.type()) * count;
-  Eigen::MatrixXd stiffness = Eigen::MatrixXd::Zero(size, size);
-  for (const QuadraturePoint& point :
-       element_quadrature(geometry.type(), stiffness_degree(geometry.type()))) {
-    const ElementPoint at = geometry.evaluate(point.reference);
-    const Eigen::MatrixXd b = strain_displacement(at.gradients);
+void element_stiffness(const ElementGeometry& geometry, const std::vector<ReferenceShape>& rule,
+                       const Eigen::Matrix<double, VoigtSize, VoigtSize>& c,
+                       ElementMatrix& stiffness) {
+  const int size = element_dimension(geometry.type()) * geometry.node_count();
+  stiffness.setZero(size, size);
+  StrainDisplacement b;
+  for (const ReferenceShape& point : rule) {
+    const ElementPoint at = geometry.evaluate(point);
+    strain_displacement(at.gradients, b);
     // K_e += B^T C B |J| w
     stiffness.noalias() += b.transpose() * c * b * (at.jacobian * point.weight);
   }
-  return stiffness;
-}
-
-Eigen::MatrixXd element_stiffness(const ElementGeometry& geometry, const Eigen::MatrixXd& c) {
-  if (c.rows() == 3) return element_stiffness<3>(geometry, Eigen::Matrix3d(c));
-  return element_stiffness<6>(geometry, Eigen::Matrix<double, 6, 6>(c));
 }
 
 /// The node graph of a mesh: node c shares an element with the nodes
@@ -222,35 +210,50 @@ long entry_offset(const NodeGraph& graph, int dimension, int row_node, int colum
   return long{dimension} * dimension * graph.offsets[column_node] + long{dimension} * place;
 }
 
+/// Adds K_e of every element of block `b` into `stiffness` (stiffness_pattern's values): C of
+/// fixed size VoigtSize.
+template <int VoigtSize>
+void add_block_stiffness(const Mesh& mesh, std::size_t b, const Material& material,
+                         const NodeGraph& graph, double* values) {
+  const ElementBlock& block = mesh.blocks[b];
+  const int dimension = mesh.dimension;
+  const int count = nodes_per_element(block.type);
+  const std::vector<ReferenceShape> rule =
+      tabulate_shapes(block.type, element_quadrature(block.type, stiffness_degree(block.type)));
+  const Eigen::Matrix<double, VoigtSize, VoigtSize> c = material.stiffness;
+  std::array<long, max_element_nodes * max_element_nodes> starts;
+  ElementMatrix local;
+  for (std::size_t e = 0; e < block.element_count(); ++e) {
+    element_stiffness<VoigtSize>({mesh, b, e}, rule, c, local);
+    const int* nodes = &block.connectivity[e * count];
+    for (int column = 0; column < count; ++column) {
+      for (int row = 0; row < count; ++row) {
+        starts[row * count + column] = entry_offset(graph, dimension, nodes[row], nodes[column]);
+      }
+    }
+    // K(d r + a, d c + b) += K_e(d i + a, d j + b) for element nodes r = nodes[i], c = nodes[j],
+    // in the order of i, a, j, b: every entry sums its elements' terms in element order.
+    for (int i = 0; i < dimension * count; ++i) {
+      for (int j = 0; j < dimension * count; ++j) {
+        const long start = starts[(i / dimension) * count + j / dimension];
+        const long column_length = long{dimension} * graph.degree(nodes[j / dimension]);
+        values[start + (j % dimension) * column_length + i % dimension] += local(i, j);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 SparseMatrix assemble_stiffness(const Mesh& mesh, const Material& material) {
   check_material_dimension(mesh, material);
-  const int dimension = mesh.dimension;
   const NodeGraph graph = node_graph(mesh);
-  SparseMatrix stiffness = stiffness_pattern(graph, dimension);
-  double* values = stiffness.valuePtr();
+  SparseMatrix stiffness = stiffness_pattern(graph, mesh.dimension);
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
-    const ElementBlock& block = mesh.blocks[b];
-    const int count = nodes_per_element(block.type);
-    std::vector<long> starts(static_cast<std::size_t>(count * count));
-    for (std::size_t e = 0; e < block.element_count(); ++e) {
-      const Eigen::MatrixXd local = element_stiffness({mesh, b, e}, material.stiffness);
-      const int* nodes = &block.connectivity[e * count];
-      for (int column = 0; column < count; ++column) {
-        for (int row = 0; row < count; ++row) {
-          starts[row * count + column] = entry_offset(graph, dimension, nodes[row], nodes[column]);
-        }
-      }
-      // K(d r + a, d c + b) += K_e(d i + a, d j + b) for element nodes r = nodes[i], c = nodes[j],
-      // in the order of i, a, j, b: every entry sums its elements' terms in element order.
-      for (int i = 0; i < dimension * count; ++i) {
-        for (int j = 0; j < dimension * count; ++j) {
-          const long start = starts[(i / dimension) * count + j / dimension];
-          const long column_length = long{dimension} * graph.degree(nodes[j / dimension]);
-          values[start + (j % dimension) * column_length + i % dimension] += local(i, j);
-        }
-      }
+    if (material.voigt_size() == 3) {
+      add_block_stiffness<3>(mesh, b, material, graph, stiffness.valuePtr());
+    } else {
+      add_block_stiffness<6>(mesh, b, material, graph, stiffness.valuePtr());
     }
   }
   return stiffness;
@@ -261,12 +264,12 @@ Eigen::VectorXd assemble_body_force(const Mesh& mesh, const VectorField& body_fo
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
     const ElementBlock& block = mesh.blocks[b];
     const int count = nodes_per_element(block.type);
-    const std::vector<QuadraturePoint> rule =
-        element_quadrature(block.type, load_degree(block.type));
+    const std::vector<ReferenceShape> rule =
+        tabulate_shapes(block.type, element_quadrature(block.type, load_degree(block.type)));
     for (std::size_t e = 0; e < block.element_count(); ++e) {
       const ElementGeometry geometry(mesh, b, e);
-      for (const QuadraturePoint& point : rule) {
-        const ElementPoint at = geometry.evaluate(point.reference);
+      for (const ReferenceShape& point : rule) {
+        const ElementPoint at = geometry.evaluate(point);
         // f_i += N_i b(x) |J| w
         const Eigen::Vector3d force = body_force(at.position) * (at.jacobian * point.weight);
         for (int i = 0; i < count; ++i) {
@@ -383,48 +386,75 @@ std::vector<Eigen::Vector3d> boundary_node_normals(const Mesh& mesh, const Bound
                       "boundary " + mesh.boundary_label(group));
 }
 
+namespace {
+
+/// The Voigt stress s = C B u_e of an element at a tabulated point of its type (b: scratch).
+VoigtVector stress_at(const ElementGeometry& geometry, const ReferenceShape& shape,
+                      const VoigtMatrix& c, const ElementVector& local, StrainDisplacement& b) {
+  strain_displacement(geometry.evaluate(shape).gradients, b);
+  return c * (b * local);
+}
+
+/// Sets the centroid stress of every element of block `b` (columns from `first`) and adds the
+/// element's stress at each of its nodes to the node's column, counting the terms in `touching`.
+/// Points with the same reference gradients share one evaluation (the same J and dN/dx).
+void add_block_stress(const Mesh& mesh, std::size_t b, const VoigtMatrix& c,
+                      const Eigen::VectorXd& displacement, Eigen::Index first, StressField& field,
+                      Eigen::VectorXd& touching) {
+  const ElementBlock& block = mesh.blocks[b];
+  std::vector<Eigen::Vector3d> points{reference_centroid(block.type)};
+  for (const Eigen::Vector3d& node : reference_nodes(block.type)) points.push_back(node);
+  const std::vector<ReferenceShape> shapes = tabulate_shapes(block.type, points);
+  const std::vector<std::size_t> same = first_with_same_gradients(shapes);
+  std::array<VoigtVector, max_element_nodes + 1> stresses;  // centroid, then node by node
+  ElementVector local;
+  StrainDisplacement scratch;
+  for (std::size_t e = 0; e < block.element_count(); ++e) {
+    const ElementGeometry geometry(mesh, b, e);
+    element_displacement(mesh, block, e, displacement, local);
+    for (std::size_t k = 0; k < shapes.size(); ++k) {
+      stresses[k] =
+          same[k] == k ? stress_at(geometry, shapes[k], c, local, scratch) : stresses[same[k]];
+    }
+    field.element_stress.col(first + static_cast<Eigen::Index>(e)) = stresses[0];
+    for (int i = 0; i < geometry.node_count(); ++i) {
+      field.nodal_stress.col(geometry.node(i)) += stresses[static_cast<std::size_t>(i) + 1];
+      touching(geometry.node(i)) += 1.0;
+    }
+  }
+}
+
+/// The von Mises stress of each column of `stresses` (Voigt stresses of `material`).
+Eigen::VectorXd von_mises_of(const Material& material, const Eigen::MatrixXd& stresses) {
+  Eigen::VectorXd values(stresses.cols());
+  for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
+    values(k) = von_mises(material, stresses.col(k));
+  }
+  return values;
+}
+
+}  // namespace
+
 StressField recover_stress(const Mesh& mesh, const Material& material,
                            const Eigen::VectorXd& displacement) {
   check_displacement_size(mesh, displacement, "recover_stress");
   check_material_dimension(mesh, material);
-  const int voigt_size = material.voigt_size();
+  const VoigtMatrix c = material.stiffness;
   StressField field;
-  field.element_stress.resize(voigt_size, static_cast<Eigen::Index>(mesh.element_count()));
+  field.element_stress.resize(c.rows(), static_cast<Eigen::Index>(mesh.element_count()));
   field.nodal_stress =
-      Eigen::MatrixXd::Zero(voigt_size, static_cast<Eigen::Index>(mesh.node_count()));
+      Eigen::MatrixXd::Zero(c.rows(), static_cast<Eigen::Index>(mesh.node_count()));
   Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
-  Eigen::Index flat = 0;
+  Eigen::Index first = 0;
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
-    const ElementBlock& block = mesh.blocks[b];
-    const std::vector<Eigen::Vector3d> node_references = reference_nodes(block.type);
-    for (std::size_t e = 0; e < block.element_count(); ++e, ++flat) {
-      const ElementGeometry geometry(mesh, b, e);
-      const Eigen::VectorXd local = element_displacement(mesh, block, e, displacement);
-      // s = C B u_e
-      const auto stress_at = [&](const Eigen::Vector3d& reference) -> Eigen::VectorXd {
-        return material.stiffness *
-               (strain_displacement(geometry.evaluate(reference).gradients) * local);
-      };
-      field.element_stress.col(flat) = stress_at(reference_centroid(block.type));
-      for (int i = 0; i < geometry.node_count(); ++i) {
-        const int node = geometry.node(i);
-        field.nodal_stress.col(node) += stress_at(node_references[i]);
-        touching(node) += 1.0;
-      }
-    }
+    add_block_stress(mesh, b, c, displacement, first, field, touching);
+    first += static_cast<Eigen::Index>(mesh.blocks[b].element_count());
   }
   for (Eigen::Index node = 0; node < touching.size(); ++node) {
     if (touching(node) > 0.0) field.nodal_stress.col(node) /= touching(node);
   }
-  const auto von_mises_of = [&](const Eigen::MatrixXd& stresses) {
-    Eigen::VectorXd values(stresses.cols());
-    for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
-      values(k) = von_mises(material, Eigen::VectorXd(stresses.col(k)));
-    }
-    return values;
-  };
-  field.element_von_mises = von_mises_of(field.element_stress);
-  field.nodal_von_mises = von_mises_of(field.nodal_stress);
+  field.element_von_mises = von_mises_of(material, field.element_stress);
+  field.nodal_von_mises = von_mises_of(material, field.nodal_stress);
   return field;
 }
 
@@ -435,13 +465,15 @@ double l2_displacement_error(const Mesh& mesh, const Eigen::VectorXd& displaceme
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
     const ElementBlock& block = mesh.blocks[b];
     const int count = nodes_per_element(block.type);
-    const std::vector<QuadraturePoint> rule = element_quadrature(block.type, 6);
+    const std::vector<ReferenceShape> rule =
+        tabulate_shapes(block.type, element_quadrature(block.type, 6));
+    ElementVector local;
     for (std::size_t e = 0; e < block.element_count(); ++e) {
       const ElementGeometry geometry(mesh, b, e);
-      const Eigen::VectorXd local = element_displacement(mesh, block, e, displacement);
+      element_displacement(mesh, block, e, displacement, local);
       const int dimension = mesh.dimension;
-      for (const QuadraturePoint& point : rule) {
-        const ElementPoint at = geometry.evaluate(point.reference);
+      for (const ReferenceShape& point : rule) {
+        const ElementPoint at = geometry.evaluate(point);
         Eigen::Vector3d approximate = Eigen::Vector3d::Zero();
         for (int i = 0; i < count; ++i) {
           approximate.head(dimension) += at.values(i) * local.segment(dimension * i, dimension);

@@ -171,10 +171,17 @@ void check_degree(int degree) {
 /// (Gmsh: 01, 12, 20, 30, 32, 31).
 constexpr int tetrahedron_edges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};
 
+/// The corners (xi_i, eta_i) of the reference quadrilateral [-1, 1]^2 and
+/// (xi_i, eta_i, zeta_i) of the reference hexahedron [-1, 1]^3, in node order.
+constexpr double quadrilateral_corners[4][2] = {{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}};
+constexpr double hexahedron_corners[8][3] = {
+    {-1.0, -1.0, -1.0}, {1.0, -1.0, -1.0}, {1.0, 1.0, -1.0}, {-1.0, 1.0, -1.0},
+    {-1.0, -1.0, 1.0},  {1.0, -1.0, 1.0},  {1.0, 1.0, 1.0},  {-1.0, 1.0, 1.0}};
+
 /// Quadratic tetrahedron: barycentric L0 = 1 - r - s - t, L1 = r, L2 = s, L3 = t; corners
 /// L_i (2 L_i - 1), the midside node of edge ij 4 L_i L_j.
-void quadratic_tetrahedron_functions(const Eigen::Vector3d& reference, Eigen::VectorXd& values,
-                                     Eigen::MatrixXd& reference_gradients) {
+void quadratic_tetrahedron_functions(const Eigen::Vector3d& reference, ShapeValues& values,
+                                     ShapeGradients& reference_gradients) {
   const Eigen::Vector4d barycentric(1.0 - reference.sum(), reference.x(), reference.y(),
                                     reference.z());
   Eigen::Matrix<double, 4, 3> barycentric_gradients;
@@ -223,8 +230,8 @@ std::vector<QuadraturePoint> edge_quadrature(int degree) {
   return gauss_legendre(degree / 2 + 1);
 }
 
-void shape_functions(ElementType type, const Eigen::Vector3d& reference, Eigen::VectorXd& values,
-                     Eigen::MatrixXd& reference_gradients) {
+void shape_functions(ElementType type, const Eigen::Vector3d& reference, ShapeValues& values,
+                     ShapeGradients& reference_gradients) {
   const double r = reference.x();
   const double s = reference.y();
   const double t = reference.z();
@@ -255,13 +262,13 @@ void shape_functions(ElementType type, const Eigen::Vector3d& reference, Eigen::
       // N_i = (1 + xi_i xi)(1 + eta_i eta) / 4 with corners (-1,-1), (1,-1), (1,1), (-1,1).
       values.resize(4);
       reference_gradients.resize(4, 2);
-      const std::vector<Eigen::Vector3d> corners = reference_nodes(type);
       for (int i = 0; i < 4; ++i) {
-        const double along_xi = 1.0 + corners[i].x() * r;
-        const double along_eta = 1.0 + corners[i].y() * s;
+        const auto [xi, eta] = quadrilateral_corners[i];
+        const double along_xi = 1.0 + xi * r;
+        const double along_eta = 1.0 + eta * s;
         values(i) = 0.25 * along_xi * along_eta;
-        reference_gradients(i, 0) = 0.25 * corners[i].x() * along_eta;
-        reference_gradients(i, 1) = 0.25 * corners[i].y() * along_xi;
+        reference_gradients(i, 0) = 0.25 * xi * along_eta;
+        reference_gradients(i, 1) = 0.25 * eta * along_xi;
       }
       return;
     }
@@ -278,15 +285,15 @@ void shape_functions(ElementType type, const Eigen::Vector3d& reference, Eigen::
       // N_i = (1 + xi_i xi)(1 + eta_i eta)(1 + zeta_i zeta) / 8 at the corners of [-1, 1]^3.
       values.resize(8);
       reference_gradients.resize(8, 3);
-      const std::vector<Eigen::Vector3d> corners = reference_nodes(type);
       for (int i = 0; i < 8; ++i) {
-        const double along_xi = 1.0 + corners[i].x() * r;
-        const double along_eta = 1.0 + corners[i].y() * s;
-        const double along_zeta = 1.0 + corners[i].z() * t;
+        const auto [xi, eta, zeta] = hexahedron_corners[i];
+        const double along_xi = 1.0 + xi * r;
+        const double along_eta = 1.0 + eta * s;
+        const double along_zeta = 1.0 + zeta * t;
         values(i) = 0.125 * along_xi * along_eta * along_zeta;
-        reference_gradients(i, 0) = 0.125 * corners[i].x() * along_eta * along_zeta;
-        reference_gradients(i, 1) = 0.125 * corners[i].y() * along_xi * along_zeta;
-        reference_gradients(i, 2) = 0.125 * corners[i].z() * along_xi * along_eta;
+        reference_gradients(i, 0) = 0.125 * xi * along_eta * along_zeta;
+        reference_gradients(i, 1) = 0.125 * eta * along_xi * along_zeta;
+        reference_gradients(i, 2) = 0.125 * zeta * along_xi * along_eta;
       }
       return;
     }
@@ -294,8 +301,8 @@ void shape_functions(ElementType type, const Eigen::Vector3d& reference, Eigen::
   throw std::invalid_argument("shape_functions: unknown element type");
 }
 
-void edge_shape_functions(FacetType type, double reference, Eigen::VectorXd& values,
-                          Eigen::VectorXd& reference_derivatives) {
+void edge_shape_functions(FacetType type, double reference, ShapeValues& values,
+                          ShapeValues& reference_derivatives) {
   const double t = reference;
   if (type == FacetType::line2) {
     values.resize(2);
@@ -318,8 +325,11 @@ std::vector<Eigen::Vector3d> reference_nodes(ElementType type) {
     case ElementType::triangle6:
       return {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0},
               {0.5, 0.0, 0.0}, {0.5, 0.5, 0.0}, {0.0, 0.5, 0.0}};
-    case ElementType::quadrilateral4:
-      return {{-1.0, -1.0, 0.0}, {1.0, -1.0, 0.0}, {1.0, 1.0, 0.0}, {-1.0, 1.0, 0.0}};
+    case ElementType::quadrilateral4: {
+      std::vector<Eigen::Vector3d> nodes;
+      for (const auto [xi, eta] : quadrilateral_corners) nodes.emplace_back(xi, eta, 0.0);
+      return nodes;
+    }
     case ElementType::tetrahedron4:
       return {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
     case ElementType::tetrahedron10: {
@@ -327,9 +337,11 @@ std::vector<Eigen::Vector3d> reference_nodes(ElementType type) {
       for (const auto& [a, b] : tetrahedron_edges) nodes.push_back(0.5 * (nodes[a] + nodes[b]));
       return nodes;
     }
-    case ElementType::hexahedron8:
-      return {{-1.0, -1.0, -1.0}, {1.0, -1.0, -1.0}, {1.0, 1.0, -1.0}, {-1.0, 1.0, -1.0},
-              {-1.0, -1.0, 1.0},  {1.0, -1.0, 1.0},  {1.0, 1.0, 1.0},  {-1.0, 1.0, 1.0}};
+    case ElementType::hexahedron8: {
+      std::vector<Eigen::Vector3d> nodes;
+      for (const auto [xi, eta, zeta] : hexahedron_corners) nodes.emplace_back(xi, eta, zeta);
+      return nodes;
+    }
   }
   throw std::invalid_argument("reference_nodes: unknown element type");
 }
@@ -349,15 +361,66 @@ Eigen::Vector3d reference_centroid(ElementType type) {
   throw std::invalid_argument("reference_centroid: unknown element type");
 }
 
-void facet_shape_functions(FacetType type, const Eigen::Vector3d& reference,
-                           Eigen::VectorXd& values, Eigen::MatrixXd& reference_gradients) {
+void facet_shape_functions(FacetType type, const Eigen::Vector3d& reference, ShapeValues& values,
+                           ShapeGradients& reference_gradients) {
   if (facet_dimension(type) == 2) {
     shape_functions(face_parametrization(type), reference, values, reference_gradients);
     return;
   }
-  Eigen::VectorXd derivatives;
+  ShapeValues derivatives;
   edge_shape_functions(type, reference.x(), values, derivatives);
   reference_gradients = derivatives;
+}
+
+std::vector<ReferenceShape> tabulate_shapes(ElementType type,
+                                            const std::vector<QuadraturePoint>& rule) {
+  std::vector<ReferenceShape> shapes(rule.size());
+  for (std::size_t k = 0; k < rule.size(); ++k) {
+    shapes[k].reference = rule[k].reference;
+    shapes[k].weight = rule[k].weight;
+    shape_functions(type, rule[k].reference, shapes[k].values, shapes[k].gradients);
+  }
+  return shapes;
+}
+
+std::vector<ReferenceShape> tabulate_shapes(ElementType type,
+                                            const std::vector<Eigen::Vector3d>& points) {
+  std::vector<ReferenceShape> shapes(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    shapes[k].reference = points[k];
+    shape_functions(type, points[k], shapes[k].values, shapes[k].gradients);
+  }
+  return shapes;
+}
+
+std::vector<std::size_t> first_with_same_gradients(const std::vector<ReferenceShape>& shapes) {
+  std::vector<std::size_t> first(shapes.size());
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    first[k] = k;
+    for (std::size_t earlier = 0; earlier < k; ++earlier) {
+      if (shapes[earlier].gradients == shapes[k].gradients) {
+        first[k] = earlier;
+        break;
+      }
+    }
+  }
+  return first;
+}
+
+double jacobian_determinant(const JacobianMatrix& jacobian) {
+  if (jacobian.rows() == 2) return Eigen::Matrix2d(jacobian).determinant();
+  return Eigen::Matrix3d(jacobian).determinant();
+}
+
+double invert_jacobian(const JacobianMatrix& jacobian, JacobianMatrix& inverse) {
+  if (jacobian.rows() == 2) {
+    const Eigen::Matrix2d fixed = jacobian;
+    inverse = fixed.inverse();
+    return fixed.determinant();
+  }
+  const Eigen::Matrix3d fixed = jacobian;
+  inverse = fixed.inverse();
+  return fixed.determinant();
 }
 
 std::vector<Eigen::Vector3d> facet_reference_nodes(FacetType type) {
@@ -414,23 +477,21 @@ ElementGeometry::ElementGeometry(const Mesh& mesh, std::size_t block, std::size_
 }
 
 ElementPoint ElementGeometry::evaluate(const Eigen::Vector3d& reference) const {
+  ReferenceShape shape;
+  shape.reference = reference;
+  shape_functions(type_, reference, shape.values, shape.gradients);
+  return evaluate(shape);
+}
+
+ElementPoint ElementGeometry::evaluate(const ReferenceShape& shape) const {
   ElementPoint point;
-  Eigen::MatrixXd reference_gradients;
-  shape_functions(type_, reference, point.values, reference_gradients);
-  // J_ij = dx_i / dxi_j = sum_k x_k,i dN_k / dxi_j; fixed-size 2 x 2 or 3 x 3 (closed-form
-  // determinant and inverse).
-  const Eigen::MatrixXd jacobian = coordinates_.transpose() * reference_gradients;
-  Eigen::MatrixXd inverse;
-  if (jacobian.rows() == 2) {
-    const Eigen::Matrix2d fixed = jacobian;
-    point.jacobian = fixed.determinant();
-    inverse = fixed.inverse();
-  } else {
-    const Eigen::Matrix3d fixed = jacobian;
-    point.jacobian = fixed.determinant();
-    inverse = fixed.inverse();
-  }
+  point.values = shape.values;
+  // J_ij = dx_i / dxi_j = sum_k x_k,i dN_k / dxi_j (closed-form determinant and inverse).
+  const JacobianMatrix jacobian = coordinates_.transpose() * shape.gradients;
+  JacobianMatrix inverse;
+  point.jacobian = invert_jacobian(jacobian, inverse);
   if (!(point.jacobian > 0.0)) {
+    const Eigen::Vector3d& reference = shape.reference;
     std::ostringstream text;
     text << describe_element(*mesh_, type_, nodes_) << " has a non-positive Jacobian "
          << point.jacobian << " at reference point (" << reference.x() << ", " << reference.y();
@@ -439,9 +500,9 @@ ElementPoint ElementGeometry::evaluate(const Eigen::Vector3d& reference) const {
     throw InputError(text.str());
   }
   // dN/dx = dN/dxi J^-1
-  point.gradients = reference_gradients * inverse;
+  point.gradients.noalias() = shape.gradients * inverse;
   point.position.setZero();
-  point.position.head(jacobian.rows()) = coordinates_.transpose() * point.values;
+  point.position.head(jacobian.rows()).noalias() = coordinates_.transpose() * point.values;
   return point;
 }
 
@@ -475,7 +536,7 @@ namespace {
 
 /// The facet's own (not yet oriented) normal direction and measure element from the columns of
 /// dx/dxi: an edge's tangent turned clockwise, a face's dx/dr x dx/ds.
-Eigen::Vector3d facet_normal_direction(const Eigen::MatrixXd& derivatives) {
+Eigen::Vector3d facet_normal_direction(const JacobianMatrix& derivatives) {
   if (derivatives.cols() == 1) {
     return Eigen::Vector3d(derivatives(1, 0), -derivatives(0, 0), 0.0);
   }
@@ -550,12 +611,12 @@ FacetGeometry::FacetGeometry(const Mesh& mesh, const BoundaryGroup& group, std::
 
 FacetPoint FacetGeometry::evaluate(const Eigen::Vector3d& reference) const {
   FacetPoint point;
-  Eigen::MatrixXd reference_gradients;
+  ShapeGradients reference_gradients;
   facet_shape_functions(type_, reference, point.values, reference_gradients);
-  point.position = coordinates_.transpose() * point.values;
+  point.position.noalias() = coordinates_.transpose() * point.values;
   // dx/dxi (3 x facet dimension); the normal is orientation (t_y, -t_x, 0) / |t| for an edge,
   // orientation (x_r x x_s) / |x_r x x_s| for a face.
-  const Eigen::MatrixXd derivatives = coordinates_.transpose() * reference_gradients;
+  const JacobianMatrix derivatives = coordinates_.transpose() * reference_gradients;
   const Eigen::Vector3d direction = facet_normal_direction(derivatives);
   point.measure_element = direction.norm();
   point.outward_normal = orientation_ * direction / point.measure_element;

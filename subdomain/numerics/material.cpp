@@ -111,7 +111,8 @@ Material make_voigt_material(const Eigen::MatrixXd& stiffness, PlaneModel model,
   return material;
 }
 
-StressTensor stress_tensor(const Material& material, const Eigen::VectorXd& voigt_stress) {
+StressTensor stress_tensor(const Material& material,
+                           const Eigen::Ref<const Eigen::VectorXd>& voigt_stress) {
   StressTensor tensor;
   if (material.voigt_size() == 6) {
     // Voigt (xx, yy, zz, yz, xz, xy) to (XX, YY, ZZ, XY, YZ, XZ).
@@ -132,7 +133,7 @@ double von_mises(const StressTensor& stress) {
   return std::sqrt(0.5 * deviatoric + 3.0 * shear);
 }
 
-double von_mises(const Material& material, const Eigen::VectorXd& voigt_stress) {
+double von_mises(const Material& material, const Eigen::Ref<const Eigen::VectorXd>& voigt_stress) {
   return von_mises(stress_tensor(material, voigt_stress));
 }
 

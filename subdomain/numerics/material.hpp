@@ -51,12 +51,13 @@ Material make_voigt_material(const Eigen::MatrixXd& stiffness, PlaneModel model,
 
 /// The full stress tensor of a Voigt stress of `material` (3 or 6 values); for a plane
 /// material YZ = XZ = 0 and ZZ = out_of_plane_poisson (s_xx + s_yy).
-StressTensor stress_tensor(const Material& material, const Eigen::VectorXd& voigt_stress);
+StressTensor stress_tensor(const Material& material,
+                           const Eigen::Ref<const Eigen::VectorXd>& voigt_stress);
 
 /// Von Mises stress of a stress tensor (XX, YY, ZZ, XY, YZ, XZ).
 double von_mises(const StressTensor& stress);
 
 /// Von Mises stress of a Voigt stress of `material` (of its full tensor, stress_tensor).
-double von_mises(const Material& material, const Eigen::VectorXd& voigt_stress);
+double von_mises(const Material& material, const Eigen::Ref<const Eigen::VectorXd>& voigt_stress);
 
 }  // namespace robin

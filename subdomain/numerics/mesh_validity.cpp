@@ -1,6 +1,6 @@
 #include "numerics/mesh_validity.hpp"
 
-#include <Eigen/Dense>
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -11,17 +11,25 @@
 namespace robin {
 namespace {
 
-/// The points at which the Jacobian is checked: the element's nodes and its quadrature points.
-std::vector<Eigen::Vector3d> check_points(ElementType type) {
+/// The reference gradients dN/dxi at which the Jacobian is checked: at the element's nodes and
+/// its quadrature points, each distinct gradient once (the same gradients give the same
+/// Jacobian: one check for an affine element), in the order of their first point.
+std::vector<ShapeGradients> check_gradients(ElementType type) {
   std::vector<Eigen::Vector3d> points = reference_nodes(type);
   for (const QuadraturePoint& point : element_quadrature(type, 4)) {
     points.push_back(point.reference);
   }
-  return points;
+  const std::vector<ReferenceShape> shapes = tabulate_shapes(type, points);
+  const std::vector<std::size_t> same = first_with_same_gradients(shapes);
+  std::vector<ShapeGradients> gradients;
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    if (same[k] == k) gradients.push_back(shapes[k].gradients);
+  }
+  return gradients;
 }
 
 /// The longest distance between two nodes of the element to the power d (its dimension).
-double size_power(const Eigen::MatrixXd& coordinates) {
+double size_power(const NodeCoordinates& coordinates) {
   double extent = 0.0;
   for (Eigen::Index i = 0; i < coordinates.rows(); ++i) {
     for (Eigen::Index j = i + 1; j < coordinates.rows(); ++j) {
@@ -49,8 +57,7 @@ double size_power(const Eigen::MatrixXd& coordinates) {
          << " and the element must not overlap itself)";
   } else {
     text << " is degenerate: its Jacobian determinant " << jacobian
-         << " is not above 1e-12 times its " << (solid ? "cubed" : "squared") << " size "
-         << extent;
+         << " is not above 1e-12 times its " << (solid ? "cubed" : "squared") << " size " << extent;
   }
   if (!mesh.source.empty()) text << "; mesh '" << mesh.source << "'";
   throw InputError(text.str());
@@ -63,27 +70,22 @@ void check_element_validity(const Mesh& mesh, const std::string& context) {
     const int count = nodes_per_element(block.type);
     const int dimension = element_dimension(block.type);
     if (dimension != mesh.dimension) {
-      throw InputError(context + ": a " + std::to_string(mesh.dimension) + "D mesh has a block of " +
-                       to_string(block.type) + " elements (" + std::to_string(dimension) + "D)" +
+      throw InputError(context + ": a " + std::to_string(mesh.dimension) +
+                       "D mesh has a block of " + to_string(block.type) + " elements (" +
+                       std::to_string(dimension) + "D)" +
                        (mesh.source.empty() ? std::string() : "; mesh '" + mesh.source + "'"));
     }
-    const std::vector<Eigen::Vector3d> points = check_points(block.type);
-    Eigen::VectorXd values;
-    Eigen::MatrixXd reference_gradients;
-    std::vector<Eigen::MatrixXd> gradients_at_points;
-    for (const Eigen::Vector3d& point : points) {
-      shape_functions(block.type, point, values, reference_gradients);
-      gradients_at_points.push_back(reference_gradients);
-    }
-    Eigen::MatrixXd coordinates(count, dimension);
+    const std::vector<ShapeGradients> gradients_at_points = check_gradients(block.type);
+    NodeCoordinates coordinates(count, dimension);
     for (std::size_t element = 0; element < block.element_count(); ++element) {
       for (int i = 0; i < count; ++i) {
         coordinates.row(i) =
             mesh.nodes[block.connectivity[element * count + i]].head(dimension).transpose();
       }
       const double extent = size_power(coordinates);
-      for (const Eigen::MatrixXd& gradients : gradients_at_points) {
-        const double jacobian = (coordinates.transpose() * gradients).determinant();
+      for (const ShapeGradients& gradients : gradients_at_points) {
+        const double jacobian =
+            jacobian_determinant(JacobianMatrix(coordinates.transpose() * gradients));
         if (!(jacobian > 1e-12 * extent)) refuse(mesh, block, element, jacobian, extent, context);
       }
     }

@@ -872,8 +872,8 @@ double twice_signed_area(const Mesh& mesh, ElementType type, const int* nodes) {
 /// element has Gmsh's orientation).
 double signed_measure(const Mesh& mesh, ElementType type, const int* nodes) {
   if (element_dimension(type) == 2) return twice_signed_area(mesh, type, nodes);
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
+  ShapeValues values;
+  ShapeGradients gradients;
   shape_functions(type, reference_centroid(type), values, gradients);
   Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();
   for (int i = 0; i < nodes_per_element(type); ++i) {

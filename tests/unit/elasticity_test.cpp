@@ -70,8 +70,8 @@ class ShapeFunctions : public testing::TestWithParam<ElementType> {};
 TEST_P(ShapeFunctions, KroneckerPartitionOfUnityAndGradients) {
   const ElementType type = GetParam();
   const std::vector<Eigen::Vector3d> nodes = reference_nodes(type);
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradients;
+  ShapeValues values;
+  ShapeGradients gradients;
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     shape_functions(type, nodes[k], values, gradients);
     for (std::size_t i = 0; i < nodes.size(); ++i)
@@ -84,8 +84,8 @@ TEST_P(ShapeFunctions, KroneckerPartitionOfUnityAndGradients) {
   // Central differences of the values.
   const double step = 1e-6;
   for (int direction = 0; direction < 2; ++direction) {
-    Eigen::VectorXd plus, minus;
-    Eigen::MatrixXd unused;
+    ShapeValues plus, minus;
+    ShapeGradients unused;
     const Eigen::Vector3d offset = step * Eigen::Vector3d::Unit(direction);
     shape_functions(type, point + offset, plus, unused);
     shape_functions(type, point - offset, minus, unused);
@@ -103,14 +103,14 @@ INSTANTIATE_TEST_SUITE_P(AllTypes, ShapeFunctions,
 TEST(EdgeShapeFunctions, KroneckerAndDerivatives) {
   for (const FacetType type : {FacetType::line2, FacetType::line3}) {
     const std::vector<double> nodes = edge_reference_nodes(type);
-    Eigen::VectorXd values, derivatives, plus, minus;
+    ShapeValues values, derivatives, plus, minus;
     for (std::size_t k = 0; k < nodes.size(); ++k) {
       edge_shape_functions(type, nodes[k], values, derivatives);
       for (std::size_t i = 0; i < nodes.size(); ++i) {
         EXPECT_NEAR(values(i), i == k ? 1.0 : 0.0, 1e-15);
       }
     }
-    Eigen::VectorXd unused;
+    ShapeValues unused;
     edge_shape_functions(type, 0.3, values, derivatives);
     edge_shape_functions(type, 0.3 + 1e-6, plus, unused);
     edge_shape_functions(type, 0.3 - 1e-6, minus, unused);

@@ -56,8 +56,8 @@ TEST(SolidElements, ShapeFunctionsInterpolateTheirNodes) {
   for (const ElementType type : solid_types) {
     const std::vector<Eigen::Vector3d> nodes = reference_nodes(type);
     ASSERT_EQ(static_cast<int>(nodes.size()), nodes_per_element(type));
-    Eigen::VectorXd values;
-    Eigen::MatrixXd gradients;
+    ShapeValues values;
+    ShapeGradients gradients;
     for (std::size_t j = 0; j < nodes.size(); ++j) {
       shape_functions(type, nodes[j], values, gradients);
       for (std::size_t i = 0; i < nodes.size(); ++i) {
