@@ -43,8 +43,8 @@ int facet_load_degree(FacetType type) {
   return type == FacetType::line3 || type == FacetType::triangle6 ? 6 : 4;
 }
 
-/// The Voigt strain components as coordinate pairs (a, b): a normal strain e_aa = du_a/dx_a
-/// when a = b, an engineering shear strain 2 e_ab = du_a/dx_b + du_b/dx_a otherwise. In 2D
+/// The Voigt strain components as coordinate pairs (a, c): a normal strain e_aa = du_a/dx_a
+/// when a = c, an engineering shear strain 2 e_ac = du_a/dx_c + du_c/dx_a otherwise. In 2D
 /// (e_xx, e_yy, 2 e_xy), in 3D (e_xx, e_yy, e_zz, 2 e_yz, 2 e_xz, 2 e_xy) (material.hpp).
 constexpr int plane_voigt_pairs[3][2] = {{0, 0}, {1, 1}, {0, 1}};
 constexpr int solid_voigt_pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}};
