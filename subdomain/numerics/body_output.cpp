@@ -43,7 +43,7 @@ std::vector<double> stress_tensors(const Material& material, const Eigen::Matrix
   std::vector<double> values;
   values.reserve(6 * static_cast<std::size_t>(stresses.cols()));
   for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
-    const StressTensor tensor = stress_tensor(material, Eigen::VectorXd(stresses.col(k)));
+    const StressTensor tensor = stress_tensor(material, stresses.col(k));
     values.insert(values.end(), tensor.data(), tensor.data() + 6);
   }
   return values;
@@ -57,79 +57,6 @@ Eigen::Vector3d resultant(const Eigen::VectorXd& nodal_vectors, int dimension) {
   return total;
 }
 
-/// Strain-displacement matrix B of an element at a point from its shape functions' gradients
-/// (one row per node): the convention of recover_stress (numerics/elasticity.hpp), in 2D
-/// strain (e_xx, e_yy, 2 e_xy) = B u_e, in 3D (e_xx, e_yy, e_zz, 2 e_yz, 2 e_xz, 2 e_xy), with
-/// u_e = (u_x0, u_y0, [u_z0,] u_x1, ...).
-Eigen::MatrixXd strain_matrix(const Eigen::MatrixXd& gradients) {
-  const Eigen::Index count = gradients.rows();
-  const Eigen::Index dimension = gradients.cols();
-  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(dimension == 2 ? 3 : 6, dimension * count);
-  for (Eigen::Index i = 0; i < count; ++i) {
-    const double dx = gradients(i, 0), dy = gradients(i, 1);
-    if (dimension == 2) {
-      b(0, 2 * i) = dx;
-      b(1, 2 * i + 1) = dy;
-      b(2, 2 * i) = dy;
-      b(2, 2 * i + 1) = dx;
-      continue;
-    }
-    const double dz = gradients(i, 2);
-    b(0, 3 * i) = dx;
-    b(1, 3 * i + 1) = dy;
-    b(2, 3 * i + 2) = dz;
-    b(3, 3 * i + 1) = dz;  // 2 e_yz = du_y/dz + du_z/dy
-    b(3, 3 * i + 2) = dy;
-    b(4, 3 * i) = dz;  // 2 e_xz = du_x/dz + du_z/dx
-    b(4, 3 * i + 2) = dx;
-    b(5, 3 * i) = dy;  // 2 e_xy = du_x/dy + du_y/dx
-    b(5, 3 * i + 1) = dx;
-  }
-  return b;
-}
-
-/// The displacements of one element's nodes, node after node.
-Eigen::VectorXd nodal_values(const Mesh& mesh, const ElementGeometry& geometry,
-                             const Eigen::VectorXd& displacement) {
-  const int dimension = mesh.dimension;
-  Eigen::VectorXd local(dimension * geometry.node_count());
-  for (int i = 0; i < geometry.node_count(); ++i) {
-    local.segment(dimension * i, dimension) =
-        displacement.segment(dimension * geometry.node(i), dimension);
-  }
-  return local;
-}
-
-/// The Voigt stress s = C B u_e of elements, evaluated as recover_stress evaluates it: the
-/// same values bit for bit, one element at a time.
-class ElementStress {
- public:
-  ElementStress(const Mesh& mesh, const Material& material, const Eigen::VectorXd& displacement)
-      : mesh_(mesh), material_(material), displacement_(displacement) {}
-
-  /// Calls visit(block, geometry, stress_at) for every element in the order of mesh.blocks;
-  /// stress_at(reference point) is the element's stress there.
-  template <class Visit>
-  void for_each_element(Visit&& visit) const {
-    for (std::size_t b = 0; b < mesh_.blocks.size(); ++b) {
-      for (std::size_t e = 0; e < mesh_.blocks[b].element_count(); ++e) {
-        const ElementGeometry geometry(mesh_, b, e);
-        const Eigen::VectorXd local = nodal_values(mesh_, geometry, displacement_);
-        const auto stress_at = [&](const Eigen::Vector3d& reference) -> Eigen::VectorXd {
-          return material_.stiffness *
-                 (strain_matrix(geometry.evaluate(reference).gradients) * local);
-        };
-        visit(mesh_.blocks[b], geometry, stress_at);
-      }
-    }
-  }
-
- private:
-  const Mesh& mesh_;
-  const Material& material_;
-  const Eigen::VectorXd& displacement_;
-};
-
 /// Voigt stress per node (columns): the average over the elements touching the node of the
 /// element's stress at the node, as recover_stress's nodal_stress.
 Eigen::MatrixXd nodal_stresses(const Mesh& mesh, const Material& material,
@@ -137,20 +64,13 @@ Eigen::MatrixXd nodal_stresses(const Mesh& mesh, const Material& material,
   Eigen::MatrixXd nodal =
       Eigen::MatrixXd::Zero(material.voigt_size(), static_cast<Eigen::Index>(mesh.node_count()));
   Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
-  const ElementBlock* references_block = nullptr;
-  std::vector<Eigen::Vector3d> references;  // the reference nodes of references_block's type
-  ElementStress(mesh, material, displacement)
-      .for_each_element(
-          [&](const ElementBlock& block, const ElementGeometry& geometry, const auto& stress_at) {
-            if (&block != references_block) {
-              references = reference_nodes(block.type);
-              references_block = &block;
-            }
-            for (int i = 0; i < geometry.node_count(); ++i) {
-              nodal.col(geometry.node(i)) += stress_at(references[i]);
-              touching(geometry.node(i)) += 1.0;
-            }
-          });
+  for_each_element_stress(mesh, material, displacement,
+                          [&](const ElementGeometry& geometry, const VoigtVector* stresses) {
+                            for (int i = 0; i < geometry.node_count(); ++i) {
+                              nodal.col(geometry.node(i)) += stresses[i + 1];
+                              touching(geometry.node(i)) += 1.0;
+                            }
+                          });
   for (Eigen::Index node = 0; node < touching.size(); ++node) {
     if (touching(node) > 0.0) nodal.col(node) /= touching(node);
   }
@@ -162,7 +82,7 @@ Eigen::MatrixXd nodal_stresses(const Mesh& mesh, const Material& material,
 void append_stress_tensors(const Material& material, const Eigen::MatrixXd& stresses,
                            std::vector<double>& tensors, std::vector<double>& von_mises_values) {
   for (Eigen::Index k = 0; k < stresses.cols(); ++k) {
-    const StressTensor tensor = stress_tensor(material, Eigen::VectorXd(stresses.col(k)));
+    const StressTensor tensor = stress_tensor(material, stresses.col(k));
     tensors.insert(tensors.end(), tensor.data(), tensor.data() + 6);
     von_mises_values.push_back(von_mises(tensor));
   }
@@ -173,14 +93,12 @@ void append_stress_tensors(const Material& material, const Eigen::MatrixXd& stre
 void append_element_stresses(const Mesh& mesh, const Material& material,
                              const Eigen::VectorXd& displacement, std::vector<double>& tensors,
                              std::vector<double>& von_mises_values) {
-  ElementStress(mesh, material, displacement)
-      .for_each_element(
-          [&](const ElementBlock& block, const ElementGeometry&, const auto& stress_at) {
-            const StressTensor tensor =
-                stress_tensor(material, stress_at(reference_centroid(block.type)));
-            tensors.insert(tensors.end(), tensor.data(), tensor.data() + 6);
-            von_mises_values.push_back(von_mises(tensor));
-          });
+  for_each_element_stress(mesh, material, displacement,
+                          [&](const ElementGeometry&, const VoigtVector* stresses) {
+                            const StressTensor tensor = stress_tensor(material, stresses[0]);
+                            tensors.insert(tensors.end(), tensor.data(), tensor.data() + 6);
+                            von_mises_values.push_back(von_mises(tensor));
+                          });
 }
 
 /// Moves `from` into the end of `values` and frees it.

@@ -395,12 +395,9 @@ VoigtVector stress_at(const ElementGeometry& geometry, const ReferenceShape& sha
   return c * (b * local);
 }
 
-/// Sets the centroid stress of every element of block `b` (columns from `first`) and adds the
-/// element's stress at each of its nodes to the node's column, counting the terms in `touching`.
-/// Points with the same reference gradients share one evaluation (the same J and dN/dx).
-void add_block_stress(const Mesh& mesh, std::size_t b, const VoigtMatrix& c,
-                      const Eigen::VectorXd& displacement, Eigen::Index first, StressField& field,
-                      Eigen::VectorXd& touching) {
+/// Calls `visit` for every element of block `b` (for_each_element_stress).
+void visit_block_stresses(const Mesh& mesh, std::size_t b, const VoigtMatrix& c,
+                          const Eigen::VectorXd& displacement, const ElementStressVisitor& visit) {
   const ElementBlock& block = mesh.blocks[b];
   std::vector<Eigen::Vector3d> points{reference_centroid(block.type)};
   for (const Eigen::Vector3d& node : reference_nodes(block.type)) points.push_back(node);
@@ -416,11 +413,7 @@ void add_block_stress(const Mesh& mesh, std::size_t b, const VoigtMatrix& c,
       stresses[k] =
           same[k] == k ? stress_at(geometry, shapes[k], c, local, scratch) : stresses[same[k]];
     }
-    field.element_stress.col(first + static_cast<Eigen::Index>(e)) = stresses[0];
-    for (int i = 0; i < geometry.node_count(); ++i) {
-      field.nodal_stress.col(geometry.node(i)) += stresses[static_cast<std::size_t>(i) + 1];
-      touching(geometry.node(i)) += 1.0;
-    }
+    visit(geometry, stresses.data());
   }
 }
 
@@ -435,21 +428,34 @@ Eigen::VectorXd von_mises_of(const Material& material, const Eigen::MatrixXd& st
 
 }  // namespace
 
-StressField recover_stress(const Mesh& mesh, const Material& material,
-                           const Eigen::VectorXd& displacement) {
-  check_displacement_size(mesh, displacement, "recover_stress");
+void for_each_element_stress(const Mesh& mesh, const Material& material,
+                             const Eigen::VectorXd& displacement,
+                             const ElementStressVisitor& visit) {
+  check_displacement_size(mesh, displacement, "for_each_element_stress");
   check_material_dimension(mesh, material);
   const VoigtMatrix c = material.stiffness;
-  StressField field;
-  field.element_stress.resize(c.rows(), static_cast<Eigen::Index>(mesh.element_count()));
-  field.nodal_stress =
-      Eigen::MatrixXd::Zero(c.rows(), static_cast<Eigen::Index>(mesh.node_count()));
-  Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
-  Eigen::Index first = 0;
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
-    add_block_stress(mesh, b, c, displacement, first, field, touching);
-    first += static_cast<Eigen::Index>(mesh.blocks[b].element_count());
+    visit_block_stresses(mesh, b, c, displacement, visit);
   }
+}
+
+StressField recover_stress(const Mesh& mesh, const Material& material,
+                           const Eigen::VectorXd& displacement) {
+  StressField field;
+  field.element_stress.resize(material.voigt_size(),
+                              static_cast<Eigen::Index>(mesh.element_count()));
+  field.nodal_stress =
+      Eigen::MatrixXd::Zero(material.voigt_size(), static_cast<Eigen::Index>(mesh.node_count()));
+  Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
+  Eigen::Index element = 0;
+  for_each_element_stress(mesh, material, displacement,
+                          [&](const ElementGeometry& geometry, const VoigtVector* stresses) {
+                            field.element_stress.col(element++) = stresses[0];
+                            for (int i = 0; i < geometry.node_count(); ++i) {
+                              field.nodal_stress.col(geometry.node(i)) += stresses[i + 1];
+                              touching(geometry.node(i)) += 1.0;
+                            }
+                          });
   for (Eigen::Index node = 0; node < touching.size(); ++node) {
     if (touching(node) > 0.0) field.nodal_stress.col(node) /= touching(node);
   }

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "numerics/finite_element.hpp"
 #include "numerics/material.hpp"
 #include "numerics/mesh.hpp"
 
@@ -58,6 +59,18 @@ std::vector<Eigen::Vector3d> boundary_normal_sums(const Mesh& mesh, const Bounda
 std::vector<Eigen::Vector3d> unit_normals(const Mesh& mesh,
                                           const std::vector<Eigen::Vector3d>& sums,
                                           const std::vector<int>& nodes, const std::string& what);
+
+/// Called for one element with its Voigt stresses s = C B u_e (material.hpp: 3 components in
+/// 2D, 6 in 3D): stresses[0] at the element's reference centroid, stresses[1 + i] at its local
+/// node i (i < geometry.node_count()).
+using ElementStressVisitor =
+    std::function<void(const ElementGeometry& geometry, const VoigtVector* stresses)>;
+
+/// Calls `visit` for every element, in the element order of mesh.blocks. Points of an element
+/// type with the same reference gradients share one evaluation (the same J and dN/dx).
+void for_each_element_stress(const Mesh& mesh, const Material& material,
+                             const Eigen::VectorXd& displacement,
+                             const ElementStressVisitor& visit);
 
 /// Voigt stress (material.hpp: 3 components in 2D, 6 in 3D) per element (at its centroid) and
 /// per node (average over the elements touching the node, each evaluated at that node).

@@ -1,12 +1,8 @@
 // User CPU time (getrusage) of the element kernels on one .msh mesh: check_element_validity,
 // assemble_stiffness and recover_stress (E = 1000, nu = 0.3; plane strain for a 2D mesh), each
 // the median of 11 calls, and a checksum of their results (equal between builds when the
-// kernels agree). Not part of the CMake build: compiled by hand against a build's
-// librobin_numerics.a (docs/benchmarks.md, "Heap-free element kernels"):
-//   g++ -std=c++20 -O2 -DNDEBUG -I<tree>/subdomain -I/usr/include/eigen3
-//       benchmarks/element_kernels_timing.cpp <build>/subdomain/librobin_numerics.a -o timing
-//       -lcholmod -lamd -lcolamd -lsuitesparseconfig -fuse-ld=lld
-//   ./timing mesh.msh
+// kernels agree). Built with the benchmarks (docs/benchmarks.md, "Heap-free element kernels"):
+//   build/benchmarks/element_kernels_benchmark mesh.msh
 #include <sys/resource.h>
 #include <algorithm>
 #include <cmath>
