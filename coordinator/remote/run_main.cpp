@@ -194,21 +194,8 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
   return code;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{
-      "robin-run: solve a contact case by Robin domain decomposition, with one local "
-      "robin-subdomain server per body"};
-  robin::CoordinatorSettings settings;
-  settings.tool = "robin-run";
-  robin::add_coordinator_options(app, settings);
-  robin::add_version_option(app, "robin-run");
-  bool curve = false;
-  app.add_flag("--curve", curve,
-               "encrypt the connections to the local servers with CurveZMQ, with keys made for "
-               "this run (off by default: the connections stay on this machine's loopback)");
-  ServerPlacement placement;
+/// The --server-* and --threads-per-server options, into `placement`.
+void add_server_options(CLI::App& app, ServerPlacement& placement) {
   app.add_option("--server-command", placement.commands,
                  "words put before each server's command line to start it elsewhere, e.g. "
                  "\"ssh node1\" or \"srun -N1 -n1\"; once for every server or once per body")
@@ -227,6 +214,24 @@ int main(int argc, char** argv) {
                  "servers started on it, unless those variables are set in this environment")
       ->type_name("N")
       ->check(CLI::Range(1, 4096));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "robin-run: solve a contact case by Robin domain decomposition, with one local "
+      "robin-subdomain server per body"};
+  robin::CoordinatorSettings settings;
+  settings.tool = "robin-run";
+  robin::add_coordinator_options(app, settings);
+  robin::add_version_option(app, "robin-run");
+  bool curve = false;
+  app.add_flag("--curve", curve,
+               "encrypt the connections to the local servers with CurveZMQ, with keys made for "
+               "this run (off by default: the connections stay on this machine's loopback)");
+  ServerPlacement placement;
+  add_server_options(app, placement);
   if (const auto code = robin::parse_command_line(app, argc, argv)) return *code;
   // --quiet quietens this terminal; the servers' log files keep --log-level.
   settings.display = std::make_shared<robin::ProgressDisplay>(
