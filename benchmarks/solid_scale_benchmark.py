@@ -19,7 +19,7 @@ writes a case file into its scratch directory (mesh_size = 1 / n: the .geo's h),
 robin-run (one robin-subdomain server per body on this machine) and robin-monolithic on it,
 once per interface operator of --operators (`[solver] interface_operator`, set with --set:
 "dense" assembles F = B K^-1 B^T once, "factor" applies it by triangular solves, "auto" is
-dense up to dense_limit = 3000 contact nodes; the contact face has (n+1)^2 nodes, node-to-node
+dense up to dense_limit = 8000 contact nodes; the contact face has (n+1)^2 nodes, node-to-node
 pairs). Sizes above 2e6 DOFs run only with --include-3e6 (which also adds 3e6 to the sizes).
 
 Prints, per run as it finishes, one line; then two Markdown tables:
