@@ -130,26 +130,29 @@ class StreamedFields {
 
   std::vector<FieldSource> point_sources() {
     const int dimension = body_.mesh().dimension;
-    return {source("point", "displacement", dimension, &StreamedFields::append_displacement),
-            source("point", "stress", 6, &StreamedFields::append_nodal_stress,
+    return {source(FieldLocation::point, "displacement", dimension,
+                   &StreamedFields::append_displacement),
+            source(FieldLocation::point, "stress", 6, &StreamedFields::append_nodal_stress,
                    stress_tensor_components()),
-            source("point", "von_mises", 1, &StreamedFields::append_nodal_von_mises),
-            source("point", "contact_pressure", 1, &StreamedFields::append_contact_pressure),
-            source("point", "contact_force", dimension, &StreamedFields::append_contact_force),
-            source("point", "reaction", dimension, &StreamedFields::append_reaction)};
+            source(FieldLocation::point, "von_mises", 1, &StreamedFields::append_nodal_von_mises),
+            source(FieldLocation::point, "contact_pressure", 1,
+                   &StreamedFields::append_contact_pressure),
+            source(FieldLocation::point, "contact_force", dimension,
+                   &StreamedFields::append_contact_force),
+            source(FieldLocation::point, "reaction", dimension, &StreamedFields::append_reaction)};
   }
 
   std::vector<FieldSource> cell_sources() {
-    return {source("cell", "stress", 6, &StreamedFields::append_element_stress,
+    return {source(FieldLocation::cell, "stress", 6, &StreamedFields::append_element_stress,
                    stress_tensor_components()),
-            source("cell", "von_mises", 1, &StreamedFields::append_element_von_mises)};
+            source(FieldLocation::cell, "von_mises", 1, &StreamedFields::append_element_von_mises)};
   }
 
  private:
   using Append = void (StreamedFields::*)(std::vector<double>& values);
 
   /// The source of a field whose values `append` makes, given to check_ (when set) once made.
-  FieldSource source(const char* location, const std::string& name, int components, Append append,
+  FieldSource source(FieldLocation location, const std::string& name, int components, Append append,
                      const std::vector<std::string>& component_names = {}) {
     return {name, components, component_names,
             [this, location, name, append](std::vector<double>& values) {
@@ -253,6 +256,10 @@ std::string write_into_place(const std::filesystem::path& directory, const std::
 const std::vector<std::string>& stress_tensor_components() {
   static const std::vector<std::string> names = {"XX", "YY", "ZZ", "XY", "YZ", "XZ"};
   return names;
+}
+
+const char* field_location_name(FieldLocation location) {
+  return location == FieldLocation::point ? "point" : "cell";
 }
 
 BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& contact_force) {

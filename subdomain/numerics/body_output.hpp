@@ -51,10 +51,15 @@ BodyOutput make_body_output(const BodySolver& body, const Eigen::VectorXd& conta
 /// mesh's named boundaries as line cells); returns the file name.
 std::string write_body_output(const std::filesystem::path& directory, const BodyOutput& output);
 
-/// Looks at a field's values before they are written: its location ("point" or "cell"), its
-/// name and its values (components per node or element, as OutputField::values); throws to
-/// abandon the file.
-using FieldCheck = std::function<void(const std::string& location, const std::string& name,
+/// Where a field's values live: one tuple per mesh node (a VTK point field) or per element
+/// (a VTK cell field).
+enum class FieldLocation { point, cell };
+/// "point" or "cell", VTK's names of the two locations (for messages).
+const char* field_location_name(FieldLocation location);
+
+/// Looks at a field's values before they are written: its location, its name and its values
+/// (components per node or element, as OutputField::values); throws to abandon the file.
+using FieldCheck = std::function<void(FieldLocation location, const std::string& name,
                                       const std::vector<double>& values)>;
 
 /// Writes <directory>/<body_name>.vtu: the file write_body_output writes of

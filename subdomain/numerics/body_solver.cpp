@@ -1,7 +1,5 @@
 #include "numerics/body_solver.hpp"
 
-#include <malloc.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -11,6 +9,7 @@
 
 #include "numerics/errors.hpp"
 #include "numerics/finite_element.hpp"
+#include "numerics/heap_memory.hpp"
 
 namespace robin {
 namespace {
@@ -20,15 +19,6 @@ std::string format_load_factor(double factor) {
   std::ostringstream text;
   text << factor;
   return text.str();
-}
-
-/// Gives the pages of freed heap memory back to the system (glibc keeps them otherwise, in the
-/// middle of its arenas), so that they do not count again beside the factor about to be
-/// allocated. Elsewhere nothing.
-void release_free_memory() {
-#if defined(__GLIBC__)
-  malloc_trim(0);
-#endif
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -293,7 +283,7 @@ SparseMatrix BodySolver::assemble_reduced_stiffness() {
 
 SetupObserver BodySolver::factorization_observer() const {
   return [observer = options_.observer](SetupStage stage) {
-    if (stage == SetupStage::factorization) release_free_memory();
+    if (stage == SetupStage::factorization) release_free_heap_memory();
     if (observer) observer(stage);
   };
 }

@@ -1,6 +1,5 @@
 #include "server/subdomain_server.hpp"
 
-#include <malloc.h>
 #include <spdlog/spdlog.h>
 #include <algorithm>
 #include <chrono>
@@ -12,6 +11,7 @@
 
 #include "numerics/body_output.hpp"
 #include "numerics/errors.hpp"
+#include "numerics/heap_memory.hpp"
 #include "robin.pb.h"
 #include "server/file_access.hpp"
 #include "server/reply_encoding.hpp"
@@ -174,11 +174,14 @@ std::string write_fields_file(const std::filesystem::path& directory, const Body
 /// Refuses fields with a NaN or an infinity (SOLVER_FAILURE naming the field and the body).
 void require_finite_fields(const BodyOutput& output, const std::string& body_name) {
   for (const auto* fields : {&output.point_fields, &output.cell_fields}) {
-    const std::string kind = fields == &output.point_fields ? "point" : "cell";
+    const FieldLocation location =
+        fields == &output.point_fields ? FieldLocation::point : FieldLocation::cell;
     for (const OutputField& field : *fields) {
       require_finite(Eigen::Map<const Eigen::VectorXd>(
                          field.values.data(), static_cast<Eigen::Index>(field.values.size())),
-                     "FieldsReply " + kind + " field '" + field.name + "'", body_name);
+                     "FieldsReply " + std::string(field_location_name(location)) + " field '" +
+                         field.name + "'",
+                     body_name);
     }
   }
 }
@@ -189,11 +192,12 @@ void require_finite_fields(const BodyOutput& output, const std::string& body_nam
 BodyOutput write_streamed_fields_file(const std::filesystem::path& directory,
                                       const BodySolver& body,
                                       const Eigen::VectorXd& contact_force) {
-  const FieldCheck check = [&body](const std::string& location, const std::string& name,
+  const FieldCheck check = [&body](FieldLocation location, const std::string& name,
                                    const std::vector<double>& values) {
     require_finite(
         Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())),
-        "FieldsReply " + location + " field '" + name + "'", body.name());
+        "FieldsReply " + std::string(field_location_name(location)) + " field '" + name + "'",
+        body.name());
   };
   try {
     BodyOutput output = write_body_fields(directory, body, contact_force, check);
@@ -208,15 +212,6 @@ BodyOutput write_streamed_fields_file(const std::filesystem::path& directory,
                        "FieldsRequest.write_directory: cannot write the fields of body '" +
                            body.name() + "' to '" + directory.string() + "': " + error.what());
   }
-}
-
-/// Gives the pages of freed heap memory back to the system (glibc keeps them otherwise, in the
-/// middle of its arenas), so that they do not count again beside the fields about to be made.
-/// Elsewhere nothing.
-void release_free_memory() {
-#if defined(__GLIBC__)
-  malloc_trim(0);
-#endif
 }
 
 /// The INTERNAL message of a request that could not allocate its memory (std::bad_alloc; the
@@ -711,7 +706,7 @@ void SubdomainServer::on_fields(const protocol::Envelope& request, protocol::Env
       message.contact_force(), body_->contact_size(), "FieldsRequest.contact_force", body_->name());
   const std::filesystem::path directory = fields_directory(message.write_directory());
   protocol::FieldsReply& fields = *reply.mutable_fields_reply();
-  release_free_memory();
+  release_free_heap_memory();
   if (omit_fields) {  // the file made field by field, from the body's own mesh
     const BodyOutput output = write_streamed_fields_file(directory, *body_, contact_force);
     fields.set_written_file(output.written_file);

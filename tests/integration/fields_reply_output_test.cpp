@@ -13,9 +13,9 @@
 #include <cmath>
 #include <functional>
 
+#include "../test_bodies.hpp"
 #include "numerics/body_output.hpp"
 #include "numerics/contact_operator.hpp"
-#include "numerics/rectangle_mesher.hpp"
 #include "remote/reply_decoding.hpp"
 #include "server/reply_encoding.hpp"
 
@@ -25,13 +25,7 @@ namespace {
 /// The block [0, 2] x [0, 1] (4 x 2 cells of two quadratic triangles each), clamped at its
 /// bottom, plane strain (nu = 0.25), its top pushed by contact forces of 1.
 BodyOutput block_output() {
-  BodyDefinition definition;
-  definition.name = "block";
-  definition.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 4, 2, ElementType::triangle6);
-  definition.material = make_isotropic_material(100.0, 0.25, PlaneModel::plane_strain, "test");
-  definition.dirichlet = {{"bottom", 0.0, 0.0, std::nullopt}};
-  definition.contact_boundaries = {"top"};
-  BodySolver body(definition);
+  BodySolver body(testing::plane_quadratic_block("block"));
   const InterfaceDescription top = body.contact_boundary();
   body.assign_contact(node_to_node_operator(
       top.node_ids, std::vector<Eigen::Vector3d>(top.node_ids.size(), Eigen::Vector3d(0, 1, 0.0)),

@@ -17,15 +17,16 @@
 #include <string>
 #include <vector>
 
+#include "../test_bodies.hpp"
 #include "../test_files.hpp"
 #include "numerics/body_output.hpp"
 #include "numerics/box_mesher.hpp"
 #include "numerics/contact_operator.hpp"
-#include "numerics/rectangle_mesher.hpp"
 
 namespace robin {
 namespace {
 
+using testing::plane_quadratic_block;
 using testing::TemporaryDirectory;
 
 std::string file_bytes(const std::filesystem::path& path) {
@@ -42,18 +43,6 @@ Eigen::VectorXd assign_contact(BodySolver& body, const Eigen::Vector3d& normal) 
       boundary.weights));
   return Eigen::VectorXd::LinSpaced(body.contact_size(), 1.0,
                                     1.0 + 0.25 * (body.contact_size() - 1));
-}
-
-/// The block [0, 2] x [0, 1] (4 x 2 cells of two quadratic triangles each), clamped at its
-/// bottom, plane strain, pushed at its top.
-BodyDefinition plane_block() {
-  BodyDefinition definition;
-  definition.name = "plane";
-  definition.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 4, 2, ElementType::triangle6);
-  definition.material = make_isotropic_material(100.0, 0.25, PlaneModel::plane_strain, "test");
-  definition.dirichlet = {{"bottom", 0.0, 0.0, std::nullopt}};
-  definition.contact_boundaries = {"top"};
-  return definition;
 }
 
 /// The box [0, 1] x [0, 0.7] x [0, 0.5] (3 x 2 x 2 cells of `type`), clamped at its bottom,
@@ -73,7 +62,7 @@ class BodyFieldsFile : public ::testing::TestWithParam<int> {};
 INSTANTIATE_TEST_SUITE_P(Bodies, BodyFieldsFile, ::testing::Values(0, 1, 2));
 
 BodyDefinition definition_of_case(int which) {
-  if (which == 0) return plane_block();
+  if (which == 0) return plane_quadratic_block("plane");
   return solid_block(which == 1 ? ElementType::tetrahedron10 : ElementType::hexahedron8);
 }
 
@@ -90,8 +79,8 @@ TEST_P(BodyFieldsFile, IsTheFileOfTheFieldsAtHandByteForByte) {
   std::vector<std::vector<double>> checked_values;
   const BodyOutput streamed = write_body_fields(
       directory.path() / "streamed", body, force,
-      [&](const std::string& location, const std::string& name, const std::vector<double>& values) {
-        checked.push_back(location + " " + name);
+      [&](FieldLocation location, const std::string& name, const std::vector<double>& values) {
+        checked.push_back(std::string(field_location_name(location)) + " " + name);
         checked_values.push_back(values);
       });
 
@@ -118,11 +107,11 @@ TEST_P(BodyFieldsFile, IsTheFileOfTheFieldsAtHandByteForByte) {
 
 TEST(BodyFieldsFile, ACheckThatThrowsLeavesNoFile) {
   const TemporaryDirectory directory("body-fields-file");
-  BodySolver body(plane_block());
+  BodySolver body(plane_quadratic_block("plane"));
   const Eigen::VectorXd force = assign_contact(body, {0, 1, 0});
-  const auto refuse_stress = [](const std::string& location, const std::string& name,
+  const auto refuse_stress = [](FieldLocation location, const std::string& name,
                                 const std::vector<double>&) {
-    if (location == "cell" && name == "von_mises") throw std::runtime_error("refused");
+    if (location == FieldLocation::cell && name == "von_mises") throw std::runtime_error("refused");
   };
   EXPECT_THROW(write_body_fields(directory.path(), body, force, refuse_stress), std::runtime_error);
   EXPECT_TRUE(std::filesystem::is_empty(directory.path()));
@@ -130,7 +119,7 @@ TEST(BodyFieldsFile, ACheckThatThrowsLeavesNoFile) {
 
 TEST(BodyFieldsFile, WrongNumberOfContactForcesIsRefusedNamingTheBody) {
   const TemporaryDirectory directory("body-fields-file");
-  BodySolver body(plane_block());
+  BodySolver body(plane_quadratic_block("plane"));
   assign_contact(body, {0, 1, 0});
   try {
     write_body_fields(directory.path(), body, Eigen::VectorXd::Ones(body.contact_size() + 1));
