@@ -25,9 +25,44 @@ namespace {
 
 /// Uncompressed bytes per zlib block (vtkZLibDataCompressor's default block size).
 constexpr std::size_t compression_block_size = 32768;
-/// zlib's fastest level: the mantissas of computed doubles are close to random, so higher levels
-/// mostly spend time; the runs of zeros and repeated values compress at any level.
+/// zlib's fastest level, with run-length matching only (Z_RLE): the mantissas of computed doubles
+/// are close to random, so a search for earlier matches (every other strategy) mostly spends
+/// time; what compresses is the runs of zeros and of repeated bytes (exponents, sign bytes,
+/// connectivity), which Z_RLE finds. The blocks are ordinary zlib streams.
 constexpr int compression_level = Z_BEST_SPEED;
+
+/// One zlib deflate state, reused for every block of a file (compress2 would allocate and free
+/// one per block).
+class BlockCompressor {
+ public:
+  explicit BlockCompressor(const std::filesystem::path& path) : path_(path) {
+    if (deflateInit2(&stream_, compression_level, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK) {
+      throw std::runtime_error("cannot write '" + path_.string() + "': zlib initialization failed");
+    }
+  }
+  ~BlockCompressor() { deflateEnd(&stream_); }
+  BlockCompressor(const BlockCompressor&) = delete;
+  BlockCompressor& operator=(const BlockCompressor&) = delete;
+
+  /// The zlib stream of `size` bytes at `data` in `buffer` (resized as needed); returns its size.
+  std::size_t compress(const char* data, std::size_t size, std::vector<Bytef>& buffer) {
+    const uLong bound = deflateBound(&stream_, static_cast<uLong>(size));
+    if (buffer.size() < bound) buffer.resize(bound);
+    deflateReset(&stream_);
+    stream_.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
+    stream_.avail_in = static_cast<uInt>(size);
+    stream_.next_out = buffer.data();
+    stream_.avail_out = static_cast<uInt>(buffer.size());
+    if (deflate(&stream_, Z_FINISH) != Z_STREAM_END) {
+      throw std::runtime_error("cannot write '" + path_.string() + "': zlib compression failed");
+    }
+    return static_cast<std::size_t>(stream_.total_out);
+  }
+
+ private:
+  z_stream stream_{};
+  const std::filesystem::path& path_;
+};
 
 /// Text escaped for an XML attribute value.
 std::string escape_xml(const std::string& text) {
@@ -419,7 +454,7 @@ constexpr std::size_t offset_width = 21;
 class ArrayWriter {
  public:
   ArrayWriter(std::ofstream& out, VtuEncoding encoding, const std::filesystem::path& path)
-      : out_(out), encoding_(encoding), path_(path) {}
+      : out_(out), encoding_(encoding), path_(path), compressor_(path) {}
 
   /// `array` holds the attributes (and a string array's values); `make` makes its values when
   /// they are written (called once, after the XML in binary mode).
@@ -495,17 +530,11 @@ class ArrayWriter {
     out_.write(header.data(), static_cast<std::streamsize>(header.size()));
     std::string sizes;
     std::uint64_t record_size = header.size();
-    std::vector<Bytef> buffer(compressBound(compression_block_size));
     for (std::size_t block = 0; block < block_count; ++block) {
       const std::size_t begin = block * compression_block_size;
       const std::size_t size = std::min(compression_block_size, bytes.size() - begin);
-      uLongf compressed_size = static_cast<uLongf>(buffer.size());
-      if (compress2(buffer.data(), &compressed_size,
-                    reinterpret_cast<const Bytef*>(bytes.data()) + begin, static_cast<uLong>(size),
-                    compression_level) != Z_OK) {
-        throw std::runtime_error("cannot write '" + path_.string() + "': zlib compression failed");
-      }
-      out_.write(reinterpret_cast<const char*>(buffer.data()),
+      const std::size_t compressed_size = compressor_.compress(bytes.data() + begin, size, buffer_);
+      out_.write(reinterpret_cast<const char*>(buffer_.data()),
                  static_cast<std::streamsize>(compressed_size));
       append_header_word(sizes, compressed_size);
       record_size += compressed_size;
@@ -520,6 +549,8 @@ class ArrayWriter {
   VtuEncoding encoding_;
   const std::filesystem::path& path_;
   std::vector<PendingArray> pending_;
+  BlockCompressor compressor_;
+  std::vector<Bytef> buffer_;  // one compressed block
 };
 
 /// The Piece element: its PointData, CellData (with boundary_id when `boundary_cells`), Points
