@@ -149,7 +149,7 @@ void reverse_facet(FacetType type, int* nodes) {
 /// the body on its left, a face with its right-hand normal out of the body).
 std::vector<int> oriented_facets(const Mesh& mesh, const BoundaryGroup& group,
                                  const std::vector<int>& nodes) {
-  const NodeElementMap adjacency(mesh);
+  const NodeElementMap adjacency(mesh, group);
   const int count = nodes_per_facet(group.type);
   const Eigen::Vector3d centre = group_facet_centre(group.type);
   std::vector<int> facets;

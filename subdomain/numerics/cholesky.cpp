@@ -190,6 +190,9 @@ void CholeskyFactor::Implementation::factorize(SparseMatrix& matrix,
                              std::to_string(common.status) + ", e.g. out of memory)");
   }
   check_memory_estimate();
+  // The analysis's workspace (several integers per unknown) is not needed beside L: the numerical
+  // factorization allocates what it uses.
+  cholmod_free_work(&common);
   ordering_seconds = seconds_since(start);
   if (observer) observer(SetupStage::factorization);
   start = std::chrono::steady_clock::now();

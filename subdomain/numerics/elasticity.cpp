@@ -284,7 +284,7 @@ Eigen::VectorXd assemble_body_force(const Mesh& mesh, const VectorField& body_fo
 Eigen::VectorXd assemble_boundary_traction(const Mesh& mesh, const BoundaryGroup& group,
                                            const TractionField& traction) {
   Eigen::VectorXd load = Eigen::VectorXd::Zero(mesh.dof_count());
-  const NodeElementMap adjacency(mesh);
+  const NodeElementMap adjacency(mesh, group);
   const int count = nodes_per_facet(group.type);
   const std::vector<QuadraturePoint> rule =
       facet_quadrature(group.type, facet_load_degree(group.type));
@@ -348,7 +348,7 @@ Eigen::VectorXd boundary_weights(const Mesh& mesh, const BoundaryGroup& group) {
 std::vector<Eigen::Vector3d> boundary_normal_sums(const Mesh& mesh, const BoundaryGroup& group,
                                                   bool facets_oriented_outward) {
   std::optional<NodeElementMap> adjacency;
-  if (!facets_oriented_outward) adjacency.emplace(mesh);
+  if (!facets_oriented_outward) adjacency.emplace(mesh, group);
   const int count = nodes_per_facet(group.type);
   const std::vector<Eigen::Vector3d> node_references = facet_reference_nodes(group.type);
   std::vector<Eigen::Vector3d> sums(mesh.node_count(), Eigen::Vector3d::Zero());

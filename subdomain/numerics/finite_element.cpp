@@ -506,21 +506,41 @@ ElementPoint ElementGeometry::evaluate(const ReferenceShape& shape) const {
   return point;
 }
 
-NodeElementMap::NodeElementMap(const Mesh& mesh) : mesh_(&mesh), elements_(mesh.node_count()) {
-  for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
-    const ElementBlock& block = mesh.blocks[b];
-    const int count = nodes_per_element(block.type);
-    for (std::size_t e = 0; e < block.element_count(); ++e) {
-      for (int i = 0; i < count; ++i)
-        elements_[block.connectivity[e * count + i]].emplace_back(b, e);
+NodeElementMap::NodeElementMap(const Mesh& mesh, const BoundaryGroup& group)
+    : mesh_(&mesh), nodes_(group.nodes()), start_(nodes_.size() + 1, 0) {
+  std::vector<int> position(mesh.node_count(), -1);  // of each group node in nodes_
+  for (std::size_t k = 0; k < nodes_.size(); ++k) position[nodes_[k]] = static_cast<int>(k);
+  const auto for_each_incidence = [&](const auto& visit) {
+    for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
+      const ElementBlock& block = mesh.blocks[b];
+      const int count = nodes_per_element(block.type);
+      for (std::size_t e = 0; e < block.element_count(); ++e) {
+        for (int i = 0; i < count; ++i) {
+          const int k = position[block.connectivity[e * count + i]];
+          if (k >= 0) visit(static_cast<std::size_t>(k), ElementIndex(b, e));
+        }
+      }
     }
-  }
+  };
+  for_each_incidence([&](std::size_t k, const ElementIndex&) { ++start_[k + 1]; });
+  for (std::size_t k = 0; k < nodes_.size(); ++k) start_[k + 1] += start_[k];
+  elements_.resize(start_.back());
+  std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
+  for_each_incidence(
+      [&](std::size_t k, const ElementIndex& element) { elements_[next[k]++] = element; });
 }
 
 std::optional<NodeElementMap::ElementIndex> NodeElementMap::element_with(
     const std::vector<int>& nodes) const {
   if (nodes.empty()) return std::nullopt;
-  for (const ElementIndex& candidate : elements_[nodes.front()]) {
+  const auto found = std::lower_bound(nodes_.begin(), nodes_.end(), nodes.front());
+  if (found == nodes_.end() || *found != nodes.front()) {
+    throw std::out_of_range("NodeElementMap: node " + std::to_string(nodes.front()) +
+                            " is not a node of its boundary group");
+  }
+  const auto k = static_cast<std::size_t>(found - nodes_.begin());
+  for (std::size_t entry = start_[k]; entry < start_[k + 1]; ++entry) {
+    const ElementIndex& candidate = elements_[entry];
     const ElementBlock& block = mesh_->blocks[candidate.first];
     const int count = nodes_per_element(block.type);
     const auto begin = block.connectivity.begin() + candidate.second * count;

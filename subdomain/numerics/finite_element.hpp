@@ -142,18 +142,21 @@ class ElementGeometry {
   NodeCoordinates coordinates_;  // n x d
 };
 
-/// The elements (block, element) that contain each node.
+/// The elements (block, element) that contain each node of one boundary group: what orienting
+/// its facets needs, in memory proportional to the group, not to the mesh (compressed rows).
 class NodeElementMap {
  public:
   using ElementIndex = std::pair<std::size_t, std::size_t>;
-  explicit NodeElementMap(const Mesh& mesh);
-  const std::vector<ElementIndex>& elements_of(int node) const { return elements_[node]; }
-  /// The first element that contains every one of `nodes`, if any.
+  NodeElementMap(const Mesh& mesh, const BoundaryGroup& group);
+  /// The first element that contains every one of `nodes`, if any; nodes.front() must be a node
+  /// of the group (std::out_of_range otherwise).
   std::optional<ElementIndex> element_with(const std::vector<int>& nodes) const;
 
  private:
   const Mesh* mesh_;
-  std::vector<std::vector<ElementIndex>> elements_;
+  std::vector<int> nodes_;          // the group's nodes, ascending
+  std::vector<std::size_t> start_;  // elements of nodes_[k]: elements_[start_[k] ...]
+  std::vector<ElementIndex> elements_;
 };
 
 /// Facet shape functions at one point, the mapped position, the unit outward normal and the

@@ -1,5 +1,7 @@
 #include "numerics/heap_memory.hpp"
 
+#include <cstdlib>  // defines __GLIBC__ (through <features.h>) with the GNU C library
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
