@@ -1,0 +1,540 @@
+#include "numerics/algebraic_multigrid.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <utility>
+
+#include "numerics/cholesky.hpp"
+
+namespace robin {
+namespace {
+
+/// y = A x (A compressed, row-major).
+void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
+  const double* values = matrix.valuePtr();
+  const double* input = x.data();
+  double* output = y.data();
+  const int rows = static_cast<int>(matrix.rows());
+  for (int row = 0; row < rows; ++row) {
+    double sum = 0.0;
+    for (int k = starts[row]; k < starts[row + 1]; ++k) sum += values[k] * input[columns[k]];
+    output[row] = sum;
+  }
+}
+
+/// r = b - A x (A compressed, row-major).
+void subtract_product(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& right_hand_side,
+                      const Eigen::VectorXd& x, Eigen::VectorXd& residual) {
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
+  const double* values = matrix.valuePtr();
+  const double* input = x.data();
+  const int rows = static_cast<int>(matrix.rows());
+  for (int row = 0; row < rows; ++row) {
+    double sum = right_hand_side[row];
+    for (int k = starts[row]; k < starts[row + 1]; ++k) sum -= values[k] * input[columns[k]];
+    residual[row] = sum;
+  }
+}
+
+/// The symmetric matrix whose lower triangle `lower` holds, with both triangles, row-major.
+RowMajorSparseMatrix symmetric_from_lower(const SparseMatrix& lower) {
+  if (lower.rows() != lower.cols()) {
+    throw std::invalid_argument("AlgebraicMultigrid: the matrix is not square");
+  }
+  RowMajorSparseMatrix full = lower.selfadjointView<Eigen::Lower>();
+  full.makeCompressed();
+  return full;
+}
+
+/// 1 / A_ii; throws std::invalid_argument for a diagonal entry that is not positive.
+Eigen::VectorXd inverse_diagonal(const RowMajorSparseMatrix& matrix) {
+  Eigen::VectorXd inverse = matrix.diagonal();
+  for (Eigen::Index row = 0; row < inverse.size(); ++row) {
+    if (!(inverse[row] > 0.0)) {
+      throw std::invalid_argument(
+          "AlgebraicMultigrid: a diagonal entry is not positive (the matrix is not positive "
+          "definite)");
+    }
+    inverse[row] = 1.0 / inverse[row];
+  }
+  return inverse;
+}
+
+/// Largest eigenvalue of D^{-1} A, estimated from below by `steps` Lanczos steps on the
+/// symmetric D^{-1/2} A D^{-1/2} (same spectrum) from a fixed pseudo-random start: the largest
+/// eigenvalue of the Lanczos tridiagonal matrix.
+double estimate_spectral_radius(const RowMajorSparseMatrix& matrix,
+                                const Eigen::VectorXd& inverse_diagonal, int steps) {
+  const Eigen::Index size = matrix.rows();
+  const Eigen::VectorXd scale = inverse_diagonal.cwiseSqrt();
+  std::mt19937 generator(2026);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd current = Eigen::VectorXd::NullaryExpr(size, [&] { return uniform(generator); });
+  current.normalize();
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(size), product(size), work(size);
+  std::vector<double> diagonal, off_diagonal;
+  double beta = 0.0;
+  for (int step = 0; step < std::min<Eigen::Index>(steps, size); ++step) {
+    work = scale.cwiseProduct(current);
+    multiply(matrix, work, product);
+    product = scale.cwiseProduct(product) - beta * previous;
+    const double alpha = product.dot(current);
+    product -= alpha * current;
+    diagonal.push_back(alpha);
+    beta = product.norm();
+    if (beta <= 1e-12 * std::abs(alpha)) break;  // an invariant subspace: the Ritz values are exact
+    off_diagonal.push_back(beta);
+    previous = std::move(current);
+    current = product / beta;
+  }
+  const Eigen::Index order = static_cast<Eigen::Index>(diagonal.size());
+  Eigen::MatrixXd tridiagonal = Eigen::MatrixXd::Zero(order, order);
+  for (Eigen::Index k = 0; k < order; ++k) {
+    tridiagonal(k, k) = diagonal[static_cast<std::size_t>(k)];
+    if (k + 1 < order) {
+      tridiagonal(k, k + 1) = tridiagonal(k + 1, k) = off_diagonal[static_cast<std::size_t>(k)];
+    }
+  }
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(tridiagonal, Eigen::EigenvaluesOnly)
+      .eigenvalues()
+      .maxCoeff();
+}
+
+/// The unknowns of each node: the unknowns of node i are unknowns[start[i] .. start[i + 1]).
+struct NodeBlocks {
+  std::vector<int> node_of;  // per unknown, the node numbered 0 .. count - 1
+  std::vector<int> start;
+  std::vector<int> unknowns;
+  int count() const { return static_cast<int>(start.size()) - 1; }
+};
+
+/// Node blocks from any non-negative node numbers, renumbered 0 .. count - 1 in increasing order.
+NodeBlocks make_node_blocks(const std::vector<int>& dof_nodes) {
+  NodeBlocks blocks;
+  int largest = -1;
+  for (int node : dof_nodes) {
+    if (node < 0) throw std::invalid_argument("AlgebraicMultigrid: a negative node number");
+    largest = std::max(largest, node);
+  }
+  std::vector<int> renumbered(static_cast<std::size_t>(largest + 1), -1);
+  for (int node : dof_nodes) renumbered[static_cast<std::size_t>(node)] = 0;
+  int count = 0;
+  for (int& number : renumbered) {
+    if (number == 0) number = count++;
+  }
+  blocks.node_of.reserve(dof_nodes.size());
+  for (int node : dof_nodes) blocks.node_of.push_back(renumbered[static_cast<std::size_t>(node)]);
+  blocks.start.assign(static_cast<std::size_t>(count) + 1, 0);
+  for (int node : blocks.node_of) ++blocks.start[static_cast<std::size_t>(node) + 1];
+  for (int node = 0; node < count; ++node) blocks.start[node + 1] += blocks.start[node];
+  blocks.unknowns.resize(dof_nodes.size());
+  std::vector<int> next(blocks.start.begin(), blocks.start.end() - 1);
+  for (std::size_t unknown = 0; unknown < dof_nodes.size(); ++unknown) {
+    blocks.unknowns[static_cast<std::size_t>(next[blocks.node_of[unknown]]++)] =
+        static_cast<int>(unknown);
+  }
+  return blocks;
+}
+
+/// The strong connections of each node (step 1 of the header comment), neighbours of node i in
+/// neighbours[start[i] .. start[i + 1]) with their block norms ||A_ij||_F in weights.
+struct NodeGraph {
+  std::vector<int> start;
+  std::vector<int> neighbours;
+  std::vector<double> weights;
+};
+
+/// ||A_ij||_F^2 for every node pair of the matrix graph, node by node; `visit(i, j, square)`.
+template <typename Visit>
+void for_each_block_norm(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+                         Visit visit) {
+  std::vector<double> accumulated(static_cast<std::size_t>(blocks.count()), 0.0);
+  std::vector<int> touched;
+  for (int node = 0; node < blocks.count(); ++node) {
+    for (int k = blocks.start[node]; k < blocks.start[node + 1]; ++k) {
+      for (RowMajorSparseMatrix::InnerIterator entry(matrix, blocks.unknowns[k]); entry; ++entry) {
+        const int other = blocks.node_of[static_cast<std::size_t>(entry.col())];
+        if (accumulated[other] == 0.0) touched.push_back(other);
+        accumulated[other] += entry.value() * entry.value() + 1e-300;  // marks even zeros
+      }
+    }
+    for (int other : touched) {
+      visit(node, other, accumulated[other]);
+      accumulated[other] = 0.0;
+    }
+    touched.clear();
+  }
+}
+
+NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+                            double threshold) {
+  std::vector<double> diagonal_norm(static_cast<std::size_t>(blocks.count()), 0.0);
+  for_each_block_norm(matrix, blocks, [&](int node, int other, double square) {
+    if (node == other) diagonal_norm[node] = std::sqrt(square);
+  });
+  NodeGraph graph;
+  graph.start.push_back(0);
+  int current = 0;
+  for_each_block_norm(matrix, blocks, [&](int node, int other, double square) {
+    while (current < node) {
+      graph.start.push_back(static_cast<int>(graph.neighbours.size()));
+      ++current;
+    }
+    const double norm = std::sqrt(square);
+    if (other != node && norm > 0.0 &&
+        norm >= threshold * std::sqrt(diagonal_norm[node] * diagonal_norm[other])) {
+      graph.neighbours.push_back(other);
+      graph.weights.push_back(norm);
+    }
+  });
+  while (current < blocks.count()) {
+    graph.start.push_back(static_cast<int>(graph.neighbours.size()));
+    ++current;
+  }
+  return graph;
+}
+
+/// Greedy aggregation (step 2 of the header comment): the aggregate of each node, and their count.
+std::pair<std::vector<int>, int> aggregate_nodes(const NodeGraph& graph) {
+  const int nodes = static_cast<int>(graph.start.size()) - 1;
+  std::vector<int> aggregate(static_cast<std::size_t>(nodes), -1);
+  int count = 0;
+  for (int node = 0; node < nodes; ++node) {  // (a) whole free neighbourhoods
+    bool free = aggregate[node] < 0;
+    for (int k = graph.start[node]; free && k < graph.start[node + 1]; ++k) {
+      free = aggregate[graph.neighbours[k]] < 0;
+    }
+    if (!free) continue;
+    aggregate[node] = count;
+    for (int k = graph.start[node]; k < graph.start[node + 1]; ++k) {
+      aggregate[graph.neighbours[k]] = count;
+    }
+    ++count;
+  }
+  const std::vector<int> first = aggregate;
+  for (int node = 0; node < nodes; ++node) {  // (b) join the strongest neighbouring aggregate
+    if (aggregate[node] >= 0) continue;
+    double strongest = -1.0;
+    for (int k = graph.start[node]; k < graph.start[node + 1]; ++k) {
+      if (first[graph.neighbours[k]] >= 0 && graph.weights[k] > strongest) {
+        strongest = graph.weights[k];
+        aggregate[node] = first[graph.neighbours[k]];
+      }
+    }
+  }
+  for (int node = 0; node < nodes; ++node) {  // (c) the rest with their remaining neighbours
+    if (aggregate[node] >= 0) continue;
+    aggregate[node] = count;
+    for (int k = graph.start[node]; k < graph.start[node + 1]; ++k) {
+      if (aggregate[graph.neighbours[k]] < 0) aggregate[graph.neighbours[k]] = count;
+    }
+    ++count;
+  }
+  return {aggregate, count};
+}
+
+/// P_tent, the coarse near-null space and the aggregate of each coarse unknown (step 3).
+struct TentativeProlongator {
+  RowMajorSparseMatrix prolongator;
+  Eigen::MatrixXd coarse_near_null_space;
+  std::vector<int> coarse_nodes;
+};
+
+TentativeProlongator tentative_prolongator(const NodeBlocks& blocks,
+                                           const std::vector<int>& aggregate, int aggregate_count,
+                                           const Eigen::MatrixXd& near_null_space) {
+  std::vector<int> by_aggregate(aggregate.begin(), aggregate.end());
+  std::vector<int> dof_aggregate(blocks.node_of.size());
+  for (std::size_t unknown = 0; unknown < dof_aggregate.size(); ++unknown) {
+    dof_aggregate[unknown] = aggregate[static_cast<std::size_t>(blocks.node_of[unknown])];
+  }
+  const NodeBlocks members = make_node_blocks(dof_aggregate);  // unknowns per aggregate
+  const Eigen::Index modes = near_null_space.cols();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(blocks.node_of.size() * static_cast<std::size_t>(modes));
+  std::vector<Eigen::MatrixXd> coarse_rows;
+  TentativeProlongator result;
+  int columns = 0;
+  for (int group = 0; group < aggregate_count; ++group) {
+    const int first = members.start[group], rows = members.start[group + 1] - first;
+    Eigen::MatrixXd local(rows, modes);
+    for (int k = 0; k < rows; ++k) local.row(k) = near_null_space.row(members.unknowns[first + k]);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(local);
+    qr.setThreshold(1e-10);
+    const int rank = std::max<int>(1, static_cast<int>(qr.rank()));
+    const Eigen::MatrixXd basis = qr.householderQ() * Eigen::MatrixXd::Identity(rows, rank);
+    const Eigen::MatrixXd upper =
+        qr.matrixR().topRows(rank).triangularView<Eigen::Upper>().toDenseMatrix();
+    coarse_rows.push_back(upper * qr.colsPermutation().transpose());
+    for (int k = 0; k < rows; ++k) {
+      for (int c = 0; c < rank; ++c) {
+        entries.emplace_back(members.unknowns[first + k], columns + c, basis(k, c));
+      }
+    }
+    for (int c = 0; c < rank; ++c) result.coarse_nodes.push_back(group);
+    columns += rank;
+  }
+  result.prolongator.resize(static_cast<Eigen::Index>(blocks.node_of.size()), columns);
+  result.prolongator.setFromTriplets(entries.begin(), entries.end());
+  result.coarse_near_null_space.resize(columns, modes);
+  for (int group = 0, row = 0; group < aggregate_count; ++group) {
+    const Eigen::MatrixXd& rows = coarse_rows[static_cast<std::size_t>(group)];
+    result.coarse_near_null_space.middleRows(row, rows.rows()) = rows;
+    row += static_cast<int>(rows.rows());
+  }
+  return result;
+}
+
+/// P = (I - omega D^{-1} A) P_tent (step 4).
+RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
+                                        const Eigen::VectorXd& inverse_diagonal, double omega,
+                                        const RowMajorSparseMatrix& tentative) {
+  RowMajorSparseMatrix product = matrix * tentative;
+  for (Eigen::Index row = 0; row < product.outerSize(); ++row) {
+    const double factor = omega * inverse_diagonal[row];
+    for (RowMajorSparseMatrix::InnerIterator entry(product, row); entry; ++entry) {
+      entry.valueRef() *= factor;
+    }
+  }
+  RowMajorSparseMatrix smoothed = tentative - product;
+  smoothed.makeCompressed();
+  return smoothed;
+}
+
+/// P' A P (step 5), symmetrized against rounding: (C + C') / 2.
+RowMajorSparseMatrix galerkin_product(const RowMajorSparseMatrix& restriction,
+                                      const RowMajorSparseMatrix& matrix,
+                                      const RowMajorSparseMatrix& prolongator) {
+  RowMajorSparseMatrix coarse;
+  {
+    const RowMajorSparseMatrix product = matrix * prolongator;
+    coarse = restriction * product;
+  }
+  const RowMajorSparseMatrix transposed = coarse.transpose();
+  RowMajorSparseMatrix symmetric = 0.5 * (coarse + transposed);
+  symmetric.makeCompressed();
+  return symmetric;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower)
+    : matrix_(symmetric_from_lower(lower)) {}
+
+void SparseMatrixOperator::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  y.resize(matrix_.rows());
+  multiply(matrix_, x, y);
+}
+
+struct AlgebraicMultigrid::Level {
+  RowMajorSparseMatrix owned_matrix;  // A_l for l > 0 (A_0 is the fine operator's)
+  const RowMajorSparseMatrix* matrix = nullptr;
+  Eigen::VectorXd inverse_diagonal;
+  RowMajorSparseMatrix prolongator, restriction;  // P, P' (empty on the coarsest level)
+  int nodes = 0;
+  double spectral_radius = 0.0;
+  double interval_low = 0.0, interval_high = 0.0;  // the Chebyshev interval
+  // workspace of apply
+  mutable Eigen::VectorXd residual, update, product, coarse_right_hand_side, coarse_solution;
+};
+
+struct AlgebraicMultigrid::CoarseSolver {
+  std::unique_ptr<CholeskyFactor> factor;
+};
+
+AlgebraicMultigrid::AlgebraicMultigrid(const SparseMatrix& lower,
+                                       const Eigen::MatrixXd& near_null_space,
+                                       const std::vector<int>& dof_nodes,
+                                       const AlgebraicMultigridOptions& options)
+    : options_(options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (near_null_space.rows() != lower.rows() || near_null_space.cols() < 1 ||
+      static_cast<Eigen::Index>(dof_nodes.size()) != lower.rows()) {
+    throw std::invalid_argument(
+        "AlgebraicMultigrid: the near-null space or the dof nodes do not match the matrix");
+  }
+  if (options_.smoother_degree < 1) {
+    throw std::invalid_argument("AlgebraicMultigrid: smoother_degree below 1");
+  }
+  fine_operator_ = std::make_unique<SparseMatrixOperator>(lower);
+  build_hierarchy(near_null_space, dof_nodes);
+  setup_seconds_ = seconds_since(start);
+}
+
+AlgebraicMultigrid::~AlgebraicMultigrid() = default;
+
+void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
+                                         const std::vector<int>& dof_nodes) {
+  Eigen::MatrixXd modes = near_null_space;
+  std::vector<int> nodes = dof_nodes;
+  auto level = std::make_unique<Level>();
+  level->matrix = &fine_operator_->matrix();
+  while (true) {
+    const RowMajorSparseMatrix& matrix = *level->matrix;
+    const int unknowns = static_cast<int>(matrix.rows());
+    level->inverse_diagonal = inverse_diagonal(matrix);
+    level->spectral_radius =
+        estimate_spectral_radius(matrix, level->inverse_diagonal, options_.lanczos_steps);
+    level->interval_high = options_.spectrum_safety * level->spectral_radius;
+    level->interval_low = level->interval_high / options_.smoother_interval_ratio;
+    const NodeBlocks blocks = make_node_blocks(nodes);
+    level->nodes = blocks.count();
+    level->residual.resize(unknowns);
+    level->update.resize(unknowns);
+    level->product.resize(unknowns);
+    if (unknowns <= options_.coarse_size_limit ||
+        static_cast<int>(levels_.size()) + 1 >= options_.maximum_levels) {
+      break;
+    }
+    const NodeGraph graph = strong_node_graph(matrix, blocks, options_.strength_threshold);
+    const auto [aggregate, aggregate_count] = aggregate_nodes(graph);
+    TentativeProlongator tentative =
+        tentative_prolongator(blocks, aggregate, aggregate_count, modes);
+    if (tentative.prolongator.cols() >= unknowns) break;  // no coarsening: this is the coarsest
+    const double omega = options_.prolongator_damping / level->spectral_radius;
+    level->prolongator =
+        options_.prolongator_damping > 0.0
+            ? smooth_prolongator(matrix, level->inverse_diagonal, omega, tentative.prolongator)
+            : std::move(tentative.prolongator);
+    level->prolongator.makeCompressed();
+    level->restriction = level->prolongator.transpose();
+    level->restriction.makeCompressed();
+    auto coarse = std::make_unique<Level>();
+    coarse->owned_matrix = galerkin_product(level->restriction, matrix, level->prolongator);
+    coarse->matrix = &coarse->owned_matrix;
+    level->coarse_right_hand_side.resize(coarse->owned_matrix.rows());
+    level->coarse_solution.resize(coarse->owned_matrix.rows());
+    modes = std::move(tentative.coarse_near_null_space);
+    nodes = std::move(tentative.coarse_nodes);
+    levels_.push_back(std::move(level));
+    level = std::move(coarse);
+  }
+  const SparseMatrix coarsest = SparseMatrix(*level->matrix).triangularView<Eigen::Lower>();
+  levels_.push_back(std::move(level));
+  coarse_solver_ = std::make_unique<CoarseSolver>();
+  coarse_solver_->factor = std::make_unique<CholeskyFactor>(coarsest, "coarsest multigrid level");
+}
+
+int AlgebraicMultigrid::size() const {
+  return fine_operator_->size();
+}
+
+void AlgebraicMultigrid::apply(const Eigen::VectorXd& residual, Eigen::VectorXd& correction) const {
+  if (residual.size() != size()) {
+    throw std::invalid_argument("AlgebraicMultigrid::apply: the vector's size differs");
+  }
+  correction.resize(size());
+  cycle(0, residual, correction);
+}
+
+void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_hand_side,
+                               Eigen::VectorXd& solution) const {
+  const Level& level = *levels_[index];
+  if (index + 1 == levels_.size()) {
+    solution = coarse_solver_->factor->solve(right_hand_side);
+    return;
+  }
+  smooth(level, right_hand_side, solution, true);
+  subtract_product(*level.matrix, right_hand_side, solution, level.residual);
+  multiply(level.restriction, level.residual, level.coarse_right_hand_side);
+  cycle(index + 1, level.coarse_right_hand_side, level.coarse_solution);
+  multiply(level.prolongator, level.coarse_solution, level.product);
+  solution += level.product;
+  smooth(level, right_hand_side, solution, false);
+}
+
+/// Chebyshev iteration for D^{-1} A x = D^{-1} b on [low, high] (Saad, Iterative Methods for
+/// Sparse Linear Systems, Algorithm 12.1): theta = (high + low) / 2, delta = (high - low) / 2,
+/// sigma = theta / delta; d_0 = D^{-1} r_0 / theta, and for k >= 1 with rho_0 = 1 / sigma,
+/// rho_k = 1 / (2 sigma - rho_{k-1}): d_k = rho_k rho_{k-1} d_{k-1} + (2 rho_k / delta) D^{-1} r_k,
+/// x_{k+1} = x_k + d_k, r_{k+1} = r_k - A d_k.
+void AlgebraicMultigrid::smooth(const Level& level, const Eigen::VectorXd& right_hand_side,
+                                Eigen::VectorXd& solution, bool zero_guess) const {
+  const double theta = 0.5 * (level.interval_high + level.interval_low);
+  const double delta = 0.5 * (level.interval_high - level.interval_low);
+  const double sigma = theta / delta;
+  Eigen::VectorXd& residual = level.residual;
+  Eigen::VectorXd& update = level.update;
+  if (zero_guess) {
+    residual = right_hand_side;
+  } else {
+    subtract_product(*level.matrix, right_hand_side, solution, residual);
+  }
+  update = level.inverse_diagonal.cwiseProduct(residual) / theta;
+  if (zero_guess) {
+    solution = update;
+  } else {
+    solution += update;
+  }
+  double rho = 1.0 / sigma;
+  for (int step = 1; step < options_.smoother_degree; ++step) {
+    multiply(*level.matrix, update, level.product);
+    residual -= level.product;
+    const double next_rho = 1.0 / (2.0 * sigma - rho);
+    update = (next_rho * rho) * update +
+             (2.0 * next_rho / delta) * level.inverse_diagonal.cwiseProduct(residual);
+    solution += update;
+    rho = next_rho;
+  }
+}
+
+std::vector<MultigridLevelSummary> AlgebraicMultigrid::levels() const {
+  std::vector<MultigridLevelSummary> summaries;
+  for (const auto& level : levels_) {
+    MultigridLevelSummary summary;
+    summary.unknowns = static_cast<int>(level->matrix->rows());
+    summary.nonzeros = static_cast<long>(level->matrix->nonZeros());
+    summary.nodes = level->nodes;
+    summary.spectral_radius = level->spectral_radius;
+    summaries.push_back(summary);
+  }
+  return summaries;
+}
+
+double AlgebraicMultigrid::operator_complexity() const {
+  double total = 0.0;
+  for (const auto& level : levels_) total += static_cast<double>(level->matrix->nonZeros());
+  return total / static_cast<double>(levels_.front()->matrix->nonZeros());
+}
+
+Eigen::MatrixXd free_rigid_body_modes(const Mesh& mesh, const DofMap& dofs) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (const Eigen::Vector3d& node : mesh.nodes) {
+    low = low.cwiseMin(node);
+    high = high.cwiseMax(node);
+  }
+  const Eigen::Vector3d centre = 0.5 * (low + high);
+  const double diagonal = (high - low).norm();
+  const double scale = diagonal > 0.0 ? diagonal : 1.0;
+  Eigen::MatrixXd modes(dofs.free_count(), rigid_mode_count(mesh.dimension));
+  for (int dof = 0; dof < dofs.total_count(); ++dof) {
+    const int free = dofs.free_index(dof);
+    if (free >= 0) modes.row(free) = rigid_mode_row(mesh, dof, centre, scale).transpose();
+  }
+  return modes;
+}
+
+std::vector<int> free_dof_nodes(const Mesh& mesh, const DofMap& dofs) {
+  std::vector<int> nodes(static_cast<std::size_t>(dofs.free_count()));
+  for (int dof = 0; dof < dofs.total_count(); ++dof) {
+    const int free = dofs.free_index(dof);
+    if (free >= 0) nodes[static_cast<std::size_t>(free)] = dof / mesh.dimension;
+  }
+  return nodes;
+}
+
+}  // namespace robin

@@ -1,0 +1,146 @@
+#pragma once
+// Smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) for a symmetric
+// positive definite sparse matrix A with a given near-null space B (n x m: for linear
+// elasticity the m rigid body modes restricted to the free dofs, m = 3 in 2D and 6 in 3D),
+// used as the preconditioner of conjugate gradients (conjugate_gradient.hpp).
+//
+// Setup, level by level from A_0 = A, B_0 = B, until a level has at most coarse_size_limit
+// unknowns (or maximum_levels is reached):
+//  1. Strength of connection on the node graph: the unknowns of a node (the dofs of one mesh node
+//     on the finest level, of one aggregate on the coarser ones) are one block. Nodes i != j are
+//     strongly connected when ||A_ij||_F >= theta sqrt(||A_ii||_F ||A_jj||_F).
+//  2. Greedy aggregation of the strong graph: (a) every node whose strong neighbours are all
+//     unaggregated forms an aggregate with them; (b) each remaining node joins the aggregate of
+//     (a) it is most strongly connected to; (c) the rest form aggregates with their remaining
+//     strong neighbours. A node without strong neighbours is an aggregate of its own.
+//  3. Tentative prolongator: for aggregate a with unknowns I_a, the QR factorization with column
+//     pivoting B(I_a, :) = Q R Pi' gives the columns Q_r (r = numerical rank, at most m) of
+//     P_tent on I_a, and the coarse near-null space rows R_r Pi' (r x m), so that
+//     P_tent B_coarse = B exactly and P_tent has orthonormal columns.
+//  4. Prolongator smoothing (damped Jacobi): P = (I - omega D^{-1} A) P_tent,
+//     omega = (4/3) / rho(D^{-1} A), D = diag(A), rho estimated by Lanczos on D^{-1/2} A D^{-1/2}.
+//  5. Galerkin coarse operator A_{l+1} = P' A_l P (symmetric positive definite: P has full
+//     column rank).
+// The coarsest matrix is factorized by CHOLMOD (cholesky.hpp).
+//
+// The preconditioner M^{-1} r is one V-cycle from a zero guess: on each level, pre-smoothing by
+// a Chebyshev polynomial in D^{-1} A (the same polynomial s: x = s(D^{-1}A) D^{-1} b from
+// x = 0), restriction of the residual by P', the next level, prolongation by P, post-smoothing
+// by the same polynomial. Both smoothing steps have the error propagation I - s(D^{-1}A) D^{-1}A,
+// which is self-adjoint in the A inner product, and the coarsest solve is exact, so M^{-1} is
+// symmetric; it is positive definite since the smoother converges (the Chebyshev interval's
+// upper end bounds rho(D^{-1} A)). Chebyshev iteration of degree k on [lambda_max / ratio,
+// lambda_max] (Adams, Brezina, Hu, Tuminaro 2003): k products with A per smoothing step.
+//
+// Matrices are stored row-major (CSR) for the products; the setup keeps, per level, A, P, P'
+// and D^{-1}, and the apply allocates nothing (its workspace is kept per level, so one
+// AlgebraicMultigrid must not be applied from two threads at once).
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
+
+#include "numerics/conjugate_gradient.hpp"
+#include "numerics/dof_map.hpp"
+#include "numerics/elasticity.hpp"
+#include "numerics/linear_operator.hpp"
+#include "numerics/mesh.hpp"
+
+namespace robin {
+
+using RowMajorSparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+
+/// y = A x for a sparse matrix stored with both triangles, row-major.
+class SparseMatrixOperator final : public LinearOperator {
+ public:
+  /// A from the lower triangle of `lower` (its upper triangle is not read; a matrix stored with
+  /// both triangles is fine), stored with both triangles.
+  explicit SparseMatrixOperator(const SparseMatrix& lower);
+  int size() const override { return static_cast<int>(matrix_.rows()); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
+  const RowMajorSparseMatrix& matrix() const { return matrix_; }
+
+ private:
+  RowMajorSparseMatrix matrix_;
+};
+
+struct AlgebraicMultigridOptions {
+  /// theta of the strength of connection (step 1 of the file comment); 0 keeps every
+  /// connection of the matrix graph.
+  double strength_threshold = 0.0;
+  /// The coarsest level has at most this many unknowns (or is the last of maximum_levels).
+  int coarse_size_limit = 2000;
+  int maximum_levels = 10;
+  /// Degree of the Chebyshev smoother (products with A per smoothing step), at least 1.
+  int smoother_degree = 2;
+  /// The Chebyshev interval is [upper / ratio, upper], upper = safety * the Lanczos estimate of
+  /// rho(D^{-1} A).
+  double smoother_interval_ratio = 30.0;
+  double spectrum_safety = 1.1;
+  /// Lanczos steps of the spectral radius estimates.
+  int lanczos_steps = 12;
+  /// omega = prolongator_damping / rho(D^{-1} A); 0 leaves P = P_tent (plain aggregation).
+  double prolongator_damping = 4.0 / 3.0;
+};
+
+/// What one level holds (for reports and tests).
+struct MultigridLevelSummary {
+  int unknowns = 0;
+  long nonzeros = 0;             // stored entries of A_l (both triangles)
+  int nodes = 0;                 // blocks of unknowns (mesh nodes, then aggregates)
+  double spectral_radius = 0.0;  // the estimate of rho(D^{-1} A_l), before the safety factor
+};
+
+class AlgebraicMultigrid final : public Preconditioner {
+ public:
+  /// Sets the hierarchy up for the symmetric positive definite `lower` (only its lower triangle
+  /// is read), the near-null space `near_null_space` (n x m, m >= 1) and `dof_nodes` (n values:
+  /// the node of each unknown; node numbers are any non-negative integers, the unknowns of one
+  /// node need not be consecutive). Throws std::invalid_argument on inconsistent sizes or a
+  /// negative node, SingularBodyError (cholesky.hpp) when the coarsest matrix is not positive
+  /// definite.
+  AlgebraicMultigrid(const SparseMatrix& lower, const Eigen::MatrixXd& near_null_space,
+                     const std::vector<int>& dof_nodes,
+                     const AlgebraicMultigridOptions& options = {});
+  ~AlgebraicMultigrid() override;
+  AlgebraicMultigrid(const AlgebraicMultigrid&) = delete;
+  AlgebraicMultigrid& operator=(const AlgebraicMultigrid&) = delete;
+
+  int size() const override;
+  /// correction = one V-cycle applied to residual from a zero guess (the file comment).
+  void apply(const Eigen::VectorXd& residual, Eigen::VectorXd& correction) const override;
+
+  /// The finest matrix with both triangles (row-major), for PCG's products.
+  const SparseMatrixOperator& fine_operator() const { return *fine_operator_; }
+  std::vector<MultigridLevelSummary> levels() const;
+  /// sum over levels of nonzeros(A_l) / nonzeros(A_0).
+  double operator_complexity() const;
+  double setup_seconds() const { return setup_seconds_; }
+
+ private:
+  struct Level;
+  void build_hierarchy(const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes);
+  void cycle(std::size_t level, const Eigen::VectorXd& right_hand_side,
+             Eigen::VectorXd& solution) const;
+  void smooth(const Level& level, const Eigen::VectorXd& right_hand_side, Eigen::VectorXd& solution,
+              bool zero_guess) const;
+
+  AlgebraicMultigridOptions options_;
+  std::unique_ptr<SparseMatrixOperator> fine_operator_;
+  std::vector<std::unique_ptr<Level>> levels_;
+  struct CoarseSolver;
+  std::unique_ptr<CoarseSolver> coarse_solver_;
+  double setup_seconds_ = 0.0;
+};
+
+/// The m rigid body modes of `mesh` (dof_map.hpp, rigid_mode_row: translations, then rotations
+/// about the centre of the nodes' bounding box scaled by its diagonal) on the free dofs of
+/// `dofs`: free x m, the near-null space of the body's reduced stiffness.
+Eigen::MatrixXd free_rigid_body_modes(const Mesh& mesh, const DofMap& dofs);
+
+/// The mesh node of each free dof of `dofs` (the dof d node + c of free index i gives node):
+/// the AMG's dof_nodes.
+std::vector<int> free_dof_nodes(const Mesh& mesh, const DofMap& dofs);
+
+}  // namespace robin
