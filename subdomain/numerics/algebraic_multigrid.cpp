@@ -30,6 +30,21 @@ void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eige
   }
 }
 
+/// y = A' x (A compressed, row-major): each row of A scattered.
+void multiply_transpose(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x,
+                        Eigen::VectorXd& y) {
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
+  const double* values = matrix.valuePtr();
+  double* output = y.data();
+  y.setZero();
+  const int rows = static_cast<int>(matrix.rows());
+  for (int row = 0; row < rows; ++row) {
+    const double value = x[row];
+    for (int k = starts[row]; k < starts[row + 1]; ++k) output[columns[k]] += values[k] * value;
+  }
+}
+
 /// r = b - A x (A compressed, row-major).
 void subtract_product(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& right_hand_side,
                       const Eigen::VectorXd& x, Eigen::VectorXd& residual) {
@@ -294,30 +309,37 @@ TentativeProlongator tentative_prolongator(const NodeBlocks& blocks,
   return result;
 }
 
-/// P = (I - omega D^{-1} A) P_tent (step 4).
+/// P = (I - omega D^{-1} A) P_tent (step 4), formed in the storage of A P_tent: the pattern of
+/// P_tent is part of it (A has its diagonal), so P_tent's entries are added in place.
 RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
                                         const Eigen::VectorXd& inverse_diagonal, double omega,
                                         const RowMajorSparseMatrix& tentative) {
-  RowMajorSparseMatrix product = matrix * tentative;
-  for (Eigen::Index row = 0; row < product.outerSize(); ++row) {
-    const double factor = omega * inverse_diagonal[row];
-    for (RowMajorSparseMatrix::InnerIterator entry(product, row); entry; ++entry) {
+  RowMajorSparseMatrix smoothed = matrix * tentative;
+  smoothed.makeCompressed();
+  for (Eigen::Index row = 0; row < smoothed.outerSize(); ++row) {
+    const double factor = -omega * inverse_diagonal[row];
+    for (RowMajorSparseMatrix::InnerIterator entry(smoothed, row); entry; ++entry) {
       entry.valueRef() *= factor;
     }
+    for (RowMajorSparseMatrix::InnerIterator entry(tentative, row); entry; ++entry) {
+      smoothed.coeffRef(row, entry.col()) += entry.value();
+    }
   }
-  RowMajorSparseMatrix smoothed = tentative - product;
-  smoothed.makeCompressed();
   return smoothed;
 }
 
-/// P' A P (step 5), symmetrized against rounding: (C + C') / 2.
-RowMajorSparseMatrix galerkin_product(const RowMajorSparseMatrix& restriction,
-                                      const RowMajorSparseMatrix& matrix,
+/// P' A P (step 5) as the sum over blocks of rows J of (P_J)' (A_J P), so that A P (the largest
+/// product of the setup) is never formed whole; symmetrized against rounding: (C + C') / 2.
+RowMajorSparseMatrix galerkin_product(const RowMajorSparseMatrix& matrix,
                                       const RowMajorSparseMatrix& prolongator) {
-  RowMajorSparseMatrix coarse;
-  {
-    const RowMajorSparseMatrix product = matrix * prolongator;
-    coarse = restriction * product;
+  const Eigen::Index rows = matrix.rows(), block = 65536;
+  RowMajorSparseMatrix coarse(prolongator.cols(), prolongator.cols());
+  for (Eigen::Index first = 0; first < rows; first += block) {
+    const Eigen::Index count = std::min(block, rows - first);
+    const RowMajorSparseMatrix product = matrix.middleRows(first, count) * prolongator;
+    const RowMajorSparseMatrix restriction = prolongator.middleRows(first, count).transpose();
+    const RowMajorSparseMatrix part = restriction * product;
+    coarse += part;
   }
   const RowMajorSparseMatrix transposed = coarse.transpose();
   RowMajorSparseMatrix symmetric = 0.5 * (coarse + transposed);
@@ -343,7 +365,7 @@ struct AlgebraicMultigrid::Level {
   RowMajorSparseMatrix owned_matrix;  // A_l for l > 0 (A_0 is the fine operator's)
   const RowMajorSparseMatrix* matrix = nullptr;
   Eigen::VectorXd inverse_diagonal;
-  RowMajorSparseMatrix prolongator, restriction;  // P, P' (empty on the coarsest level)
+  RowMajorSparseMatrix prolongator;  // P (empty on the coarsest level)
   int nodes = 0;
   double spectral_radius = 0.0;
   double interval_low = 0.0, interval_high = 0.0;  // the Chebyshev interval
@@ -410,10 +432,8 @@ void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
             ? smooth_prolongator(matrix, level->inverse_diagonal, omega, tentative.prolongator)
             : std::move(tentative.prolongator);
     level->prolongator.makeCompressed();
-    level->restriction = level->prolongator.transpose();
-    level->restriction.makeCompressed();
     auto coarse = std::make_unique<Level>();
-    coarse->owned_matrix = galerkin_product(level->restriction, matrix, level->prolongator);
+    coarse->owned_matrix = galerkin_product(matrix, level->prolongator);
     coarse->matrix = &coarse->owned_matrix;
     level->coarse_right_hand_side.resize(coarse->owned_matrix.rows());
     level->coarse_solution.resize(coarse->owned_matrix.rows());
@@ -449,7 +469,7 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
   }
   smooth(level, right_hand_side, solution, true);
   subtract_product(*level.matrix, right_hand_side, solution, level.residual);
-  multiply(level.restriction, level.residual, level.coarse_right_hand_side);
+  multiply_transpose(level.prolongator, level.residual, level.coarse_right_hand_side);
   cycle(index + 1, level.coarse_right_hand_side, level.coarse_solution);
   multiply(level.prolongator, level.coarse_solution, level.product);
   solution += level.product;
