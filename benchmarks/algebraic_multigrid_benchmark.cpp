@@ -1,5 +1,5 @@
 // algebraic_multigrid_benchmark [CELLS_X ...] [--skip-cholmod-above DOFS] [--degree K]
-//     [--theta T]
+//     [--theta T] [--gauss-seidel]
 // Conjugate gradients preconditioned by smoothed-aggregation AMG (numerics/algebraic_multigrid.hpp)
 // against CHOLMOD (numerics/cholesky.hpp) on the stiffness of a hexahedron8 box [0, 2] x [0, 1] x
 // [0, 1] of 2n x n x n cells (one argument n per size; default 26, 34 and 43: 1.1e5, 2.5e5
@@ -133,6 +133,8 @@ int main(int argc, char** argv) {
       skip_cholmod_above = std::atol(argv[++k]);
     } else if (std::strcmp(argv[k], "--degree") == 0 && k + 1 < argc) {
       options.smoother_degree = std::atoi(argv[++k]);
+    } else if (std::strcmp(argv[k], "--gauss-seidel") == 0) {
+      options.smoother = robin::MultigridSmoother::symmetric_gauss_seidel;
     } else if (std::strcmp(argv[k], "--theta") == 0 && k + 1 < argc) {
       options.strength_threshold = std::atof(argv[++k]);
     } else if (std::atoi(argv[k]) > 0) {
@@ -140,7 +142,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: algebraic_multigrid_benchmark [CELLS_X ...] [--skip-cholmod-above "
-                   "DOFS] [--degree K] [--theta T]\n");
+                   "DOFS] [--degree K] [--theta T] [--gauss-seidel]\n");
       return 1;
     }
   }

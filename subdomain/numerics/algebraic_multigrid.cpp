@@ -467,13 +467,41 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
     solution = coarse_solver_->factor->solve(right_hand_side);
     return;
   }
-  smooth(level, right_hand_side, solution, true);
+  if (options_.smoother == MultigridSmoother::chebyshev) {
+    smooth(level, right_hand_side, solution, true);
+  } else {
+    solution.setZero();
+    smooth_gauss_seidel(level, right_hand_side, solution, true);
+  }
   subtract_product(*level.matrix, right_hand_side, solution, level.residual);
   multiply_transpose(level.prolongator, level.residual, level.coarse_right_hand_side);
   cycle(index + 1, level.coarse_right_hand_side, level.coarse_solution);
   multiply(level.prolongator, level.coarse_solution, level.product);
   solution += level.product;
-  smooth(level, right_hand_side, solution, false);
+  if (options_.smoother == MultigridSmoother::chebyshev) {
+    smooth(level, right_hand_side, solution, false);
+  } else {
+    smooth_gauss_seidel(level, right_hand_side, solution, false);
+  }
+}
+
+/// One Gauss-Seidel sweep over the rows, ascending (forward) or descending:
+/// x_i += (b_i - sum_j A_ij x_j) / A_ii, with the x_j already updated in this sweep.
+void AlgebraicMultigrid::smooth_gauss_seidel(const Level& level,
+                                             const Eigen::VectorXd& right_hand_side,
+                                             Eigen::VectorXd& solution, bool forward) const {
+  const RowMajorSparseMatrix& matrix = *level.matrix;
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
+  const double* values = matrix.valuePtr();
+  double* x = solution.data();
+  const int rows = static_cast<int>(matrix.rows());
+  for (int step = 0; step < rows; ++step) {
+    const int row = forward ? step : rows - 1 - step;
+    double sum = right_hand_side[row];
+    for (int k = starts[row]; k < starts[row + 1]; ++k) sum -= values[k] * x[columns[k]];
+    x[row] += sum * level.inverse_diagonal[row];
+  }
 }
 
 /// Chebyshev iteration for D^{-1} A x = D^{-1} b on [low, high] (Saad, Iterative Methods for

@@ -65,7 +65,14 @@ class SparseMatrixOperator final : public LinearOperator {
   RowMajorSparseMatrix matrix_;
 };
 
+/// The smoother of the V-cycle (the file comment).
+enum class MultigridSmoother {
+  chebyshev,               // the Chebyshev polynomial in D^{-1} A, pre and post
+  symmetric_gauss_seidel,  // a forward Gauss-Seidel sweep before, a backward one after
+};
+
 struct AlgebraicMultigridOptions {
+  MultigridSmoother smoother = MultigridSmoother::chebyshev;
   /// theta of the strength of connection (step 1 of the file comment); 0 keeps every
   /// connection of the matrix graph.
   double strength_threshold = 0.0;
@@ -123,6 +130,8 @@ class AlgebraicMultigrid final : public Preconditioner {
   void build_hierarchy(const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes);
   void cycle(std::size_t level, const Eigen::VectorXd& right_hand_side,
              Eigen::VectorXd& solution) const;
+  void smooth_gauss_seidel(const Level& level, const Eigen::VectorXd& right_hand_side,
+                           Eigen::VectorXd& solution, bool forward) const;
   void smooth(const Level& level, const Eigen::VectorXd& right_hand_side, Eigen::VectorXd& solution,
               bool zero_guess) const;
 
