@@ -173,19 +173,21 @@ template <typename Visit>
 void for_each_block_norm(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
                          Visit visit) {
   std::vector<double> accumulated(static_cast<std::size_t>(blocks.count()), 0.0);
+  std::vector<int> seen_by(static_cast<std::size_t>(blocks.count()), -1);  // the last node
   std::vector<int> touched;
   for (int node = 0; node < blocks.count(); ++node) {
     for (int k = blocks.start[node]; k < blocks.start[node + 1]; ++k) {
       for (RowMajorSparseMatrix::InnerIterator entry(matrix, blocks.unknowns[k]); entry; ++entry) {
         const int other = blocks.node_of[static_cast<std::size_t>(entry.col())];
-        if (accumulated[other] == 0.0) touched.push_back(other);
-        accumulated[other] += entry.value() * entry.value() + 1e-300;  // marks even zeros
+        if (seen_by[other] != node) {
+          seen_by[other] = node;
+          accumulated[other] = 0.0;
+          touched.push_back(other);
+        }
+        accumulated[other] += entry.value() * entry.value();
       }
     }
-    for (int other : touched) {
-      visit(node, other, accumulated[other]);
-      accumulated[other] = 0.0;
-    }
+    for (int other : touched) visit(node, other, accumulated[other]);
     touched.clear();
   }
 }
@@ -267,7 +269,6 @@ struct TentativeProlongator {
 TentativeProlongator tentative_prolongator(const NodeBlocks& blocks,
                                            const std::vector<int>& aggregate, int aggregate_count,
                                            const Eigen::MatrixXd& near_null_space) {
-  std::vector<int> by_aggregate(aggregate.begin(), aggregate.end());
   std::vector<int> dof_aggregate(blocks.node_of.size());
   for (std::size_t unknown = 0; unknown < dof_aggregate.size(); ++unknown) {
     dof_aggregate[unknown] = aggregate[static_cast<std::size_t>(blocks.node_of[unknown])];

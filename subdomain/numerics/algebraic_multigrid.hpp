@@ -28,13 +28,22 @@
 // x = 0), restriction of the residual by P', the next level, prolongation by P, post-smoothing
 // by the same polynomial. Both smoothing steps have the error propagation I - s(D^{-1}A) D^{-1}A,
 // which is self-adjoint in the A inner product, and the coarsest solve is exact, so M^{-1} is
-// symmetric; it is positive definite since the smoother converges (the Chebyshev interval's
-// upper end bounds rho(D^{-1} A)). Chebyshev iteration of degree k on [lambda_max / ratio,
-// lambda_max] (Adams, Brezina, Hu, Tuminaro 2003): k products with A per smoothing step.
+// symmetric; it is positive definite when the smoother converges in the A-norm, which for
+// Chebyshev needs the interval's upper end to bound rho(D^{-1} A): the Lanczos estimate is a
+// lower bound, hence the safety factor (AlgebraicMultigridOptions::spectrum_safety).
+// The smoother is the Chebyshev iteration of degree k on [upper / ratio, upper], upper = safety x
+// the estimate of rho(D^{-1} A) (Adams, Brezina, Hu, Tuminaro 2003): k products with A per
+// smoothing step. The alternative smoother (MultigridSmoother::symmetric_gauss_seidel) is, with
+// A = L + D + L', a forward Gauss-Seidel sweep (D + L)^{-1} before the coarse correction and a
+// backward one (D + L')^{-1} after it: the post-smoother is the transpose of the pre-smoother,
+// which again makes the V-cycle symmetric (and positive definite: Gauss-Seidel converges for
+// SPD A).
 //
-// Matrices are stored row-major (CSR) for the products; the setup keeps, per level, A, P, P'
-// and D^{-1}, and the apply allocates nothing (its workspace is kept per level, so one
-// AlgebraicMultigrid must not be applied from two threads at once).
+// Matrices are stored row-major (CSR) for the products; the setup keeps, per level, A, P and
+// D^{-1} (P' x is computed by scattering the rows of P), and P' A P is summed over blocks of rows
+// so that A P is never formed whole. The apply allocates only the coarsest level's solution (the
+// CholeskyFactor's solve); its other workspace is kept per level, so one AlgebraicMultigrid must
+// not be applied from two threads at once.
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -115,7 +124,8 @@ class AlgebraicMultigrid final : public Preconditioner {
   AlgebraicMultigrid& operator=(const AlgebraicMultigrid&) = delete;
 
   int size() const override;
-  /// correction = one V-cycle applied to residual from a zero guess (the file comment).
+  /// correction = one V-cycle applied to residual from a zero guess (the file comment); the two
+  /// must be distinct vectors.
   void apply(const Eigen::VectorXd& residual, Eigen::VectorXd& correction) const override;
 
   /// The finest matrix with both triangles (row-major), for PCG's products.

@@ -101,8 +101,9 @@ double difference_from_cholmod(const ClampedBody& body, const PcgRun& run) {
   return (run.solution - direct).norm() / direct.norm();
 }
 
-void expect_matches_cholmod(const ClampedBody& body) {
-  const PcgRun run = solve_with_multigrid(body);
+void expect_matches_cholmod(const ClampedBody& body,
+                            const AlgebraicMultigridOptions& options = test_options()) {
+  const PcgRun run = solve_with_multigrid(body, options);
   EXPECT_EQ(run.result.status, ConjugateGradientStatus::converged);
   // the residual independently of the solver's report
   const SparseMatrixOperator matrix(body.lower);
@@ -120,6 +121,13 @@ TEST(AlgebraicMultigrid, HexahedralCubeMatchesCholmod) {
 
 TEST(AlgebraicMultigrid, StretchedHexahedralBoxMatchesCholmod) {
   expect_matches_cholmod(clamped_box({4.0, 1.0, 1.0}, {16, 4, 4}, ElementType::hexahedron8));
+}
+
+TEST(AlgebraicMultigrid, GaussSeidelSmootherMatchesCholmod) {
+  AlgebraicMultigridOptions options = test_options();
+  options.smoother = MultigridSmoother::symmetric_gauss_seidel;
+  expect_matches_cholmod(clamped_box({4.0, 1.0, 1.0}, {16, 4, 4}, ElementType::hexahedron8),
+                         options);
 }
 
 TEST(AlgebraicMultigrid, LinearTetrahedraMatchCholmod) {
@@ -212,6 +220,9 @@ TEST(AlgebraicMultigrid, VCycleIsSymmetricPositiveDefinite) {
   AlgebraicMultigridOptions cubic = test_options();
   cubic.smoother_degree = 3;
   expect_symmetric_positive(body, cubic);
+  AlgebraicMultigridOptions gauss_seidel = test_options();
+  gauss_seidel.smoother = MultigridSmoother::symmetric_gauss_seidel;
+  expect_symmetric_positive(body, gauss_seidel);
 }
 
 TEST(ConjugateGradient, InitialGuessAndZeroLoad) {
