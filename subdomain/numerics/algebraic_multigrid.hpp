@@ -88,8 +88,10 @@ struct AlgebraicMultigridOptions {
   /// The coarsest level has at most this many unknowns (or is the last of maximum_levels).
   int coarse_size_limit = 2000;
   int maximum_levels = 10;
-  /// Degree of the Chebyshev smoother (products with A per smoothing step), at least 1.
-  int smoother_degree = 2;
+  /// Degree of the Chebyshev smoother (products with A per smoothing step), at least 1. Degree 1
+  /// is Jacobi damped by 2 / (upper + upper / ratio). It needs more PCG iterations than 2 or 3
+  /// but the fewest products with A in all on hexahedral elasticity (docs/benchmarks.md).
+  int smoother_degree = 1;
   /// The Chebyshev interval is [upper / ratio, upper], upper = safety * the Lanczos estimate of
   /// rho(D^{-1} A).
   double smoother_interval_ratio = 30.0;
