@@ -90,7 +90,7 @@ struct AlgebraicMultigridOptions {
   int maximum_levels = 10;
   /// Degree of the Chebyshev smoother (products with A per smoothing step), at least 1. Degree 1
   /// is Jacobi damped by 2 / (upper + upper / ratio). It needs more PCG iterations than 2 or 3
-  /// but the fewest products with A in all on hexahedral elasticity (docs/benchmarks.md).
+  /// but was the fastest to 1e-10 on hexahedral elasticity (docs/benchmarks.md).
   int smoother_degree = 1;
   /// The Chebyshev interval is [upper / ratio, upper], upper = safety * the Lanczos estimate of
   /// rho(D^{-1} A).
