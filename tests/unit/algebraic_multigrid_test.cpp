@@ -9,6 +9,7 @@
 #include <iostream>
 #include <optional>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -231,6 +232,21 @@ TEST(AlgebraicMultigrid, VCycleIsSymmetricPositiveDefinite) {
   AlgebraicMultigridOptions gauss_seidel = test_options();
   gauss_seidel.smoother = MultigridSmoother::symmetric_gauss_seidel;
   expect_symmetric_positive(body, gauss_seidel);
+}
+
+TEST(AlgebraicMultigrid, InconsistentInputIsRefused) {
+  const ClampedBody body = clamped_box({1.0, 1.0, 1.0}, {3, 3, 3}, ElementType::hexahedron8);
+  const Eigen::MatrixXd short_modes = body.near_null_space.topRows(body.lower.rows() - 1);
+  EXPECT_THROW(AlgebraicMultigrid(body.lower, short_modes, body.dof_nodes), std::invalid_argument);
+  std::vector<int> nodes = body.dof_nodes;
+  nodes.pop_back();
+  EXPECT_THROW(AlgebraicMultigrid(body.lower, body.near_null_space, nodes), std::invalid_argument);
+  nodes = body.dof_nodes;
+  nodes[0] = -1;
+  EXPECT_THROW(AlgebraicMultigrid(body.lower, body.near_null_space, nodes), std::invalid_argument);
+  const AlgebraicMultigrid multigrid(body.lower, body.near_null_space, body.dof_nodes);
+  Eigen::VectorXd correction;
+  EXPECT_THROW(multigrid.apply(Eigen::VectorXd::Ones(3), correction), std::invalid_argument);
 }
 
 TEST(ConjugateGradient, InitialGuessAndZeroLoad) {
