@@ -3,6 +3,7 @@
 #include <suitesparse/cholmod.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <new>
 #include <stdexcept>
@@ -121,22 +122,25 @@ cholmod_sparse* supervariable_graph(const SymmetricPattern& pattern, const std::
   return graph;
 }
 
-/// Fill-reducing order of `graph`: the better of AMD and METIS by the flop count of the
-/// symbolic factorization (CHOLMOD's choice among two methods). Restores common's settings.
-std::vector<int> order_graph(cholmod_sparse* graph, cholmod_common& common,
-                             const std::string& body_name) {
+/// An elimination order of a graph's vertices and the flops of its (vertex-level) factorization.
+struct GraphOrder {
+  std::vector<int> order;
+  double flops = 0.0;
+};
+
+/// The order of `graph` by one of CHOLMOD's ordering methods (CHOLMOD_AMD, CHOLMOD_METIS) and
+/// the flop count of its symbolic factorization. Restores common's settings.
+GraphOrder order_by(cholmod_sparse* graph, int method, cholmod_common& common,
+                    const std::string& body_name) {
   const int method_count = common.nmethods;
   const int first_ordering = common.method[0].ordering;
-  const int second_ordering = common.method[1].ordering;
   const int supernodal = common.supernodal;
-  common.nmethods = 2;
-  common.method[0].ordering = CHOLMOD_AMD;
-  common.method[1].ordering = CHOLMOD_METIS;
+  common.nmethods = 1;
+  common.method[0].ordering = method;
   common.supernodal = CHOLMOD_SIMPLICIAL;  // only the permutation is wanted
   cholmod_factor* symbolic = cholmod_analyze(graph, &common);
   common.nmethods = method_count;
   common.method[0].ordering = first_ordering;
-  common.method[1].ordering = second_ordering;
   common.supernodal = supernodal;
   if (symbolic == nullptr || common.status < CHOLMOD_OK) {
     if (symbolic != nullptr) cholmod_free_factor(&symbolic, &common);
@@ -145,9 +149,33 @@ std::vector<int> order_graph(cholmod_sparse* graph, cholmod_common& common,
                              std::to_string(common.status) + ")");
   }
   const auto* permutation = static_cast<const int*>(symbolic->Perm);
-  std::vector<int> order(permutation, permutation + graph->nrow);
+  GraphOrder result{std::vector<int>(permutation, permutation + graph->nrow), common.fl};
   cholmod_free_factor(&symbolic, &common);
-  return order;
+  return result;
+}
+
+/// Fill-reducing order of `graph`, whose vertices stand for `unknowns_per_vertex` unknowns each
+/// on average: AMD's, or METIS's when METIS is tried and needs fewer flops. METIS (nested
+/// dissection) costs far more than AMD, in proportion to the graph's entries, and pays off only
+/// through a cheaper numerical factorization: it is tried when the factorization with AMD's
+/// order needs more than metis_threshold flops per stored entry of the graph, the flops of the
+/// unknowns estimated as unknowns_per_vertex^3 times the graph's (a vertex's unknowns form a
+/// dense block). Below that (small and mid-size plane bodies) METIS's own cost exceeds what it
+/// saves; above it (large plane bodies, solid bodies of every size) it saves more.
+std::vector<int> order_graph(cholmod_sparse* graph, double unknowns_per_vertex,
+                             cholmod_common& common, const std::string& body_name) {
+  constexpr double metis_threshold = 2e4;  // docs/benchmarks.md, "AMD or METIS"
+  GraphOrder best = order_by(graph, CHOLMOD_AMD, common, body_name);
+  const double entries = static_cast<double>(static_cast<const int*>(graph->p)[graph->ncol]);
+  const double unknown_flops = best.flops * std::pow(unknowns_per_vertex, 3);
+  if (unknown_flops > metis_threshold * entries) {
+    GraphOrder nested = order_by(graph, CHOLMOD_METIS, common, body_name);
+    if (std::getenv("ROBIN_ORDER_DEBUG"))
+      std::fprintf(stderr, "ORDER %s metis flops %.3e amd %.3e\n", body_name.c_str(), nested.flops,
+                   best.flops);
+    if (nested.flops < best.flops) best = std::move(nested);
+  }
+  return std::move(best.order);
 }
 
 }  // namespace
@@ -181,7 +209,9 @@ std::vector<int> fill_reducing_ordering(const SparseMatrix& matrix,
     }
     std::vector<int> order;
     try {
-      order = order_graph(graph, common, body_name);
+      const double unknowns_per_vertex =
+          static_cast<double>(leading_count) / static_cast<double>(graph->nrow);
+      order = order_graph(graph, unknowns_per_vertex, common, body_name);
     } catch (...) {
       cholmod_free_sparse(&graph, &common);
       throw;

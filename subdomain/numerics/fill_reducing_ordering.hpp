@@ -9,9 +9,12 @@
 // node-level elimination does, so the order is as good as one computed on the unknowns, at a
 // fraction of the cost of AMD and METIS on the full graph.
 //
-// On the supervariable graph both AMD and METIS (nested dissection) are computed and the one
-// whose symbolic factor needs fewer floating-point operations is kept (CHOLMOD's cholmod_analyze
-// with two methods): METIS wins on large 2D and on 3D bodies, AMD on small 2D ones.
+// On the supervariable graph AMD is computed first. METIS (nested dissection) costs far more and
+// pays off only through a cheaper numerical factorization, so it is computed too only when the
+// factorization with AMD's order needs many floating-point operations per entry of the graph
+// (more than 2e4, the unknowns' flops estimated from the graph's), and the order with fewer flops
+// is kept: METIS is tried on large plane bodies and on solid bodies of every size, not on small
+// and mid-size plane bodies, where its own cost exceeds what it saves (docs/benchmarks.md).
 
 #include <string>
 #include <vector>
