@@ -40,7 +40,16 @@ TRIANGLE3 or QUADRILATERAL4 boundary faces is served like a plane body (Interfac
 FieldsReply with dimension 3, three components per vector); TETRAHEDRON10 cells and TRIANGLE6
 faces are refused with UNSUPPORTED naming the cell type (mesh_data.py).
 
-Every reply echoes the request_id and carries version (protocol_major, 1). Failures are Error
+Since 2.5: InterfaceDescription, the Acknowledge of AssignContact and FieldsReply carry
+peak_resident_bytes, the process's peak resident set size (resident_memory.py); a FieldsRequest
+with omit_fields_from_reply and write_directory is answered without the mesh and the fields
+(the file written as without the flag), and the flag without write_directory is
+INVALID_ARGUMENT. As in robin-subdomain, the server's own minor version decides, not the
+request's: a 2.4 client does not know these fields (proto3 skips them) and cannot set the flag.
+A server made with protocol_minor below 5 (robin-subdomain-py --protocol-minor, testing only)
+sends no peak_resident_bytes and ignores the flag, as a 2.4 server does.
+
+Every reply echoes the request_id and carries version (protocol_major, protocol_minor). Failures are Error
 replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH (another
 major version, e.g. a 1.x request), WRONG_STATE (also for another run's run_id),
 INVALID_ARGUMENT (sizes, the constraint operator, non-finite values, a refused write_directory),
@@ -63,14 +72,18 @@ from .fields import body_fields, vtu_bytes
 from .mesh import VTK_CELL_TYPE
 from .mesh_data import quoted
 from .paths import PathRefused, check_output_directory, write_under_root
+from .resident_memory import peak_resident_bytes
 from .setup_decoding import decode_setup_body
 
-PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 4
+PROTOCOL_MAJOR, PROTOCOL_MINOR = 2, 5
 MAXIMUM_LOAD_FACTOR = 1e6         # SetLoadFactor: a larger magnitude is BAD_INPUT
 AWAITING_SETUP, AWAITING_ASSIGNMENT, READY = "awaiting_setup", "awaiting_assignment", "ready"
 REQUESTS = ("hello", "setup_body", "assign_contact", "contact_solve", "correction",
             "neumann_solve", "fields", "end_run", "shutdown", "set_load_factor")
 CAPABILITIES = ("contact_solve", "correction_solve", "fields", "neumann_solve")
+# The FieldsReply fields left out for FieldsRequest.omit_fields_from_reply (protocol 2.5).
+OMITTED_FIELDS = ("node_coordinates", "node_tags", "cell_types", "cell_offsets", "connectivity",
+                  "point_fields", "cell_fields", "boundaries")
 
 
 def _add_stage_times(stage_times, stages):
@@ -133,14 +146,19 @@ DEFAULT_MAXIMUM_DOFS = 20000000
 
 class SubdomainProtocol:
     def __init__(self, protocol, name="", protocol_major=PROTOCOL_MAJOR, logger=None,
-                 data_directory=None, output_root=None, maximum_dofs=DEFAULT_MAXIMUM_DOFS):
-        """`data_directory`: where SetupBody.mesh_path is resolved (None: refused);
+                 data_directory=None, output_root=None, maximum_dofs=DEFAULT_MAXIMUM_DOFS,
+                 protocol_minor=PROTOCOL_MINOR):
+        """`protocol_major`, `protocol_minor`: the version the server announces and speaks
+        (others than PROTOCOL_MAJOR, PROTOCOL_MINOR for testing only; below minor 5 no 2.5
+        field is sent and omit_fields_from_reply is ignored);
+        `data_directory`: where SetupBody.mesh_path is resolved (None: refused);
         `output_root`: where FieldsRequest.write_directory is created (None: refused);
         `maximum_dofs`: the largest body (2 degrees of freedom per node) set up, checked after
         the mesh is decoded and before assembly (0: no limit)."""
         self.protocol = protocol          # the robin_pb2 module
         self.name = name
         self.protocol_major = protocol_major
+        self.protocol_minor = protocol_minor
         self.data_directory = data_directory
         self.output_root = output_root
         self.maximum_dofs = maximum_dofs
@@ -207,7 +225,7 @@ class SubdomainProtocol:
             record.outcome = "%s: %s" % (self.protocol.ErrorCode.Name(reply.error.code),
                                          reply.error.message)
         reply.version.major = self.protocol_major
-        reply.version.minor = PROTOCOL_MINOR
+        reply.version.minor = self.protocol_minor
         body = " body '%s'" % record.body if record.body else ""
         self.logger.log(logging.WARNING if record.failed else logging.INFO, "%s%s%s: %s (%.3f ms)",
                         record.type, body, record.iteration, record.outcome, 1e3 * seconds)
@@ -223,7 +241,7 @@ class SubdomainProtocol:
                 "VERSION_MISMATCH",
                 "protocol version mismatch: the request speaks %d.%d, this server %d.%d (the major "
                 "versions must be equal); use a matching coordinator or server" %
-                (major, request.version.minor, self.protocol_major, PROTOCOL_MINOR))
+                (major, request.version.minor, self.protocol_major, self.protocol_minor))
 
     def _dispatch(self, request, content, reply, record):
         handlers = {"hello": self._on_hello, "setup_body": self._on_setup_body,
@@ -240,7 +258,7 @@ class SubdomainProtocol:
         if len(request.UnknownFields()) > 0:
             raise RequestError("UNSUPPORTED", "the request type is unknown to this server "
                                "(protocol %d.%d); check HelloReply.capabilities" %
-                               (self.protocol_major, PROTOCOL_MINOR))
+                               (self.protocol_major, self.protocol_minor))
         raise RequestError("MALFORMED_MESSAGE", "the Envelope carries no request (no content)")
 
     def _require_state(self, minimum, request_type):
@@ -313,6 +331,8 @@ class SubdomainProtocol:
             ("mesh", mesh_seconds), ("assembly", body.assembly_seconds),
             ("factorization", body.factorization_seconds)))
         reply.interface.request_seconds = time.perf_counter() - record.start
+        if self._reports_peak_resident():
+            reply.interface.peak_resident_bytes = peak_resident_bytes()
         self.settings = settings
         self.body = body
         self.run_id = request.run_id
@@ -354,6 +374,8 @@ class SubdomainProtocol:
         self.state = READY
         self._acknowledge(reply)
         _add_stage_times(reply.acknowledge.stage_times, (("interface operator", interface_seconds),))
+        if self._reports_peak_resident():
+            reply.acknowledge.peak_resident_bytes = peak_resident_bytes()
         record.outcome = "ok, %d constraints, %d entries" % (operator.row_count,
                                                              len(operator.values))
 
@@ -439,11 +461,27 @@ class SubdomainProtocol:
         reply.load_factor_set.state = self.state
         reply.load_factor_set.compute_seconds = time.perf_counter() - start
 
+    def _reports_peak_resident(self):
+        """Whether replies carry peak_resident_bytes (protocol 2.5)."""
+        return self.protocol_minor >= 5
+
+    def _omits_fields(self, message):
+        """Whether the FieldsReply leaves out the mesh and the fields (2.5,
+        omit_fields_from_reply; ignored below 5); INVALID_ARGUMENT without write_directory."""
+        if self.protocol_minor < 5 or not message.omit_fields_from_reply:
+            return False
+        if not message.write_directory:
+            raise RequestError("INVALID_ARGUMENT", "body '%s': FieldsRequest."
+                               "omit_fields_from_reply is set without write_directory: the "
+                               "fields would go nowhere" % self.body.name)
+        return True
+
     def _on_fields(self, request, reply, record):
         start = time.perf_counter()
         message = request.fields
         self._require_same_run(request, "FieldsRequest")
         self._require_state(READY, "FieldsRequest")
+        omit_fields = self._omits_fields(message)
         force = _checked_vector(message.contact_force, self.body.contact.size(),
                                 "FieldsRequest.contact_force", self.body.name)
         if message.write_directory:
@@ -460,7 +498,12 @@ class SubdomainProtocol:
                                          self.body.name + ".vtu", text),
                 message.write_directory)
             reply.fields_reply.written_file = path
+        if omit_fields:   # the file holds them, written exactly as without the flag
+            for name in OMITTED_FIELDS:
+                reply.fields_reply.ClearField(name)
         _add_stage_times(reply.fields_reply.stage_times, (("fields", time.perf_counter() - start),))
+        if self._reports_peak_resident():
+            reply.fields_reply.peak_resident_bytes = peak_resident_bytes()
 
     def _output_refusal(self, action, write_directory):
         """action(), its PathRefused or OSError an INVALID_ARGUMENT naming the body and the

@@ -1,5 +1,5 @@
 """robin-subdomain-py: serves one elastic body of a robin-contact run over ZeroMQ
-(proto/robin.proto, protocol 2.0), with the command line of the C++ robin-subdomain.
+(proto/robin.proto, protocol 2.5), with the command line of the C++ robin-subdomain.
 
 Files: the server reads a mesh file only for SetupBody.mesh_path, and only under the directory
 given by --data-directory DIR (without it every mesh_path is refused); it writes result files
@@ -105,12 +105,18 @@ def parse_arguments(arguments):
     # Testing only: announce and accept another protocol major version.
     parser.add_argument("--protocol-major", type=int, default=PROTOCOL_MAJOR,
                         help=argparse.SUPPRESS)
+    # Testing only: announce another protocol minor version and speak it (below 5: no
+    # peak_resident_bytes, omit_fields_from_reply ignored), as robin-subdomain --protocol-minor.
+    parser.add_argument("--protocol-minor", type=int, default=PROTOCOL_MINOR,
+                        help=argparse.SUPPRESS)
     curve = curve_option(arguments)
     if curve is not None:
         parser.exit(2, "%s: error: %s\n" % (parser.prog, CURVE_REFUSAL % curve))
     options = parser.parse_args(arguments)
     if options.max_message_size <= 0:
         parser.error("--max-message-size must be a positive number")
+    if options.protocol_minor < 0:
+        parser.error("--protocol-minor must be 0 or a positive number")
     if options.max_dofs < 0:
         parser.error("--max-dofs must be 0 (no limit) or a positive number")
     for option, value in (("--data-directory", options.data_directory),
@@ -234,7 +240,8 @@ def main(arguments=None):
         handler = SubdomainProtocol(protocol_module, options.name, options.protocol_major, logger,
                                     data_directory=options.data_directory,
                                     output_root=options.output_root,
-                                    maximum_dofs=options.max_dofs)
+                                    maximum_dofs=options.max_dofs,
+                                    protocol_minor=options.protocol_minor)
         reason = serve(handler, options, lambda: bool(stop_requested), logger)
         logger.info("stopped: %s", reason)
         return 0

@@ -1,6 +1,6 @@
 """The protocol state machine of the Python subdomain server (protocol 2.0), without a socket:
 states and their transitions, the error codes of refused requests, and replies that echo the
-request id and carry version 2.0 (a 1.x request is VERSION_MISMATCH naming both versions).
+request id and carry version 2.5 (a 1.x request is VERSION_MISMATCH naming both versions).
 SetupBody: MeshData checked (sizes, indices, names, inverted or folded cells named by tag and
 source), mesh_path confined to the data directory, InterfaceDescription with its fixed components
 and its segments oriented with the body on their left. AssignContact: every inconsistency of the
@@ -71,9 +71,12 @@ def changed_mesh(change):
 
 
 class ServerTestCase(unittest.TestCase):
+    SERVER_MINOR = 5   # the minor version the server speaks (protocol 2.5), on every reply
+
     def make_server(self, **options):
         server = SubdomainProtocol(protocol, **options)
         server.logger.disabled = True
+        self.expected_version = (2, options.get("protocol_minor", self.SERVER_MINOR))
         return server
 
     def setUp(self):
@@ -82,7 +85,7 @@ class ServerTestCase(unittest.TestCase):
     def ask(self, data):
         reply = protocol.Envelope()
         reply.ParseFromString(self.server.handle(data))
-        self.assertEqual((reply.version.major, reply.version.minor), (2, 4))
+        self.assertEqual((reply.version.major, reply.version.minor), self.expected_version)
         return reply
 
     def expect_error(self, data, code, state):
@@ -118,7 +121,7 @@ class StateMachine(ServerTestCase):
         for major, minor in ((1, 2), (1, 0), (3, 1)):
             message = self.expect_error(request(major=major, minor=minor, hello=protocol.Hello()),
                                         "VERSION_MISMATCH", "awaiting_setup")
-            self.assertIn("the request speaks %d.%d, this server 2.4" % (major, minor), message)
+            self.assertIn("the request speaks %d.%d, this server 2.5" % (major, minor), message)
         self.expect_error(request(major=1, minor=2, setup_body=setup_body()), "VERSION_MISMATCH",
                           "awaiting_setup")
         self.expect_error(request(acknowledge=protocol.Acknowledge()), "UNSUPPORTED",
