@@ -10,12 +10,18 @@ The bodies (support.box_tetrahedra, box_hexahedra; interior nodes moved off the 
   - 8-node hexahedra with an isotropic material given by E and nu, the same loads and sides.
 The requests: SetupBody, AssignContact (node-to-node rows with the C++ server's normals),
 ContactSolveRequest with an obstacle that closes part of the contact, CorrectionRequest,
-NeumannSolveRequest and FieldsRequest.
+NeumannSolveRequest and FieldsRequest, all saying version 2.4: both servers, which speak 2.5,
+answer SetupBody, AssignContact and FieldsRequest with a positive peak_resident_bytes (the
+server's own minor version decides which fields a reply carries, not the request's); a
+FieldsRequest with omit_fields_from_reply and write_directory (under each server's
+--output-root) is answered by both without mesh and fields, with the same resultants.
 """
 
 import os
 import pathlib
+import shutil
 import subprocess
+import tempfile
 import unittest
 
 import numpy as np
@@ -119,14 +125,17 @@ class AgainstCpp(unittest.TestCase):
         directory = bin_directory()
         cls.context = zmq.Context()
         script = support.PYTHON_DIRECTORY / "robin-subdomain-py"
-        cls.cpp = Server([str(directory / "robin-subdomain")], cls.context)
-        cls.python = Server(["/usr/bin/python3", str(script)], cls.context)
+        cls.output_root = tempfile.mkdtemp(prefix="robin-against-cpp-")
+        root = ["--output-root", cls.output_root]
+        cls.cpp = Server([str(directory / "robin-subdomain")] + root, cls.context)
+        cls.python = Server(["/usr/bin/python3", str(script)] + root, cls.context)
 
     @classmethod
     def tearDownClass(cls):
         cls.cpp.stop()
         cls.python.stop()
         cls.context.term()
+        shutil.rmtree(cls.output_root)
 
     def both(self, **content):
         replies = [server.ask(**content) for server in (self.cpp, self.python)]
@@ -175,13 +184,45 @@ class AgainstCpp(unittest.TestCase):
         for name in ("reaction_resultant", "applied_force"):
             self.close(getattr(cpp, name), getattr(python, name), name)
 
+    def expect_peak_resident_sizes(self, *pairs):
+        """Both servers speak 2.5 and answer these requests, which say 2.4, with a positive
+        peak_resident_bytes: the server's own minor version decides, not the request's."""
+        for pair in pairs:
+            for server, message in zip(("robin-subdomain", "robin-subdomain-py"), pair):
+                self.assertGreater(message.peak_resident_bytes, 0,
+                                   "%s, %s" % (server, message.DESCRIPTOR.name))
+
+    def compare_omitted_fields(self, force, body_name):
+        """FieldsRequest.omit_fields_from_reply (2.5) with write_directory: both replies without
+        mesh and fields, with the same resultants, dimension and file name (each server writes
+        its own file under its directory: cpp/, python/)."""
+        replies = []
+        for server, directory in ((self.cpp, "cpp"), (self.python, "python")):
+            reply = server.ask(fields=protocol.FieldsRequest(
+                contact_force=force, write_directory=directory, omit_fields_from_reply=True))
+            self.assertEqual(reply.WhichOneof("content"), "fields_reply", reply)
+            replies.append(reply.fields_reply)
+            self.assertEqual(reply.fields_reply.written_file,
+                             os.path.join(self.output_root, directory, body_name + ".vtu"))
+            self.assertTrue(os.path.isfile(reply.fields_reply.written_file))
+        for name in ("node_coordinates", "node_tags", "cell_types", "cell_offsets",
+                     "connectivity", "point_fields", "cell_fields", "boundaries"):
+            self.assertEqual([len(getattr(reply, name)) for reply in replies], [0, 0], name)
+        self.assertEqual([reply.dimension for reply in replies], [3, 3])
+        self.assertEqual([[entry.stage for entry in reply.stage_times] for reply in replies],
+                         [["fields"], ["fields"]])
+        for name in ("reaction_resultant", "applied_force"):
+            self.close(getattr(replies[0], name), getattr(replies[1], name), "omitted " + name)
+
     def run_body(self, body):
         self.measured = {}
         cpp, python = self.both(setup_body=body)
         self.compare_interface(cpp.interface, python.interface)
         assign = free_node_to_node_assignment(cpp.interface)
         count = len(assign.weights)
-        self.both(assign_contact=assign)
+        acknowledgements = self.both(assign_contact=assign)
+        self.expect_peak_resident_sizes([cpp.interface, python.interface],
+                                        [reply.acknowledge for reply in acknowledgements])
         # Free trace first (far obstacle), then an obstacle that closes the nodes with x < 1.
         far = self.both(contact_solve=protocol.ContactSolveRequest(obstacle=[1.0] * count))
         free = np.array(far[0].contact_result.normal_trace)
@@ -211,6 +252,8 @@ class AgainstCpp(unittest.TestCase):
                    python_neumann.neumann_result.normal_trace, "NeumannSolveResult")
         cpp_fields, python_fields = self.both(fields=protocol.FieldsRequest(contact_force=force))
         self.compare_fields(cpp_fields.fields_reply, python_fields.fields_reply)
+        self.expect_peak_resident_sizes([cpp_fields.fields_reply, python_fields.fields_reply])
+        self.compare_omitted_fields(force, body.body_name)
         self.both(end_run=protocol.EndRun())
         worst = max(self.measured, key=self.measured.get)
         print("\n%s: %d comparisons, largest relative difference %.3g (%s)" % (
