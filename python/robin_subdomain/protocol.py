@@ -49,13 +49,14 @@ request's: a 2.4 client does not know these fields (proto3 skips them) and canno
 A server made with protocol_minor below 5 (robin-subdomain-py --protocol-minor, testing only)
 sends no peak_resident_bytes and ignores the flag, as a 2.4 server does.
 
-Every reply echoes the request_id and carries version (protocol_major, protocol_minor). Failures are Error
-replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH (another
-major version, e.g. a 1.x request), WRONG_STATE (also for another run's run_id),
-INVALID_ARGUMENT (sizes, the constraint operator, non-finite values, a refused write_directory),
-BAD_INPUT (the body definition, its mesh, a refused mesh_path), SINGULAR_BODY, SOLVER_FAILURE
-(a reply would carry a non-finite number), UNSUPPORTED (a reply sent as a request, a request
-unknown to this version), INTERNAL (anything else).
+Every reply echoes the request_id and carries version (protocol_major, protocol_minor). Failures
+are Error replies: MALFORMED_MESSAGE (not an Envelope, no version, no content), VERSION_MISMATCH
+(another major version, e.g. a 1.x request), WRONG_STATE (also for another run's run_id),
+INVALID_ARGUMENT (sizes, the constraint operator, non-finite values, a refused write_directory,
+omit_fields_from_reply without write_directory), BAD_INPUT (the body definition, its mesh, a
+refused mesh_path), SINGULAR_BODY, SOLVER_FAILURE (a reply would carry a non-finite number),
+UNSUPPORTED (a reply sent as a request, a request unknown to this version), INTERNAL (anything
+else).
 """
 
 import logging

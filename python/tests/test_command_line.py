@@ -68,6 +68,11 @@ class CurveOptions(unittest.TestCase):
         self.assertEqual(status, 2)
         self.assertIn("--max-dofs must be 0 (no limit) or a positive number", stderr)
 
+    def test_negative_protocol_minor_is_refused(self):
+        status, _, stderr = run_server("--listen", "tcp://127.0.0.1:*", "--protocol-minor", "-1")
+        self.assertEqual(status, 2)
+        self.assertIn("--protocol-minor must be 0 or a positive number", stderr)
+
 
 class Directories(unittest.TestCase):
     def setUp(self):
@@ -90,13 +95,14 @@ class Directories(unittest.TestCase):
             self.assertEqual(stdout, "")
             self.assertIn("%s '%s' is not an existing directory" % (option, missing), stderr)
 
-    def start_server(self):
-        """Starts the server with both directories; returns (process, ask) where ask(**content)
-        sends one request Envelope (version 2.0) and returns the reply Envelope."""
+    def start_server(self, *options):
+        """Starts the server with both directories and `options`; returns (process, ask) where
+        ask(**content) sends one request Envelope (version 2.0) and returns the reply
+        Envelope."""
         import zmq
         process = subprocess.Popen(
             [sys.executable, str(SERVER), "--listen", "tcp://127.0.0.1:*", "--log-level", "warn",
-             "--data-directory", str(self.data), "--output-root", str(self.output)],
+             "--data-directory", str(self.data), "--output-root", str(self.output)] + list(options),
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
             text=True, env=server_environment())
         self.addCleanup(self.stop, process)
@@ -129,6 +135,19 @@ class Directories(unittest.TestCase):
                                   contact_boundaries=["contact"])
         body.dirichlet.add(boundary="bottom", x=0.0, y=0.0)
         return body
+
+    def test_protocol_minor_4_plays_a_2_4_server(self):
+        """The testing option --protocol-minor (robin-subdomain's): 2.5 by default, with the peak
+        resident size in InterfaceDescription; with 4, version 2.4 on every reply and none."""
+        for options, version, reports_peak in (((), (2, 5), True),
+                                               (("--protocol-minor", "4"), (2, 4), False)):
+            with self.subTest(options=options):
+                process, ask = self.start_server(*options)
+                reply = ask(setup_body=self.setup_body("lower.msh"))
+                self.assertEqual((reply.version.major, reply.version.minor), version)
+                self.assertEqual(reply.interface.peak_resident_bytes > 0, reports_peak, reply)
+                self.assertEqual(ask(shutdown=protocol.Shutdown()).version.minor, version[1])
+                self.assertEqual(process.wait(timeout=30), 0)
 
     def test_served_files_stay_under_the_directories(self):
         process, ask = self.start_server()
