@@ -454,7 +454,7 @@ constexpr std::size_t offset_width = 21;
 class ArrayWriter {
  public:
   ArrayWriter(std::ofstream& out, VtuEncoding encoding, const std::filesystem::path& path)
-      : out_(out), encoding_(encoding), path_(path), compressor_(path) {}
+      : out_(out), encoding_(encoding), compressor_(path) {}
 
   /// `array` holds the attributes (and a string array's values); `make` makes its values when
   /// they are written (called once, after the XML in binary mode).
@@ -547,7 +547,6 @@ class ArrayWriter {
 
   std::ofstream& out_;
   VtuEncoding encoding_;
-  const std::filesystem::path& path_;
   std::vector<PendingArray> pending_;
   BlockCompressor compressor_;
   std::vector<Bytef> buffer_;  // one compressed block
