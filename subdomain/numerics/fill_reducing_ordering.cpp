@@ -170,9 +170,6 @@ std::vector<int> order_graph(cholmod_sparse* graph, double unknowns_per_vertex,
   const double unknown_flops = best.flops * std::pow(unknowns_per_vertex, 3);
   if (unknown_flops > metis_threshold * entries) {
     GraphOrder nested = order_by(graph, CHOLMOD_METIS, common, body_name);
-    if (std::getenv("ROBIN_ORDER_DEBUG"))
-      std::fprintf(stderr, "ORDER %s metis flops %.3e amd %.3e\n", body_name.c_str(), nested.flops,
-                   best.flops);
     if (nested.flops < best.flops) best = std::move(nested);
   }
   return std::move(best.order);
