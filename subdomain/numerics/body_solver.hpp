@@ -65,6 +65,13 @@ enum class InterfaceOperatorKind {
   factor,     // F applied through the factor: one solve (two triangular solves) per product
 };
 
+/// How the body's stiffness systems K x = b are solved.
+enum class LinearSolverKind {
+  direct,     // a sparse Cholesky factor (CHOLMOD), computed once; contact solved in its dual
+  multigrid,  // conjugate gradients preconditioned by smoothed-aggregation AMG; memory O(dofs);
+              // contact solved in its primal form by a primal-dual active set method
+};
+
 /// What a body whose Dirichlet conditions leave a rigid motion free is.
 enum class RigidMotions {
   refuse,           // an error at setup (SingularBodyError): a forgotten support
@@ -74,6 +81,7 @@ enum class RigidMotions {
 struct BodySolverOptions {
   RigidMotions rigid_motions = RigidMotions::refuse;
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
+  LinearSolverKind linear_solver = LinearSolverKind::direct;
   /// The automatic choice's limit on contact nodes. A dense F costs 8 n_c^2 bytes, and with the
   /// contact dofs last a dense trailing block of (d n_c)^2 / 2 entries in L; a solid body whose
   /// contact face has n_c nodes has a factor of far more entries than both, and applying F
