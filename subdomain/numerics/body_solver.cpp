@@ -4,12 +4,15 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <set>
 #include <sstream>
 
+#include "numerics/algebraic_multigrid.hpp"
 #include "numerics/errors.hpp"
 #include "numerics/finite_element.hpp"
 #include "numerics/heap_memory.hpp"
+#include "numerics/primal_contact.hpp"
 
 namespace robin {
 namespace {
@@ -25,21 +28,23 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// F = B K^{-1} B' applied through the factor: one solve (two triangular solves) per product.
-class FactorComplianceOperator final : public LinearOperator {
+/// F = B K^{-1} B' applied through solves with K: one solve (two triangular solves of the
+/// factor, or one conjugate gradient solve) per product.
+class SolveComplianceOperator final : public LinearOperator {
  public:
-  FactorComplianceOperator(const SparseMatrix& trace, const GeneralizedInverse& factor)
-      : trace_(trace), trace_transpose_(trace.transpose()), factor_(factor) {}
+  using StiffnessSolve = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
+  SolveComplianceOperator(const SparseMatrix& trace, StiffnessSolve solve)
+      : trace_(trace), trace_transpose_(trace.transpose()), solve_(std::move(solve)) {}
   int size() const override { return static_cast<int>(trace_.rows()); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
     // y = B K^{-1} (B' x)
-    y.noalias() = trace_ * factor_.solve(Eigen::VectorXd(trace_transpose_ * x));
+    y.noalias() = trace_ * solve_(Eigen::VectorXd(trace_transpose_ * x));
   }
 
  private:
   const SparseMatrix& trace_;
   SparseMatrix trace_transpose_;
-  const GeneralizedInverse& factor_;
+  StiffnessSolve solve_;
 };
 
 /// F assembled column block by column block: F(:, J) = B K^{-1} B'(:, J).
@@ -57,6 +62,28 @@ Eigen::MatrixXd assemble_dense_compliance(const SparseMatrix& trace,
   // Symmetrise away the rounding of the solves: F is symmetric by construction.
   const Eigen::MatrixXd symmetric = 0.5 * (compliance + compliance.transpose());
   return symmetric;
+}
+
+/// Whether the rows of B (`trace`) that read a free dof are linearly independent: B B' over them
+/// is positive definite (CholeskyFactor's pivot test), and then so is every subset of them.
+bool independent_rows(const SparseMatrix& trace, const std::string& body_name) {
+  const Eigen::VectorXd row_sizes = trace.cwiseAbs() * Eigen::VectorXd::Ones(trace.cols());
+  std::vector<Eigen::Triplet<double>> selection;
+  for (Eigen::Index row = 0; row < trace.rows(); ++row) {
+    if (row_sizes[row] > 0.0) {
+      selection.emplace_back(static_cast<int>(selection.size()), static_cast<int>(row), 1.0);
+    }
+  }
+  if (selection.empty()) return true;
+  SparseMatrix select(static_cast<Eigen::Index>(selection.size()), trace.rows());
+  select.setFromTriplets(selection.begin(), selection.end());
+  const SparseMatrix rows = select * trace;
+  try {
+    const CholeskyFactor factor(SparseMatrix(rows * rows.transpose()), body_name);
+    return true;
+  } catch (const SingularBodyError&) {
+    return false;
+  }
 }
 
 /// Prescribed value of every dof from the Dirichlet conditions. Two conditions that give the
@@ -204,7 +231,7 @@ bool same_prescribed_set(const std::vector<std::optional<double>>& prescribed, c
 
 bool same_factor_options(const BodySolverOptions& left, const BodySolverOptions& right) {
   return left.interface_operator == right.interface_operator &&
-         left.dense_limit == right.dense_limit &&
+         left.linear_solver == right.linear_solver && left.dense_limit == right.dense_limit &&
          left.contact_unknowns_last == right.contact_unknowns_last &&
          left.maximum_dofs == right.maximum_dofs &&
          left.maximum_factor_bytes == right.maximum_factor_bytes &&
@@ -261,6 +288,11 @@ void BodySolver::assemble() {
   timings_.assembly_seconds = seconds_since(start);
 
   start = std::chrono::steady_clock::now();
+  if (options_.linear_solver == LinearSolverKind::multigrid) {
+    set_up_multigrid(std::move(reduced_stiffness));
+    timings_.factorization_seconds = seconds_since(start);
+    return;
+  }
   report(SetupStage::ordering);
   Eigen::MatrixXd kernel = options_.rigid_motions == RigidMotions::refuse
                                ? Eigen::MatrixXd(dofs_->free_count(), 0)
@@ -273,6 +305,67 @@ void BodySolver::assemble() {
   // the ordering as the factor measured it; the rest (numerical factorization, K^{-1} f) here
   timings_.ordering_seconds = factor_->ordering_seconds();
   timings_.factorization_seconds = seconds_since(start) - timings_.ordering_seconds;
+}
+
+void BodySolver::set_up_multigrid(SparseMatrix&& reduced_stiffness) {
+  if (options_.rigid_motions != RigidMotions::refuse &&
+      !removes_rigid_motions(definition_.mesh, *dofs_)) {
+    throw InputError("body '" + name() +
+                     "': a floating body (rigid motions held by contact) needs the direct linear "
+                     "solver; linear_solver = \"multigrid\" solves only bodies whose supports "
+                     "hold them");
+  }
+  report(SetupStage::factorization);
+  release_free_heap_memory();
+  {
+    const SparseMatrix stiffness = std::move(reduced_stiffness);
+    multigrid_ = std::make_unique<MultigridStiffnessSolver>(
+        stiffness, free_rigid_body_modes(definition_.mesh, *dofs_),
+        free_dof_nodes(definition_.mesh, *dofs_), PrimalContactOptions{}.relative_tolerance,
+        name());
+  }  // the AMG keeps its own copy of K with both triangles
+  free_solution_ = solve_stiffness(reduced_load_);  // K^{-1} f
+  rigid_amplitudes_ = Eigen::VectorXd::Zero(0);
+  no_rigid_modes_.resize(dofs_->free_count(), 0);
+}
+
+Eigen::VectorXd BodySolver::solve_stiffness(const Eigen::VectorXd& right_hand_side,
+                                            const Eigen::VectorXd& initial) const {
+  if (multigrid_) return multigrid_->solve(right_hand_side, initial);
+  return factor_->solve(right_hand_side);
+}
+
+long BodySolver::factor_nonzeros() const {
+  return factor_ ? factor_->factor_nonzeros() : 0;
+}
+
+long BodySolver::solve_count() const {
+  return factor_ ? factor_->solve_count() : multigrid_->solve_count();
+}
+
+LinearSolverKind BodySolver::linear_solver() const {
+  return multigrid_ ? LinearSolverKind::multigrid : LinearSolverKind::direct;
+}
+
+void BodySolver::fall_back_to_direct_solver() {
+  SparseMatrix lower = SparseMatrix(multigrid_->stiffness_matrix()).triangularView<Eigen::Lower>();
+  multigrid_.reset();
+  factor_ = std::make_unique<GeneralizedInverse>(
+      std::move(lower), Eigen::MatrixXd(dofs_->free_count(), 0), name(), std::vector<int>{},
+      options_.maximum_factor_bytes, factorization_observer());
+  free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
+}
+
+long BodySolver::inner_iterations() const {
+  return multigrid_ ? multigrid_->iterations() : 0;
+}
+
+int BodySolver::rigid_mode_count() const {
+  return factor_ ? factor_->rigid_mode_count() : 0;
+}
+
+const Eigen::MatrixXd& BodySolver::rigid_modes() const {
+  return factor_ ? factor_->kernel() : no_rigid_modes_;
 }
 
 SparseMatrix BodySolver::assemble_reduced_stiffness() {
@@ -407,6 +500,7 @@ void BodySolver::assign_contact(const ContactOperator& contact) {
     trace_.resize(row_count, dofs_->free_count());
     trace_.setFromTriplets(triplets.begin(), triplets.end());
   }
+  if (multigrid_ && !independent_rows(trace_, name())) fall_back_to_direct_solver();
   rigid_trace_ = trace_ * rigid_modes();  // B R
   update_free_trace();
   if (!keep_compliance) build_interface_operator();
@@ -456,7 +550,7 @@ void BodySolver::replace_loads(BodyDefinition definition, const BodySolverOption
   reduced_load_ = dofs_->reduce_load(prescribed_stiffness_, full_load_);
   timings_.assembly_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
-  free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f with the kept factor
+  free_solution_ = solve_stiffness(reduced_load_);  // K^{-1} f with the kept factor or AMG
   timings_.ordering_seconds = 0.0;
   timings_.factorization_seconds = seconds_since(start);
   load_factor_ = 1.0;
@@ -471,12 +565,17 @@ void BodySolver::build_interface_operator() {
   const bool dense_fits =
       options_.maximum_factor_bytes <= 0.0 || dense_bytes <= options_.maximum_factor_bytes;
   const bool dense = dense_fits && dense_interface_operator(contact_size());
-  if (dense && factor_->has_trailing_block()) {
+  if (multigrid_) {
+    // never dense: n_c conjugate gradient solves; the contact solve does not use F
+    compliance_ = std::make_unique<SolveComplianceOperator>(
+        trace_, [this](const Eigen::VectorXd& load) { return solve_stiffness(load); });
+  } else if (dense && factor_->has_trailing_block()) {
     compliance_ = std::make_unique<DenseOperator>(factor_->trailing_congruence(trace_));
   } else if (dense) {
     compliance_ = std::make_unique<DenseOperator>(assemble_dense_compliance(trace_, *factor_));
   } else {
-    compliance_ = std::make_unique<FactorComplianceOperator>(trace_, *factor_);
+    compliance_ = std::make_unique<SolveComplianceOperator>(
+        trace_, [this](const Eigen::VectorXd& load) { return factor_->solve(load); });
   }
 }
 
@@ -488,6 +587,7 @@ bool BodySolver::dense_interface_operator(long contact_count) const {
 
 void BodySolver::reset_warm_start() {
   warm_start_ = Eigen::VectorXd::Zero(contact_size());
+  primal_state_ = std::make_unique<PrimalContactState>();
   warm_multiplier_ = Eigen::VectorXd::Zero(rigid_mode_count());
   rigid_amplitudes_ = Eigen::VectorXd::Zero(rigid_mode_count());
 }
@@ -496,6 +596,9 @@ void BodySolver::set_load_factor(double factor) {
   if (!std::isfinite(factor) || std::abs(factor) > maximum_load_factor) {
     throw InputError("body '" + name() + "': load factor " + format_load_factor(factor) +
                      " is not a finite number of magnitude at most 1e6");
+  }
+  if (factor != load_factor_ && primal_state_) {
+    primal_state_->contact_force.resize(0);  // its u is no longer the solution at this factor
   }
   load_factor_ = factor;
   if (unit_free_trace_.size() > 0) free_trace_ = load_factor_ * unit_free_trace_;
@@ -509,6 +612,7 @@ ContactSolveResult BodySolver::solve_contact(const Eigen::VectorXd& obstacle,
                      " values for " + std::to_string(contact_size()) + " contact nodes");
   }
   if (rigid_mode_count() > 0) return solve_floating_contact(obstacle, parameters);
+  if (multigrid_) return solve_primal_contact(obstacle);
   // Dual problem: minimise 1/2 l'F l - l'(e - g), l >= 0. Its gradient F l - (e - g) equals
   // g - u_N, so u_N = g - gradient and the KKT conditions are the Signorini conditions.
   const Eigen::VectorXd right_hand_side = free_trace_ - obstacle;
@@ -519,6 +623,18 @@ ContactSolveResult BodySolver::solve_contact(const Eigen::VectorXd& obstacle,
 
   ContactSolveResult result = contact_solve_result(qp, obstacle);
   if (qp.status == QpStatus::converged) warm_start_ = qp.solution;
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+ContactSolveResult BodySolver::solve_primal_contact(const Eigen::VectorXd& obstacle) {
+  const auto start = std::chrono::steady_clock::now();
+  // B (u_f + u_p) <= g  <=>  B u_f <= g - t B u_p;  the load t f
+  const Eigen::VectorXd bound = obstacle - load_factor_ * prescribed_trace_;
+  const PrimalContactResult primal =
+      robin::solve_primal_contact(*multigrid_, trace_, load_factor_ * reduced_load_, bound,
+                                  load_factor_ * free_solution_, *primal_state_);
+  ContactSolveResult result = contact_solve_result(primal, obstacle);
   result.seconds = seconds_since(start);
   return result;
 }
@@ -561,8 +677,11 @@ Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force,
                                          const Eigen::VectorXd& rigid_amplitudes) const {
   // u_f = K^{-1} (t f - B' lambda) (+ R alpha with K^+), u_p = t u_p1 (t the load factor)
   Eigen::VectorXd free_values = load_factor_ * free_solution_;
-  if (contact_force.size() > 0 && contact_force.lpNorm<Eigen::Infinity>() > 0) {
-    free_values -= factor_->solve(apply_transpose_trace(contact_force));
+  if (primal_state_ && primal_state_->contact_force.size() == contact_force.size() &&
+      contact_force.size() > 0 && primal_state_->contact_force == contact_force) {
+    free_values = primal_state_->displacement;  // the last primal contact solve's u
+  } else if (contact_force.size() > 0 && contact_force.lpNorm<Eigen::Infinity>() > 0) {
+    free_values -= solve_stiffness(apply_transpose_trace(contact_force));
   }
   if (rigid_mode_count() > 0) {
     if (rigid_amplitudes.size() != rigid_mode_count()) {

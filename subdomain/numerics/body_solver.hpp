@@ -35,6 +35,20 @@
 // (coupling_scheme.hpp). Its Neumann solve, K u = f - B'lambda for a given lambda, is defined
 // only for balanced lambda, which a Neumann body does not get: solve_neumann refuses it.
 //
+// Iterative inner solver (BodySolverOptions::linear_solver = multigrid; docs/method.md). K is
+// not factorized: K x = b is solved by conjugate gradients preconditioned by smoothed-aggregation
+// AMG (algebraic_multigrid.hpp), whose memory grows like the dofs, not like a 3D factor's fill.
+// F is then never formed; the local contact problem is solved in its primal form by a primal-dual
+// active set method with projected conjugate gradients (primal_contact.hpp), warm-started from
+// the previous solve's displacement and active set; e, the correction w_N = B K^{-1} B' r and the
+// Neumann solve are one conjugate gradient solve each, and compliance() applies F by one solve
+// per product. The answers equal the direct solver's to the iterative tolerance. Floating bodies
+// need the direct solver (InputError). The primal method needs linearly independent contact rows
+// (B B' positive definite over the rows that read a free dof): node-to-node rows and the rows of a
+// mortar interface's non-mortar side have them; the mortar side's rows, when the non-mortar side
+// is finer, do not. Then assign_contact factorizes K after all and the body continues with the
+// direct solver (linear_solver() says which one it uses).
+//
 // Load factor t (quasi-static load steps): every load of the body (body force, tractions,
 // pressures) and every prescribed displacement is multiplied by t, so f(t) = t f, u_p(t) = t u_p
 // and e(t) = t e, by linearity; K, its factor and F do not depend on t and are kept.
@@ -58,6 +72,9 @@
 #include "numerics/setup_progress.hpp"
 
 namespace robin {
+
+class MultigridStiffnessSolver;  // primal_contact.hpp
+struct PrimalContactState;       // primal_contact.hpp
 
 enum class InterfaceOperatorKind {
   automatic,  // dense when the contact size is at most dense_limit, otherwise factor
@@ -170,12 +187,19 @@ class BodySolver {
   const DofMap& dofs() const { return *dofs_; }
   int free_dof_count() const { return dofs_->free_count(); }
   const BodyTimings& timings() const { return timings_; }
-  long factor_nonzeros() const { return factor_->factor_nonzeros(); }
-  long solve_count() const { return factor_->solve_count(); }
+  /// Entries of the Cholesky factor L (0 with the multigrid solver).
+  long factor_nonzeros() const;
+  /// Solves with K: triangular solve pairs of the factor, or conjugate gradient solves.
+  long solve_count() const;
+  /// Conjugate gradient iterations of the multigrid solver so far (0 with the direct solver).
+  long inner_iterations() const;
+  /// The solver in use: the option's, or direct after assign_contact fell back to it (the file
+  /// comment).
+  LinearSolverKind linear_solver() const;
   /// k, the number of rigid motions the Dirichlet conditions leave free (0: K is SPD).
-  int rigid_mode_count() const { return factor_->rigid_mode_count(); }
+  int rigid_mode_count() const;
   /// R (free x k, orthonormal columns).
-  const Eigen::MatrixXd& rigid_modes() const { return factor_->kernel(); }
+  const Eigen::MatrixXd& rigid_modes() const;
   /// G' = B R (n_c x k), valid after assign_contact.
   const Eigen::MatrixXd& rigid_trace() const { return rigid_trace_; }
   /// h = R'f at the current load factor (k values).
@@ -260,6 +284,15 @@ class BodySolver {
 
  private:
   void assemble();
+  /// The multigrid hierarchy of K and K^{-1} f by conjugate gradients (linear_solver multigrid).
+  void set_up_multigrid(SparseMatrix&& reduced_stiffness);
+  /// x = K^{-1} b by the factor or by conjugate gradients from `initial` (zero when empty).
+  Eigen::VectorXd solve_stiffness(const Eigen::VectorXd& right_hand_side,
+                                  const Eigen::VectorXd& initial = {}) const;
+  /// Factorizes K (from the multigrid solver's copy) and continues with the direct solver.
+  void fall_back_to_direct_solver();
+  /// The local contact problem in its primal form (linear_solver multigrid).
+  ContactSolveResult solve_primal_contact(const Eigen::VectorXd& obstacle);
   /// Assembles K, keeps its prescribed part (DofMap::prescribed_part: the reduced load and the
   /// reactions read nothing else) and returns the lower triangle of K_ff, freeing K.
   SparseMatrix assemble_reduced_stiffness();
@@ -291,8 +324,11 @@ class BodySolver {
   SparseMatrix prescribed_stiffness_;  // K's entries in a prescribed row or column
   Eigen::VectorXd full_load_;
   Eigen::VectorXd reduced_load_;
-  std::unique_ptr<GeneralizedInverse> factor_;  // K^{-1}, or K^+ for a floating body
-  Eigen::VectorXd free_solution_;               // K^{-1} f (free dofs) at load factor 1
+  std::unique_ptr<GeneralizedInverse> factor_;  // K^{-1}, or K^+ for a floating body (direct)
+  std::unique_ptr<MultigridStiffnessSolver> multigrid_;  // K^{-1} by AMG-PCG (multigrid)
+  std::unique_ptr<PrimalContactState> primal_state_;     // the last primal contact solve
+  Eigen::MatrixXd no_rigid_modes_;                       // R = free x 0 (multigrid)
+  Eigen::VectorXd free_solution_;                        // K^{-1} f (free dofs) at load factor 1
 
   ContactOperator contact_;
   Eigen::VectorXd boundary_weights_;

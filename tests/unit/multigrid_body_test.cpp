@@ -1,0 +1,219 @@
+// BodySolver with the iterative inner solver (linear_solver = multigrid: AMG-preconditioned
+// conjugate gradients, the contact problem by the primal-dual active set method with projected
+// conjugate gradients, numerics/primal_contact.hpp) against the same body with the direct
+// solver (a CHOLMOD factor, the contact problem in its dual form by MPRGP; body_solver_test.cpp
+// checks that one against an independent solve).
+//
+// The bodies: a solid box (hexahedra; tetrahedra) clamped at its bottom, pushed up by a body
+// force and a traction, its top the contact face with node-to-node rows (normal (0, 0, 1)), and
+// the 2D block of tests/test_bodies.hpp on a finer mesh. The obstacle g_j = e_j (0.3 + 1.2 x_j / L)
+// (e the free trace) closes the contact for x < 7/12 L and leaves the rest open: a partial contact.
+//
+// Tolerances. The conjugate gradients stop at ||b - K x|| <= 1e-10 ||b||; the error of x is then
+// at most cond(K) times that relative residual, in practice far less. The bounds below (1e-7
+// relative) allow cond(K) up to 1e3 in that worst case; the measured errors are printed.
+// Also checked: the Signorini conditions of the multigrid result itself (lambda >= 0, no
+// penetration beyond 1e-9 of the displacement scale, complementarity), the same active set,
+// the displacement field, a second solve warm-started after a change of obstacle and load
+// factor, and the refusal of a floating body.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../test_bodies.hpp"
+#include "numerics/body_solver.hpp"
+#include "numerics/box_mesher.hpp"
+#include "numerics/contact_operator.hpp"
+#include "numerics/elasticity.hpp"
+#include "numerics/errors.hpp"
+#include "numerics/material.hpp"
+#include "numerics/rectangle_mesher.hpp"
+
+namespace robin {
+namespace {
+
+constexpr double agreement = 1e-7;  // relative (the file comment)
+
+BodyDefinition solid_box(ElementType type) {
+  BodyDefinition body;
+  body.name = "box";
+  body.mesh = make_box_mesh({0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, {16, 8, 8}, type);
+  body.material = make_isotropic_solid_material(1000.0, 0.3, "box");
+  body.body_force = Eigen::Vector3d(0.0, 0.0, 40.0);
+  body.dirichlet.push_back({"bottom", 0.0, 0.0, 0.0});
+  TractionCondition traction;
+  traction.boundary = "right";
+  traction.vector = Eigen::Vector3d(-4.0, 1.0, 1.5);
+  body.tractions.push_back(traction);
+  body.contact_boundaries = {"top"};
+  return body;
+}
+
+/// The block of tests/test_bodies.hpp on a finer mesh (40 x 20 cells: AMG has coarse levels),
+/// pushed up by a body force.
+BodyDefinition plane_block() {
+  BodyDefinition body = testing::plane_quadratic_block("block");
+  body.mesh = make_rectangle_mesh(0.0, 0.0, 2.0, 1.0, 40, 20, ElementType::triangle6);
+  body.body_force = Eigen::Vector3d(0.0, 30.0, 0.0);
+  return body;
+}
+
+/// Node-to-node rows on every node of "top" with the outward normal (the last axis).
+ContactOperator top_operator(const Mesh& mesh) {
+  const std::vector<int> nodes = mesh.boundary("top").nodes();
+  const Eigen::VectorXd weights = boundary_weights(mesh, mesh.boundary("top"));
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  normal[mesh.dimension - 1] = 1.0;
+  std::vector<double> node_weights;
+  for (int node : nodes) node_weights.push_back(weights[node]);
+  return node_to_node_operator(nodes, std::vector<Eigen::Vector3d>(nodes.size(), normal),
+                               node_weights);
+}
+
+std::unique_ptr<BodySolver> make_solver(const BodyDefinition& body, LinearSolverKind kind) {
+  BodySolverOptions options;
+  options.linear_solver = kind;
+  auto solver = std::make_unique<BodySolver>(body, options);
+  solver->assign_contact(top_operator(solver->mesh()));
+  return solver;
+}
+
+/// g_j = e_j (0.3 + 1.2 x_j / L): closed where x_j < 7/12 L (the file comment).
+Eigen::VectorXd partial_obstacle(const BodySolver& solver) {
+  const ContactOperator& contact = solver.contact_operator();
+  const Eigen::VectorXd& free_trace = solver.free_trace();
+  double length = 0.0;
+  for (const Eigen::Vector3d& node : solver.mesh().nodes) length = std::max(length, node.x());
+  Eigen::VectorXd obstacle(contact.row_count());
+  for (int row = 0; row < contact.row_count(); ++row) {
+    const double x = solver.mesh().nodes[contact.nodes[contact.row_offsets[row]]].x();
+    obstacle[row] = free_trace[row] * (0.3 + 1.2 * x / length);
+  }
+  return obstacle;
+}
+
+double relative_difference(const Eigen::VectorXd& value, const Eigen::VectorXd& reference) {
+  return (value - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>();
+}
+
+struct Case {
+  std::string label;
+  BodyDefinition body;
+};
+
+std::vector<Case> cases() {
+  return {{"hexahedra", solid_box(ElementType::hexahedron8)},
+          {"tetrahedra", solid_box(ElementType::tetrahedron4)},
+          {"plane triangle6", plane_block()}};
+}
+
+TEST(MultigridBody, TracesAndCorrectionEqualTheDirectSolver) {
+  for (const Case& test : cases()) {
+    const auto direct = make_solver(test.body, LinearSolverKind::direct);
+    const auto multigrid = make_solver(test.body, LinearSolverKind::multigrid);
+    EXPECT_EQ(multigrid->factor_nonzeros(), 0) << test.label;
+    const double free_error = relative_difference(multigrid->free_trace(), direct->free_trace());
+    EXPECT_GT(direct->free_trace().minCoeff(), 0.0) << test.label << ": the top must rise";
+    EXPECT_LE(free_error, agreement) << test.label;
+
+    Eigen::VectorXd force(direct->contact_size());
+    for (Eigen::Index i = 0; i < force.size(); ++i) force[i] = 1.0 + 0.5 * std::cos(1.3 * i);
+    const double correction_error =
+        relative_difference(multigrid->solve_correction(force), direct->solve_correction(force));
+    const double neumann_error =
+        relative_difference(multigrid->solve_neumann(force), direct->solve_neumann(force));
+    EXPECT_LE(correction_error, agreement) << test.label;
+    EXPECT_LE(neumann_error, agreement) << test.label;
+    EXPECT_GT(multigrid->inner_iterations(), 0) << test.label;
+    std::cout << test.label << ": free trace " << free_error << ", correction " << correction_error
+              << ", Neumann " << neumann_error << " relative; " << multigrid->inner_iterations()
+              << " CG iterations in " << multigrid->solve_count() << " solves\n";
+  }
+}
+
+TEST(MultigridBody, ContactSolveEqualsTheDirectSolverAndIsSignorini) {
+  for (const Case& test : cases()) {
+    const auto direct = make_solver(test.body, LinearSolverKind::direct);
+    const auto multigrid = make_solver(test.body, LinearSolverKind::multigrid);
+    const Eigen::VectorXd obstacle = partial_obstacle(*direct);
+    const ContactSolveResult expected = direct->solve_contact(obstacle);
+    const ContactSolveResult result = multigrid->solve_contact(obstacle);
+    ASSERT_EQ(expected.status, QpStatus::converged) << test.label << ": " << expected.message;
+    ASSERT_EQ(result.status, QpStatus::converged) << test.label << ": " << result.message;
+    const long closed = std::count(expected.active.begin(), expected.active.end(), true);
+    EXPECT_GE(closed, 3) << test.label;
+    EXPECT_GE(direct->contact_size() - closed, 3) << test.label;
+    EXPECT_EQ(result.active, expected.active) << test.label;
+
+    const double force_error = relative_difference(result.contact_force, expected.contact_force);
+    const double trace_error = relative_difference(result.normal_trace, expected.normal_trace);
+    EXPECT_LE(force_error, agreement) << test.label;
+    EXPECT_LE(trace_error, agreement) << test.label;
+    const double scale = obstacle.lpNorm<Eigen::Infinity>();
+    EXPECT_GE(result.contact_force.minCoeff(), 0.0) << test.label;
+    EXPECT_LE(result.penetration, 1e-9 * scale) << test.label;
+    EXPECT_LE(result.complementarity, 1e-9 * scale * result.contact_force.lpNorm<Eigen::Infinity>())
+        << test.label;
+
+    const double displacement_error =
+        relative_difference(multigrid->displacement(result.contact_force),
+                            direct->displacement(expected.contact_force));
+    EXPECT_LE(displacement_error, agreement) << test.label;
+    std::cout << test.label << ": " << closed << " of " << direct->contact_size()
+              << " closed; force " << force_error << ", trace " << trace_error << ", displacement "
+              << displacement_error << " relative; " << result.iterations << " active set steps, "
+              << result.operator_applications << " CG iterations\n";
+  }
+}
+
+TEST(MultigridBody, WarmStartAfterANewObstacleAndLoadFactor) {
+  for (const Case& test : cases()) {
+    const auto direct = make_solver(test.body, LinearSolverKind::direct);
+    const auto multigrid = make_solver(test.body, LinearSolverKind::multigrid);
+    const Eigen::VectorXd first = partial_obstacle(*direct);
+    ASSERT_EQ(multigrid->solve_contact(first).status, QpStatus::converged) << test.label;
+    // more load and an obstacle lowered on one side: rows close and open
+    const Eigen::VectorXd second =
+        first.cwiseProduct(Eigen::VectorXd::LinSpaced(first.size(), 1.4, 0.8));
+    direct->set_load_factor(1.3);
+    multigrid->set_load_factor(1.3);
+    const ContactSolveResult expected = direct->solve_contact(second);
+    const ContactSolveResult result = multigrid->solve_contact(second);
+    ASSERT_EQ(result.status, QpStatus::converged) << test.label << ": " << result.message;
+    EXPECT_EQ(result.active, expected.active) << test.label;
+    EXPECT_LE(relative_difference(result.contact_force, expected.contact_force), agreement)
+        << test.label;
+    EXPECT_LE(relative_difference(result.normal_trace, expected.normal_trace), agreement)
+        << test.label;
+    EXPECT_LE(relative_difference(multigrid->displacement(result.contact_force),
+                                  direct->displacement(expected.contact_force)),
+              agreement)
+        << test.label;
+  }
+}
+
+TEST(MultigridBody, RefusesAFloatingBody) {
+  BodyDefinition body = solid_box(ElementType::hexahedron8);
+  body.dirichlet.clear();
+  body.body_force = Eigen::Vector3d::Zero();
+  body.tractions.clear();
+  BodySolverOptions options;
+  options.linear_solver = LinearSolverKind::multigrid;
+  options.rigid_motions = RigidMotions::held_by_contact;
+  try {
+    BodySolver solver(body, options);
+    FAIL() << "a floating body was accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("body 'box'"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("direct"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace robin
