@@ -20,8 +20,9 @@ const std::vector<std::string> root_keys{"title",     "dimension", "gap",  "solv
                                          "reference", "interface"};
 const std::vector<std::string> contact_keys{"method", "non_mortar"};
 const std::vector<std::string> gap_keys{"expression", "constants"};
-const std::vector<std::string> solver_keys{
-    "qp_tolerance", "qp_max_iterations", "interface_operator", "dense_limit", "pairing_tolerance"};
+const std::vector<std::string> solver_keys{"qp_tolerance",       "qp_max_iterations",
+                                           "interface_operator", "dense_limit",
+                                           "linear_solver",      "pairing_tolerance"};
 const std::vector<std::string> coupling_keys{"relaxation",
                                              "tolerance",
                                              "max_iterations",
@@ -131,6 +132,10 @@ void read_solver(const CheckedTable& root, SolverOptions& solver) {
                                                         : InterfaceOperatorKind::factor;
   }
   solver.body.dense_limit = integer_at_least(*table, "dense_limit", 1, solver.body.dense_limit);
+  if (const auto kind = table->optional_choice("linear_solver", {"direct", "multigrid"})) {
+    solver.body.linear_solver =
+        *kind == "multigrid" ? LinearSolverKind::multigrid : LinearSolverKind::direct;
+  }
   solver.pairing_tolerance =
       number_above(*table, "pairing_tolerance", 0.0, solver.pairing_tolerance);
 }

@@ -197,6 +197,7 @@ TEST(CaseFile, FullCaseReadsEveryKey) {
   EXPECT_EQ(definition.solver.qp.max_iterations, 12345);
   EXPECT_EQ(definition.solver.body.interface_operator, InterfaceOperatorKind::factor);
   EXPECT_EQ(definition.solver.body.dense_limit, 777);
+  EXPECT_EQ(definition.solver.body.linear_solver, LinearSolverKind::multigrid);
   EXPECT_EQ(definition.solver.pairing_tolerance, 2e-5);
 
   const CouplingOptions& coupling = definition.coupling;
@@ -297,6 +298,7 @@ TEST(CaseFile, MissingOptionalTablesGiveTheDocumentedDefaults) {
   EXPECT_EQ(definition.solver.qp.max_iterations, 20000);
   EXPECT_EQ(definition.solver.body.interface_operator, InterfaceOperatorKind::automatic);
   EXPECT_EQ(definition.solver.body.dense_limit, 8000);
+  EXPECT_EQ(definition.solver.body.linear_solver, LinearSolverKind::direct);
   EXPECT_EQ(definition.solver.pairing_tolerance, 1e-6);
   EXPECT_EQ(definition.coupling.relaxation, 0.5);
   EXPECT_EQ(definition.coupling.tolerance, 1e-8);
@@ -335,6 +337,18 @@ TEST(CaseFile, AlgorithmKeys) {
   EXPECT_EQ(defaults.contact_body, ContactBodyChoice::automatic);
   EXPECT_EQ(defaults.stopping, StoppingRule::either_sequence);
   EXPECT_EQ(defaults.acceleration.method, AccelerationMethod::iqn_ils);
+}
+
+TEST(CaseFile, LinearSolverKey) {
+  const auto linear_solver = [](const std::string& value) {
+    const std::string text = replaced(base_case(), "qp_tolerance = 1e-12",
+                                      "qp_tolerance = 1e-12\nlinear_solver = \"" + value + "\"");
+    return read_case_file(write_case(text)).solver.body.linear_solver;
+  };
+  EXPECT_EQ(linear_solver("direct"), LinearSolverKind::direct);
+  EXPECT_EQ(linear_solver("multigrid"), LinearSolverKind::multigrid);
+  EXPECT_EQ(read_case_file(write_case(base_case())).solver.body.linear_solver,
+            LinearSolverKind::direct);
 }
 
 /// Every choice converts to the text users write and back; other texts are none of them.
@@ -806,6 +820,18 @@ std::vector<ErrorCase> error_cases() {
        1,
        {"case.toml:{line}: solver.interface_operator: 'sparse' is not one of: auto, dense, "
         "factor"}},
+      {"UnknownLinearSolver",
+       "qp_tolerance = 1e-12",
+       "linear_solver = \"amg\"",
+       "amg",
+       1,
+       {"case.toml:{line}: solver.linear_solver: 'amg' is not one of: direct, multigrid"}},
+      {"LinearSolverNotAString",
+       "qp_tolerance = 1e-12",
+       "linear_solver = 2",
+       "linear_solver",
+       1,
+       {"case.toml:{line}: solver.linear_solver: expected a string, found an integer"}},
       {"UnknownInitialObstacle",
        "\"gap\"",
        "\"none\"",
