@@ -65,11 +65,22 @@ std::string interface_operator_name(InterfaceOperatorKind kind) {
   return "auto";
 }
 
+std::string linear_solver_name(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::multigrid:
+      return "multigrid";
+    case LinearSolverKind::direct:
+      break;
+  }
+  return "direct";
+}
+
 void encode_solver(const SolverOptions& solver, protocol::SolverSettings& message) {
   message.set_qp_tolerance(solver.qp.relative_tolerance);
   message.set_qp_max_iterations(static_cast<std::uint32_t>(solver.qp.max_iterations));
   message.set_interface_operator(interface_operator_name(solver.body.interface_operator));
   message.set_dense_limit(static_cast<std::uint32_t>(std::max(solver.body.dense_limit, 0)));
+  message.set_linear_solver(linear_solver_name(solver.body.linear_solver));
 }
 
 }  // namespace

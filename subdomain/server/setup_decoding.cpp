@@ -208,6 +208,12 @@ InterfaceOperatorKind decode_interface_operator(const std::string& name,
        "is '" + name + "', expected \"auto\", \"dense\" or \"factor\"");
 }
 
+LinearSolverKind decode_linear_solver(const std::string& name, const std::string& context) {
+  if (name.empty() || name == "direct") return LinearSolverKind::direct;
+  if (name == "multigrid") return LinearSolverKind::multigrid;
+  fail(context, "solver.linear_solver", "is '" + name + "', expected \"direct\" or \"multigrid\"");
+}
+
 void decode_solver(const protocol::SolverSettings& message, const std::string& context,
                    DecodedSetup& setup) {
   const double tolerance = message.qp_tolerance();
@@ -229,6 +235,7 @@ void decode_solver(const protocol::SolverSettings& message, const std::string& c
     }
     setup.body.dense_limit = static_cast<int>(message.dense_limit());
   }
+  setup.body.linear_solver = decode_linear_solver(message.linear_solver(), context);
 }
 
 /// SetupBody.contact_boundaries: 1 to maximum_contact_boundaries names, each a boundary of the

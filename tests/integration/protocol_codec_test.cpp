@@ -115,6 +115,22 @@ TEST(SetupEncoding, TwoBlocksBodiesCarryTheCaseValues) {
   EXPECT_EQ(message.solver().qp_tolerance(), definition.solver.qp.relative_tolerance);
 }
 
+// The solver hints travel as the strings of docs/protocol.md (SolverSettings).
+TEST(SetupEncoding, SolverHintsTravelAsTheirProtocolStrings) {
+  CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  load_meshes(definition);
+  const BodyCase& upper = definition.bodies[1];
+  SolverOptions solver = definition.solver;
+  protocol::SetupBody message = encode_setup_body(upper.definition, upper.context, solver);
+  EXPECT_EQ(message.solver().interface_operator(), "auto");
+  EXPECT_EQ(message.solver().linear_solver(), "direct");
+  solver.body.interface_operator = InterfaceOperatorKind::factor;
+  solver.body.linear_solver = LinearSolverKind::multigrid;
+  message = encode_setup_body(upper.definition, upper.context, solver);
+  EXPECT_EQ(message.solver().interface_operator(), "factor");
+  EXPECT_EQ(message.solver().linear_solver(), "multigrid");
+}
+
 TEST(SetupEncoding, ConstraintOperatorTravelsInCompressedRows) {
   ContactOperator contact;
   contact.add_entry(4, 0, 0.6);

@@ -1195,6 +1195,37 @@ TEST(SubdomainServer, HugeBodyNameIsBadInput) {
   expect_hello(server, 5);
 }
 
+// SolverSettings.interface_operator and linear_solver are hints, but only their documented
+// strings (docs/protocol.md): "" and each value are accepted, any other string is BAD_INPUT
+// naming the body, the field and the value.
+TEST(SubdomainServer, SolverHintsAcceptTheirValuesAndRefuseOthers) {
+  SubdomainServer server(quiet_settings());
+  std::uint64_t id = 1;
+  for (const char* value : {"", "direct", "multigrid"}) {
+    protocol::SetupBody setup = lower_block_setup();
+    setup.mutable_solver()->set_linear_solver(value);
+    EXPECT_TRUE(exchange(server, setup_request(id++, setup)).has_interface()) << value;
+  }
+  protocol::SetupBody bad = lower_block_setup();
+  bad.mutable_solver()->set_linear_solver("amg");
+  protocol::Envelope reply = exchange(server, setup_request(id++, bad));
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  EXPECT_NE(reply.error().message().find(
+                "body 'lower': SetupBody.solver.linear_solver is 'amg', expected \"direct\" or "
+                "\"multigrid\""),
+            std::string::npos)
+      << reply.error().message();
+  bad = lower_block_setup();
+  bad.mutable_solver()->set_interface_operator("sparse");
+  reply = exchange(server, setup_request(id++, bad));
+  expect_error(reply, protocol::BAD_INPUT, "awaiting_setup");
+  EXPECT_NE(reply.error().message().find("body 'lower': SetupBody.solver.interface_operator is "
+                                         "'sparse', expected \"auto\", \"dense\" or \"factor\""),
+            std::string::npos)
+      << reply.error().message();
+  expect_hello(server, id++);
+}
+
 /// A unit square of two counter-clockwise triangles with tags 7 and 8, boundaries "bottom",
 /// "right", "top" and "left", as MeshData built by hand.
 protocol::MeshData square_mesh_data() {
