@@ -111,7 +111,11 @@ def _solver(message, context):
               "is '%s', expected \"auto\", \"dense\" or \"factor\"" % message.interface_operator)
     if message.dense_limit > 2 ** 31 - 1:
         _fail(context, "solver.dense_limit", "is too large")
-    # interface_operator and dense_limit are hints; this server always assembles F densely.
+    if message.linear_solver not in ("", "direct", "multigrid"):
+        _fail(context, "solver.linear_solver",
+              "is '%s', expected \"direct\" or \"multigrid\"" % message.linear_solver)
+    # interface_operator, dense_limit and linear_solver are hints; this server always assembles
+    # F densely and solves K x = b directly.
     return settings
 
 

@@ -449,6 +449,23 @@ class BadBodies(ServerTestCase):
         three.dirichlet.add(boundary="left", z=0.0)
         self.refused(three, "dirichlet[1].z")
 
+    def test_solver_hints(self):
+        """SolverSettings.interface_operator and linear_solver are hints (this server always
+        assembles F densely and solves directly), but only their documented strings."""
+        for value in ("", "direct", "multigrid"):
+            body = setup_body()
+            body.solver.linear_solver = value
+            reply = self.ask(request(setup_body=body))
+            self.assertEqual(reply.WhichOneof("content"), "interface", (value, reply))
+        body = setup_body()
+        body.solver.linear_solver = "amg"
+        self.refused(body, "body 'lower': SetupBody.solver.linear_solver is 'amg', expected "
+                     "\"direct\" or \"multigrid\"")
+        body = setup_body()
+        body.solver.interface_operator = "sparse"
+        self.refused(body, "body 'lower': SetupBody.solver.interface_operator is 'sparse', "
+                     "expected \"auto\", \"dense\" or \"factor\"")
+
     def test_mesh_data_sizes_and_indices(self):
         node_count = len(LOWER_MESH.coordinates) // 2
 
