@@ -109,6 +109,7 @@ robin::protocol::SetupBody voigt_setup() {
   solver.set_qp_max_iterations(500);
   solver.set_interface_operator("dense");
   solver.set_dense_limit(100);
+  solver.set_linear_solver("multigrid");
   return setup;
 }
 
@@ -127,6 +128,7 @@ robin::protocol::SetupBody mesh_path_setup() {
   bottom.set_y(0.0);
   setup.add_contact_boundaries("top");
   setup.mutable_solver()->set_interface_operator("factor");
+  setup.mutable_solver()->set_linear_solver("direct");
   return setup;
 }
 
