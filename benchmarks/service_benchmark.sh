@@ -2,8 +2,9 @@
 # Prints the coupled-service benchmark table (docs/benchmarks.md): the partial-contact two-block
 # case at several mesh sizes (about 1e4, 1e5 and 1e6 DOFs by default), solved by robin-run (two
 # robin-subdomain processes over tcp://127.0.0.1) and by robin-monolithic.
-# Usage: [INTERFACE_OPERATOR=auto|dense|factor] benchmarks/service_benchmark.sh [build directory] [mesh sizes...]
-# INTERFACE_OPERATOR sets [solver] interface_operator (default: the case's, i.e. auto).
+# Usage: [INTERFACE_OPERATOR=auto|dense|factor] [LINEAR_SOLVER=direct|multigrid] benchmarks/service_benchmark.sh [build directory] [mesh sizes...]
+# INTERFACE_OPERATOR sets [solver] interface_operator (default: the case's, i.e. auto),
+# LINEAR_SOLVER [solver] linear_solver (default: the case's, i.e. direct).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -14,7 +15,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 echo "machine: $(uname -m), $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2/1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
-echo "command: INTERFACE_OPERATOR=${INTERFACE_OPERATOR:-} benchmarks/service_benchmark.sh $build ${sizes[*]}"
+echo "command: INTERFACE_OPERATOR=${INTERFACE_OPERATOR:-} ${LINEAR_SOLVER:+LINEAR_SOLVER=$LINEAR_SOLVER }benchmarks/service_benchmark.sh $build ${sizes[*]}"
 echo
 printf '| %-7s | %-8s | %-5s | %-5s | %-10s | %-10s | %-10s | %-8s | %-9s | %-11s | %-10s | %-10s | %-9s |\n' \
   h DOFs pairs iter "DD wall" "DD setup" "DD iter." "mono" "DD/mono" "bytes/iter" "msg/iter." "msg/wall" "per iter"
@@ -23,8 +24,14 @@ for size in "${sizes[@]}"; do
   case_file="$work/case_$size.toml"
   sed -e "s|^mesh_size = .*|mesh_size = $size|" \
       -e "s|^mesh = \"meshes/|mesh = \"$PWD/examples/meshes/|" examples/two_blocks_partial.toml > "$case_file"
-  if [ -n "${INTERFACE_OPERATOR:-}" ]; then
-    printf '\n[solver]\ninterface_operator = "%s"\n' "$INTERFACE_OPERATOR" >> "$case_file"
+  if [ -n "${INTERFACE_OPERATOR:-}" ] || [ -n "${LINEAR_SOLVER:-}" ]; then
+    printf '\n[solver]\n' >> "$case_file"
+    if [ -n "${INTERFACE_OPERATOR:-}" ]; then
+      printf 'interface_operator = "%s"\n' "$INTERFACE_OPERATOR" >> "$case_file"
+    fi
+    if [ -n "${LINEAR_SOLVER:-}" ]; then
+      printf 'linear_solver = "%s"\n' "$LINEAR_SOLVER" >> "$case_file"
+    fi
   fi
   dd_start=$(date +%s.%N)
   dd_status=0

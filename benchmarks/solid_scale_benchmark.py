@@ -3,6 +3,7 @@
 
     /usr/bin/python3 benchmarks/solid_scale_benchmark.py [--build build]
         [--sizes 1e4 1e5 1e6] [--include-3e6] [--operators dense factor]
+        [--linear-solvers direct multigrid]
         [--tools robin-run robin-monolithic] [--timeout 900] [--memory-limit 18]
         [--robin-timeout 1800] [--keep DIR]
     /usr/bin/python3 benchmarks/solid_scale_benchmark.py --tabulate DIR/results.json ...
@@ -20,16 +21,19 @@ robin-run (one robin-subdomain server per body on this machine) and robin-monoli
 once per interface operator of --operators (`[solver] interface_operator`, set with --set:
 "dense" assembles F = B K^-1 B^T once, "factor" applies it by triangular solves, "auto" is
 dense up to dense_limit = 8000 contact nodes; the contact face has (n+1)^2 nodes, node-to-node
-pairs). Sizes above 2e6 DOFs run only with --include-3e6 (which also adds 3e6 to the sizes).
+pairs), and once per linear solver of --linear-solvers (`[solver] linear_solver`, also set with
+--set: "direct", the default and the only one run without the option, factorizes K once;
+"multigrid" solves by AMG-preconditioned conjugate gradients, docs/case-format.md). Sizes above
+2e6 DOFs run only with --include-3e6 (which also adds 3e6 to the sizes).
 
 Prints, per run as it finishes, one line; then two Markdown tables:
 
   1. the stages of summary.json's `profile` (docs/outputs.md), one row per stage, one column per
-     size, operator and tool, in seconds ("server:" rows are the larger of the two bodies';
+     size, operator (and linear solver, when not "direct") and tool, in seconds ("server:" rows are the larger of the two bodies';
      robin-run sets them up in parallel, robin-monolithic one after the other), the iterations,
      wall time, peak RSS of each robin-subdomain server, of the coordinator and of
      robin-monolithic, and robin-monolithic's factor fill (nonzeros of L per body);
-  2. one row per size and operator: DOFs, contact nodes, robin-run's outer iterations, their
+  2. one row per size, operator and linear solver: DOFs, contact nodes, robin-run's outer iterations, their
      time and messaging share (summary.json timings.messaging_share_of_iteration), the wall
      times of robin-run and robin-monolithic and their ratio, the peak RSS per server, and the
      agreement: the largest difference of the contact forces of contact.csv (the mean of the
@@ -51,6 +55,7 @@ No time is asserted anywhere: the tables are measurements on a machine that may 
 """
 
 import argparse
+import itertools
 import json
 import os
 import shutil
@@ -258,9 +263,11 @@ def cell(value, digits=3):
     return f"%.{digits}f" % value
 
 
-def run_one(binaries, tool, case, operator, output, arguments):
+def run_one(binaries, tool, case, operator, linear_solver, output, arguments):
     command = [str(binaries / tool), str(case), "--output", str(output), "--quiet",
                "--set", f"solver.interface_operator={operator}"]
+    if linear_solver != "direct":  # without the key: as before the option (direct)
+        command += ["--set", f"solver.linear_solver={linear_solver}"]
     if tool == "robin-run":
         command += ["--timeout", repr(arguments.robin_timeout)]
     status, wall, maxrss, peaks, largest_sum, stopped, timeline = run_guarded(
@@ -277,7 +284,7 @@ def run_one(binaries, tool, case, operator, output, arguments):
     coordinator = [kib / 1024 for label, kib in peaks.values() if label.startswith("robin-run")]
     timings = summary.get("timings", {})
     result = {
-        "tool": tool, "operator": operator, "command": " ".join(command), "status": status,
+        "tool": tool, "operator": operator, "linear_solver": linear_solver, "command": " ".join(command), "status": status,
         "stopped": stopped, "wall": wall, "column": column,
         "stages": sum(profile.get(key) or 0.0 for key in COORDINATOR_KEYS) if profile else None,
         "dofs": sum(body.get("dofs", 0) for body in summary.get("bodies", [])) or None,
@@ -308,6 +315,13 @@ def status_text(result):
     return f"exit {result['status']}: {result['message'] or 'no summary'}"
 
 
+def solver_label(result):
+    """The interface operator of a run, and its linear solver when not "direct" (results.json
+    of runs before --linear-solvers have none: direct)."""
+    linear_solver = result.get("linear_solver") or "direct"
+    return result["operator"] + ("" if linear_solver == "direct" else f", {linear_solver}")
+
+
 def print_tables(results):
     """The two Markdown tables of the module docstring; returns the number of runs that failed,
     were stopped or did not converge."""
@@ -315,7 +329,7 @@ def print_tables(results):
         if r.get("dofs") is None:
             r["dofs"] = 2 * body_dofs(r["n"])
     # Table 1: the stages, one column per run.
-    headers = [f"n = {r['n']}, {r['dofs']} DOFs, {r['operator']}, "
+    headers = [f"n = {r['n']}, {r['dofs']} DOFs, {solver_label(r)}, "
                f"{'DD' if r['tool'] == 'robin-run' else 'mono'}" for r in results]
     print("\n" + table_row(["stage (s)"] + headers))
     print(table_rule(len(headers) + 1))
@@ -343,7 +357,7 @@ def print_tables(results):
     for label, function in extra:
         print(table_row([label] + [function(r) for r in results]))
 
-    # Table 2: one row per size and operator.
+    # Table 2: one row per size, operator and linear solver.
     print("\n" + table_row(["DOFs (n)", "contact nodes", "F", "DD outer iterations",
                             "DD iterations (s)", "messaging share of the iterations",
                             "DD wall (s)", "mono wall (s)", "DD / mono",
@@ -353,13 +367,13 @@ def print_tables(results):
     failures = 0
     pairs = []
     for r in results:
-        if (r["n"], r["operator"]) not in pairs:
-            pairs.append((r["n"], r["operator"]))
-    for n, operator in pairs:
+        if (r["n"], solver_label(r)) not in pairs:
+            pairs.append((r["n"], solver_label(r)))
+    for n, label in pairs:
         if True:
-            dd = next((r for r in results if r["n"] == n and r["operator"] == operator
+            dd = next((r for r in results if r["n"] == n and solver_label(r) == label
                        and r["tool"] == "robin-run"), None)
-            mono = next((r for r in results if r["n"] == n and r["operator"] == operator
+            mono = next((r for r in results if r["n"] == n and solver_label(r) == label
                          and r["tool"] == "robin-monolithic"), None)
             for r in (dd, mono):
                 failures += r is not None and (r["status"] != 0 or r["stopped"] is not None)
@@ -368,7 +382,7 @@ def print_tables(results):
             ratio = dd["wall"] / mono["wall"] if ok(dd) and ok(mono) else None
             difference = agreement(dd["forces"], mono["forces"]) if ok(dd) and ok(mono) else None
             print(table_row([
-                f"{dofs} ({n})", (n + 1) ** 2, operator,
+                f"{dofs} ({n})", (n + 1) ** 2, label,
                 cell(dd["iterations"]) if ok(dd) else "–",
                 cell(dd["column"][12]) if ok(dd) else "–",
                 cell(dd["messaging_share"], 2) if ok(dd) else "–",
@@ -397,6 +411,9 @@ def main():
     parser.add_argument("--operators", nargs="+", default=["dense", "factor"],
                         choices=["dense", "factor", "auto"],
                         help="[solver] interface_operator values to run (default dense factor)")
+    parser.add_argument("--linear-solvers", nargs="+", default=["direct"],
+                        choices=["direct", "multigrid"],
+                        help="[solver] linear_solver values to run (default direct)")
     parser.add_argument("--tools", nargs="+", default=["robin-run", "robin-monolithic"],
                         choices=["robin-run", "robin-monolithic"], help="the tools to run")
     parser.add_argument("--timeout", type=float, default=900.0,
@@ -442,15 +459,19 @@ def main():
         for size in sizes:
             n = cells_for(size)
             case = write_case(scratch, n)
-            for operator in arguments.operators:
+            for operator, linear_solver in itertools.product(arguments.operators,
+                                                             arguments.linear_solvers):
+                suffix = "" if linear_solver == "direct" else f"_{linear_solver}"
                 for tool in arguments.tools:
-                    output = scratch / f"n{n}_{operator}_{tool}"
-                    result = run_one(binaries, tool, case, operator, output, arguments)
+                    output = scratch / f"n{n}_{operator}{suffix}_{tool}"
+                    result = run_one(binaries, tool, case, operator, linear_solver, output,
+                                     arguments)
                     result.update(size=size, n=n, contact_nodes=(n + 1) ** 2)
                     if result["dofs"] is None:  # no summary.json: the count the mesh gives
                         result["dofs"] = 2 * body_dofs(n)
                     results.append(result)
-                    print(f"{size:g} DOFs (n = {n}, {result['dofs']} DOFs), {operator}, {tool}: "
+                    print(f"{size:g} DOFs (n = {n}, {result['dofs']} DOFs), "
+                          f"{solver_label(result)}, {tool}: "
                           f"{status_text(result)}, {result['wall']:.1f} s, largest resident "
                           f"sum {result['largest_resident_sum']:.0f} MiB", flush=True)
                     if result["stopped"] or result["wall"] > 120:
