@@ -47,6 +47,7 @@ TEST(CaseOverrides, ReplaceAndAddKeysOfEveryKind) {
       "title=\"sweep 1\"",                // a TOML string
       "body[1].body_force=[0.0, -2.5]",   // a key the file does not have
       "solver.interface_operator=dense",  // a bare word is a string
+      "solver.linear_solver=multigrid",
       "coupling.per_body=false",
       "solver.qp_max_iterations=77",
       "body[2].dirichlet[1].fix=x"};
@@ -58,6 +59,7 @@ TEST(CaseOverrides, ReplaceAndAddKeysOfEveryKind) {
   EXPECT_EQ(definition.bodies[0].definition.body_force.x(), 0.0);
   EXPECT_EQ(definition.bodies[0].definition.body_force.y(), -2.5);
   EXPECT_EQ(definition.solver.body.interface_operator, InterfaceOperatorKind::dense);
+  EXPECT_EQ(definition.solver.body.linear_solver, LinearSolverKind::multigrid);
   EXPECT_FALSE(definition.coupling.acceleration.per_body);
   EXPECT_EQ(definition.solver.qp.max_iterations, 77);
   ASSERT_EQ(definition.bodies[1].definition.dirichlet.size(), 1u);
