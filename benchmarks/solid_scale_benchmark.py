@@ -29,16 +29,17 @@ pairs), and once per linear solver of --linear-solvers (`[solver] linear_solver`
 Prints, per run as it finishes, one line; then two Markdown tables:
 
   1. the stages of summary.json's `profile` (docs/outputs.md), one row per stage, one column per
-     size, operator (and linear solver, when not "direct") and tool, in seconds ("server:" rows are the larger of the two bodies';
-     robin-run sets them up in parallel, robin-monolithic one after the other), the iterations,
-     wall time, peak RSS of each robin-subdomain server, of the coordinator and of
-     robin-monolithic, and robin-monolithic's factor fill (nonzeros of L per body);
-  2. one row per size, operator and linear solver: DOFs, contact nodes, robin-run's outer iterations, their
-     time and messaging share (summary.json timings.messaging_share_of_iteration), the wall
-     times of robin-run and robin-monolithic and their ratio, the peak RSS per server, and the
-     agreement: the largest difference of the contact forces of contact.csv (the mean of the
-     lambda1 and lambda2 columns, row by row) between robin-run and robin-monolithic, relative
-     to the largest contact force.
+     size, operator (and linear solver, when not "direct") and tool, in seconds ("server:" rows
+     are the larger of the two bodies'; robin-run sets them up in parallel, robin-monolithic one
+     after the other), the iterations, wall time, peak RSS of each robin-subdomain server, of
+     the coordinator and of robin-monolithic, and robin-monolithic's factor fill (nonzeros of L
+     per body);
+  2. one row per size, operator and linear solver: DOFs, contact nodes, robin-run's outer
+     iterations, their time and messaging share (summary.json
+     timings.messaging_share_of_iteration), the wall times of robin-run and robin-monolithic and
+     their ratio, the peak RSS per server, and the agreement: the largest difference of the
+     contact forces of contact.csv (the mean of the lambda1 and lambda2 columns, row by row)
+     between robin-run and robin-monolithic, relative to the largest contact force.
 
 Runs are measured with benchmark_support (VmHWM of every process of the run polled from /proc
 every 0.1 s). A run is stopped (SIGTERM, then SIGKILL of the processes seen) when it takes longer
@@ -284,7 +285,8 @@ def run_one(binaries, tool, case, operator, linear_solver, output, arguments):
     coordinator = [kib / 1024 for label, kib in peaks.values() if label.startswith("robin-run")]
     timings = summary.get("timings", {})
     result = {
-        "tool": tool, "operator": operator, "linear_solver": linear_solver, "command": " ".join(command), "status": status,
+        "tool": tool, "operator": operator, "linear_solver": linear_solver,
+        "command": " ".join(command), "status": status,
         "stopped": stopped, "wall": wall, "column": column,
         "stages": sum(profile.get(key) or 0.0 for key in COORDINATOR_KEYS) if profile else None,
         "dofs": sum(body.get("dofs", 0) for body in summary.get("bodies", [])) or None,
