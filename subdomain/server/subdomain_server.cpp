@@ -581,6 +581,9 @@ void SubdomainServer::on_setup_body(protocol::Envelope& request, protocol::Envel
   record.outcome = "ok, " + std::to_string(body_->mesh().node_count()) + " nodes, " +
                    std::to_string(body_->free_dof_count()) + " free dofs, " +
                    std::to_string(interface_nodes_.size()) + " contact boundary nodes";
+  if (body_->linear_solver() == LinearSolverKind::multigrid) {
+    record.outcome += ", multigrid solver";
+  }
   if (reuse) record.outcome += ", factorization of the previous run reused";
   if (const std::uint64_t peak = peak_resident_bytes(); peak > 0) {
     record.outcome +=
@@ -602,8 +605,16 @@ void SubdomainServer::on_assign_contact(const protocol::Envelope& request,
     throw RequestError(protocol::INVALID_ARGUMENT, error.what());
   }
   state_ = ServerState::awaiting_assignment;  // until the body accepted the assignment
+  const LinearSolverKind solver = body_->linear_solver();
   body_->assign_contact(contact);
   state_ = ServerState::ready;
+  if (solver != body_->linear_solver()) {
+    settings_.logger->warn(
+        "body '{}': its {} contact rows are linearly dependent (the mortar side of a finer "
+        "non-mortar side), which the multigrid solver's primal contact solve cannot project on: "
+        "K factorized, the body continues with the direct solver",
+        printable_for_log(body_->name(), 80), body_->contact_size());
+  }
   acknowledge(reply);
   if (settings_.protocol_minor >= 2) {
     add_stage_time(*reply.mutable_acknowledge()->mutable_stage_times(),
@@ -626,8 +637,12 @@ void SubdomainServer::on_contact_solve(const protocol::Envelope& request, protoc
   require_finite(result.normal_trace, "ContactSolveResult.normal_trace", body_->name());
   require_finite(result.contact_force, "ContactSolveResult.contact_force", body_->name());
   encode_contact_result(result, *reply.mutable_contact_result());
-  record.outcome = protocol::SolveStatus_Name(to_protocol(result.status)) + ", " +
-                   std::to_string(result.iterations) + " QP iterations";
+  record.outcome =
+      protocol::SolveStatus_Name(to_protocol(result.status)) + ", " +
+      std::to_string(result.iterations) +
+      (body_->linear_solver() == LinearSolverKind::multigrid
+           ? " active set steps, " + std::to_string(result.operator_applications) + " CG iterations"
+           : " QP iterations");
   if (!result.message.empty()) record.outcome += " (" + result.message + ")";
 }
 
