@@ -15,7 +15,8 @@
 // Also checked: the Signorini conditions of the multigrid result itself (lambda >= 0, no
 // penetration beyond 1e-9 of the displacement scale, complementarity), the same active set,
 // the displacement field, a second solve warm-started after a change of obstacle and load
-// factor, and the refusal of a floating body.
+// factor, the refusal of a floating body, and the fall-back to the factor when the contact rows
+// are linearly dependent (as on the mortar side of a finer non-mortar side).
 
 #include <gtest/gtest.h>
 
@@ -196,6 +197,39 @@ TEST(MultigridBody, WarmStartAfterANewObstacleAndLoadFactor) {
               agreement)
         << test.label;
   }
+}
+
+// Rows u_z(a) for every top node a, then 0.5 u_z(a) + 0.5 u_z(b) for consecutive nodes: the
+// second kind are combinations of the first, so B B' is singular and no active set's projection
+// exists. The body factorizes K at assign_contact and answers as the direct solver.
+TEST(MultigridBody, DependentContactRowsFallBackToTheFactor) {
+  const BodyDefinition body = solid_box(ElementType::hexahedron8);
+  const std::vector<int> nodes = body.mesh.boundary("top").nodes();
+  ContactOperator contact;
+  for (int node : nodes) {
+    contact.add_entry(node, 2, 1.0);
+    contact.finish_row(0.1);
+  }
+  for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+    contact.add_entry(nodes[i], 2, 0.5);
+    contact.add_entry(nodes[i + 1], 2, 0.5);
+    contact.finish_row(0.1);
+  }
+  BodySolverOptions options;
+  options.linear_solver = LinearSolverKind::multigrid;
+  BodySolver multigrid(body, options);
+  BodySolver direct(body);
+  EXPECT_EQ(multigrid.linear_solver(), LinearSolverKind::multigrid);
+  multigrid.assign_contact(contact);
+  direct.assign_contact(contact);
+  EXPECT_EQ(multigrid.linear_solver(), LinearSolverKind::direct);
+  EXPECT_GT(multigrid.factor_nonzeros(), 0);
+  const Eigen::VectorXd obstacle = 0.5 * direct.free_trace();
+  const ContactSolveResult expected = direct.solve_contact(obstacle);
+  const ContactSolveResult result = multigrid.solve_contact(obstacle);
+  ASSERT_EQ(result.status, QpStatus::converged) << result.message;
+  // the same dual QP (MPRGP to 1e-12 of ||F|| ||lambda||), F from a factor of another order
+  EXPECT_LE(relative_difference(result.normal_trace, expected.normal_trace), 1e-10);
 }
 
 TEST(MultigridBody, RefusesAFloatingBody) {
