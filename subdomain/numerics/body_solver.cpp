@@ -650,6 +650,20 @@ Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_fo
     // w_N = B K^dagger B' r = B P K^+ P B' r, P = I - R R'
     return trace_ * factor_->solve_minimum_norm(apply_transpose_trace(interface_force));
   }
+  if (multigrid_) {
+    // To the accuracy of the contact solves: relative to the larger of B'r and the last contact
+    // force B'lambda, so that the small r of a nearly converged coupling costs few iterations.
+    const Eigen::VectorXd load = apply_transpose_trace(interface_force);
+    const double load_norm = load.norm();
+    const double contact_load_norm =
+        primal_state_->contact_force.size() == contact_size()
+            ? apply_transpose_trace(primal_state_->contact_force).norm()
+            : 0.0;
+    if (load_norm == 0.0) return Eigen::VectorXd::Zero(contact_size());
+    const double tolerance =
+        multigrid_->relative_tolerance() * std::max(load_norm, contact_load_norm) / load_norm;
+    return trace_ * multigrid_->solve(load, {}, tolerance);
+  }
   compliance_->apply(interface_force, trace);  // w_N = B K^{-1} B' r
   return trace;
 }

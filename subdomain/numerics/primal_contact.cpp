@@ -184,10 +184,12 @@ double MultigridStiffnessSolver::setup_seconds() const {
 }
 
 Eigen::VectorXd MultigridStiffnessSolver::solve(const Eigen::VectorXd& right_hand_side,
-                                                const Eigen::VectorXd& initial) const {
+                                                const Eigen::VectorXd& initial,
+                                                double relative_tolerance) const {
   Eigen::VectorXd solution = initial;
   const ConjugateGradientResult result =
-      solve_with(stiffness(), preconditioner(), right_hand_side, solution, relative_tolerance_);
+      solve_with(stiffness(), preconditioner(), right_hand_side, solution,
+                 relative_tolerance > 0.0 ? relative_tolerance : relative_tolerance_);
   if (result.status != ConjugateGradientStatus::converged) {
     throw std::runtime_error("body '" + body_name_ +
                              "': the stiffness solve failed: " + describe(result));

@@ -65,10 +65,11 @@ class MultigridStiffnessSolver {
   double relative_tolerance() const { return relative_tolerance_; }
   const std::string& body_name() const { return body_name_; }
 
-  /// x = K^{-1} b from the initial guess `initial` (zero when empty). Throws std::runtime_error
-  /// naming the body when conjugate gradients stop without converging.
-  Eigen::VectorXd solve(const Eigen::VectorXd& right_hand_side,
-                        const Eigen::VectorXd& initial = {}) const;
+  /// x = K^{-1} b from the initial guess `initial` (zero when empty), to `relative_tolerance`
+  /// (this solver's own when 0). Throws std::runtime_error naming the body when conjugate
+  /// gradients stop without converging.
+  Eigen::VectorXd solve(const Eigen::VectorXd& right_hand_side, const Eigen::VectorXd& initial = {},
+                        double relative_tolerance = 0.0) const;
   /// Conjugate gradients for `matrix` x = b with `preconditioner` (the projected operators of the
   /// contact problem), counted like solve(); returns the result, throws as solve() does.
   ConjugateGradientResult solve_with(const LinearOperator& matrix,
@@ -109,7 +110,7 @@ struct PrimalContactResult {
 struct PrimalContactOptions {
   /// The active set thresholds and the projected conjugate gradients' tolerance (the file
   /// comment); at least the stiffness solver's tolerance is used.
-  double relative_tolerance = 1e-10;
+  double relative_tolerance = 1e-12;
   int maximum_active_set_steps = 100;
 };
 

@@ -5,9 +5,9 @@
 //  - robin-coordinator against two robin-subdomain servers started beforehand writes the same;
 //  - robin-run and robin-monolithic on examples/hertz_3d.toml write the same contact forces;
 //  - with the iterative inner solver (solver.linear_solver = "multigrid": AMG-preconditioned
-//    conjugate gradients stopped at a relative residual of 1e-10, docs/method.md) robin-run
+//    conjugate gradients stopped at a relative residual of 1e-12, docs/method.md) robin-run
 //    reproduces the patch test's pressure and the direct robin-monolithic's contact forces on
-//    the sphere to 1e-7 relative (an error bound of cond(K) x 1e-10 for cond(K) up to 1e3);
+//    the sphere to 1e-7 relative (an error bound of cond(K) x 1e-12 for cond(K) up to 1e5);
 //  - robin-coordinator's coupling with the independent Python server owning the hexahedral
 //    block and robin-subdomain the tetrahedral one gives the monolithic mortar solution.
 

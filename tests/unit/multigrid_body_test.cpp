@@ -9,8 +9,8 @@
 // the 2D block of tests/test_bodies.hpp on a finer mesh. The obstacle g_j = e_j (0.3 + 1.2 x_j / L)
 // (e the free trace) closes the contact for x < 7/12 L and leaves the rest open: a partial contact.
 //
-// Tolerances. The conjugate gradients stop at ||b - K x|| <= 1e-10 ||b||; the error of x is then
-// at most cond(K) times that relative residual, in practice far less. The bounds below (1e-7
+// Tolerances. The conjugate gradients stop at ||b - K x|| <= 1e-12 ||b||; the error of x is then
+// at most cond(K) times that relative residual, in practice far less. The bounds below (1e-9
 // relative) allow cond(K) up to 1e3 in that worst case; the measured errors are printed.
 // Also checked: the Signorini conditions of the multigrid result itself (lambda >= 0, no
 // penetration beyond 1e-9 of the displacement scale, complementarity), the same active set,
@@ -39,7 +39,7 @@
 namespace robin {
 namespace {
 
-constexpr double agreement = 1e-7;  // relative (the file comment)
+constexpr double agreement = 1e-9;  // relative (the file comment)
 
 BodyDefinition solid_box(ElementType type) {
   BodyDefinition body;
