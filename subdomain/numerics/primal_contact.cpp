@@ -142,6 +142,62 @@ std::vector<bool> penetrating_rows(const Eigen::VectorXd& trace_of_solution,
   return rows;
 }
 
+struct ActiveSetStep {
+  Eigen::VectorXd force;  // lambda (zero off the active set)
+  ConjugateGradientResult inner;
+  double projected_gradient_norm = 0.0;  // ||P (b - K u)||
+};
+
+/// One step of the method: `solution` becomes the minimiser of the energy on B_A u = c_A, from
+/// the nearest point of that set to it, to `tolerance` (the file comment).
+ActiveSetStep solve_on_active_set(const MultigridStiffnessSolver& stiffness,
+                                  const ActiveConstraints& constraints, const Eigen::VectorXd& load,
+                                  const Eigen::VectorXd& bound, double tolerance,
+                                  Eigen::VectorXd& solution) {
+  ActiveSetStep outcome;
+  outcome.inner.status = ConjugateGradientStatus::converged;
+  const Eigen::VectorXd start = constraints.move_onto(solution, bound);  // u_0
+  Eigen::VectorXd product;
+  stiffness.stiffness().apply(start, product);
+  const Eigen::VectorXd load_part = constraints.project(load);
+  const Eigen::VectorXd stiffness_part = constraints.project(product);
+  const Eigen::VectorXd right_hand_side = load_part - stiffness_part;
+  const double scale = load_part.norm() + stiffness_part.norm();
+  Eigen::VectorXd step_in_kernel = Eigen::VectorXd::Zero(stiffness.size());
+  if (right_hand_side.norm() > tolerance * scale) {
+    const ProjectedStiffness projected_stiffness(stiffness.stiffness(), constraints);
+    const ProjectedPreconditioner projected_preconditioner(stiffness.preconditioner(), constraints);
+    outcome.inner =
+        stiffness.solve_with(projected_stiffness, projected_preconditioner, right_hand_side,
+                             step_in_kernel, tolerance * scale / right_hand_side.norm());
+  }
+  solution = start + step_in_kernel;
+  stiffness.stiffness().apply(solution, product);
+  const Eigen::VectorXd residual = load - product;  // B_A' lambda_A
+  outcome.projected_gradient_norm = constraints.project(residual).norm();
+  const Eigen::VectorXd active_force = constraints.multipliers(residual);
+  outcome.force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(bound.size()));
+  for (std::size_t k = 0; k < constraints.rows().size(); ++k) {
+    outcome.force[constraints.rows()[k]] = active_force[static_cast<Eigen::Index>(k)];
+  }
+  return outcome;
+}
+
+/// The next active set: the active rows whose force is not negative beyond the noise, and the
+/// inactive ones that penetrate beyond it (the file comment).
+std::vector<bool> next_active_set(const std::vector<bool>& active, const Eigen::VectorXd& force,
+                                  const Eigen::VectorXd& trace_of_solution,
+                                  const Eigen::VectorXd& bound, const std::vector<bool>& movable,
+                                  double tolerance) {
+  const double force_threshold = tolerance * force.lpNorm<Eigen::Infinity>();
+  std::vector<bool> next = penetrating_rows(
+      trace_of_solution, bound, movable, tolerance * trace_of_solution.lpNorm<Eigen::Infinity>());
+  for (std::size_t j = 0; j < next.size(); ++j) {
+    if (active[j]) next[j] = force[static_cast<Eigen::Index>(j)] >= -force_threshold;
+  }
+  return next;
+}
+
 void check_sizes(const MultigridStiffnessSolver& stiffness, const SparseMatrix& trace,
                  const Eigen::VectorXd& load, const Eigen::VectorXd& bound,
                  const Eigen::VectorXd& initial_displacement) {
@@ -236,58 +292,37 @@ PrimalContactResult solve_primal_contact(const MultigridStiffnessSolver& stiffne
     result.displacement = solution;
   };
   record(Eigen::VectorXd::Zero(trace.rows()), trace * solution);
-  Eigen::VectorXd product;
+  // the steps to a loose tolerance while the active set changes, then the last one to the final
+  double step_tolerance = std::max(tolerance, options.changing_set_tolerance);
   for (int step = 1; step <= options.maximum_active_set_steps; ++step) {
     result.iterations = step;
     const ActiveConstraints constraints(row_trace, indices_of(active), stiffness.body_name());
-    const Eigen::VectorXd start = constraints.move_onto(solution, bound);  // u_0
-    stiffness.stiffness().apply(start, product);
-    const Eigen::VectorXd load_part = constraints.project(load);
-    const Eigen::VectorXd stiffness_part = constraints.project(product);
-    const Eigen::VectorXd right_hand_side = load_part - stiffness_part;
-    const double scale = load_part.norm() + stiffness_part.norm();
-    Eigen::VectorXd step_in_kernel = Eigen::VectorXd::Zero(stiffness.size());
-    if (right_hand_side.norm() > tolerance * scale) {
-      const ProjectedStiffness projected_stiffness(stiffness.stiffness(), constraints);
-      const ProjectedPreconditioner projected_preconditioner(stiffness.preconditioner(),
-                                                             constraints);
-      const ConjugateGradientResult inner =
-          stiffness.solve_with(projected_stiffness, projected_preconditioner, right_hand_side,
-                               step_in_kernel, tolerance * scale / right_hand_side.norm());
-      result.operator_applications += inner.iterations;
-      if (inner.status != ConjugateGradientStatus::converged) {
-        result.status = inner.status == ConjugateGradientStatus::breakdown
-                            ? QpStatus::breakdown
-                            : QpStatus::not_converged;
-        result.message = "active set step " + std::to_string(step) + ": " + describe(inner);
-        return result;
-      }
-    }
-    solution = start + step_in_kernel;
-    stiffness.stiffness().apply(solution, product);
-    const Eigen::VectorXd residual = load - product;  // B_A' lambda_A
-    result.projected_gradient_norm = constraints.project(residual).norm();
-    const Eigen::VectorXd active_force = constraints.multipliers(residual);
-    Eigen::VectorXd force = Eigen::VectorXd::Zero(trace.rows());
-    for (std::size_t k = 0; k < constraints.rows().size(); ++k) {
-      force[constraints.rows()[k]] = active_force[static_cast<Eigen::Index>(k)];
+    const ActiveSetStep outcome =
+        solve_on_active_set(stiffness, constraints, load, bound, step_tolerance, solution);
+    result.operator_applications += outcome.inner.iterations;
+    result.projected_gradient_norm = outcome.projected_gradient_norm;
+    if (outcome.inner.status != ConjugateGradientStatus::converged) {
+      result.status = outcome.inner.status == ConjugateGradientStatus::breakdown
+                          ? QpStatus::breakdown
+                          : QpStatus::not_converged;
+      result.message = "active set step " + std::to_string(step) + ": " + describe(outcome.inner);
+      return result;
     }
     const Eigen::VectorXd trace_of_solution = trace * solution;
-    const double force_threshold = tolerance * force.lpNorm<Eigen::Infinity>();
-    std::vector<bool> next = penetrating_rows(
-        trace_of_solution, bound, movable, tolerance * trace_of_solution.lpNorm<Eigen::Infinity>());
-    for (std::size_t j = 0; j < next.size(); ++j) {
-      if (active[j]) next[j] = force[static_cast<Eigen::Index>(j)] >= -force_threshold;
-    }
-    record(force, trace_of_solution);
-    if (next == active) {
+    const std::vector<bool> next =
+        next_active_set(active, outcome.force, trace_of_solution, bound, movable, step_tolerance);
+    record(outcome.force, trace_of_solution);
+    if (next == active && step_tolerance > tolerance) {
+      step_tolerance = tolerance;  // the same set again, to the final tolerance
+    } else if (next == active) {
       result.status = QpStatus::converged;
       state.displacement = solution;
       state.active = active;
       state.contact_force = result.solution;
       return result;
+    } else {
+      active = next;
     }
-    active = std::move(next);
   }
   result.message = "the active set still changed after " +
                    std::to_string(options.maximum_active_set_steps) + " steps";

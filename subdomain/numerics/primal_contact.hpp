@@ -27,8 +27,12 @@
 //        u { j not in A : (B u - c)_j > tolerance ||B u||_inf },
 // the semismooth Newton step's set {lambda_j + rho (B u - c)_j > 0} with noise thresholds. When
 // A' = A the Signorini conditions hold to the tolerances; negative lambda_j within the threshold
-// are returned as 0. Rows of B without a free dof cannot be made active (their value is fixed).
-// The first active set is the previous solve's, or { j : (B u - c)_j > 0 } at the initial u.
+// are returned as 0. The steps are inexact while the set changes: solved (and thresholded) to
+// PrimalContactOptions::changing_set_tolerance; the first step that finds the set unchanged is
+// repeated from its own solution to the final tolerance, and the method stops when that one
+// finds it unchanged too. Rows of B without a free dof cannot be made active (their value is
+// fixed). The first active set is the previous solve's, or { j : (B u - c)_j > 0 } at the initial
+// u.
 
 #include <Eigen/Core>
 #include <memory>
@@ -111,6 +115,10 @@ struct PrimalContactOptions {
   /// The active set thresholds and the projected conjugate gradients' tolerance (the file
   /// comment); at least the stiffness solver's tolerance is used.
   double relative_tolerance = 1e-12;
+  /// The tolerance of the steps while the active set still changes (inexact steps: the set only
+  /// needs to be right); the step that finds the set unchanged is repeated to
+  /// relative_tolerance.
+  double changing_set_tolerance = 1e-6;
   int maximum_active_set_steps = 100;
 };
 
