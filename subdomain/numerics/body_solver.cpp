@@ -694,6 +694,12 @@ Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force,
   if (primal_state_ && primal_state_->contact_force.size() == contact_force.size() &&
       contact_force.size() > 0 && primal_state_->contact_force == contact_force) {
     free_values = primal_state_->displacement;  // the last primal contact solve's u
+  } else if (multigrid_ && primal_state_ && contact_force.size() == contact_size() &&
+             primal_state_->displacement.size() == free_dof_count()) {
+    // K u = t f - B' lambda from the last contact solve's u, near it when lambda is near its
+    free_values =
+        multigrid_->solve(load_factor_ * reduced_load_ - apply_transpose_trace(contact_force),
+                          primal_state_->displacement);
   } else if (contact_force.size() > 0 && contact_force.lpNorm<Eigen::Infinity>() > 0) {
     free_values -= solve_stiffness(apply_transpose_trace(contact_force));
   }
