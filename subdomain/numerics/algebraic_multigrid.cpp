@@ -559,31 +559,4 @@ double AlgebraicMultigrid::operator_complexity() const {
   return total / static_cast<double>(levels_.front()->matrix->nonZeros());
 }
 
-Eigen::MatrixXd free_rigid_body_modes(const Mesh& mesh, const DofMap& dofs) {
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = -low;
-  for (const Eigen::Vector3d& node : mesh.nodes) {
-    low = low.cwiseMin(node);
-    high = high.cwiseMax(node);
-  }
-  const Eigen::Vector3d centre = 0.5 * (low + high);
-  const double diagonal = (high - low).norm();
-  const double scale = diagonal > 0.0 ? diagonal : 1.0;
-  Eigen::MatrixXd modes(dofs.free_count(), rigid_mode_count(mesh.dimension));
-  for (int dof = 0; dof < dofs.total_count(); ++dof) {
-    const int free = dofs.free_index(dof);
-    if (free >= 0) modes.row(free) = rigid_mode_row(mesh, dof, centre, scale).transpose();
-  }
-  return modes;
-}
-
-std::vector<int> free_dof_nodes(const Mesh& mesh, const DofMap& dofs) {
-  std::vector<int> nodes(static_cast<std::size_t>(dofs.free_count()));
-  for (int dof = 0; dof < dofs.total_count(); ++dof) {
-    const int free = dofs.free_index(dof);
-    if (free >= 0) nodes[static_cast<std::size_t>(free)] = dof / mesh.dimension;
-  }
-  return nodes;
-}
-
 }  // namespace robin

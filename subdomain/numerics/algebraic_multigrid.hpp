@@ -155,13 +155,4 @@ class AlgebraicMultigrid final : public Preconditioner {
   double setup_seconds_ = 0.0;
 };
 
-/// The m rigid body modes of `mesh` (dof_map.hpp, rigid_mode_row: translations, then rotations
-/// about the centre of the nodes' bounding box scaled by its diagonal) on the free dofs of
-/// `dofs`: free x m, the near-null space of the body's reduced stiffness.
-Eigen::MatrixXd free_rigid_body_modes(const Mesh& mesh, const DofMap& dofs);
-
-/// The mesh node of each free dof of `dofs` (the dof d node + c of free index i gives node):
-/// the AMG's dof_nodes.
-std::vector<int> free_dof_nodes(const Mesh& mesh, const DofMap& dofs);
-
 }  // namespace robin

@@ -168,6 +168,31 @@ bool is_free_motion(const Eigen::VectorXd& eigenvalues, int index) {
 
 }  // namespace
 
+Eigen::MatrixXd free_rigid_body_modes(const Mesh& mesh, const DofMap& dofs) {
+  if (dofs.total_count() != mesh.dof_count()) {
+    throw std::invalid_argument("free_rigid_body_modes: dof count is not dimension x nodes");
+  }
+  Eigen::MatrixXd modes(dofs.free_count(), mode_count(mesh));
+  if (mesh.node_count() == 0) return modes;
+  const auto [centre, scale] = centre_and_scale(mesh);
+  for (int dof = 0; dof < dofs.total_count(); ++dof) {
+    if (!dofs.is_prescribed(dof)) {
+      modes.row(dofs.free_index(dof)) = rigid_mode_row(mesh, dof, centre, scale).transpose();
+    }
+  }
+  return modes;
+}
+
+std::vector<int> free_dof_nodes(const Mesh& mesh, const DofMap& dofs) {
+  std::vector<int> nodes(static_cast<std::size_t>(dofs.free_count()));
+  for (int dof = 0; dof < dofs.total_count(); ++dof) {
+    if (!dofs.is_prescribed(dof)) {
+      nodes[static_cast<std::size_t>(dofs.free_index(dof))] = dof / mesh.dimension;
+    }
+  }
+  return nodes;
+}
+
 bool removes_rigid_motions(const Mesh& mesh, const DofMap& dofs) {
   if (dofs.total_count() != mesh.dof_count()) {
     throw std::invalid_argument("removes_rigid_motions: dof count is not dimension x nodes");
@@ -187,13 +212,7 @@ Eigen::MatrixXd rigid_body_modes(const Mesh& mesh, const DofMap& dofs) {
   const int count = static_cast<int>(free_motions.size());
   Eigen::MatrixXd coefficients(mode_count(mesh), count);  // c: the null space of Q_p
   for (int k = 0; k < count; ++k) coefficients.col(k) = gram.eigenvectors().col(free_motions[k]);
-  const auto [centre, scale] = centre_and_scale(mesh);
-  Eigen::MatrixXd modes(dofs.free_count(), count);  // Q_f c
-  for (int dof = 0; dof < dofs.total_count(); ++dof) {
-    if (dofs.is_prescribed(dof)) continue;
-    modes.row(dofs.free_index(dof)) =
-        rigid_mode_row(mesh, dof, centre, scale).transpose() * coefficients;
-  }
+  const Eigen::MatrixXd modes = free_rigid_body_modes(mesh, dofs) * coefficients;  // Q_f c
   // Orthonormal columns: the thin Q of a Householder QR.
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(modes);
   return qr.householderQ() * Eigen::MatrixXd::Identity(dofs.free_count(), count);

@@ -60,6 +60,14 @@ int rigid_mode_count(int dimension);
 Eigen::VectorXd rigid_mode_row(const Mesh& mesh, int dof, const Eigen::Vector3d& centre,
                                double scale = 1.0);
 
+/// The m rigid modes Q of `mesh` (rigid_mode_row about the mean of the nodes, scaled by the largest
+/// distance of a node from it) on the free dofs of `dofs`: Q_f, free x m. For elasticity they
+/// span the near-null space of the reduced stiffness (algebraic_multigrid.hpp).
+Eigen::MatrixXd free_rigid_body_modes(const Mesh& mesh, const DofMap& dofs);
+
+/// The mesh node of each free dof of `dofs` (the dof d node + c of free index i gives node).
+std::vector<int> free_dof_nodes(const Mesh& mesh, const DofMap& dofs);
+
 /// True when the prescribed dofs remove every rigid motion of the mesh (in 2D two translations
 /// and one rotation, in 3D three of each): the m rigid modes (m = 3 or 6) restricted to the
 /// prescribed dofs have rank m.
