@@ -6,6 +6,12 @@
 // e, the correction F r, the Neumann solve e - F lambda and the nodal contact pressure and force
 // of the body output for a fixed force. The 1.x numbers are tests/data/node_to_node_1x/<case>.csv,
 // written by the last 1.x code (commit b8a3768; the program is in that directory's README.md).
+// The solved columns agree to 1e-11 relative, not 1e-12: the references were written on an Intel
+// Xeon, and on an AMD EPYC the same code (also the commit before this bound was set) differs from
+// them by 1.9e-12 on the asymmetric pair's compliant body (free trace, correction, Neumann solve):
+// the rounding of the BLAS kernels inside the supernodal factorization differs between CPUs, and
+// that body's condition number amplifies it. A changed row, normal or weight changes these columns
+// by far more than 1e-11; the geometric columns (nodes, normals, weights) keep 1e-12.
 
 #include <gtest/gtest.h>
 
@@ -30,6 +36,9 @@
 
 namespace robin {
 namespace {
+
+/// The solved columns' bound (the file comment).
+constexpr double reproduction_tolerance = 1e-11;
 
 /// One line of a reference file.
 struct ReferenceRow {
@@ -158,7 +167,7 @@ void expect_same_as_1x(const std::string& case_name) {
         const ReferenceRow& row = *rows[static_cast<std::size_t>(i)];
         worst = std::max(worst, std::abs(value(i, row.node) - row.values.at(column)) / scale);
       }
-      EXPECT_LE(worst, 1e-12) << column;
+      EXPECT_LE(worst, reproduction_tolerance) << column;
       std::cout << case_name << " body " << alpha << " " << column << ": relative difference "
                 << worst << "\n";
     }
