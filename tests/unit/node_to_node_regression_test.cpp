@@ -6,12 +6,13 @@
 // e, the correction F r, the Neumann solve e - F lambda and the nodal contact pressure and force
 // of the body output for a fixed force. The 1.x numbers are tests/data/node_to_node_1x/<case>.csv,
 // written by the last 1.x code (commit b8a3768; the program is in that directory's README.md).
-// The solved columns agree to 1e-11 relative, not 1e-12: the references were written on an Intel
-// Xeon, and on an AMD EPYC the same code (also the commit before this bound was set) differs from
-// them by 1.9e-12 on the asymmetric pair's compliant body (free trace, correction, Neumann solve):
-// the rounding of the BLAS kernels inside the supernodal factorization differs between CPUs, and
-// that body's condition number amplifies it. A changed row, normal or weight changes these columns
-// by far more than 1e-11; the geometric columns (nodes, normals, weights) keep 1e-12.
+// The solved columns agree to 1e-11 relative, not 1e-12: within 1e-12 on the Intel Xeon of the
+// earlier sessions (OpenBLAS's Cooperlake kernels), but on an AMD EPYC the same code (also the
+// commit before this bound was set) differs from the references by 1.9e-12 on the asymmetric
+// pair's compliant body (free trace, correction, Neumann solve), presumably the rounding of the
+// BLAS kernels inside the supernodal factorization, amplified by that body's condition number. A
+// changed row, normal or weight changes these columns by far more than 1e-11; the geometric columns
+// (nodes, normals, weights) keep 1e-12.
 
 #include <gtest/gtest.h>
 
