@@ -294,11 +294,15 @@ PrimalContactResult solve_primal_contact(const MultigridStiffnessSolver& stiffne
   record(Eigen::VectorXd::Zero(trace.rows()), trace * solution);
   // the steps to a loose tolerance while the active set changes, then the last one to the final
   double step_tolerance = std::max(tolerance, options.changing_set_tolerance);
+  std::unique_ptr<const ActiveConstraints> constraints;  // of `active`; kept while it repeats
   for (int step = 1; step <= options.maximum_active_set_steps; ++step) {
     result.iterations = step;
-    const ActiveConstraints constraints(row_trace, indices_of(active), stiffness.body_name());
+    if (!constraints) {
+      constraints = std::make_unique<const ActiveConstraints>(row_trace, indices_of(active),
+                                                              stiffness.body_name());
+    }
     const ActiveSetStep outcome =
-        solve_on_active_set(stiffness, constraints, load, bound, step_tolerance, solution);
+        solve_on_active_set(stiffness, *constraints, load, bound, step_tolerance, solution);
     result.operator_applications += outcome.inner.iterations;
     result.projected_gradient_norm = outcome.projected_gradient_norm;
     if (outcome.inner.status != ConjugateGradientStatus::converged) {
@@ -322,6 +326,7 @@ PrimalContactResult solve_primal_contact(const MultigridStiffnessSolver& stiffne
       return result;
     } else {
       active = next;
+      constraints.reset();
     }
   }
   result.message = "the active set still changed after " +

@@ -49,15 +49,45 @@ std::map<std::string, std::vector<std::string>> run_case(const std::string& tool
   return testing::read_csv(directory.path() / name / "contact.csv");
 }
 
+/// Every row of `columns` (contact.csv) has the patch test's exact pressure to `relative`.
+void expect_patch_pressure(const std::map<std::string, std::vector<std::string>>& columns,
+                           double relative) {
+  ASSERT_TRUE(columns.count("pressure"));
+  ASSERT_GT(columns.at("pressure").size(), 20u);
+  for (const std::string& pressure : columns.at("pressure")) {
+    EXPECT_NEAR(std::stod(pressure), exact_patch_pressure(), relative * exact_patch_pressure());
+  }
+}
+
+/// The contact forces lambda1, lambda2 of `run` equal those of `monolithic` to `relative` of the
+/// largest monolithic lambda1.
+void expect_same_contact_forces(const std::map<std::string, std::vector<std::string>>& run,
+                                const std::map<std::string, std::vector<std::string>>& monolithic,
+                                double relative) {
+  ASSERT_EQ(run.at("lambda1").size(), monolithic.at("lambda1").size());
+  double largest = 0.0;
+  for (const std::string& value : monolithic.at("lambda1")) {
+    largest = std::max(largest, std::abs(std::stod(value)));
+  }
+  ASSERT_GT(largest, 0.0);
+  for (const char* column : {"lambda1", "lambda2"}) {
+    for (std::size_t k = 0; k < run.at(column).size(); ++k) {
+      EXPECT_NEAR(std::stod(run.at(column)[k]), std::stod(monolithic.at(column)[k]),
+                  relative * largest)
+          << column << " row " << k;
+    }
+  }
+}
+
+/// robin-monolithic's arguments for the sphere on the coarse mesh the sphere tests use.
+const std::vector<std::string> coarse_sphere = {"--set", "body[1].mesh_size=0.04", "--set",
+                                                "body[2].mesh_size=0.04"};
+
 TEST(SolidService, RobinRunReproducesTheThreeDimensionalPatchTestPressure) {
   const TemporaryDirectory output("solid-patch");
   const auto columns = run_case("robin-run", "non_matching_solids.toml", {}, output, "run");
   ASSERT_TRUE(columns.count("z") && columns.count("nz")) << "contact.csv of a solid case has z, nz";
-  const std::vector<std::string>& pressures = columns.at("pressure");
-  ASSERT_GT(pressures.size(), 20u);
-  for (const std::string& pressure : pressures) {
-    EXPECT_NEAR(std::stod(pressure), exact_patch_pressure(), 1e-8 * exact_patch_pressure());
-  }
+  expect_patch_pressure(columns, 1e-8);
 }
 
 TEST(SolidService, RobinCoordinatorAgainstTwoServersReproducesThePatchTestPressure) {
@@ -69,67 +99,35 @@ TEST(SolidService, RobinCoordinatorAgainstTwoServersReproducesThePatchTestPressu
   const auto columns =
       run_case("robin-coordinator", "non_matching_solids.toml",
                {"--subdomain", lower.endpoint(), "--subdomain", upper.endpoint()}, output, "run");
-  ASSERT_TRUE(columns.count("pressure"));
-  ASSERT_GT(columns.at("pressure").size(), 20u);
-  for (const std::string& pressure : columns.at("pressure")) {
-    EXPECT_NEAR(std::stod(pressure), exact_patch_pressure(), 1e-8 * exact_patch_pressure());
-  }
+  expect_patch_pressure(columns, 1e-8);
 }
 
 TEST(SolidService, RobinRunEqualsRobinMonolithicOnTheSphere) {
   const TemporaryDirectory output("solid-hertz");
-  const std::vector<std::string> coarse = {"--set", "body[1].mesh_size=0.04", "--set",
-                                           "body[2].mesh_size=0.04"};
-  std::vector<std::string> tight = coarse;
+  std::vector<std::string> tight = coarse_sphere;
   tight.insert(tight.end(), {"--tolerance", "1e-11"});
   const auto run = run_case("robin-run", "hertz_3d.toml", tight, output, "run");
-  const auto monolithic = run_case("robin-monolithic", "hertz_3d.toml", coarse, output, "mono");
-  ASSERT_EQ(run.at("lambda1").size(), monolithic.at("lambda1").size());
-  double largest = 0.0;
-  for (const std::string& value : monolithic.at("lambda1")) {
-    largest = std::max(largest, std::abs(std::stod(value)));
-  }
-  ASSERT_GT(largest, 0.0);
-  for (const char* column : {"lambda1", "lambda2"}) {
-    for (std::size_t k = 0; k < run.at(column).size(); ++k) {
-      EXPECT_NEAR(std::stod(run.at(column)[k]), std::stod(monolithic.at(column)[k]), 1e-8 * largest)
-          << column << " row " << k;
-    }
-  }
+  const auto monolithic =
+      run_case("robin-monolithic", "hertz_3d.toml", coarse_sphere, output, "mono");
+  expect_same_contact_forces(run, monolithic, 1e-8);
 }
 
 TEST(SolidService, RobinRunWithTheMultigridSolverReproducesThePatchTestPressure) {
   const TemporaryDirectory output("solid-patch-multigrid");
   const auto columns = run_case("robin-run", "non_matching_solids.toml",
                                 {"--set", "solver.linear_solver=multigrid"}, output, "run");
-  ASSERT_TRUE(columns.count("pressure"));
-  ASSERT_GT(columns.at("pressure").size(), 20u);
-  for (const std::string& pressure : columns.at("pressure")) {
-    EXPECT_NEAR(std::stod(pressure), exact_patch_pressure(), 1e-7 * exact_patch_pressure());
-  }
+  expect_patch_pressure(columns, 1e-7);
 }
 
 TEST(SolidService, RobinRunWithTheMultigridSolverEqualsTheDirectMonolithicOnTheSphere) {
   const TemporaryDirectory output("solid-hertz-multigrid");
-  const std::vector<std::string> coarse = {"--set", "body[1].mesh_size=0.04", "--set",
-                                           "body[2].mesh_size=0.04"};
-  std::vector<std::string> multigrid = coarse;
+  std::vector<std::string> multigrid = coarse_sphere;
   multigrid.insert(multigrid.end(),
                    {"--tolerance", "1e-10", "--set", "solver.linear_solver=multigrid"});
   const auto run = run_case("robin-run", "hertz_3d.toml", multigrid, output, "run");
-  const auto monolithic = run_case("robin-monolithic", "hertz_3d.toml", coarse, output, "mono");
-  ASSERT_EQ(run.at("lambda1").size(), monolithic.at("lambda1").size());
-  double largest = 0.0;
-  for (const std::string& value : monolithic.at("lambda1")) {
-    largest = std::max(largest, std::abs(std::stod(value)));
-  }
-  ASSERT_GT(largest, 0.0);
-  for (const char* column : {"lambda1", "lambda2"}) {
-    for (std::size_t k = 0; k < run.at(column).size(); ++k) {
-      EXPECT_NEAR(std::stod(run.at(column)[k]), std::stod(monolithic.at(column)[k]), 1e-7 * largest)
-          << column << " row " << k;
-    }
-  }
+  const auto monolithic =
+      run_case("robin-monolithic", "hertz_3d.toml", coarse_sphere, output, "mono");
+  expect_same_contact_forces(run, monolithic, 1e-7);
 }
 
 TEST(SolidService, PythonServerOwningTheHexahedraEqualsMonolithic) {
