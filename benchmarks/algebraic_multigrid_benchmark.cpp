@@ -61,6 +61,7 @@ struct Problem {
   Eigen::MatrixXd near_null_space;
   std::vector<int> dof_nodes;
   Eigen::VectorXd load;
+  std::vector<Eigen::Vector3d> positions;
 };
 
 Problem clamped_box(int cells) {
@@ -77,6 +78,7 @@ Problem clamped_box(int cells) {
   problem.lower = dofs.reduce_matrix_lower(robin::assemble_stiffness(mesh, material));
   problem.near_null_space = robin::free_rigid_body_modes(mesh, dofs);
   problem.dof_nodes = robin::free_dof_nodes(mesh, dofs);
+  problem.positions = mesh.nodes;
   problem.load = dofs.restrict(robin::assemble_body_force(mesh, [](const Eigen::Vector3d& x) {
     return Eigen::Vector3d(0.1 * x.y(), -1.0, 0.2 * x.z());
   }));
@@ -86,7 +88,7 @@ Problem clamped_box(int cells) {
 Eigen::VectorXd run_multigrid(const Problem& problem,
                               const robin::AlgebraicMultigridOptions& options) {
   const robin::AlgebraicMultigrid multigrid(problem.lower, problem.near_null_space,
-                                            problem.dof_nodes, options);
+                                            problem.dof_nodes, problem.positions, options);
   const auto start = Clock::now();
   Eigen::VectorXd solution;
   robin::ConjugateGradientOptions parameters;

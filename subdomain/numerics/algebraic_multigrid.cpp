@@ -15,11 +15,13 @@
 namespace robin {
 namespace {
 
-/// y = A x (A compressed, row-major).
-void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+/// y = A x (A compressed, row-major; its values from `values`, double or single precision,
+/// summed in double).
+template <typename Value>
+void multiply(const RowMajorSparseMatrix& matrix, const Value* values, const Eigen::VectorXd& x,
+              Eigen::VectorXd& y) {
   const int* starts = matrix.outerIndexPtr();
   const int* columns = matrix.innerIndexPtr();
-  const double* values = matrix.valuePtr();
   const double* input = x.data();
   double* output = y.data();
   const int rows = static_cast<int>(matrix.rows());
@@ -30,12 +32,32 @@ void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eige
   }
 }
 
-/// y = A' x (A compressed, row-major): each row of A scattered.
-void multiply_transpose(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x,
-                        Eigen::VectorXd& y) {
+void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  multiply(matrix, matrix.valuePtr(), x, y);
+}
+
+/// y = A_F x: only the entries of A (compressed, row-major) with keep[k] set.
+void multiply_kept(const RowMajorSparseMatrix& matrix, const std::vector<char>& keep,
+                   const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   const int* starts = matrix.outerIndexPtr();
   const int* columns = matrix.innerIndexPtr();
   const double* values = matrix.valuePtr();
+  const int rows = static_cast<int>(matrix.rows());
+  for (int row = 0; row < rows; ++row) {
+    double sum = 0.0;
+    for (int k = starts[row]; k < starts[row + 1]; ++k) {
+      if (keep[static_cast<std::size_t>(k)]) sum += values[k] * x[columns[k]];
+    }
+    y[row] = sum;
+  }
+}
+
+/// y = A' x (A compressed, row-major, values from `values`): each row of A scattered.
+template <typename Value>
+void multiply_transpose(const RowMajorSparseMatrix& matrix, const Value* values,
+                        const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
   double* output = y.data();
   y.setZero();
   const int rows = static_cast<int>(matrix.rows());
@@ -45,12 +67,13 @@ void multiply_transpose(const RowMajorSparseMatrix& matrix, const Eigen::VectorX
   }
 }
 
-/// r = b - A x (A compressed, row-major).
-void subtract_product(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& right_hand_side,
-                      const Eigen::VectorXd& x, Eigen::VectorXd& residual) {
+/// r = b - A x (A compressed, row-major, values from `values`).
+template <typename Value>
+void subtract_product(const RowMajorSparseMatrix& matrix, const Value* values,
+                      const Eigen::VectorXd& right_hand_side, const Eigen::VectorXd& x,
+                      Eigen::VectorXd& residual) {
   const int* starts = matrix.outerIndexPtr();
   const int* columns = matrix.innerIndexPtr();
-  const double* values = matrix.valuePtr();
   const double* input = x.data();
   const int rows = static_cast<int>(matrix.rows());
   for (int row = 0; row < rows; ++row) {
@@ -84,11 +107,12 @@ Eigen::VectorXd inverse_diagonal(const RowMajorSparseMatrix& matrix) {
   return inverse;
 }
 
-/// Largest eigenvalue of D^{-1} A, estimated from below by `steps` Lanczos steps on the
-/// symmetric D^{-1/2} A D^{-1/2} (same spectrum) from a fixed pseudo-random start: the largest
-/// eigenvalue of the Lanczos tridiagonal matrix.
+/// Largest eigenvalue of D^{-1} A (of D^{-1} A_F with `keep`: multiply_kept), estimated from below
+/// by `steps` Lanczos steps on the symmetric D^{-1/2} A D^{-1/2} (same spectrum) from a fixed
+/// pseudo-random start: the largest eigenvalue of the Lanczos tridiagonal matrix.
 double estimate_spectral_radius(const RowMajorSparseMatrix& matrix,
-                                const Eigen::VectorXd& inverse_diagonal, int steps) {
+                                const Eigen::VectorXd& inverse_diagonal, int steps,
+                                const std::vector<char>& keep = {}) {
   const Eigen::Index size = matrix.rows();
   const Eigen::VectorXd scale = inverse_diagonal.cwiseSqrt();
   std::mt19937 generator(2026);
@@ -100,7 +124,11 @@ double estimate_spectral_radius(const RowMajorSparseMatrix& matrix,
   double beta = 0.0;
   for (int step = 0; step < std::min<Eigen::Index>(steps, size); ++step) {
     work = scale.cwiseProduct(current);
-    multiply(matrix, work, product);
+    if (keep.empty()) {
+      multiply(matrix, work, product);
+    } else {
+      multiply_kept(matrix, keep, work, product);
+    }
     product = scale.cwiseProduct(product) - beta * previous;
     const double alpha = product.dot(current);
     product -= alpha * current;
@@ -220,6 +248,96 @@ NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks
   return graph;
 }
 
+/// The position of each node block: `positions` indexed by the node numbers of `nodes` (the
+/// level's node of each unknown), read at each block's first unknown.
+std::vector<Eigen::Vector3d> block_positions(const NodeBlocks& blocks,
+                                             const std::vector<int>& nodes,
+                                             const std::vector<Eigen::Vector3d>& positions) {
+  std::vector<Eigen::Vector3d> result(static_cast<std::size_t>(blocks.count()));
+  for (int block = 0; block < blocks.count(); ++block) {
+    const int unknown = blocks.unknowns[static_cast<std::size_t>(blocks.start[block])];
+    result[static_cast<std::size_t>(block)] =
+        positions[static_cast<std::size_t>(nodes[static_cast<std::size_t>(unknown)])];
+  }
+  return result;
+}
+
+/// The strong connections by the distance Laplacian (step 1 of the header comment), with the
+/// weights w_ij in graph.weights.
+NodeGraph distance_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+                              const std::vector<Eigen::Vector3d>& positions, double threshold) {
+  const auto weight = [&](int node, int other) {
+    const double square =
+        (positions[static_cast<std::size_t>(node)] - positions[static_cast<std::size_t>(other)])
+            .squaredNorm();
+    return square > 0.0 ? 1.0 / square : std::numeric_limits<double>::infinity();
+  };
+  std::vector<double> diagonal(static_cast<std::size_t>(blocks.count()), 0.0);
+  for_each_block_norm(matrix, blocks, [&](int node, int other, double) {
+    if (node != other) diagonal[static_cast<std::size_t>(node)] += weight(node, other);
+  });
+  NodeGraph graph;
+  graph.start.push_back(0);
+  int current = 0;
+  for_each_block_norm(matrix, blocks, [&](int node, int other, double square) {
+    while (current < node) {
+      graph.start.push_back(static_cast<int>(graph.neighbours.size()));
+      ++current;
+    }
+    if (other == node || square == 0.0) return;
+    const double strength = weight(node, other);
+    if (strength >= threshold * std::sqrt(diagonal[static_cast<std::size_t>(node)] *
+                                          diagonal[static_cast<std::size_t>(other)])) {
+      graph.neighbours.push_back(other);
+      graph.weights.push_back(strength);
+    }
+  });
+  while (current < blocks.count()) {
+    graph.start.push_back(static_cast<int>(graph.neighbours.size()));
+    ++current;
+  }
+  return graph;
+}
+
+/// The position of each aggregate: the mean of its nodes' positions.
+std::vector<Eigen::Vector3d> aggregate_positions(const std::vector<int>& aggregate,
+                                                 int aggregate_count,
+                                                 const std::vector<Eigen::Vector3d>& positions) {
+  std::vector<Eigen::Vector3d> sums(static_cast<std::size_t>(aggregate_count),
+                                    Eigen::Vector3d::Zero());
+  std::vector<int> counts(static_cast<std::size_t>(aggregate_count), 0);
+  for (std::size_t node = 0; node < aggregate.size(); ++node) {
+    sums[static_cast<std::size_t>(aggregate[node])] += positions[node];
+    ++counts[static_cast<std::size_t>(aggregate[node])];
+  }
+  for (std::size_t group = 0; group < sums.size(); ++group) sums[group] /= counts[group];
+  return sums;
+}
+
+/// Per stored entry of A (row-major order), whether its two nodes are the same or strongly
+/// connected in `graph`: the entries of the filtered matrix A_F.
+std::vector<char> strong_entries(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+                                 const NodeGraph& graph) {
+  std::vector<char> keep(static_cast<std::size_t>(matrix.nonZeros()), 0);
+  std::vector<int> strong_for(static_cast<std::size_t>(blocks.count()), -1);
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
+  for (int node = 0; node < blocks.count(); ++node) {
+    strong_for[static_cast<std::size_t>(node)] = node;
+    for (int k = graph.start[node]; k < graph.start[node + 1]; ++k) {
+      strong_for[static_cast<std::size_t>(graph.neighbours[k])] = node;
+    }
+    for (int k = blocks.start[node]; k < blocks.start[node + 1]; ++k) {
+      const int row = blocks.unknowns[k];
+      for (int entry = starts[row]; entry < starts[row + 1]; ++entry) {
+        const int other = blocks.node_of[static_cast<std::size_t>(columns[entry])];
+        keep[static_cast<std::size_t>(entry)] = strong_for[static_cast<std::size_t>(other)] == node;
+      }
+    }
+  }
+  return keep;
+}
+
 /// Greedy aggregation (step 2 of the header comment): the aggregate of each node, and their count.
 std::pair<std::vector<int>, int> aggregate_nodes(const NodeGraph& graph) {
   const int nodes = static_cast<int>(graph.start.size()) - 1;
@@ -310,23 +428,53 @@ TentativeProlongator tentative_prolongator(const NodeBlocks& blocks,
   return result;
 }
 
-/// P = (I - omega D^{-1} A) P_tent (step 4), formed in the storage of A P_tent: the pattern of
-/// P_tent is part of it (A has its diagonal), so P_tent's entries are added in place.
+/// P = (I - omega D^{-1} A_F) P_tent (step 4), A_F the entries of A with keep[k] set, row by
+/// row with a sparse accumulator (P_tent has one aggregate's columns per row).
 RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
+                                        const std::vector<char>& keep,
                                         const Eigen::VectorXd& inverse_diagonal, double omega,
                                         const RowMajorSparseMatrix& tentative) {
-  RowMajorSparseMatrix smoothed = matrix * tentative;
-  smoothed.makeCompressed();
-  for (Eigen::Index row = 0; row < smoothed.outerSize(); ++row) {
+  const Eigen::Index rows = matrix.rows(), columns = tentative.cols();
+  std::vector<double> accumulated(static_cast<std::size_t>(columns), 0.0);
+  std::vector<Eigen::Index> last_row(static_cast<std::size_t>(columns), -1);
+  std::vector<int> row_columns;
+  std::vector<int> starts(static_cast<std::size_t>(rows) + 1, 0);
+  std::vector<int> indices;
+  std::vector<double> values;
+  indices.reserve(static_cast<std::size_t>(tentative.nonZeros()) * 8);
+  values.reserve(indices.capacity());
+  const auto add = [&](Eigen::Index row, int column, double value) {
+    if (last_row[static_cast<std::size_t>(column)] != row) {
+      last_row[static_cast<std::size_t>(column)] = row;
+      accumulated[static_cast<std::size_t>(column)] = 0.0;
+      row_columns.push_back(column);
+    }
+    accumulated[static_cast<std::size_t>(column)] += value;
+  };
+  for (Eigen::Index row = 0; row < rows; ++row) {
     const double factor = -omega * inverse_diagonal[row];
-    for (RowMajorSparseMatrix::InnerIterator entry(smoothed, row); entry; ++entry) {
-      entry.valueRef() *= factor;
+    for (int k = matrix.outerIndexPtr()[row]; k < matrix.outerIndexPtr()[row + 1]; ++k) {
+      if (!keep[static_cast<std::size_t>(k)]) continue;
+      const double scaled = factor * matrix.valuePtr()[k];
+      for (RowMajorSparseMatrix::InnerIterator entry(tentative, matrix.innerIndexPtr()[k]); entry;
+           ++entry) {
+        add(row, static_cast<int>(entry.col()), scaled * entry.value());
+      }
     }
     for (RowMajorSparseMatrix::InnerIterator entry(tentative, row); entry; ++entry) {
-      smoothed.coeffRef(row, entry.col()) += entry.value();
+      add(row, static_cast<int>(entry.col()), entry.value());
     }
+    std::sort(row_columns.begin(), row_columns.end());
+    for (int column : row_columns) {
+      indices.push_back(column);
+      values.push_back(accumulated[static_cast<std::size_t>(column)]);
+    }
+    row_columns.clear();
+    starts[static_cast<std::size_t>(row) + 1] = static_cast<int>(indices.size());
   }
-  return smoothed;
+  return Eigen::Map<const RowMajorSparseMatrix>(rows, columns,
+                                                static_cast<Eigen::Index>(indices.size()),
+                                                starts.data(), indices.data(), values.data());
 }
 
 /// P' A P (step 5) as the sum over blocks of rows J of (P_J)' (A_J P), so that A P (the largest
@@ -348,6 +496,11 @@ RowMajorSparseMatrix galerkin_product(const RowMajorSparseMatrix& matrix,
   return symmetric;
 }
 
+/// The stored values of `matrix` rounded to single precision.
+std::vector<float> single_precision(const RowMajorSparseMatrix& matrix) {
+  return std::vector<float>(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros());
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -367,6 +520,9 @@ struct AlgebraicMultigrid::Level {
   const RowMajorSparseMatrix* matrix = nullptr;
   Eigen::VectorXd inverse_diagonal;
   RowMajorSparseMatrix prolongator;  // P (empty on the coarsest level)
+  // the values of A_l and P rounded to single precision, read by the V-cycle (the patterns are
+  // those of *matrix and prolongator)
+  std::vector<float> matrix_values, prolongator_values;
   int nodes = 0;
   double spectral_radius = 0.0;
   double interval_low = 0.0, interval_high = 0.0;  // the Chebyshev interval
@@ -381,6 +537,7 @@ struct AlgebraicMultigrid::CoarseSolver {
 AlgebraicMultigrid::AlgebraicMultigrid(const SparseMatrix& lower,
                                        const Eigen::MatrixXd& near_null_space,
                                        const std::vector<int>& dof_nodes,
+                                       const std::vector<Eigen::Vector3d>& node_positions,
                                        const AlgebraicMultigridOptions& options)
     : options_(options) {
   const auto start = std::chrono::steady_clock::now();
@@ -393,14 +550,20 @@ AlgebraicMultigrid::AlgebraicMultigrid(const SparseMatrix& lower,
     throw std::invalid_argument("AlgebraicMultigrid: smoother_degree below 1");
   }
   fine_operator_ = std::make_unique<SparseMatrixOperator>(lower);
-  build_hierarchy(near_null_space, dof_nodes);
+  for (int node : dof_nodes) {
+    if (!node_positions.empty() && node >= static_cast<int>(node_positions.size())) {
+      throw std::invalid_argument("AlgebraicMultigrid: a dof's node has no position");
+    }
+  }
+  build_hierarchy(near_null_space, dof_nodes, node_positions);
   setup_seconds_ = seconds_since(start);
 }
 
 AlgebraicMultigrid::~AlgebraicMultigrid() = default;
 
 void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
-                                         const std::vector<int>& dof_nodes) {
+                                         const std::vector<int>& dof_nodes,
+                                         std::vector<Eigen::Vector3d> positions) {
   Eigen::MatrixXd modes = near_null_space;
   std::vector<int> nodes = dof_nodes;
   auto level = std::make_unique<Level>();
@@ -422,16 +585,29 @@ void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
         static_cast<int>(levels_.size()) + 1 >= options_.maximum_levels) {
       break;
     }
-    const NodeGraph graph = strong_node_graph(matrix, blocks, options_.strength_threshold);
+    std::vector<Eigen::Vector3d> positions_of_blocks;
+    if (!positions.empty()) positions_of_blocks = block_positions(blocks, nodes, positions);
+    const NodeGraph graph = positions.empty()
+                                ? strong_node_graph(matrix, blocks, options_.strength_threshold)
+                                : distance_node_graph(matrix, blocks, positions_of_blocks,
+                                                      options_.distance_strength_threshold);
     const auto [aggregate, aggregate_count] = aggregate_nodes(graph);
     TentativeProlongator tentative =
         tentative_prolongator(blocks, aggregate, aggregate_count, modes);
     if (tentative.prolongator.cols() >= unknowns) break;  // no coarsening: this is the coarsest
-    const double omega = options_.prolongator_damping / level->spectral_radius;
-    level->prolongator =
-        options_.prolongator_damping > 0.0
-            ? smooth_prolongator(matrix, level->inverse_diagonal, omega, tentative.prolongator)
-            : std::move(tentative.prolongator);
+    if (!positions.empty()) {
+      positions = aggregate_positions(aggregate, aggregate_count, positions_of_blocks);
+    }
+    if (options_.prolongator_damping > 0.0) {
+      const std::vector<char> keep = strong_entries(matrix, blocks, graph);
+      const double omega =
+          options_.prolongator_damping /
+          estimate_spectral_radius(matrix, level->inverse_diagonal, options_.lanczos_steps, keep);
+      level->prolongator =
+          smooth_prolongator(matrix, keep, level->inverse_diagonal, omega, tentative.prolongator);
+    } else {
+      level->prolongator = std::move(tentative.prolongator);
+    }
     level->prolongator.makeCompressed();
     auto coarse = std::make_unique<Level>();
     coarse->owned_matrix = galerkin_product(matrix, level->prolongator);
@@ -445,6 +621,10 @@ void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
   }
   const SparseMatrix coarsest = SparseMatrix(*level->matrix).triangularView<Eigen::Lower>();
   levels_.push_back(std::move(level));
+  for (auto& each : levels_) {
+    each->matrix_values = single_precision(*each->matrix);
+    each->prolongator_values = single_precision(each->prolongator);
+  }
   coarse_solver_ = std::make_unique<CoarseSolver>();
   coarse_solver_->factor = std::make_unique<CholeskyFactor>(coarsest, "coarsest multigrid level");
 }
@@ -474,10 +654,13 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
     solution.setZero();
     smooth_gauss_seidel(level, right_hand_side, solution, true);
   }
-  subtract_product(*level.matrix, right_hand_side, solution, level.residual);
-  multiply_transpose(level.prolongator, level.residual, level.coarse_right_hand_side);
+  subtract_product(*level.matrix, level.matrix_values.data(), right_hand_side, solution,
+                   level.residual);
+  multiply_transpose(level.prolongator, level.prolongator_values.data(), level.residual,
+                     level.coarse_right_hand_side);
   cycle(index + 1, level.coarse_right_hand_side, level.coarse_solution);
-  multiply(level.prolongator, level.coarse_solution, level.product);
+  multiply(level.prolongator, level.prolongator_values.data(), level.coarse_solution,
+           level.product);
   solution += level.product;
   if (options_.smoother == MultigridSmoother::chebyshev) {
     smooth(level, right_hand_side, solution, false);
@@ -494,7 +677,7 @@ void AlgebraicMultigrid::smooth_gauss_seidel(const Level& level,
   const RowMajorSparseMatrix& matrix = *level.matrix;
   const int* starts = matrix.outerIndexPtr();
   const int* columns = matrix.innerIndexPtr();
-  const double* values = matrix.valuePtr();
+  const float* values = level.matrix_values.data();
   double* x = solution.data();
   const int rows = static_cast<int>(matrix.rows());
   for (int step = 0; step < rows; ++step) {
@@ -520,7 +703,8 @@ void AlgebraicMultigrid::smooth(const Level& level, const Eigen::VectorXd& right
   if (zero_guess) {
     residual = right_hand_side;
   } else {
-    subtract_product(*level.matrix, right_hand_side, solution, residual);
+    subtract_product(*level.matrix, level.matrix_values.data(), right_hand_side, solution,
+                     residual);
   }
   update = level.inverse_diagonal.cwiseProduct(residual) / theta;
   if (zero_guess) {
@@ -530,7 +714,7 @@ void AlgebraicMultigrid::smooth(const Level& level, const Eigen::VectorXd& right
   }
   double rho = 1.0 / sigma;
   for (int step = 1; step < options_.smoother_degree; ++step) {
-    multiply(*level.matrix, update, level.product);
+    multiply(*level.matrix, level.matrix_values.data(), update, level.product);
     residual -= level.product;
     const double next_rho = 1.0 / (2.0 * sigma - rho);
     update = (next_rho * rho) * update +

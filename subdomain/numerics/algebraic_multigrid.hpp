@@ -7,8 +7,14 @@
 // Setup, level by level from A_0 = A, B_0 = B, until a level has at most coarse_size_limit
 // unknowns (or maximum_levels is reached):
 //  1. Strength of connection on the node graph: the unknowns of a node (the dofs of one mesh node
-//     on the finest level, of one aggregate on the coarser ones) are one block. Nodes i != j are
-//     strongly connected when ||A_ij||_F >= theta sqrt(||A_ii||_F ||A_jj||_F).
+//     on the finest level, of one aggregate on the coarser ones) are one block. With node
+//     positions (the mesh's; an aggregate's is the mean of its nodes'), by the distance
+//     Laplacian: for the nodes i != j that A couples, w_ij = 1 / |x_i - x_j|^2, L_ii = sum_j
+//     w_ij, and i, j are strongly connected when w_ij >= theta sqrt(L_ii L_jj). On a stretched
+//     or graded mesh this keeps the connections across the short sides of a cell and drops those
+//     along its long side, so that aggregates follow the strong coupling (semi-coarsening),
+//     which the matrix entries of elasticity do not show clearly. Without positions, by the
+//     block norms: ||A_ij||_F >= theta sqrt(||A_ii||_F ||A_jj||_F).
 //  2. Greedy aggregation of the strong graph: (a) every node whose strong neighbours are all
 //     unaggregated forms an aggregate with them; (b) each remaining node joins the aggregate of
 //     (a) it is most strongly connected to; (c) the rest form aggregates with their remaining
@@ -17,8 +23,11 @@
 //     pivoting B(I_a, :) = Q R Pi' gives the columns Q_r (r = numerical rank, at most m) of
 //     P_tent on I_a, and the coarse near-null space rows R_r Pi' (r x m), so that
 //     P_tent B_coarse = B exactly and P_tent has orthonormal columns.
-//  4. Prolongator smoothing (damped Jacobi): P = (I - omega D^{-1} A) P_tent,
-//     omega = (4/3) / rho(D^{-1} A), D = diag(A), rho estimated by Lanczos on D^{-1/2} A D^{-1/2}.
+//  4. Prolongator smoothing (damped Jacobi) with the filtered matrix A_F (the blocks A_ij of the
+//     strongly connected nodes and the diagonal blocks; the weak ones dropped):
+//     P = (I - omega D^{-1} A_F) P_tent, omega = (4/3) / rho(D^{-1} A_F), D = diag(A), rho
+//     estimated by Lanczos on D^{-1/2} A_F D^{-1/2}. P then spreads only along strong
+//     connections, which keeps the coarse operators sparse.
 //  5. Galerkin coarse operator A_{l+1} = P' A_l P (symmetric positive definite: P has full
 //     column rank).
 // The coarsest matrix is factorized by CHOLMOD (cholesky.hpp).
@@ -39,6 +48,10 @@
 // which again makes the V-cycle symmetric (and positive definite: Gauss-Seidel converges for
 // SPD A).
 //
+// The V-cycle reads A_l and P in single precision (their values rounded to float, summed in
+// double): it is the exact V-cycle of the rounded matrices, so still symmetric positive
+// definite, and the products that conjugate gradients converge on (K x, in double) are
+// untouched; the V-cycle's memory traffic, which bounds its speed, drops by a third.
 // Matrices are stored row-major (CSR) for the products; the setup keeps, per level, A, P and
 // D^{-1} (P' x is computed by scattering the rows of P), and P' A P is summed over blocks of rows
 // so that A P is never formed whole. The apply allocates only the coarsest level's solution (the
@@ -85,6 +98,10 @@ struct AlgebraicMultigridOptions {
   /// theta of the strength of connection (step 1 of the file comment); 0 keeps every
   /// connection of the matrix graph.
   double strength_threshold = 0.0;
+  /// theta of the distance-Laplacian strength (used instead when node positions are given): 0.03
+  /// keeps every neighbour of a cube-shaped hexahedron but its corner diagonals, and drops the
+  /// neighbours along the long side of an interior cell stretched about 2 to 1 or more.
+  double distance_strength_threshold = 0.03;
   /// The coarsest level has at most this many unknowns (or is the last of maximum_levels).
   int coarse_size_limit = 2000;
   int maximum_levels = 10;
@@ -115,11 +132,13 @@ class AlgebraicMultigrid final : public Preconditioner {
   /// Sets the hierarchy up for the symmetric positive definite `lower` (only its lower triangle
   /// is read), the near-null space `near_null_space` (n x m, m >= 1) and `dof_nodes` (n values:
   /// the node of each unknown; node numbers are any non-negative integers, the unknowns of one
-  /// node need not be consecutive). Throws std::invalid_argument on inconsistent sizes or a
-  /// negative node, SingularBodyError (cholesky.hpp) when the coarsest matrix is not positive
-  /// definite.
+  /// node need not be consecutive). `node_positions`, indexed by those node numbers, selects the
+  /// distance-Laplacian strength of connection (step 1); empty selects the block norms. Throws
+  /// std::invalid_argument on inconsistent sizes, a negative node or a node without a position,
+  /// SingularBodyError (cholesky.hpp) when the coarsest matrix is not positive definite.
   AlgebraicMultigrid(const SparseMatrix& lower, const Eigen::MatrixXd& near_null_space,
                      const std::vector<int>& dof_nodes,
+                     const std::vector<Eigen::Vector3d>& node_positions = {},
                      const AlgebraicMultigridOptions& options = {});
   ~AlgebraicMultigrid() override;
   AlgebraicMultigrid(const AlgebraicMultigrid&) = delete;
@@ -139,7 +158,8 @@ class AlgebraicMultigrid final : public Preconditioner {
 
  private:
   struct Level;
-  void build_hierarchy(const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes);
+  void build_hierarchy(const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes,
+                       std::vector<Eigen::Vector3d> positions);
   void cycle(std::size_t level, const Eigen::VectorXd& right_hand_side,
              Eigen::VectorXd& solution) const;
   void smooth_gauss_seidel(const Level& level, const Eigen::VectorXd& right_hand_side,

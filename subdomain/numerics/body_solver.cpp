@@ -321,8 +321,8 @@ void BodySolver::set_up_multigrid(SparseMatrix&& reduced_stiffness) {
     const SparseMatrix stiffness = std::move(reduced_stiffness);
     multigrid_ = std::make_unique<MultigridStiffnessSolver>(
         stiffness, free_rigid_body_modes(definition_.mesh, *dofs_),
-        free_dof_nodes(definition_.mesh, *dofs_), PrimalContactOptions{}.relative_tolerance,
-        name());
+        free_dof_nodes(definition_.mesh, *dofs_), definition_.mesh.nodes,
+        PrimalContactOptions{}.relative_tolerance, name());
   }  // the AMG keeps its own copy of K with both triangles
   free_solution_ = solve_stiffness(reduced_load_);  // K^{-1} f
   rigid_amplitudes_ = Eigen::VectorXd::Zero(0);

@@ -51,12 +51,13 @@ namespace robin {
 class MultigridStiffnessSolver {
  public:
   /// Sets the AMG hierarchy up for the symmetric positive definite `lower` (its lower triangle),
-  /// with `near_null_space` (free x m) and `dof_nodes` as AlgebraicMultigrid takes them.
-  /// `relative_tolerance` is the conjugate gradients' stopping tolerance; `body_name` names the
-  /// body in errors.
+  /// with `near_null_space` (free x m), `dof_nodes` and `node_positions` as AlgebraicMultigrid
+  /// takes them. `relative_tolerance` is the conjugate gradients' stopping tolerance;
+  /// `body_name` names the body in errors.
   MultigridStiffnessSolver(const SparseMatrix& lower, const Eigen::MatrixXd& near_null_space,
-                           const std::vector<int>& dof_nodes, double relative_tolerance,
-                           std::string body_name);
+                           const std::vector<int>& dof_nodes,
+                           const std::vector<Eigen::Vector3d>& node_positions,
+                           double relative_tolerance, std::string body_name);
   ~MultigridStiffnessSolver();
   MultigridStiffnessSolver(const MultigridStiffnessSolver&) = delete;
   MultigridStiffnessSolver& operator=(const MultigridStiffnessSolver&) = delete;

@@ -1,11 +1,13 @@
 // Smoothed-aggregation AMG as the preconditioner of conjugate gradients on clamped elastic
 // bodies: the PCG solution against CHOLMOD's (an independent direct solve), iteration counts
-// under mesh refinement and against plain CG, and the symmetry and positivity of the V-cycle.
+// under mesh refinement, on a graded mesh (distance-Laplacian against block-norm strength) and
+// against plain CG, and the symmetry and positivity of the V-cycle.
 
 #include "numerics/algebraic_multigrid.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <iostream>
 #include <optional>
 #include <random>
@@ -25,11 +27,13 @@ namespace robin {
 namespace {
 
 /// The free-free stiffness (lower triangle) of `mesh` with every dof of boundary `clamped`
-/// prescribed (zero), the AMG's near-null space and dof nodes, and a load.
+/// prescribed (zero), the AMG's near-null space, dof nodes and node positions (empty: the
+/// block-norm strength of connection), and a load.
 struct ClampedBody {
   SparseMatrix lower;
   Eigen::MatrixXd near_null_space;
   std::vector<int> dof_nodes;
+  std::vector<Eigen::Vector3d> positions;
   Eigen::VectorXd load;
 };
 
@@ -45,6 +49,7 @@ ClampedBody clamp(const Mesh& mesh, const Material& material, const std::string&
   body.lower = dofs.reduce_matrix_lower(assemble_stiffness(mesh, material));
   body.near_null_space = free_rigid_body_modes(mesh, dofs);
   body.dof_nodes = free_dof_nodes(mesh, dofs);
+  body.positions = mesh.nodes;
   // a smooth body force plus a random part, so that every mode of the error is excited
   std::mt19937 generator(7);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -80,7 +85,8 @@ struct PcgRun {
 PcgRun solve_with_multigrid(const ClampedBody& body,
                             const AlgebraicMultigridOptions& options = test_options(),
                             double tolerance = 1e-10) {
-  const AlgebraicMultigrid multigrid(body.lower, body.near_null_space, body.dof_nodes, options);
+  const AlgebraicMultigrid multigrid(body.lower, body.near_null_space, body.dof_nodes,
+                                     body.positions, options);
   PcgRun run;
   ConjugateGradientOptions parameters;
   parameters.relative_tolerance = tolerance;
@@ -169,8 +175,42 @@ TEST(AlgebraicMultigrid, PartlyPrescribedNodesMatchCholmod) {
   body.lower = dofs.reduce_matrix_lower(assemble_stiffness(mesh, material));
   body.near_null_space = free_rigid_body_modes(mesh, dofs);
   body.dof_nodes = free_dof_nodes(mesh, dofs);
+  body.positions = mesh.nodes;
   body.load = Eigen::VectorXd::LinSpaced(dofs.free_count(), -1.0, 1.0);
   expect_matches_cholmod(body);
+}
+
+TEST(AlgebraicMultigrid, BlockNormStrengthWithoutPositionsMatchesCholmod) {
+  ClampedBody body = clamped_box({4.0, 1.0, 1.0}, {16, 4, 4}, ElementType::hexahedron8);
+  body.positions.clear();
+  expect_matches_cholmod(body);
+}
+
+/// A cube of 12^3 hexahedra graded towards the corner x = y = z = 0: along each axis the cells
+/// grow geometrically, the last 8 times the first, so cells far along one axis and near the
+/// origin along another have aspect ratios up to 8 (the grading of
+/// benchmarks/meshes/solid_scale_block.geo); clamped on its bottom face z = 0.
+TEST(AlgebraicMultigrid, DistanceStrengthOnAGradedMeshMatchesCholmodInFewerIterations) {
+  const int cells = 12;
+  Mesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), {1.0, 1.0, 1.0}, {cells, cells, cells},
+                            ElementType::hexahedron8);
+  const double ratio = std::pow(8.0, 1.0 / (cells - 1));  // of neighbouring cells
+  const auto graded = [&](double coordinate) {            // maps k / cells to the graded node k
+    const double k = std::round(coordinate * cells);
+    return (std::pow(ratio, k) - 1.0) / (std::pow(ratio, cells) - 1.0);
+  };
+  for (Eigen::Vector3d& node : mesh.nodes) node = node.unaryExpr(graded);
+  ClampedBody body =
+      clamp(mesh, make_isotropic_solid_material(210.0, 0.3, "test"), "bottom", {0, 1, 2});
+  AlgebraicMultigridOptions options = test_options();
+  options.coarse_size_limit = 200;
+  expect_matches_cholmod(body, options);
+  const PcgRun distance = solve_with_multigrid(body, options, 1e-12);
+  body.positions.clear();
+  const PcgRun block_norm = solve_with_multigrid(body, options, 1e-12);
+  ASSERT_EQ(distance.result.status, ConjugateGradientStatus::converged);
+  ASSERT_EQ(block_norm.result.status, ConjugateGradientStatus::converged);
+  EXPECT_LT(distance.result.iterations, block_norm.result.iterations);
 }
 
 /// Iterations on the cube at 8^3 and 16^3 cells (8 times the unknowns, h halved).
@@ -203,7 +243,8 @@ TEST(AlgebraicMultigrid, PlainConjugateGradientsNeedManyMoreIterations) {
 
 /// x'M^{-1}y = y'M^{-1}x and x'M^{-1}x > 0 for random x, y.
 void expect_symmetric_positive(const ClampedBody& body, const AlgebraicMultigridOptions& options) {
-  const AlgebraicMultigrid multigrid(body.lower, body.near_null_space, body.dof_nodes, options);
+  const AlgebraicMultigrid multigrid(body.lower, body.near_null_space, body.dof_nodes,
+                                     body.positions, options);
   std::mt19937 generator(99);
   std::normal_distribution<double> normal;
   for (int trial = 0; trial < 5; ++trial) {
@@ -244,6 +285,9 @@ TEST(AlgebraicMultigrid, InconsistentInputIsRefused) {
   nodes = body.dof_nodes;
   nodes[0] = -1;
   EXPECT_THROW(AlgebraicMultigrid(body.lower, body.near_null_space, nodes), std::invalid_argument);
+  std::vector<Eigen::Vector3d> positions(body.positions.begin(), body.positions.end() - 1);
+  EXPECT_THROW(AlgebraicMultigrid(body.lower, body.near_null_space, body.dof_nodes, positions),
+               std::invalid_argument);
   const AlgebraicMultigrid multigrid(body.lower, body.near_null_space, body.dof_nodes);
   Eigen::VectorXd correction;
   EXPECT_THROW(multigrid.apply(Eigen::VectorXd::Ones(3), correction), std::invalid_argument);
