@@ -15,25 +15,17 @@
 namespace robin {
 namespace {
 
-/// y = A x (A compressed, row-major; its values from `values`, double or single precision,
-/// summed in double).
-template <typename Value>
-void multiply(const RowMajorSparseMatrix& matrix, const Value* values, const Eigen::VectorXd& x,
-              Eigen::VectorXd& y) {
+/// y = A x (A compressed, row-major).
+void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   const int* starts = matrix.outerIndexPtr();
   const int* columns = matrix.innerIndexPtr();
-  const double* input = x.data();
-  double* output = y.data();
+  const double* values = matrix.valuePtr();
   const int rows = static_cast<int>(matrix.rows());
   for (int row = 0; row < rows; ++row) {
     double sum = 0.0;
-    for (int k = starts[row]; k < starts[row + 1]; ++k) sum += values[k] * input[columns[k]];
-    output[row] = sum;
+    for (int k = starts[row]; k < starts[row + 1]; ++k) sum += values[k] * x[columns[k]];
+    y[row] = sum;
   }
-}
-
-void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  multiply(matrix, matrix.valuePtr(), x, y);
 }
 
 /// y = A_F x: only the entries of A (compressed, row-major) with keep[k] set.
@@ -52,45 +44,84 @@ void multiply_kept(const RowMajorSparseMatrix& matrix, const std::vector<char>& 
   }
 }
 
-/// y = A' x (A compressed, row-major, values from `values`): each row of A scattered.
+/// Compressed rows with values of type Value: the V-cycle's storage of a level's matrix (its
+/// lower triangle, diagonal included) and prolongator.
 template <typename Value>
-void multiply_transpose(const RowMajorSparseMatrix& matrix, const Value* values,
+struct CompressedRows {
+  std::vector<int> starts, columns;
+  std::vector<Value> values;
+  int rows() const { return static_cast<int>(starts.size()) - 1; }
+};
+
+/// The rows of `matrix` with its values rounded to Value.
+template <typename Value>
+CompressedRows<Value> compressed_rows(const RowMajorSparseMatrix& matrix) {
+  CompressedRows<Value> rows;
+  rows.starts.assign(matrix.outerIndexPtr(), matrix.outerIndexPtr() + matrix.rows() + 1);
+  rows.columns.assign(matrix.innerIndexPtr(), matrix.innerIndexPtr() + matrix.nonZeros());
+  rows.values.assign(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros());
+  return rows;
+}
+
+/// y = P x (summed in double).
+void multiply(const CompressedRows<float>& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  for (int row = 0; row < matrix.rows(); ++row) {
+    double sum = 0.0;
+    for (int k = matrix.starts[row]; k < matrix.starts[row + 1]; ++k) {
+      sum += matrix.values[k] * x[matrix.columns[k]];
+    }
+    y[row] = sum;
+  }
+}
+
+/// y = P' x: each row of P scattered; y has P's column count.
+void multiply_transpose(const CompressedRows<float>& matrix, const Eigen::VectorXd& x,
+                        Eigen::VectorXd& y) {
+  y.setZero();
+  for (int row = 0; row < matrix.rows(); ++row) {
+    const double value = x[row];
+    for (int k = matrix.starts[row]; k < matrix.starts[row + 1]; ++k) {
+      y[matrix.columns[k]] += matrix.values[k] * value;
+    }
+  }
+}
+
+/// y = A x for the symmetric A whose lower triangle (diagonal included) is in the compressed
+/// rows (starts, columns, values): each stored a_ij, j < i, is read once for y_i += a_ij x_j
+/// and y_j += a_ij x_i. Summed in double.
+template <typename Value>
+void multiply_symmetric(const int* starts, const int* columns, const Value* values, int rows,
                         const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  const int* starts = matrix.outerIndexPtr();
-  const int* columns = matrix.innerIndexPtr();
+  const double* input = x.data();
   double* output = y.data();
   y.setZero();
-  const int rows = static_cast<int>(matrix.rows());
   for (int row = 0; row < rows; ++row) {
-    const double value = x[row];
-    for (int k = starts[row]; k < starts[row + 1]; ++k) output[columns[k]] += values[k] * value;
+    const double x_row = input[row];
+    double sum = 0.0;
+    for (int k = starts[row]; k < starts[row + 1]; ++k) {
+      const int column = columns[k];
+      const double value = values[k];
+      sum += value * input[column];
+      if (column != row) output[column] += value * x_row;
+    }
+    output[row] += sum;
   }
 }
 
-/// r = b - A x (A compressed, row-major, values from `values`).
 template <typename Value>
-void subtract_product(const RowMajorSparseMatrix& matrix, const Value* values,
-                      const Eigen::VectorXd& right_hand_side, const Eigen::VectorXd& x,
-                      Eigen::VectorXd& residual) {
-  const int* starts = matrix.outerIndexPtr();
-  const int* columns = matrix.innerIndexPtr();
-  const double* input = x.data();
-  const int rows = static_cast<int>(matrix.rows());
-  for (int row = 0; row < rows; ++row) {
-    double sum = right_hand_side[row];
-    for (int k = starts[row]; k < starts[row + 1]; ++k) sum -= values[k] * input[columns[k]];
-    residual[row] = sum;
-  }
+void multiply_symmetric(const CompressedRows<Value>& lower, const Eigen::VectorXd& x,
+                        Eigen::VectorXd& y) {
+  multiply_symmetric(lower.starts.data(), lower.columns.data(), lower.values.data(), lower.rows(),
+                     x, y);
 }
 
-/// The symmetric matrix whose lower triangle `lower` holds, with both triangles, row-major.
-RowMajorSparseMatrix symmetric_from_lower(const SparseMatrix& lower) {
-  if (lower.rows() != lower.cols()) {
-    throw std::invalid_argument("AlgebraicMultigrid: the matrix is not square");
-  }
-  RowMajorSparseMatrix full = lower.selfadjointView<Eigen::Lower>();
-  full.makeCompressed();
-  return full;
+/// r = b - A x, A symmetric from its lower triangle (multiply_symmetric); `product` is
+/// workspace.
+void subtract_symmetric_product(const CompressedRows<float>& lower,
+                                const Eigen::VectorXd& right_hand_side, const Eigen::VectorXd& x,
+                                Eigen::VectorXd& product, Eigen::VectorXd& residual) {
+  multiply_symmetric(lower, x, product);
+  residual = right_hand_side - product;
 }
 
 /// 1 / A_ii; throws std::invalid_argument for a diagonal entry that is not positive.
@@ -496,33 +527,35 @@ RowMajorSparseMatrix galerkin_product(const RowMajorSparseMatrix& matrix,
   return symmetric;
 }
 
-/// The stored values of `matrix` rounded to single precision.
-std::vector<float> single_precision(const RowMajorSparseMatrix& matrix) {
-  return std::vector<float>(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros());
-}
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
 
-SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower)
-    : matrix_(symmetric_from_lower(lower)) {}
+SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower) {
+  if (lower.rows() != lower.cols()) {
+    throw std::invalid_argument("SparseMatrixOperator: the matrix is not square");
+  }
+  lower_ = lower.triangularView<Eigen::Lower>();
+  lower_.makeCompressed();
+}
 
 void SparseMatrixOperator::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-  y.resize(matrix_.rows());
-  multiply(matrix_, x, y);
+  y.resize(lower_.rows());
+  multiply_symmetric(lower_.outerIndexPtr(), lower_.innerIndexPtr(), lower_.valuePtr(),
+                     static_cast<int>(lower_.rows()), x, y);
 }
 
 struct AlgebraicMultigrid::Level {
-  RowMajorSparseMatrix owned_matrix;  // A_l for l > 0 (A_0 is the fine operator's)
-  const RowMajorSparseMatrix* matrix = nullptr;
+  RowMajorSparseMatrix matrix;  // A_l, both triangles (during the setup only)
   Eigen::VectorXd inverse_diagonal;
-  RowMajorSparseMatrix prolongator;  // P (empty on the coarsest level)
-  // the values of A_l and P rounded to single precision, read by the V-cycle (the patterns are
-  // those of *matrix and prolongator)
-  std::vector<float> matrix_values, prolongator_values;
+  RowMajorSparseMatrix prolongator;  // P (during the setup only; empty on the coarsest level)
+  // what the V-cycle reads: the lower triangle of A_l and P, in single precision
+  CompressedRows<float> lower;
+  CompressedRows<float> prolongation;
+  int unknowns = 0;
+  long nonzeros = 0;  // of A_l, both triangles
   int nodes = 0;
   double spectral_radius = 0.0;
   double interval_low = 0.0, interval_high = 0.0;  // the Chebyshev interval
@@ -561,15 +594,27 @@ AlgebraicMultigrid::AlgebraicMultigrid(const SparseMatrix& lower,
 
 AlgebraicMultigrid::~AlgebraicMultigrid() = default;
 
+/// Keeps of a set-up level what the V-cycle reads (the lower triangle of A_l and P in single
+/// precision, the sizes) and frees its double-precision matrices.
+void AlgebraicMultigrid::finish_level(Level& level) {
+  level.unknowns = static_cast<int>(level.matrix.rows());
+  level.nonzeros = static_cast<long>(level.matrix.nonZeros());
+  level.lower =
+      compressed_rows<float>(RowMajorSparseMatrix(level.matrix.triangularView<Eigen::Lower>()));
+  level.prolongation = compressed_rows<float>(level.prolongator);
+  level.matrix = RowMajorSparseMatrix();
+  level.prolongator = RowMajorSparseMatrix();
+}
+
 void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
                                          const std::vector<int>& dof_nodes,
                                          std::vector<Eigen::Vector3d> positions) {
   Eigen::MatrixXd modes = near_null_space;
   std::vector<int> nodes = dof_nodes;
   auto level = std::make_unique<Level>();
-  level->matrix = &fine_operator_->matrix();
+  level->matrix = fine_operator_->lower().selfadjointView<Eigen::Lower>();
   while (true) {
-    const RowMajorSparseMatrix& matrix = *level->matrix;
+    const RowMajorSparseMatrix& matrix = level->matrix;
     const int unknowns = static_cast<int>(matrix.rows());
     level->inverse_diagonal = inverse_diagonal(matrix);
     level->spectral_radius =
@@ -610,21 +655,18 @@ void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
     }
     level->prolongator.makeCompressed();
     auto coarse = std::make_unique<Level>();
-    coarse->owned_matrix = galerkin_product(matrix, level->prolongator);
-    coarse->matrix = &coarse->owned_matrix;
-    level->coarse_right_hand_side.resize(coarse->owned_matrix.rows());
-    level->coarse_solution.resize(coarse->owned_matrix.rows());
+    coarse->matrix = galerkin_product(matrix, level->prolongator);
+    level->coarse_right_hand_side.resize(coarse->matrix.rows());
+    level->coarse_solution.resize(coarse->matrix.rows());
     modes = std::move(tentative.coarse_near_null_space);
     nodes = std::move(tentative.coarse_nodes);
+    finish_level(*level);
     levels_.push_back(std::move(level));
     level = std::move(coarse);
   }
-  const SparseMatrix coarsest = SparseMatrix(*level->matrix).triangularView<Eigen::Lower>();
+  const SparseMatrix coarsest = SparseMatrix(level->matrix).triangularView<Eigen::Lower>();
+  finish_level(*level);
   levels_.push_back(std::move(level));
-  for (auto& each : levels_) {
-    each->matrix_values = single_precision(*each->matrix);
-    each->prolongator_values = single_precision(each->prolongator);
-  }
   coarse_solver_ = std::make_unique<CoarseSolver>();
   coarse_solver_->factor = std::make_unique<CholeskyFactor>(coarsest, "coarsest multigrid level");
 }
@@ -654,13 +696,10 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
     solution.setZero();
     smooth_gauss_seidel(level, right_hand_side, solution, true);
   }
-  subtract_product(*level.matrix, level.matrix_values.data(), right_hand_side, solution,
-                   level.residual);
-  multiply_transpose(level.prolongator, level.prolongator_values.data(), level.residual,
-                     level.coarse_right_hand_side);
+  subtract_symmetric_product(level.lower, right_hand_side, solution, level.product, level.residual);
+  multiply_transpose(level.prolongation, level.residual, level.coarse_right_hand_side);
   cycle(index + 1, level.coarse_right_hand_side, level.coarse_solution);
-  multiply(level.prolongator, level.prolongator_values.data(), level.coarse_solution,
-           level.product);
+  multiply(level.prolongation, level.coarse_solution, level.product);
   solution += level.product;
   if (options_.smoother == MultigridSmoother::chebyshev) {
     smooth(level, right_hand_side, solution, false);
@@ -670,21 +709,37 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
 }
 
 /// One Gauss-Seidel sweep over the rows, ascending (forward) or descending:
-/// x_i += (b_i - sum_j A_ij x_j) / A_ii, with the x_j already updated in this sweep.
+/// x_i += (b_i - sum_j A_ij x_j) / A_ii, with the x_j already updated in this sweep. From the
+/// lower triangle: the row i holds A_ij for j <= i; the terms of the other triangle are summed in
+/// `level.update` by scattering the rows, of the values before the sweep (forward; none from
+/// a zero guess) or of those the sweep has updated (backward).
 void AlgebraicMultigrid::smooth_gauss_seidel(const Level& level,
                                              const Eigen::VectorXd& right_hand_side,
                                              Eigen::VectorXd& solution, bool forward) const {
-  const RowMajorSparseMatrix& matrix = *level.matrix;
-  const int* starts = matrix.outerIndexPtr();
-  const int* columns = matrix.innerIndexPtr();
-  const float* values = level.matrix_values.data();
+  const int* starts = level.lower.starts.data();
+  const int* columns = level.lower.columns.data();
+  const float* values = level.lower.values.data();
+  const int rows = level.lower.rows();
   double* x = solution.data();
-  const int rows = static_cast<int>(matrix.rows());
+  double* other_triangle = level.update.data();
+  level.update.setZero();
+  if (forward) {
+    for (int row = 0; row < rows; ++row) {  // the upper triangle's terms, x before the sweep
+      for (int k = starts[row]; k < starts[row + 1]; ++k) {
+        if (columns[k] != row) other_triangle[columns[k]] += values[k] * x[row];
+      }
+    }
+  }
   for (int step = 0; step < rows; ++step) {
     const int row = forward ? step : rows - 1 - step;
-    double sum = right_hand_side[row];
+    double sum = right_hand_side[row] - other_triangle[row];
     for (int k = starts[row]; k < starts[row + 1]; ++k) sum -= values[k] * x[columns[k]];
     x[row] += sum * level.inverse_diagonal[row];
+    if (!forward) {
+      for (int k = starts[row]; k < starts[row + 1]; ++k) {
+        if (columns[k] != row) other_triangle[columns[k]] += values[k] * x[row];
+      }
+    }
   }
 }
 
@@ -703,8 +758,7 @@ void AlgebraicMultigrid::smooth(const Level& level, const Eigen::VectorXd& right
   if (zero_guess) {
     residual = right_hand_side;
   } else {
-    subtract_product(*level.matrix, level.matrix_values.data(), right_hand_side, solution,
-                     residual);
+    subtract_symmetric_product(level.lower, right_hand_side, solution, level.product, residual);
   }
   update = level.inverse_diagonal.cwiseProduct(residual) / theta;
   if (zero_guess) {
@@ -714,7 +768,7 @@ void AlgebraicMultigrid::smooth(const Level& level, const Eigen::VectorXd& right
   }
   double rho = 1.0 / sigma;
   for (int step = 1; step < options_.smoother_degree; ++step) {
-    multiply(*level.matrix, level.matrix_values.data(), update, level.product);
+    multiply_symmetric(level.lower, update, level.product);
     residual -= level.product;
     const double next_rho = 1.0 / (2.0 * sigma - rho);
     update = (next_rho * rho) * update +
@@ -728,8 +782,8 @@ std::vector<MultigridLevelSummary> AlgebraicMultigrid::levels() const {
   std::vector<MultigridLevelSummary> summaries;
   for (const auto& level : levels_) {
     MultigridLevelSummary summary;
-    summary.unknowns = static_cast<int>(level->matrix->rows());
-    summary.nonzeros = static_cast<long>(level->matrix->nonZeros());
+    summary.unknowns = level->unknowns;
+    summary.nonzeros = level->nonzeros;
     summary.nodes = level->nodes;
     summary.spectral_radius = level->spectral_radius;
     summaries.push_back(summary);
@@ -739,8 +793,8 @@ std::vector<MultigridLevelSummary> AlgebraicMultigrid::levels() const {
 
 double AlgebraicMultigrid::operator_complexity() const {
   double total = 0.0;
-  for (const auto& level : levels_) total += static_cast<double>(level->matrix->nonZeros());
-  return total / static_cast<double>(levels_.front()->matrix->nonZeros());
+  for (const auto& level : levels_) total += static_cast<double>(level->nonzeros);
+  return total / static_cast<double>(levels_.front()->nonzeros);
 }
 
 }  // namespace robin

@@ -73,18 +73,20 @@ namespace robin {
 
 using RowMajorSparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
-/// y = A x for a sparse matrix stored with both triangles, row-major.
+/// y = A x for a symmetric sparse matrix stored as its lower triangle (row-major): each stored
+/// entry is read once for both triangles.
 class SparseMatrixOperator final : public LinearOperator {
  public:
   /// A from the lower triangle of `lower` (its upper triangle is not read; a matrix stored with
-  /// both triangles is fine), stored with both triangles.
+  /// both triangles is fine).
   explicit SparseMatrixOperator(const SparseMatrix& lower);
-  int size() const override { return static_cast<int>(matrix_.rows()); }
+  int size() const override { return static_cast<int>(lower_.rows()); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
-  const RowMajorSparseMatrix& matrix() const { return matrix_; }
+  /// The lower triangle, diagonal included.
+  const RowMajorSparseMatrix& lower() const { return lower_; }
 
  private:
-  RowMajorSparseMatrix matrix_;
+  RowMajorSparseMatrix lower_;
 };
 
 /// The smoother of the V-cycle (the file comment).
@@ -149,7 +151,7 @@ class AlgebraicMultigrid final : public Preconditioner {
   /// must be distinct vectors.
   void apply(const Eigen::VectorXd& residual, Eigen::VectorXd& correction) const override;
 
-  /// The finest matrix with both triangles (row-major), for PCG's products.
+  /// The finest matrix (its lower triangle), for PCG's products.
   const SparseMatrixOperator& fine_operator() const { return *fine_operator_; }
   std::vector<MultigridLevelSummary> levels() const;
   /// sum over levels of nonzeros(A_l) / nonzeros(A_0).
@@ -160,6 +162,7 @@ class AlgebraicMultigrid final : public Preconditioner {
   struct Level;
   void build_hierarchy(const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes,
                        std::vector<Eigen::Vector3d> positions);
+  static void finish_level(Level& level);
   void cycle(std::size_t level, const Eigen::VectorXd& right_hand_side,
              Eigen::VectorXd& solution) const;
   void smooth_gauss_seidel(const Level& level, const Eigen::VectorXd& right_hand_side,

@@ -323,7 +323,7 @@ void BodySolver::set_up_multigrid(SparseMatrix&& reduced_stiffness) {
         stiffness, free_rigid_body_modes(definition_.mesh, *dofs_),
         free_dof_nodes(definition_.mesh, *dofs_), definition_.mesh.nodes,
         PrimalContactOptions{}.relative_tolerance, name());
-  }  // the AMG keeps its own copy of K with both triangles
+  }  // the AMG keeps its own copy of K (its lower triangle)
   free_solution_ = solve_stiffness(reduced_load_);  // K^{-1} f
   rigid_amplitudes_ = Eigen::VectorXd::Zero(0);
   no_rigid_modes_.resize(dofs_->free_count(), 0);

@@ -229,7 +229,7 @@ const LinearOperator& MultigridStiffnessSolver::stiffness() const {
 }
 
 const RowMajorSparseMatrix& MultigridStiffnessSolver::stiffness_matrix() const {
-  return multigrid_->fine_operator().matrix();
+  return multigrid_->fine_operator().lower();
 }
 
 const Preconditioner& MultigridStiffnessSolver::preconditioner() const {

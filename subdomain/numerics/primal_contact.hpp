@@ -64,7 +64,7 @@ class MultigridStiffnessSolver {
 
   int size() const;
   const LinearOperator& stiffness() const;
-  /// K with both triangles (row-major), as the AMG holds it.
+  /// The lower triangle of K (row-major), as the AMG holds it.
   const RowMajorSparseMatrix& stiffness_matrix() const;
   const Preconditioner& preconditioner() const;
   double relative_tolerance() const { return relative_tolerance_; }
