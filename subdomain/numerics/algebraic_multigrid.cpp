@@ -44,45 +44,32 @@ void multiply_kept(const RowMajorSparseMatrix& matrix, const std::vector<char>& 
   }
 }
 
-/// Compressed rows with values of type Value: the V-cycle's storage of a level's matrix (its
-/// lower triangle, diagonal included) and prolongator.
-template <typename Value>
-struct CompressedRows {
-  std::vector<int> starts, columns;
-  std::vector<Value> values;
-  int rows() const { return static_cast<int>(starts.size()) - 1; }
-};
-
-/// The rows of `matrix` with its values rounded to Value.
-template <typename Value>
-CompressedRows<Value> compressed_rows(const RowMajorSparseMatrix& matrix) {
-  CompressedRows<Value> rows;
-  rows.starts.assign(matrix.outerIndexPtr(), matrix.outerIndexPtr() + matrix.rows() + 1);
-  rows.columns.assign(matrix.innerIndexPtr(), matrix.innerIndexPtr() + matrix.nonZeros());
-  rows.values.assign(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros());
-  return rows;
-}
+/// The V-cycle's storage of a level's matrix (its lower triangle, diagonal included) and
+/// prolongator: compressed rows in single precision.
+using SinglePrecisionRows = Eigen::SparseMatrix<float, Eigen::RowMajor, int>;
 
 /// y = P x (summed in double).
-void multiply(const CompressedRows<float>& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  for (int row = 0; row < matrix.rows(); ++row) {
+void multiply(const SinglePrecisionRows& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
+  const float* values = matrix.valuePtr();
+  for (Eigen::Index row = 0; row < matrix.rows(); ++row) {
     double sum = 0.0;
-    for (int k = matrix.starts[row]; k < matrix.starts[row + 1]; ++k) {
-      sum += matrix.values[k] * x[matrix.columns[k]];
-    }
+    for (int k = starts[row]; k < starts[row + 1]; ++k) sum += values[k] * x[columns[k]];
     y[row] = sum;
   }
 }
 
 /// y = P' x: each row of P scattered; y has P's column count.
-void multiply_transpose(const CompressedRows<float>& matrix, const Eigen::VectorXd& x,
+void multiply_transpose(const SinglePrecisionRows& matrix, const Eigen::VectorXd& x,
                         Eigen::VectorXd& y) {
+  const int* starts = matrix.outerIndexPtr();
+  const int* columns = matrix.innerIndexPtr();
+  const float* values = matrix.valuePtr();
   y.setZero();
-  for (int row = 0; row < matrix.rows(); ++row) {
+  for (Eigen::Index row = 0; row < matrix.rows(); ++row) {
     const double value = x[row];
-    for (int k = matrix.starts[row]; k < matrix.starts[row + 1]; ++k) {
-      y[matrix.columns[k]] += matrix.values[k] * value;
-    }
+    for (int k = starts[row]; k < starts[row + 1]; ++k) y[columns[k]] += values[k] * value;
   }
 }
 
@@ -108,20 +95,29 @@ void multiply_symmetric(const int* starts, const int* columns, const Value* valu
   }
 }
 
-template <typename Value>
-void multiply_symmetric(const CompressedRows<Value>& lower, const Eigen::VectorXd& x,
+void multiply_symmetric(const SinglePrecisionRows& lower, const Eigen::VectorXd& x,
                         Eigen::VectorXd& y) {
-  multiply_symmetric(lower.starts.data(), lower.columns.data(), lower.values.data(), lower.rows(),
-                     x, y);
+  multiply_symmetric(lower.outerIndexPtr(), lower.innerIndexPtr(), lower.valuePtr(),
+                     static_cast<int>(lower.rows()), x, y);
 }
 
 /// r = b - A x, A symmetric from its lower triangle (multiply_symmetric); `product` is
 /// workspace.
-void subtract_symmetric_product(const CompressedRows<float>& lower,
+void subtract_symmetric_product(const SinglePrecisionRows& lower,
                                 const Eigen::VectorXd& right_hand_side, const Eigen::VectorXd& x,
                                 Eigen::VectorXd& product, Eigen::VectorXd& residual) {
   multiply_symmetric(lower, x, product);
   residual = right_hand_side - product;
+}
+
+/// Whether every stored entry of the column-major `matrix` is on or below the diagonal.
+bool is_lower_triangular(const SparseMatrix& matrix) {
+  for (Eigen::Index column = 0; column < matrix.outerSize(); ++column) {
+    for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
+      if (entry.row() < column) return false;
+    }
+  }
+  return true;
 }
 
 /// 1 / A_ii; throws std::invalid_argument for a diagonal entry that is not positive.
@@ -460,7 +456,8 @@ TentativeProlongator tentative_prolongator(const NodeBlocks& blocks,
 }
 
 /// P = (I - omega D^{-1} A_F) P_tent (step 4), A_F the entries of A with keep[k] set, row by
-/// row with a sparse accumulator (P_tent has one aggregate's columns per row).
+/// row with a sparse accumulator (P_tent has one aggregate's columns per row): a first pass
+/// counts each row's entries, a second writes them into P's exact storage.
 RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
                                         const std::vector<char>& keep,
                                         const Eigen::VectorXd& inverse_diagonal, double omega,
@@ -469,11 +466,6 @@ RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
   std::vector<double> accumulated(static_cast<std::size_t>(columns), 0.0);
   std::vector<Eigen::Index> last_row(static_cast<std::size_t>(columns), -1);
   std::vector<int> row_columns;
-  std::vector<int> starts(static_cast<std::size_t>(rows) + 1, 0);
-  std::vector<int> indices;
-  std::vector<double> values;
-  indices.reserve(static_cast<std::size_t>(tentative.nonZeros()) * 8);
-  values.reserve(indices.capacity());
   const auto add = [&](Eigen::Index row, int column, double value) {
     if (last_row[static_cast<std::size_t>(column)] != row) {
       last_row[static_cast<std::size_t>(column)] = row;
@@ -482,7 +474,8 @@ RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
     }
     accumulated[static_cast<std::size_t>(column)] += value;
   };
-  for (Eigen::Index row = 0; row < rows; ++row) {
+  const auto accumulate_row = [&](Eigen::Index row) {  // row_columns and accumulated
+    row_columns.clear();
     const double factor = -omega * inverse_diagonal[row];
     for (int k = matrix.outerIndexPtr()[row]; k < matrix.outerIndexPtr()[row + 1]; ++k) {
       if (!keep[static_cast<std::size_t>(k)]) continue;
@@ -495,24 +488,33 @@ RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
     for (RowMajorSparseMatrix::InnerIterator entry(tentative, row); entry; ++entry) {
       add(row, static_cast<int>(entry.col()), entry.value());
     }
-    std::sort(row_columns.begin(), row_columns.end());
-    for (int column : row_columns) {
-      indices.push_back(column);
-      values.push_back(accumulated[static_cast<std::size_t>(column)]);
-    }
-    row_columns.clear();
-    starts[static_cast<std::size_t>(row) + 1] = static_cast<int>(indices.size());
+  };
+  RowMajorSparseMatrix smoothed(rows, columns);
+  int* starts = smoothed.outerIndexPtr();
+  starts[0] = 0;
+  for (Eigen::Index row = 0; row < rows; ++row) {
+    accumulate_row(row);
+    starts[row + 1] = starts[row] + static_cast<int>(row_columns.size());
   }
-  return Eigen::Map<const RowMajorSparseMatrix>(rows, columns,
-                                                static_cast<Eigen::Index>(indices.size()),
-                                                starts.data(), indices.data(), values.data());
+  std::fill(last_row.begin(), last_row.end(), -1);
+  smoothed.resizeNonZeros(starts[rows]);
+  for (Eigen::Index row = 0; row < rows; ++row) {
+    accumulate_row(row);
+    std::sort(row_columns.begin(), row_columns.end());
+    int position = smoothed.outerIndexPtr()[row];
+    for (int column : row_columns) {
+      smoothed.innerIndexPtr()[position] = column;
+      smoothed.valuePtr()[position++] = accumulated[static_cast<std::size_t>(column)];
+    }
+  }
+  return smoothed;
 }
 
 /// P' A P (step 5) as the sum over blocks of rows J of (P_J)' (A_J P), so that A P (the largest
 /// product of the setup) is never formed whole; symmetrized against rounding: (C + C') / 2.
 RowMajorSparseMatrix galerkin_product(const RowMajorSparseMatrix& matrix,
                                       const RowMajorSparseMatrix& prolongator) {
-  const Eigen::Index rows = matrix.rows(), block = 65536;
+  const Eigen::Index rows = matrix.rows(), block = 16384;
   RowMajorSparseMatrix coarse(prolongator.cols(), prolongator.cols());
   for (Eigen::Index first = 0; first < rows; first += block) {
     const Eigen::Index count = std::min(block, rows - first);
@@ -533,18 +535,26 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower) {
+SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower)
+    : SparseMatrixOperator(SparseMatrix(lower)) {}
+
+SparseMatrixOperator::SparseMatrixOperator(SparseMatrix&& lower) {
   if (lower.rows() != lower.cols()) {
     throw std::invalid_argument("SparseMatrixOperator: the matrix is not square");
   }
-  lower_ = lower.triangularView<Eigen::Lower>();
+  if (is_lower_triangular(lower)) {
+    lower_.swap(lower);
+  } else {
+    lower_ = lower.triangularView<Eigen::Lower>();
+  }
   lower_.makeCompressed();
 }
 
 void SparseMatrixOperator::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   y.resize(lower_.rows());
+  // the columns of the lower triangle are the rows of the upper one: the same symmetric product
   multiply_symmetric(lower_.outerIndexPtr(), lower_.innerIndexPtr(), lower_.valuePtr(),
-                     static_cast<int>(lower_.rows()), x, y);
+                     static_cast<int>(lower_.cols()), x, y);
 }
 
 struct AlgebraicMultigrid::Level {
@@ -552,8 +562,8 @@ struct AlgebraicMultigrid::Level {
   Eigen::VectorXd inverse_diagonal;
   RowMajorSparseMatrix prolongator;  // P (during the setup only; empty on the coarsest level)
   // what the V-cycle reads: the lower triangle of A_l and P, in single precision
-  CompressedRows<float> lower;
-  CompressedRows<float> prolongation;
+  SinglePrecisionRows lower;
+  SinglePrecisionRows prolongation;
   int unknowns = 0;
   long nonzeros = 0;  // of A_l, both triangles
   int nodes = 0;
@@ -572,6 +582,13 @@ AlgebraicMultigrid::AlgebraicMultigrid(const SparseMatrix& lower,
                                        const std::vector<int>& dof_nodes,
                                        const std::vector<Eigen::Vector3d>& node_positions,
                                        const AlgebraicMultigridOptions& options)
+    : AlgebraicMultigrid(SparseMatrix(lower), near_null_space, dof_nodes, node_positions, options) {
+}
+
+AlgebraicMultigrid::AlgebraicMultigrid(SparseMatrix&& lower, const Eigen::MatrixXd& near_null_space,
+                                       const std::vector<int>& dof_nodes,
+                                       const std::vector<Eigen::Vector3d>& node_positions,
+                                       const AlgebraicMultigridOptions& options)
     : options_(options) {
   const auto start = std::chrono::steady_clock::now();
   if (near_null_space.rows() != lower.rows() || near_null_space.cols() < 1 ||
@@ -582,7 +599,7 @@ AlgebraicMultigrid::AlgebraicMultigrid(const SparseMatrix& lower,
   if (options_.smoother_degree < 1) {
     throw std::invalid_argument("AlgebraicMultigrid: smoother_degree below 1");
   }
-  fine_operator_ = std::make_unique<SparseMatrixOperator>(lower);
+  fine_operator_ = std::make_unique<SparseMatrixOperator>(std::move(lower));
   for (int node : dof_nodes) {
     if (!node_positions.empty() && node >= static_cast<int>(node_positions.size())) {
       throw std::invalid_argument("AlgebraicMultigrid: a dof's node has no position");
@@ -595,15 +612,21 @@ AlgebraicMultigrid::AlgebraicMultigrid(const SparseMatrix& lower,
 AlgebraicMultigrid::~AlgebraicMultigrid() = default;
 
 /// Keeps of a set-up level what the V-cycle reads (the lower triangle of A_l and P in single
-/// precision, the sizes) and frees its double-precision matrices.
-void AlgebraicMultigrid::finish_level(Level& level) {
+/// precision, the sizes) and frees its double-precision matrices. `lower` is A_l's lower
+/// triangle when at hand (the finest level's), else it is taken from the level's matrix.
+void AlgebraicMultigrid::finish_level(Level& level, const SparseMatrix* lower) {
   level.unknowns = static_cast<int>(level.matrix.rows());
   level.nonzeros = static_cast<long>(level.matrix.nonZeros());
-  level.lower =
-      compressed_rows<float>(RowMajorSparseMatrix(level.matrix.triangularView<Eigen::Lower>()));
-  level.prolongation = compressed_rows<float>(level.prolongator);
-  level.matrix = RowMajorSparseMatrix();
-  level.prolongator = RowMajorSparseMatrix();
+  if (lower) {
+    level.lower = lower->cast<float>();
+  } else {
+    level.lower = level.matrix.triangularView<Eigen::Lower>().cast<float>();
+  }
+  level.lower.makeCompressed();
+  RowMajorSparseMatrix().swap(level.matrix);  // swapped out: assignment would keep the storage
+  level.prolongation = level.prolongator.cast<float>();
+  level.prolongation.makeCompressed();
+  RowMajorSparseMatrix().swap(level.prolongator);
 }
 
 void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
@@ -660,12 +683,12 @@ void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
     level->coarse_solution.resize(coarse->matrix.rows());
     modes = std::move(tentative.coarse_near_null_space);
     nodes = std::move(tentative.coarse_nodes);
-    finish_level(*level);
+    finish_level(*level, levels_.empty() ? &fine_operator_->lower() : nullptr);
     levels_.push_back(std::move(level));
     level = std::move(coarse);
   }
   const SparseMatrix coarsest = SparseMatrix(level->matrix).triangularView<Eigen::Lower>();
-  finish_level(*level);
+  finish_level(*level, levels_.empty() ? &fine_operator_->lower() : nullptr);
   levels_.push_back(std::move(level));
   coarse_solver_ = std::make_unique<CoarseSolver>();
   coarse_solver_->factor = std::make_unique<CholeskyFactor>(coarsest, "coarsest multigrid level");
@@ -716,10 +739,10 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
 void AlgebraicMultigrid::smooth_gauss_seidel(const Level& level,
                                              const Eigen::VectorXd& right_hand_side,
                                              Eigen::VectorXd& solution, bool forward) const {
-  const int* starts = level.lower.starts.data();
-  const int* columns = level.lower.columns.data();
-  const float* values = level.lower.values.data();
-  const int rows = level.lower.rows();
+  const int* starts = level.lower.outerIndexPtr();
+  const int* columns = level.lower.innerIndexPtr();
+  const float* values = level.lower.valuePtr();
+  const int rows = static_cast<int>(level.lower.rows());
   double* x = solution.data();
   double* other_triangle = level.update.data();
   level.update.setZero();

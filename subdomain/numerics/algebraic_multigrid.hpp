@@ -73,20 +73,22 @@ namespace robin {
 
 using RowMajorSparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
-/// y = A x for a symmetric sparse matrix stored as its lower triangle (row-major): each stored
-/// entry is read once for both triangles.
+/// y = A x for a symmetric sparse matrix stored as its lower triangle: each stored entry is read
+/// once for both triangles.
 class SparseMatrixOperator final : public LinearOperator {
  public:
-  /// A from the lower triangle of `lower` (its upper triangle is not read; a matrix stored with
-  /// both triangles is fine).
+  /// A from the lower triangle of `lower` (its upper triangle is dropped; a matrix stored with
+  /// both triangles is fine). The rvalue overload takes over the storage of a lower triangle
+  /// (Eigen's sparse matrices have no move constructor: a by-value parameter would copy).
   explicit SparseMatrixOperator(const SparseMatrix& lower);
+  explicit SparseMatrixOperator(SparseMatrix&& lower);
   int size() const override { return static_cast<int>(lower_.rows()); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
-  /// The lower triangle, diagonal included.
-  const RowMajorSparseMatrix& lower() const { return lower_; }
+  /// The lower triangle, diagonal included (column-major).
+  const SparseMatrix& lower() const { return lower_; }
 
  private:
-  RowMajorSparseMatrix lower_;
+  SparseMatrix lower_;
 };
 
 /// The smoother of the V-cycle (the file comment).
@@ -132,12 +134,18 @@ struct MultigridLevelSummary {
 class AlgebraicMultigrid final : public Preconditioner {
  public:
   /// Sets the hierarchy up for the symmetric positive definite `lower` (only its lower triangle
-  /// is read), the near-null space `near_null_space` (n x m, m >= 1) and `dof_nodes` (n values:
-  /// the node of each unknown; node numbers are any non-negative integers, the unknowns of one
-  /// node need not be consecutive). `node_positions`, indexed by those node numbers, selects the
-  /// distance-Laplacian strength of connection (step 1); empty selects the block norms. Throws
-  /// std::invalid_argument on inconsistent sizes, a negative node or a node without a position,
-  /// SingularBodyError (cholesky.hpp) when the coarsest matrix is not positive definite.
+  /// is kept; its storage is taken over), the near-null space `near_null_space` (n x m, m >= 1) and
+  /// `dof_nodes` (n values: the node of each unknown; node numbers are any non-negative integers,
+  /// the unknowns of one node need not be consecutive). `node_positions`, indexed by those node
+  /// numbers, selects the distance-Laplacian strength of connection (step 1); empty selects the
+  /// block norms. Throws std::invalid_argument on inconsistent sizes, a negative node or a node
+  /// without a position, SingularBodyError (cholesky.hpp) when the coarsest matrix is not positive
+  /// definite.
+  AlgebraicMultigrid(SparseMatrix&& lower, const Eigen::MatrixXd& near_null_space,
+                     const std::vector<int>& dof_nodes,
+                     const std::vector<Eigen::Vector3d>& node_positions = {},
+                     const AlgebraicMultigridOptions& options = {});
+  /// The same for a copy of `lower`.
   AlgebraicMultigrid(const SparseMatrix& lower, const Eigen::MatrixXd& near_null_space,
                      const std::vector<int>& dof_nodes,
                      const std::vector<Eigen::Vector3d>& node_positions = {},
@@ -162,7 +170,7 @@ class AlgebraicMultigrid final : public Preconditioner {
   struct Level;
   void build_hierarchy(const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes,
                        std::vector<Eigen::Vector3d> positions);
-  static void finish_level(Level& level);
+  static void finish_level(Level& level, const SparseMatrix* lower);
   void cycle(std::size_t level, const Eigen::VectorXd& right_hand_side,
              Eigen::VectorXd& solution) const;
   void smooth_gauss_seidel(const Level& level, const Eigen::VectorXd& right_hand_side,

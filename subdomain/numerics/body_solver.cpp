@@ -317,14 +317,11 @@ void BodySolver::set_up_multigrid(SparseMatrix&& reduced_stiffness) {
   }
   report(SetupStage::factorization);
   release_free_heap_memory();
-  {
-    const SparseMatrix stiffness = std::move(reduced_stiffness);
-    multigrid_ = std::make_unique<MultigridStiffnessSolver>(
-        stiffness, free_rigid_body_modes(definition_.mesh, *dofs_),
-        free_dof_nodes(definition_.mesh, *dofs_), definition_.mesh.nodes,
-        PrimalContactOptions{}.relative_tolerance, name());
-  }  // the AMG keeps its own copy of K (its lower triangle)
-  free_solution_ = solve_stiffness(reduced_load_);  // K^{-1} f
+  multigrid_ = std::make_unique<MultigridStiffnessSolver>(
+      std::move(reduced_stiffness), free_rigid_body_modes(definition_.mesh, *dofs_),
+      free_dof_nodes(definition_.mesh, *dofs_), definition_.mesh.nodes,
+      PrimalContactOptions{}.relative_tolerance, name());  // K moved into the AMG
+  free_solution_ = solve_stiffness(reduced_load_);         // K^{-1} f
   rigid_amplitudes_ = Eigen::VectorXd::Zero(0);
   no_rigid_modes_.resize(dofs_->free_count(), 0);
 }
@@ -348,7 +345,7 @@ LinearSolverKind BodySolver::linear_solver() const {
 }
 
 void BodySolver::fall_back_to_direct_solver() {
-  SparseMatrix lower = SparseMatrix(multigrid_->stiffness_matrix()).triangularView<Eigen::Lower>();
+  SparseMatrix lower = multigrid_->stiffness_matrix();
   multigrid_.reset();
   factor_ = std::make_unique<GeneralizedInverse>(
       std::move(lower), Eigen::MatrixXd(dofs_->free_count(), 0), name(), std::vector<int>{},

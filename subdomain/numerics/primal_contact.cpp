@@ -210,11 +210,11 @@ void check_sizes(const MultigridStiffnessSolver& stiffness, const SparseMatrix& 
 }  // namespace
 
 MultigridStiffnessSolver::MultigridStiffnessSolver(
-    const SparseMatrix& lower, const Eigen::MatrixXd& near_null_space,
-    const std::vector<int>& dof_nodes, const std::vector<Eigen::Vector3d>& node_positions,
-    double relative_tolerance, std::string body_name)
-    : multigrid_(
-          std::make_unique<AlgebraicMultigrid>(lower, near_null_space, dof_nodes, node_positions)),
+    SparseMatrix&& lower, const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes,
+    const std::vector<Eigen::Vector3d>& node_positions, double relative_tolerance,
+    std::string body_name)
+    : multigrid_(std::make_unique<AlgebraicMultigrid>(std::move(lower), near_null_space, dof_nodes,
+                                                      node_positions)),
       relative_tolerance_(relative_tolerance),
       body_name_(std::move(body_name)) {}
 
@@ -228,7 +228,7 @@ const LinearOperator& MultigridStiffnessSolver::stiffness() const {
   return multigrid_->fine_operator();
 }
 
-const RowMajorSparseMatrix& MultigridStiffnessSolver::stiffness_matrix() const {
+const SparseMatrix& MultigridStiffnessSolver::stiffness_matrix() const {
   return multigrid_->fine_operator().lower();
 }
 

@@ -50,11 +50,12 @@ namespace robin {
 /// K^{-1} b by AMG-preconditioned conjugate gradients (the file comment).
 class MultigridStiffnessSolver {
  public:
-  /// Sets the AMG hierarchy up for the symmetric positive definite `lower` (its lower triangle),
+  /// Sets the AMG hierarchy up for the symmetric positive definite `lower` (its lower triangle;
+  /// its storage taken over),
   /// with `near_null_space` (free x m), `dof_nodes` and `node_positions` as AlgebraicMultigrid
   /// takes them. `relative_tolerance` is the conjugate gradients' stopping tolerance;
   /// `body_name` names the body in errors.
-  MultigridStiffnessSolver(const SparseMatrix& lower, const Eigen::MatrixXd& near_null_space,
+  MultigridStiffnessSolver(SparseMatrix&& lower, const Eigen::MatrixXd& near_null_space,
                            const std::vector<int>& dof_nodes,
                            const std::vector<Eigen::Vector3d>& node_positions,
                            double relative_tolerance, std::string body_name);
@@ -64,8 +65,8 @@ class MultigridStiffnessSolver {
 
   int size() const;
   const LinearOperator& stiffness() const;
-  /// The lower triangle of K (row-major), as the AMG holds it.
-  const RowMajorSparseMatrix& stiffness_matrix() const;
+  /// The lower triangle of K, as the AMG holds it.
+  const SparseMatrix& stiffness_matrix() const;
   const Preconditioner& preconditioner() const;
   double relative_tolerance() const { return relative_tolerance_; }
   const std::string& body_name() const { return body_name_; }
