@@ -298,6 +298,7 @@ PrimalContactResult solve_primal_contact(const MultigridStiffnessSolver& stiffne
   std::unique_ptr<const ActiveConstraints> constraints;  // of `active`; kept while it repeats
   for (int step = 1; step <= options.maximum_active_set_steps; ++step) {
     result.iterations = step;
+    if (step > options.inexact_steps) step_tolerance = tolerance;
     if (!constraints) {
       constraints = std::make_unique<const ActiveConstraints>(row_trace, indices_of(active),
                                                               stiffness.body_name());

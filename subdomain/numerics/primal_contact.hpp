@@ -30,9 +30,10 @@
 // are returned as 0. The steps are inexact while the set changes: solved (and thresholded) to
 // PrimalContactOptions::changing_set_tolerance; the first step that finds the set unchanged is
 // repeated from its own solution to the final tolerance, and the method stops when that one
-// finds it unchanged too. Rows of B without a free dof cannot be made active (their value is
-// fixed). The first active set is the previous solve's, or { j : (B u - c)_j > 0 } at the initial
-// u.
+// finds it unchanged too. After PrimalContactOptions::inexact_steps steps every step is solved to
+// the final tolerance (so that rounding of the inexact steps cannot make the set cycle). Rows of B
+// without a free dof cannot be made active (their value is fixed). The first active set is the
+// previous solve's, or { j : (B u - c)_j > 0 } at the initial u.
 
 #include <Eigen/Core>
 #include <memory>
@@ -120,7 +121,9 @@ struct PrimalContactOptions {
   /// The tolerance of the steps while the active set still changes (inexact steps: the set only
   /// needs to be right); the step that finds the set unchanged is repeated to
   /// relative_tolerance.
-  double changing_set_tolerance = 1e-6;
+  double changing_set_tolerance = 1e-3;
+  /// At most this many inexact steps; the later ones are solved to relative_tolerance.
+  int inexact_steps = 10;
   int maximum_active_set_steps = 100;
 };
 
