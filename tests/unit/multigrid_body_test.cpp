@@ -17,7 +17,9 @@
 // the displacement field (of the last solve's force, kept, and of another force, solved from the
 // kept one), a second solve warm-started after a change of obstacle and load
 // factor, the refusal of a floating body, and the fall-back to the factor when the contact rows
-// are linearly dependent (as on the mortar side of a finer non-mortar side).
+// are linearly dependent (as on the mortar side of a finer non-mortar side). And
+// solve_primal_contact's inexact active-set steps (the default, none, very loose ones limited
+// to two) against the Signorini conditions of the KKT system solved by CHOLMOD.
 
 #include <gtest/gtest.h>
 
@@ -25,16 +27,20 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "../test_bodies.hpp"
 #include "numerics/body_solver.hpp"
 #include "numerics/box_mesher.hpp"
+#include "numerics/cholesky.hpp"
 #include "numerics/contact_operator.hpp"
+#include "numerics/dof_map.hpp"
 #include "numerics/elasticity.hpp"
 #include "numerics/errors.hpp"
 #include "numerics/material.hpp"
+#include "numerics/primal_contact.hpp"
 #include "numerics/rectangle_mesher.hpp"
 
 namespace robin {
@@ -252,6 +258,68 @@ TEST(MultigridBody, RefusesAFloatingBody) {
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("body 'box'"), std::string::npos) << error.what();
     EXPECT_NE(std::string(error.what()).find("direct"), std::string::npos) << error.what();
+  }
+}
+
+/// solve_primal_contact itself on the clamped box's contact problem (K and B on the free dofs,
+/// the partial obstacle of the file comment from e = B K^{-1} b by CHOLMOD), with the default
+/// inexact steps, with every step exact (inexact_steps = 0), and with very loose inexact steps
+/// (changing_set_tolerance 0.1) limited to two: each result satisfies the Signorini conditions
+/// of the KKT system solved independently by CHOLMOD, u = K^{-1} (b - B' lambda).
+TEST(PrimalContact, InexactStepsAndTheirLimitGiveTheSignoriniSolution) {
+  const BodyDefinition body = solid_box(ElementType::hexahedron8);
+  const Mesh& mesh = body.mesh;
+  std::vector<std::optional<double>> prescribed(static_cast<std::size_t>(mesh.dof_count()));
+  for (int node : mesh.boundary("bottom").nodes()) {
+    for (int component = 0; component < 3; ++component) prescribed[3 * node + component] = 0.0;
+  }
+  const DofMap dofs(prescribed);
+  const SparseMatrix lower = dofs.reduce_matrix_lower(assemble_stiffness(mesh, body.material));
+  const Eigen::VectorXd load = dofs.restrict(
+      assemble_body_force(mesh, [](const Eigen::Vector3d&) { return Eigen::Vector3d(0, 0, 40); }));
+  const ContactOperator contact = top_operator(mesh);
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int row = 0; row < contact.row_count(); ++row) {
+    for (std::size_t k = contact.row_offsets[row]; k < contact.row_offsets[row + 1]; ++k) {
+      const int dof = 3 * contact.nodes[k] + contact.components[k];
+      if (!dofs.is_prescribed(dof))
+        triplets.emplace_back(row, dofs.free_index(dof), contact.values[k]);
+    }
+  }
+  SparseMatrix trace(contact.row_count(), dofs.free_count());
+  trace.setFromTriplets(triplets.begin(), triplets.end());
+  const CholeskyFactor factor(lower, "box");
+  const Eigen::VectorXd free_trace = trace * factor.solve(load);
+  Eigen::VectorXd bound(contact.row_count());
+  for (int row = 0; row < contact.row_count(); ++row) {
+    bound[row] = free_trace[row] * (0.3 + 1.2 * mesh.nodes[contact.nodes[row]].x() / 2.0);
+  }
+  const MultigridStiffnessSolver stiffness(SparseMatrix(lower), free_rigid_body_modes(mesh, dofs),
+                                           free_dof_nodes(mesh, dofs), mesh.nodes, 1e-12, "box");
+  PrimalContactOptions exact;
+  exact.inexact_steps = 0;
+  PrimalContactOptions loose;
+  loose.changing_set_tolerance = 0.1;
+  loose.inexact_steps = 2;
+  for (const PrimalContactOptions& options : {PrimalContactOptions{}, exact, loose}) {
+    PrimalContactState state;
+    const PrimalContactResult result = solve_primal_contact(
+        stiffness, trace, load, bound, Eigen::VectorXd::Zero(stiffness.size()), state, options);
+    ASSERT_EQ(result.status, QpStatus::converged) << result.message;
+    const Eigen::VectorXd& force = result.solution;
+    const Eigen::VectorXd contact_load = load - trace.transpose() * force;
+    const Eigen::VectorXd gap = bound - trace * factor.solve(contact_load);
+    const double scale = bound.lpNorm<Eigen::Infinity>();
+    const long closed = (force.array() > 0.0).count();
+    EXPECT_GE(closed, 3);
+    EXPECT_LE(closed, contact.row_count() - 3);
+    EXPECT_GE(force.minCoeff(), 0.0);
+    EXPECT_GE(gap.minCoeff(), -1e-9 * scale);  // no penetration
+    EXPECT_LE(force.cwiseProduct(gap).cwiseAbs().maxCoeff(),
+              1e-9 * scale * force.lpNorm<Eigen::Infinity>());  // complementarity
+    std::cout << "changing_set_tolerance " << options.changing_set_tolerance << ", inexact_steps "
+              << options.inexact_steps << ": " << closed << " closed, " << result.iterations
+              << " active set steps, " << result.operator_applications << " CG iterations\n";
   }
 }
 
