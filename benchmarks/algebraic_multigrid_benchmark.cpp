@@ -1,14 +1,17 @@
-// algebraic_multigrid_benchmark [CELLS_X ...] [--skip-cholmod-above DOFS] [--degree K]
-//     [--theta T] [--gauss-seidel]
+// algebraic_multigrid_benchmark [CELLS_X ...] [--mesh FILE.msh BOUNDARY]
+//     [--skip-cholmod-above DOFS] [--degree K] [--theta T] [--distance-theta T]
+//     [--no-positions] [--gauss-seidel]
 // Conjugate gradients preconditioned by smoothed-aggregation AMG (numerics/algebraic_multigrid.hpp)
 // against CHOLMOD (numerics/cholesky.hpp) on the stiffness of a hexahedron8 box [0, 2] x [0, 1] x
 // [0, 1] of 2n x n x n cells (one argument n per size; default 26, 34 and 43: 1.1e5, 2.5e5
-// and 5.0e5 free dofs) clamped on its left face, under a smooth body force. Prints one markdown row
-// per size and solver: setup seconds (AMG hierarchy; CHOLMOD ordering and factorization),
-// iterations and seconds of PCG to relative residual 1e-10 (CHOLMOD: one solve), the relative
-// difference of the two solutions, the AMG's levels and operator complexity or the factor's
-// entries, and the peak resident memory (VmHWM) of the process during the solver's setup and
-// solve: the peak is reset before each solver (after the problem's assembly, whose matrix and
+// and 5.0e5 free dofs) clamped on its left face, under a smooth body force; with --mesh, also
+// (first) the Gmsh mesh FILE.msh clamped on its boundary BOUNDARY under the same force. The AMG
+// gets the node positions (the distance-Laplacian strength) unless --no-positions. Prints one
+// markdown row per size and solver: setup seconds (AMG hierarchy; CHOLMOD ordering and
+// factorization), iterations and seconds of PCG to relative residual 1e-10 (CHOLMOD: one solve),
+// the relative difference of the two solutions, the AMG's levels and operator complexity or the
+// factor's entries, and the peak resident memory (VmHWM) of the process during the solver's setup
+// and solve: the peak is reset before each solver (after the problem's assembly, whose matrix and
 // load are resident throughout and included). CHOLMOD is skipped above --skip-cholmod-above free
 // dofs.
 
@@ -30,6 +33,7 @@
 #include "numerics/dof_map.hpp"
 #include "numerics/elasticity.hpp"
 #include "numerics/material.hpp"
+#include "numerics/msh_file.hpp"
 
 namespace {
 
@@ -64,12 +68,10 @@ struct Problem {
   std::vector<Eigen::Vector3d> positions;
 };
 
-Problem clamped_box(int cells) {
-  const robin::Mesh mesh =
-      robin::make_box_mesh(Eigen::Vector3d::Zero(), {2.0, 1.0, 1.0}, {2 * cells, cells, cells},
-                           robin::ElementType::hexahedron8);
+/// `mesh` clamped on `boundary` under a smooth body force.
+Problem clamped_body(const robin::Mesh& mesh, const std::string& boundary) {
   std::vector<std::optional<double>> prescribed(static_cast<std::size_t>(mesh.dof_count()));
-  for (int node : mesh.boundary("left").nodes()) {
+  for (int node : mesh.boundary(boundary).nodes()) {
     for (int component = 0; component < 3; ++component) prescribed[3 * node + component] = 0.0;
   }
   const robin::DofMap dofs(prescribed);
@@ -83,6 +85,13 @@ Problem clamped_box(int cells) {
     return Eigen::Vector3d(0.1 * x.y(), -1.0, 0.2 * x.z());
   }));
   return problem;
+}
+
+Problem clamped_box(int cells) {
+  return clamped_body(
+      robin::make_box_mesh(Eigen::Vector3d::Zero(), {2.0, 1.0, 1.0}, {2 * cells, cells, cells},
+                           robin::ElementType::hexahedron8),
+      "left");
 }
 
 Eigen::VectorXd run_multigrid(const Problem& problem,
@@ -129,6 +138,8 @@ void run_cholmod(const Problem& problem, const Eigen::VectorXd& iterative) {
 int main(int argc, char** argv) {
   std::vector<int> cells;
   long skip_cholmod_above = 400000;
+  bool use_positions = true;
+  std::string mesh_path, clamped_boundary;
   robin::AlgebraicMultigridOptions options;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--skip-cholmod-above") == 0 && k + 1 < argc) {
@@ -139,21 +150,34 @@ int main(int argc, char** argv) {
       options.smoother = robin::MultigridSmoother::symmetric_gauss_seidel;
     } else if (std::strcmp(argv[k], "--theta") == 0 && k + 1 < argc) {
       options.strength_threshold = std::atof(argv[++k]);
+    } else if (std::strcmp(argv[k], "--distance-theta") == 0 && k + 1 < argc) {
+      options.distance_strength_threshold = std::atof(argv[++k]);
+    } else if (std::strcmp(argv[k], "--no-positions") == 0) {
+      use_positions = false;
+    } else if (std::strcmp(argv[k], "--mesh") == 0 && k + 2 < argc) {
+      mesh_path = argv[++k];
+      clamped_boundary = argv[++k];
     } else if (std::atoi(argv[k]) > 0) {
       cells.push_back(std::atoi(argv[k]));
     } else {
       std::fprintf(stderr,
-                   "usage: algebraic_multigrid_benchmark [CELLS_X ...] [--skip-cholmod-above "
-                   "DOFS] [--degree K] [--theta T] [--gauss-seidel]\n");
+                   "usage: algebraic_multigrid_benchmark [CELLS_X ...] [--mesh FILE.msh "
+                   "BOUNDARY] [--skip-cholmod-above DOFS] [--degree K] [--theta T] "
+                   "[--distance-theta T] [--no-positions] [--gauss-seidel]\n");
       return 1;
     }
   }
-  if (cells.empty()) cells = {26, 34, 43};
+  if (cells.empty() && mesh_path.empty()) cells = {26, 34, 43};
   std::printf(
       "| free dofs | solver | setup (s) | iterations | solve (s) | relative residual | "
       "hierarchy / factor | peak RSS (MiB) |\n|---|---|---|---|---|---|---|---|\n");
-  for (int n : cells) {
-    const Problem problem = clamped_box(n);
+  std::vector<Problem> problems;
+  if (!mesh_path.empty()) {
+    problems.push_back(clamped_body(robin::read_msh_file(mesh_path), clamped_boundary));
+  }
+  for (int n : cells) problems.push_back(clamped_box(n));
+  for (Problem& problem : problems) {
+    if (!use_positions) problem.positions.clear();
     reset_peak_resident();
     const Eigen::VectorXd solution = run_multigrid(problem, options);
     reset_peak_resident();
