@@ -44,7 +44,7 @@ std::vector<CorrectionSolveResult> correction_solves(const std::vector<Subdomain
                                                      const std::vector<Eigen::VectorXd>& forces,
                                                      int iteration) {
   for (std::size_t body = 0; body < ports.size(); ++body) {
-    ports[body]->start_correction(forces[body], iteration);
+    ports[body]->start_correction(forces[body], iteration, 0.0);
   }
   std::vector<CorrectionSolveResult> results;
   for (SubdomainPort* port : ports) results.push_back(port->finish_correction());

@@ -47,9 +47,10 @@ ContactSolveResult InProcessPort::finish_contact_solve() {
   return contact_result_;
 }
 
-void InProcessPort::start_correction(const Eigen::VectorXd& interface_force, int /*iteration*/) {
+void InProcessPort::start_correction(const Eigen::VectorXd& interface_force, int /*iteration*/,
+                                     double relative_accuracy) {
   const auto start = std::chrono::steady_clock::now();
-  correction_result_.normal_trace = body().solve_correction(interface_force);
+  correction_result_.normal_trace = body().solve_correction(interface_force, relative_accuracy);
   correction_result_.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   timings_.compute_seconds += correction_result_.seconds;

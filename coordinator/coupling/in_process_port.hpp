@@ -16,7 +16,8 @@ class InProcessPort final : public SubdomainPort {
   void assign_contact(const ContactOperator& contact) override;
   void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) override;
   ContactSolveResult finish_contact_solve() override;
-  void start_correction(const Eigen::VectorXd& interface_force, int iteration) override;
+  void start_correction(const Eigen::VectorXd& interface_force, int iteration,
+                        double relative_accuracy) override;
   CorrectionSolveResult finish_correction() override;
   void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;
   CorrectionSolveResult finish_neumann_solve() override;

@@ -426,12 +426,18 @@ namespace {
 /// warm start changes). It scales the displacement floor of the residuals (force_displacement) and,
 /// like them, scales with the loads. The responses also choose the contact body of
 /// "dirichlet-neumann" with contact_body "auto" (CouplingProblem::probe_responses).
+/// The accuracy the probe needs: c scales a floor of the residuals and compares bodies, so
+/// three digits are plenty (the hint of CorrectionRequest.relative_accuracy).
+constexpr double probe_relative_accuracy = 1e-3;
+
 std::vector<Eigen::VectorXd> probe_responses(const std::vector<SubdomainPort*>& ports,
                                              const CouplingProblem& problem) {
   std::vector<Eigen::VectorXd> probes;
   for (std::size_t body = 0; body < ports.size(); ++body) {
     probes.push_back(problem.graph.body_part(static_cast<int>(body), problem.probe_forces));
-    if (probes.back().size() > 0) ports[body]->start_correction(probes.back(), 0);
+    if (probes.back().size() > 0) {
+      ports[body]->start_correction(probes.back(), 0, probe_relative_accuracy);
+    }
   }
   std::vector<Eigen::VectorXd> responses(ports.size());
   for (std::size_t body = 0; body < ports.size(); ++body) {

@@ -81,7 +81,11 @@ class SubdomainPort {
   virtual void assign_contact(const ContactOperator& contact) = 0;
   virtual void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) = 0;
   virtual ContactSolveResult finish_contact_solve() = 0;
-  virtual void start_correction(const Eigen::VectorXd& interface_force, int iteration) = 0;
+  /// The correction w_N = F r. `relative_accuracy` 0 asks for the server's full accuracy; a
+  /// value in (0, 1) says that the caller needs w_N only to that relative accuracy (the
+  /// compliance probe), which an iterative inner solver may use to stop earlier.
+  virtual void start_correction(const Eigen::VectorXd& interface_force, int iteration,
+                                double relative_accuracy) = 0;
   virtual CorrectionSolveResult finish_correction() = 0;
   /// The Neumann solve of the Dirichlet-Neumann iteration: K u = f - B' lambda for a given
   /// nodal contact force lambda (pair order; compression positive); returns u_N = B u in

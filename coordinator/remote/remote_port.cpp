@@ -285,10 +285,12 @@ ContactSolveResult RemotePort::finish_contact_solve() {
   }
 }
 
-void RemotePort::start_correction(const Eigen::VectorXd& interface_force, int iteration) {
+void RemotePort::start_correction(const Eigen::VectorXd& interface_force, int iteration,
+                                  double relative_accuracy) {
   Envelope request;
   protocol::CorrectionRequest& correction = *request.mutable_correction();
   correction.set_iteration(static_cast<std::uint32_t>(iteration));
+  correction.set_relative_accuracy(relative_accuracy);
   append(interface_force, *correction.mutable_interface_force());
   send_request(request, "correction (iteration " + std::to_string(iteration) + ")",
                options_.request_timeout_seconds);

@@ -90,7 +90,8 @@ class RemotePort final : public SubdomainPort {
   void assign_contact(const ContactOperator& contact) override;
   void start_contact_solve(const Eigen::VectorXd& obstacle, int iteration) override;
   ContactSolveResult finish_contact_solve() override;
-  void start_correction(const Eigen::VectorXd& interface_force, int iteration) override;
+  void start_correction(const Eigen::VectorXd& interface_force, int iteration,
+                        double relative_accuracy) override;
   CorrectionSolveResult finish_correction() override;
   /// NeumannSolveRequest (protocol 1.1): u_N for the contact force lambda (pair order).
   void start_neumann_solve(const Eigen::VectorXd& contact_force, int iteration) override;

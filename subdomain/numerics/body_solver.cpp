@@ -636,11 +636,16 @@ ContactSolveResult BodySolver::solve_primal_contact(const Eigen::VectorXd& obsta
   return result;
 }
 
-Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_force) const {
+Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_force,
+                                             double relative_accuracy) const {
   if (interface_force.size() != contact_size()) {
     throw InputError("body '" + name() + "': interface force has " +
                      std::to_string(interface_force.size()) + " values for " +
                      std::to_string(contact_size()) + " contact nodes");
+  }
+  if (!(relative_accuracy >= 0.0 && relative_accuracy < 1.0)) {
+    throw InputError("body '" + name() + "': relative accuracy " +
+                     std::to_string(relative_accuracy) + " of a correction outside [0, 1)");
   }
   Eigen::VectorXd trace;
   if (rigid_mode_count() > 0) {
@@ -657,8 +662,9 @@ Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_fo
             ? apply_transpose_trace(primal_state_->contact_force).norm()
             : 0.0;
     if (load_norm == 0.0) return Eigen::VectorXd::Zero(contact_size());
-    const double tolerance =
-        multigrid_->relative_tolerance() * std::max(load_norm, contact_load_norm) / load_norm;
+    const double tolerance = std::max(
+        multigrid_->relative_tolerance() * std::max(load_norm, contact_load_norm) / load_norm,
+        relative_accuracy);
     return trace_ * multigrid_->solve(load, {}, tolerance);
   }
   compliance_->apply(interface_force, trace);  // w_N = B K^{-1} B' r

@@ -257,8 +257,12 @@ class BodySolver {
   static constexpr double maximum_load_factor = 1e6;
 
   /// Paper step 2: w_N = B K^{-1} B' r for an interface force vector r (force); for a floating
-  /// body w_N = B K^dagger B' r (the file comment).
-  Eigen::VectorXd solve_correction(const Eigen::VectorXd& interface_force) const;
+  /// body w_N = B K^dagger B' r (the file comment). `relative_accuracy` in (0, 1) says w_N is
+  /// needed only to that relative accuracy: the multigrid solver's conjugate gradients then
+  /// stop at that relative residual (the direct solver is exact anyway); 0 asks for full
+  /// accuracy. Throws InputError for a force of the wrong size or an accuracy outside [0, 1).
+  Eigen::VectorXd solve_correction(const Eigen::VectorXd& interface_force,
+                                   double relative_accuracy = 0.0) const;
   /// The Neumann solve of the Dirichlet-Neumann iteration: u_N = B K^{-1} (f - B' lambda)
   /// = e - F lambda for a nodal contact force lambda (compression positive). Same cost as a
   /// correction solve (one product with F). Throws SingularBodyError for a floating body.

@@ -657,7 +657,14 @@ void SubdomainServer::on_correction(const protocol::Envelope& request, protocol:
   const Eigen::VectorXd interface_force =
       checked_vector(message.interface_force(), body_->contact_size(),
                      "CorrectionRequest.interface_force", body_->name());
-  const Eigen::VectorXd trace = body_->solve_correction(interface_force);  // w_N = B K^-1 B' r
+  const double relative_accuracy = message.relative_accuracy();
+  if (!(relative_accuracy >= 0.0 && relative_accuracy < 1.0)) {
+    throw RequestError(protocol::INVALID_ARGUMENT,
+                       "CorrectionRequest.relative_accuracy of body '" + body_->name() + "' is " +
+                           std::to_string(relative_accuracy) + ", outside [0, 1)");
+  }
+  // w_N = B K^-1 B' r
+  const Eigen::VectorXd trace = body_->solve_correction(interface_force, relative_accuracy);
   require_finite(trace, "CorrectionResult.normal_trace", body_->name());
   protocol::CorrectionResult& result = *reply.mutable_correction_result();
   result.mutable_normal_trace()->Assign(trace.begin(), trace.end());

@@ -145,6 +145,33 @@ TEST(MultigridBody, TracesAndCorrectionEqualTheDirectSolver) {
   }
 }
 
+/// A correction with the accuracy hint 1e-3 (the compliance probe's): fewer conjugate gradient
+/// iterations than the full one, and still within 1e-2 of the direct solver's (its relative
+/// residual is 1e-3; the error may exceed it by up to cond(K), here little). Hints outside
+/// [0, 1) are refused.
+TEST(MultigridBody, CorrectionWithAnAccuracyHintStopsEarlier) {
+  const BodyDefinition body = solid_box(ElementType::hexahedron8);
+  const auto direct = make_solver(body, LinearSolverKind::direct);
+  const auto multigrid = make_solver(body, LinearSolverKind::multigrid);
+  Eigen::VectorXd force(direct->contact_size());
+  for (Eigen::Index i = 0; i < force.size(); ++i) force[i] = (i % 2 == 0 ? 1.0 : -1.0);
+  const Eigen::VectorXd expected = direct->solve_correction(force);
+  long before = multigrid->inner_iterations();
+  const Eigen::VectorXd full = multigrid->solve_correction(force);
+  const long full_iterations = multigrid->inner_iterations() - before;
+  before = multigrid->inner_iterations();
+  const Eigen::VectorXd hinted = multigrid->solve_correction(force, 1e-3);
+  const long hinted_iterations = multigrid->inner_iterations() - before;
+  EXPECT_LE(relative_difference(full, expected), agreement);
+  const double hinted_error = relative_difference(hinted, expected);
+  EXPECT_LE(hinted_error, 1e-2);
+  EXPECT_LT(hinted_iterations, full_iterations);
+  std::cout << "full: " << full_iterations << " CG iterations; hint 1e-3: " << hinted_iterations
+            << " CG iterations, error " << hinted_error << "\n";
+  EXPECT_THROW(multigrid->solve_correction(force, 1.0), InputError);
+  EXPECT_THROW(multigrid->solve_correction(force, -1e-3), InputError);
+}
+
 TEST(MultigridBody, ContactSolveEqualsTheDirectSolverAndIsSignorini) {
   for (const Case& test : cases()) {
     const auto direct = make_solver(test.body, LinearSolverKind::direct);

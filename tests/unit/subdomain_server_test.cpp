@@ -531,6 +531,29 @@ TEST_F(ReadyServer, CorrectionAndFieldsOfWrongLengthAreInvalid) {
   expect_error(exchange(server, fields), protocol::INVALID_ARGUMENT, "ready");
 }
 
+/// CorrectionRequest.relative_accuracy is a hint in [0, 1): other values are invalid, and this
+/// body's direct solver answers a hinted correction exactly like a full one.
+TEST_F(ReadyServer, CorrectionAccuracyHintOutsideZeroToOneIsInvalid) {
+  for (const double accuracy : {-0.5, 1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    protocol::Envelope correction = request(3);
+    correction.mutable_correction()->mutable_interface_force()->Resize(21, 1.0);
+    correction.mutable_correction()->set_relative_accuracy(accuracy);
+    const protocol::Envelope reply = exchange(server, correction);
+    expect_error(reply, protocol::INVALID_ARGUMENT, "ready");
+    EXPECT_NE(reply.error().message().find("CorrectionRequest.relative_accuracy of body 'lower'"),
+              std::string::npos)
+        << reply.error().message();
+  }
+  protocol::Envelope correction = request(4);
+  correction.mutable_correction()->mutable_interface_force()->Resize(21, 1.0);
+  correction.mutable_correction()->set_relative_accuracy(1e-3);
+  const protocol::Envelope reply = exchange(server, correction);
+  ASSERT_TRUE(reply.has_correction_result()) << reply.DebugString();
+  reference.assign_contact(assign_all(interface));
+  expect_equal_vectors(to_vector(reply.correction_result().normal_trace()),
+                       reference.solve_correction(Eigen::VectorXd::Ones(21)));
+}
+
 TEST_F(ReadyServer, NeumannSolveIsTheNormalTraceOfTheDisplacement) {
   Eigen::VectorXd force(21);  // compressive, varying along the edge (x in [-1, 1])
   for (int i = 0; i < 21; ++i) force[i] = 2.0 + interface.coordinates[i].x();
