@@ -247,12 +247,11 @@ void for_each_block_norm(const RowMajorSparseMatrix& matrix, const NodeBlocks& b
   }
 }
 
-NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
-                            double threshold) {
-  std::vector<double> diagonal_norm(static_cast<std::size_t>(blocks.count()), 0.0);
-  for_each_block_norm(matrix, blocks, [&](int node, int other, double square) {
-    if (node == other) diagonal_norm[node] = std::sqrt(square);
-  });
+/// The node graph of `matrix` with the pairs i != j whose `strength(i, j, ||A_ij||_F^2)` is
+/// positive, that value as their weight.
+template <typename Strength>
+NodeGraph strong_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+                       Strength strength) {
   NodeGraph graph;
   graph.start.push_back(0);
   int current = 0;
@@ -261,11 +260,11 @@ NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks
       graph.start.push_back(static_cast<int>(graph.neighbours.size()));
       ++current;
     }
-    const double norm = std::sqrt(square);
-    if (other != node && norm > 0.0 &&
-        norm >= threshold * std::sqrt(diagonal_norm[node] * diagonal_norm[other])) {
+    if (other == node) return;
+    const double weight = strength(node, other, square);
+    if (weight > 0.0) {
       graph.neighbours.push_back(other);
-      graph.weights.push_back(norm);
+      graph.weights.push_back(weight);
     }
   });
   while (current < blocks.count()) {
@@ -273,6 +272,18 @@ NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks
     ++current;
   }
   return graph;
+}
+
+NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+                            double threshold) {
+  std::vector<double> diagonal_norm(static_cast<std::size_t>(blocks.count()), 0.0);
+  for_each_block_norm(matrix, blocks, [&](int node, int other, double square) {
+    if (node == other) diagonal_norm[node] = std::sqrt(square);
+  });
+  return strong_graph(matrix, blocks, [&](int node, int other, double square) {
+    const double norm = std::sqrt(square);
+    return norm >= threshold * std::sqrt(diagonal_norm[node] * diagonal_norm[other]) ? norm : 0.0;
+  });
 }
 
 /// The position of each node block: `positions` indexed by the node numbers of `nodes` (the
@@ -303,27 +314,14 @@ NodeGraph distance_node_graph(const RowMajorSparseMatrix& matrix, const NodeBloc
   for_each_block_norm(matrix, blocks, [&](int node, int other, double) {
     if (node != other) diagonal[static_cast<std::size_t>(node)] += weight(node, other);
   });
-  NodeGraph graph;
-  graph.start.push_back(0);
-  int current = 0;
-  for_each_block_norm(matrix, blocks, [&](int node, int other, double square) {
-    while (current < node) {
-      graph.start.push_back(static_cast<int>(graph.neighbours.size()));
-      ++current;
-    }
-    if (other == node || square == 0.0) return;
+  return strong_graph(matrix, blocks, [&](int node, int other, double square) {
+    if (square == 0.0) return 0.0;
     const double strength = weight(node, other);
-    if (strength >= threshold * std::sqrt(diagonal[static_cast<std::size_t>(node)] *
-                                          diagonal[static_cast<std::size_t>(other)])) {
-      graph.neighbours.push_back(other);
-      graph.weights.push_back(strength);
-    }
+    return strength >= threshold * std::sqrt(diagonal[static_cast<std::size_t>(node)] *
+                                             diagonal[static_cast<std::size_t>(other)])
+               ? strength
+               : 0.0;
   });
-  while (current < blocks.count()) {
-    graph.start.push_back(static_cast<int>(graph.neighbours.size()));
-    ++current;
-  }
-  return graph;
 }
 
 /// The position of each aggregate: the mean of its nodes' positions.
