@@ -48,13 +48,15 @@
 // which again makes the V-cycle symmetric (and positive definite: Gauss-Seidel converges for
 // SPD A).
 //
-// The V-cycle reads A_l and P in single precision (their values rounded to float, summed in
-// double): it is the exact V-cycle of the rounded matrices, so still symmetric positive
-// definite, and the products that conjugate gradients converge on (K x, in double) are
-// untouched; the V-cycle's memory traffic, which bounds its speed, drops by a third.
-// Matrices are stored row-major (CSR) for the products; the setup keeps, per level, A, P and
-// D^{-1} (P' x is computed by scattering the rows of P), and P' A P is summed over blocks of rows
-// so that A P is never formed whole. The apply allocates only the coarsest level's solution (the
+// Storage. The finest matrix is kept as its lower triangle in double (the products of conjugate
+// gradients, y = A x with each stored entry read once for both triangles). After the setup each
+// level keeps the lower triangle of A_l and P as compressed rows in single precision, and
+// D^{-1}: the V-cycle sums in double, and it is the exact V-cycle of the rounded matrices, so
+// still symmetric positive definite, while the products that conjugate gradients converge on
+// stay in double. (Its speed is bound by memory traffic, which single precision and one
+// triangle reduce.) P' x is computed by scattering the rows of P. During the setup A_l is held
+// with both triangles in double, and P' A P is summed over blocks of rows so that A P is never
+// formed whole. The apply allocates only the coarsest level's solution (the
 // CholeskyFactor's solve); its other workspace is kept per level, so one AlgebraicMultigrid must
 // not be applied from two threads at once.
 
