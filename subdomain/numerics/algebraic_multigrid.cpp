@@ -73,9 +73,10 @@ void multiply_transpose(const SinglePrecisionRows& matrix, const Eigen::VectorXd
   }
 }
 
-/// y = A x for the symmetric A whose lower triangle (diagonal included) is in the compressed
-/// rows (starts, columns, values): each stored a_ij, j < i, is read once for y_i += a_ij x_j
-/// and y_j += a_ij x_i. Summed in double.
+/// y = A x for the symmetric A whose lower or upper triangle (diagonal included) is in the
+/// compressed rows (starts, columns, values): each stored a_ij, j != i, is read once for
+/// y_i += a_ij x_j and y_j += a_ij x_i. Summed in double. (A column-major lower triangle is
+/// the compressed rows of the upper one.)
 template <typename Value>
 void multiply_symmetric(const int* starts, const int* columns, const Value* values, int rows,
                         const Eigen::VectorXd& x, Eigen::VectorXd& y) {
