@@ -673,7 +673,7 @@ void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
       level->prolongator =
           smooth_prolongator(matrix, keep, level->inverse_diagonal, omega, tentative.prolongator);
     } else {
-      level->prolongator = std::move(tentative.prolongator);
+      level->prolongator.swap(tentative.prolongator);  // Eigen 3.4: no move assignment
     }
     level->prolongator.makeCompressed();
     auto coarse = std::make_unique<Level>();
