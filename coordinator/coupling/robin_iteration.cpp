@@ -417,6 +417,10 @@ RobinResult run_robin_iteration(SubdomainPort& body1, SubdomainPort& body2,
 
 namespace {
 
+/// The accuracy the probe needs: c scales a floor of the residuals and compares bodies, so
+/// three digits are plenty (the hint of CorrectionRequest.relative_accuracy).
+constexpr double probe_relative_accuracy = 1e-3;
+
 /// The local interface compliance c = max over bodies of |F^a r^a| / |r^a| (max norms), r^a the
 /// short-wavelength probe on body a's rows (boundary weights of alternating sign,
 /// coupling_scheme.hpp): the interface displacement per unit nodal force of a load that does
@@ -426,10 +430,6 @@ namespace {
 /// warm start changes). It scales the displacement floor of the residuals (force_displacement) and,
 /// like them, scales with the loads. The responses also choose the contact body of
 /// "dirichlet-neumann" with contact_body "auto" (CouplingProblem::probe_responses).
-/// The accuracy the probe needs: c scales a floor of the residuals and compares bodies, so
-/// three digits are plenty (the hint of CorrectionRequest.relative_accuracy).
-constexpr double probe_relative_accuracy = 1e-3;
-
 std::vector<Eigen::VectorXd> probe_responses(const std::vector<SubdomainPort*>& ports,
                                              const CouplingProblem& problem) {
   std::vector<Eigen::VectorXd> probes;
