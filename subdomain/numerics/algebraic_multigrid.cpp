@@ -715,7 +715,6 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
   if (options_.smoother == MultigridSmoother::chebyshev) {
     smooth(level, right_hand_side, solution, true);
   } else {
-    solution.setZero();
     smooth_gauss_seidel(level, right_hand_side, solution, true);
   }
   subtract_symmetric_product(level.lower, right_hand_side, solution, level.product, level.residual);
@@ -730,11 +729,11 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
   }
 }
 
-/// One Gauss-Seidel sweep over the rows, ascending (forward) or descending:
-/// x_i += (b_i - sum_j A_ij x_j) / A_ii, with the x_j already updated in this sweep. From the
-/// lower triangle: the row i holds A_ij for j <= i; the terms of the other triangle are summed in
-/// `level.update` by scattering the rows, of the values before the sweep (forward; none from
-/// a zero guess) or of those the sweep has updated (backward).
+/// One Gauss-Seidel sweep over the rows, ascending (forward, the pre-smoother: from x = 0) or
+/// descending (the post-smoother, from the given x): x_i += (b_i - sum_j A_ij x_j) / A_ii, with
+/// the x_j already updated in this sweep. From the lower triangle: the row i holds A_ij for
+/// j <= i; the forward sweep needs no other terms (x_j = 0 for j > i), the backward one sums the
+/// terms of the updated x_j, j > i, in `level.update` by scattering each row once it is updated.
 void AlgebraicMultigrid::smooth_gauss_seidel(const Level& level,
                                              const Eigen::VectorXd& right_hand_side,
                                              Eigen::VectorXd& solution, bool forward) const {
@@ -742,16 +741,10 @@ void AlgebraicMultigrid::smooth_gauss_seidel(const Level& level,
   const int* columns = level.lower.innerIndexPtr();
   const float* values = level.lower.valuePtr();
   const int rows = static_cast<int>(level.lower.rows());
+  if (forward) solution.setZero();
   double* x = solution.data();
   double* other_triangle = level.update.data();
   level.update.setZero();
-  if (forward) {
-    for (int row = 0; row < rows; ++row) {  // the upper triangle's terms, x before the sweep
-      for (int k = starts[row]; k < starts[row + 1]; ++k) {
-        if (columns[k] != row) other_triangle[columns[k]] += values[k] * x[row];
-      }
-    }
-  }
   for (int step = 0; step < rows; ++step) {
     const int row = forward ? step : rows - 1 - step;
     double sum = right_hand_side[row] - other_triangle[row];
