@@ -73,52 +73,12 @@ void multiply_transpose(const SinglePrecisionRows& matrix, const Eigen::VectorXd
   }
 }
 
-/// y = A x for the symmetric A whose lower or upper triangle (diagonal included) is in the
-/// compressed rows (starts, columns, values): each stored a_ij, j != i, is read once for
-/// y_i += a_ij x_j and y_j += a_ij x_i. Summed in double. (A column-major lower triangle is
-/// the compressed rows of the upper one.)
-template <typename Value>
-void multiply_symmetric(const int* starts, const int* columns, const Value* values, int rows,
-                        const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  const double* input = x.data();
-  double* output = y.data();
-  y.setZero();
-  for (int row = 0; row < rows; ++row) {
-    const double x_row = input[row];
-    double sum = 0.0;
-    for (int k = starts[row]; k < starts[row + 1]; ++k) {
-      const int column = columns[k];
-      const double value = values[k];
-      sum += value * input[column];
-      if (column != row) output[column] += value * x_row;
-    }
-    output[row] += sum;
-  }
-}
-
-void multiply_symmetric(const SinglePrecisionRows& lower, const Eigen::VectorXd& x,
-                        Eigen::VectorXd& y) {
-  multiply_symmetric(lower.outerIndexPtr(), lower.innerIndexPtr(), lower.valuePtr(),
-                     static_cast<int>(lower.rows()), x, y);
-}
-
-/// r = b - A x, A symmetric from its lower triangle (multiply_symmetric); `product` is
-/// workspace.
-void subtract_symmetric_product(const SinglePrecisionRows& lower,
+/// r = b - A x; `product` is workspace.
+void subtract_symmetric_product(const BlockSymmetricMatrix<float>& matrix,
                                 const Eigen::VectorXd& right_hand_side, const Eigen::VectorXd& x,
                                 Eigen::VectorXd& product, Eigen::VectorXd& residual) {
-  multiply_symmetric(lower, x, product);
+  matrix.multiply(x, product);
   residual = right_hand_side - product;
-}
-
-/// Whether every stored entry of the column-major `matrix` is on or below the diagonal.
-bool is_lower_triangular(const SparseMatrix& matrix) {
-  for (Eigen::Index column = 0; column < matrix.outerSize(); ++column) {
-    for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
-      if (entry.row() < column) return false;
-    }
-  }
-  return true;
 }
 
 /// 1 / A_ii; throws std::invalid_argument for a diagonal entry that is not positive.
@@ -534,35 +494,31 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower)
-    : SparseMatrixOperator(SparseMatrix(lower)) {}
+SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower,
+                                           const std::vector<int>& unknown_blocks)
+    : SparseMatrixOperator(
+          lower.rows() == lower.cols()
+              ? RowMajorSparseMatrix(lower.selfadjointView<Eigen::Lower>())
+              : throw std::invalid_argument("SparseMatrixOperator: the matrix is not square"),
+          unknown_blocks) {}
 
-SparseMatrixOperator::SparseMatrixOperator(SparseMatrix&& lower) {
-  if (lower.rows() != lower.cols()) {
-    throw std::invalid_argument("SparseMatrixOperator: the matrix is not square");
-  }
-  if (is_lower_triangular(lower)) {
-    lower_.swap(lower);
-  } else {
-    lower_ = lower.triangularView<Eigen::Lower>();
-  }
-  lower_.makeCompressed();
-}
+SparseMatrixOperator::SparseMatrixOperator(const RowMajorSparseMatrix& matrix,
+                                           const std::vector<int>& unknown_blocks)
+    : matrix_(matrix, unknown_blocks) {}
 
 void SparseMatrixOperator::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-  y.resize(lower_.rows());
-  // the columns of the lower triangle are the rows of the upper one: the same symmetric product
-  multiply_symmetric(lower_.outerIndexPtr(), lower_.innerIndexPtr(), lower_.valuePtr(),
-                     static_cast<int>(lower_.cols()), x, y);
+  matrix_.multiply(x, y);
 }
 
 struct AlgebraicMultigrid::Level {
   RowMajorSparseMatrix matrix;  // A_l, both triangles (during the setup only)
   Eigen::VectorXd inverse_diagonal;
   RowMajorSparseMatrix prolongator;  // P (during the setup only; empty on the coarsest level)
-  // what the V-cycle reads: the lower triangle of A_l and P, in single precision
-  SinglePrecisionRows lower;
+  // what the V-cycle reads, in single precision: A_l by blocks, P, and for the Gauss-Seidel
+  // smoother the scalar lower triangle of A_l
+  BlockSymmetricMatrix<float> blocks;
   SinglePrecisionRows prolongation;
+  SinglePrecisionRows lower;
   int unknowns = 0;
   long nonzeros = 0;  // of A_l, both triangles
   int nodes = 0;
@@ -590,6 +546,9 @@ AlgebraicMultigrid::AlgebraicMultigrid(SparseMatrix&& lower, const Eigen::Matrix
                                        const AlgebraicMultigridOptions& options)
     : options_(options) {
   const auto start = std::chrono::steady_clock::now();
+  if (lower.rows() != lower.cols()) {
+    throw std::invalid_argument("AlgebraicMultigrid: the matrix is not square");
+  }
   if (near_null_space.rows() != lower.rows() || near_null_space.cols() < 1 ||
       static_cast<Eigen::Index>(dof_nodes.size()) != lower.rows()) {
     throw std::invalid_argument(
@@ -598,43 +557,46 @@ AlgebraicMultigrid::AlgebraicMultigrid(SparseMatrix&& lower, const Eigen::Matrix
   if (options_.smoother_degree < 1) {
     throw std::invalid_argument("AlgebraicMultigrid: smoother_degree below 1");
   }
-  fine_operator_ = std::make_unique<SparseMatrixOperator>(std::move(lower));
   for (int node : dof_nodes) {
     if (!node_positions.empty() && node >= static_cast<int>(node_positions.size())) {
       throw std::invalid_argument("AlgebraicMultigrid: a dof's node has no position");
     }
   }
-  build_hierarchy(near_null_space, dof_nodes, node_positions);
+  RowMajorSparseMatrix matrix = lower.selfadjointView<Eigen::Lower>();
+  SparseMatrix().swap(lower);  // freed: the blocks and the levels hold A from here
+  build_hierarchy(std::move(matrix), near_null_space, dof_nodes, node_positions);
   setup_seconds_ = seconds_since(start);
 }
 
 AlgebraicMultigrid::~AlgebraicMultigrid() = default;
 
-/// Keeps of a set-up level what the V-cycle reads (the lower triangle of A_l and P in single
-/// precision, the sizes) and frees its double-precision matrices. `lower` is A_l's lower
-/// triangle when at hand (the finest level's), else it is taken from the level's matrix.
-void AlgebraicMultigrid::finish_level(Level& level, const SparseMatrix* lower) {
+/// Keeps of a set-up level what the V-cycle reads (A_l by the blocks `unknown_blocks` and P in
+/// single precision, A_l's scalar lower triangle for the Gauss-Seidel smoother, the sizes) and
+/// frees its double-precision matrices.
+void AlgebraicMultigrid::finish_level(Level& level, const std::vector<int>& unknown_blocks) const {
   level.unknowns = static_cast<int>(level.matrix.rows());
   level.nonzeros = static_cast<long>(level.matrix.nonZeros());
-  if (lower) {
-    level.lower = lower->cast<float>();
-  } else {
+  level.blocks = BlockSymmetricMatrix<float>(level.matrix, unknown_blocks);
+  if (options_.smoother == MultigridSmoother::symmetric_gauss_seidel) {
     level.lower = level.matrix.triangularView<Eigen::Lower>().cast<float>();
+    level.lower.makeCompressed();
   }
-  level.lower.makeCompressed();
   RowMajorSparseMatrix().swap(level.matrix);  // swapped out: assignment would keep the storage
   level.prolongation = level.prolongator.cast<float>();
   level.prolongation.makeCompressed();
   RowMajorSparseMatrix().swap(level.prolongator);
 }
 
-void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
+void AlgebraicMultigrid::build_hierarchy(RowMajorSparseMatrix&& fine_matrix,
+                                         const Eigen::MatrixXd& near_null_space,
                                          const std::vector<int>& dof_nodes,
                                          std::vector<Eigen::Vector3d> positions) {
   Eigen::MatrixXd modes = near_null_space;
   std::vector<int> nodes = dof_nodes;
   auto level = std::make_unique<Level>();
-  level->matrix = fine_operator_->lower().selfadjointView<Eigen::Lower>();
+  level->matrix.swap(fine_matrix);
+  fine_operator_ =
+      std::make_unique<SparseMatrixOperator>(level->matrix, make_node_blocks(nodes).node_of);
   while (true) {
     const RowMajorSparseMatrix& matrix = level->matrix;
     const int unknowns = static_cast<int>(matrix.rows());
@@ -682,12 +644,12 @@ void AlgebraicMultigrid::build_hierarchy(const Eigen::MatrixXd& near_null_space,
     level->coarse_solution.resize(coarse->matrix.rows());
     modes = std::move(tentative.coarse_near_null_space);
     nodes = std::move(tentative.coarse_nodes);
-    finish_level(*level, levels_.empty() ? &fine_operator_->lower() : nullptr);
+    finish_level(*level, blocks.node_of);
     levels_.push_back(std::move(level));
     level = std::move(coarse);
   }
   const SparseMatrix coarsest = SparseMatrix(level->matrix).triangularView<Eigen::Lower>();
-  finish_level(*level, levels_.empty() ? &fine_operator_->lower() : nullptr);
+  finish_level(*level, make_node_blocks(nodes).node_of);
   levels_.push_back(std::move(level));
   coarse_solver_ = std::make_unique<CoarseSolver>();
   coarse_solver_->factor = std::make_unique<CholeskyFactor>(coarsest, "coarsest multigrid level");
@@ -717,7 +679,8 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
   } else {
     smooth_gauss_seidel(level, right_hand_side, solution, true);
   }
-  subtract_symmetric_product(level.lower, right_hand_side, solution, level.product, level.residual);
+  subtract_symmetric_product(level.blocks, right_hand_side, solution, level.product,
+                             level.residual);
   multiply_transpose(level.prolongation, level.residual, level.coarse_right_hand_side);
   cycle(index + 1, level.coarse_right_hand_side, level.coarse_solution);
   multiply(level.prolongation, level.coarse_solution, level.product);
@@ -773,7 +736,7 @@ void AlgebraicMultigrid::smooth(const Level& level, const Eigen::VectorXd& right
   if (zero_guess) {
     residual = right_hand_side;
   } else {
-    subtract_symmetric_product(level.lower, right_hand_side, solution, level.product, residual);
+    subtract_symmetric_product(level.blocks, right_hand_side, solution, level.product, residual);
   }
   update = level.inverse_diagonal.cwiseProduct(residual) / theta;
   if (zero_guess) {
@@ -783,7 +746,7 @@ void AlgebraicMultigrid::smooth(const Level& level, const Eigen::VectorXd& right
   }
   double rho = 1.0 / sigma;
   for (int step = 1; step < options_.smoother_degree; ++step) {
-    multiply_symmetric(level.lower, update, level.product);
+    level.blocks.multiply(update, level.product);
     residual -= level.product;
     const double next_rho = 1.0 / (2.0 * sigma - rho);
     update = (next_rho * rho) * update +

@@ -48,13 +48,16 @@
 // which again makes the V-cycle symmetric (and positive definite: Gauss-Seidel converges for
 // SPD A).
 //
-// Storage. The finest matrix is kept as its lower triangle in double (the products of conjugate
-// gradients, y = A x with each stored entry read once for both triangles). After the setup each
-// level keeps the lower triangle of A_l and P as compressed rows in single precision, and
-// D^{-1}: the V-cycle sums in double, and it is the exact V-cycle of the rounded matrices, so
-// still symmetric positive definite, while the products that conjugate gradients converge on
-// stay in double. (Its speed is bound by memory traffic, which single precision and one
-// triangle reduce.) P' x is computed by scattering the rows of P. During the setup A_l is held
+// Storage. The finest matrix is kept in double by blocks of the unknowns of a node (the lower
+// block triangle, block_symmetric_matrix.hpp: the products of conjugate gradients, y = A x with
+// each stored entry read once for both triangles). After the setup each level keeps A_l the same
+// way in single precision (blocks of a node's, then an aggregate's unknowns), P as compressed
+// rows in single precision, and D^{-1}: the V-cycle sums in double, and it is the exact V-cycle
+// of the rounded matrices, so still symmetric positive definite, while the products that
+// conjugate gradients converge on stay in double. (Its speed is bound by memory traffic, which
+// single precision, one triangle and one column index per block reduce.) With the Gauss-Seidel
+// smoother a level also keeps its scalar lower triangle in single precision (the sweeps run over
+// its rows). P' x is computed by scattering the rows of P. During the setup A_l is held
 // with both triangles in double, and P' A P is summed over blocks of rows so that A P is never
 // formed whole. The apply allocates only the coarsest level's solution (the
 // CholeskyFactor's solve); its other workspace is kept per level, so one AlgebraicMultigrid must
@@ -65,6 +68,7 @@
 #include <memory>
 #include <vector>
 
+#include "numerics/block_symmetric_matrix.hpp"
 #include "numerics/conjugate_gradient.hpp"
 #include "numerics/dof_map.hpp"
 #include "numerics/elasticity.hpp"
@@ -73,24 +77,25 @@
 
 namespace robin {
 
-using RowMajorSparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
-
-/// y = A x for a symmetric sparse matrix stored as its lower triangle: each stored entry is read
-/// once for both triangles.
+/// y = A x for a symmetric sparse matrix stored by blocks of unknowns (block_symmetric_matrix.hpp,
+/// double precision): each stored entry is read once for both triangles.
 class SparseMatrixOperator final : public LinearOperator {
  public:
-  /// A from the lower triangle of `lower` (its upper triangle is dropped; a matrix stored with
-  /// both triangles is fine). The rvalue overload takes over the storage of a lower triangle
-  /// (Eigen's sparse matrices have no move constructor: a by-value parameter would copy).
-  explicit SparseMatrixOperator(const SparseMatrix& lower);
-  explicit SparseMatrixOperator(SparseMatrix&& lower);
-  int size() const override { return static_cast<int>(lower_.rows()); }
+  /// A from the lower triangle of `lower` (its upper triangle is ignored; a matrix stored with
+  /// both triangles is fine), in blocks of the given `unknown_blocks` (BlockSymmetricMatrix;
+  /// empty: one block per unknown).
+  explicit SparseMatrixOperator(const SparseMatrix& lower,
+                                const std::vector<int>& unknown_blocks = {});
+  /// A from the symmetric `matrix` (both triangles stored).
+  SparseMatrixOperator(const RowMajorSparseMatrix& matrix, const std::vector<int>& unknown_blocks);
+  int size() const override { return matrix_.size(); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
-  /// The lower triangle, diagonal included (column-major).
-  const SparseMatrix& lower() const { return lower_; }
+  /// The lower triangle, diagonal included (column-major), rebuilt from the blocks.
+  SparseMatrix lower() const { return matrix_.lower_triangle(); }
+  int block_size() const { return matrix_.block_size(); }
 
  private:
-  SparseMatrix lower_;
+  BlockSymmetricMatrix<double> matrix_;
 };
 
 /// The smoother of the V-cycle (the file comment).
@@ -161,7 +166,7 @@ class AlgebraicMultigrid final : public Preconditioner {
   /// must be distinct vectors.
   void apply(const Eigen::VectorXd& residual, Eigen::VectorXd& correction) const override;
 
-  /// The finest matrix (its lower triangle), for PCG's products.
+  /// The finest matrix (by node blocks, double), for PCG's products.
   const SparseMatrixOperator& fine_operator() const { return *fine_operator_; }
   std::vector<MultigridLevelSummary> levels() const;
   /// sum over levels of nonzeros(A_l) / nonzeros(A_0).
@@ -170,9 +175,9 @@ class AlgebraicMultigrid final : public Preconditioner {
 
  private:
   struct Level;
-  void build_hierarchy(const Eigen::MatrixXd& near_null_space, const std::vector<int>& dof_nodes,
-                       std::vector<Eigen::Vector3d> positions);
-  static void finish_level(Level& level, const SparseMatrix* lower);
+  void build_hierarchy(RowMajorSparseMatrix&& matrix, const Eigen::MatrixXd& near_null_space,
+                       const std::vector<int>& dof_nodes, std::vector<Eigen::Vector3d> positions);
+  void finish_level(Level& level, const std::vector<int>& unknown_blocks) const;
   void cycle(std::size_t level, const Eigen::VectorXd& right_hand_side,
              Eigen::VectorXd& solution) const;
   void smooth_gauss_seidel(const Level& level, const Eigen::VectorXd& right_hand_side,

@@ -228,7 +228,7 @@ const LinearOperator& MultigridStiffnessSolver::stiffness() const {
   return multigrid_->fine_operator();
 }
 
-const SparseMatrix& MultigridStiffnessSolver::stiffness_matrix() const {
+SparseMatrix MultigridStiffnessSolver::stiffness_matrix() const {
   return multigrid_->fine_operator().lower();
 }
 

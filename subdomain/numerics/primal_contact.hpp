@@ -66,8 +66,8 @@ class MultigridStiffnessSolver {
 
   int size() const;
   const LinearOperator& stiffness() const;
-  /// The lower triangle of K, as the AMG holds it.
-  const SparseMatrix& stiffness_matrix() const;
+  /// The lower triangle of K, rebuilt from the AMG's blocks.
+  SparseMatrix stiffness_matrix() const;
   const Preconditioner& preconditioner() const;
   double relative_tolerance() const { return relative_tolerance_; }
   const std::string& body_name() const { return body_name_; }
