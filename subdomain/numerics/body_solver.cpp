@@ -585,6 +585,8 @@ bool BodySolver::dense_interface_operator(long contact_count) const {
 void BodySolver::reset_warm_start() {
   warm_start_ = Eigen::VectorXd::Zero(contact_size());
   primal_state_ = std::make_unique<PrimalContactState>();
+  kept_correction_.resize(0);
+  kept_correction_force_.resize(0);
   warm_multiplier_ = Eigen::VectorXd::Zero(rigid_mode_count());
   rigid_amplitudes_ = Eigen::VectorXd::Zero(rigid_mode_count());
 }
@@ -665,7 +667,9 @@ Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_fo
     const double tolerance = std::max(
         multigrid_->relative_tolerance() * std::max(load_norm, contact_load_norm) / load_norm,
         relative_accuracy);
-    return trace_ * multigrid_->solve(load, {}, tolerance);
+    kept_correction_ = multigrid_->solve(load, {}, tolerance);
+    kept_correction_force_ = interface_force;
+    return trace_ * kept_correction_;
   }
   compliance_->apply(interface_force, trace);  // w_N = B K^{-1} B' r
   return trace;
@@ -699,10 +703,10 @@ Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force,
     free_values = primal_state_->displacement;  // the last primal contact solve's u
   } else if (multigrid_ && primal_state_ && contact_force.size() == contact_size() &&
              primal_state_->displacement.size() == free_dof_count()) {
-    // K u = t f - B' lambda from the last contact solve's u, near it when lambda is near its
+    // K u = t f - B' lambda from the last contact solve's u and correction
     free_values =
         multigrid_->solve(load_factor_ * reduced_load_ - apply_transpose_trace(contact_force),
-                          primal_state_->displacement);
+                          displacement_guess(contact_force));
   } else if (contact_force.size() > 0 && contact_force.lpNorm<Eigen::Infinity>() > 0) {
     free_values -= solve_stiffness(apply_transpose_trace(contact_force));
   }
@@ -717,6 +721,21 @@ Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force,
   Eigen::VectorXd full = dofs_->expand(free_values);  // prescribed values at factor 1
   if (load_factor_ != 1.0) full += (load_factor_ - 1.0) * dofs_->prescribed_values();
   return full;
+}
+
+Eigen::VectorXd BodySolver::displacement_guess(const Eigen::VectorXd& contact_force) const {
+  const Eigen::VectorXd& contact_displacement = primal_state_->displacement;
+  const Eigen::VectorXd& contact_solution_force = primal_state_->contact_force;  // lambda_u
+  if (kept_correction_.size() != free_dof_count() ||
+      contact_solution_force.size() != contact_force.size()) {
+    return contact_displacement;
+  }
+  // s = W' K (x - u) / W' K W with K x = t f - B' lambda, K u = t f - B' lambda_u, K W = B' r
+  const Eigen::VectorXd correction_trace = trace_ * kept_correction_;  // B W
+  const double energy = correction_trace.dot(kept_correction_force_);  // W' K W
+  if (!(energy > 0.0)) return contact_displacement;
+  const double step = correction_trace.dot(contact_solution_force - contact_force) / energy;
+  return contact_displacement + step * kept_correction_;
 }
 
 Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& displacement) const {

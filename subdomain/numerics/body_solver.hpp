@@ -270,7 +270,12 @@ class BodySolver {
 
   /// Full displacement (mesh.dimension per node, prescribed values included) under contact forces
   /// lambda: u_f = K^+ (t f - B' lambda) + R alpha, alpha the rigid amplitudes of the last contact
-  /// solve (none without rigid motions).
+  /// solve (none without rigid motions). With the multigrid solver, for a lambda other than the
+  /// last contact solve's lambda_u, conjugate gradients start from u + s W, u that solve's
+  /// displacement and W = K^{-1} B' r the last correction's (K u = t f - B' lambda_u, K W = B' r),
+  /// s = (B W)'(lambda_u - lambda) / (B W)' r the step that minimises the energy norm of the
+  /// start's error: for the other obstacle sequence's force lambda = lambda_u + r (the fields of
+  /// a completed sequence, docs/method.md) the start is already the solution.
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force) const;
   /// The same with given rigid amplitudes alpha (k values), e.g. the monolithic reference's.
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force,
@@ -297,6 +302,8 @@ class BodySolver {
   void fall_back_to_direct_solver();
   /// The local contact problem in its primal form (linear_solver multigrid).
   ContactSolveResult solve_primal_contact(const Eigen::VectorXd& obstacle);
+  /// u + s W of displacement()'s comment (u alone without a kept correction).
+  Eigen::VectorXd displacement_guess(const Eigen::VectorXd& contact_force) const;
   /// Assembles K, keeps its prescribed part (DofMap::prescribed_part: the reduced load and the
   /// reactions read nothing else) and returns the lower triangle of K_ff, freeing K.
   SparseMatrix assemble_reduced_stiffness();
@@ -331,8 +338,10 @@ class BodySolver {
   std::unique_ptr<GeneralizedInverse> factor_;  // K^{-1}, or K^+ for a floating body (direct)
   std::unique_ptr<MultigridStiffnessSolver> multigrid_;  // K^{-1} by AMG-PCG (multigrid)
   std::unique_ptr<PrimalContactState> primal_state_;     // the last primal contact solve
-  Eigen::MatrixXd no_rigid_modes_;                       // R = free x 0 (multigrid)
-  Eigen::VectorXd free_solution_;                        // K^{-1} f (free dofs) at load factor 1
+  // the last correction (multigrid): r and W = K^{-1} B' r, the start of displacement()'s solves
+  mutable Eigen::VectorXd kept_correction_force_, kept_correction_;
+  Eigen::MatrixXd no_rigid_modes_;  // R = free x 0 (multigrid)
+  Eigen::VectorXd free_solution_;   // K^{-1} f (free dofs) at load factor 1
 
   ContactOperator contact_;
   Eigen::VectorXd boundary_weights_;

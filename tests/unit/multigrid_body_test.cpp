@@ -15,11 +15,11 @@
 // Also checked: the Signorini conditions of the multigrid result itself (lambda >= 0, no
 // penetration beyond 1e-9 of the displacement scale, complementarity), the same active set,
 // the displacement field (of the last solve's force, kept, and of another force, solved from the
-// kept one), a second solve warm-started after a change of obstacle and load
-// factor, the refusal of a floating body, and the fall-back to the factor when the contact rows
-// are linearly dependent (as on the mortar side of a finer non-mortar side). And
-// solve_primal_contact's inexact active-set steps (the default, none, very loose ones limited
-// to two) against the Signorini conditions of the KKT system solved by CHOLMOD.
+// kept one, and from the kept one and the last correction), a second solve warm-started after a
+// change of obstacle and load factor, the refusal of a floating body, and the fall-back to the
+// factor when the contact rows are linearly dependent (as on the mortar side of a finer non-mortar
+// side). And solve_primal_contact's inexact active-set steps (the default, none, very loose ones
+// limited to two) against the Signorini conditions of the KKT system solved by CHOLMOD.
 
 #include <gtest/gtest.h>
 
@@ -209,6 +209,41 @@ TEST(MultigridBody, ContactSolveEqualsTheDirectSolverAndIsSignorini) {
               << " closed; force " << force_error << ", trace " << trace_error << ", displacement "
               << displacement_error << " relative; " << result.iterations << " active set steps, "
               << result.operator_applications << " CG iterations\n";
+  }
+}
+
+/// The fields of the other obstacle sequence: after a contact solve (lambda_u) and a correction
+/// with r = lambda - lambda_u, displacement(lambda) starts from u - W (K W = B' r), which is
+/// already its solution: it equals the direct solver's and takes far fewer conjugate gradient
+/// iterations than the same solve from u alone (a second body without the correction).
+TEST(MultigridBody, OtherSequenceFieldsStartFromTheLastCorrection) {
+  for (const Case& test : cases()) {
+    const auto direct = make_solver(test.body, LinearSolverKind::direct);
+    const auto corrected = make_solver(test.body, LinearSolverKind::multigrid);
+    const auto uncorrected = make_solver(test.body, LinearSolverKind::multigrid);
+    const Eigen::VectorXd obstacle = partial_obstacle(*direct);
+    const ContactSolveResult solution = corrected->solve_contact(obstacle);
+    ASSERT_EQ(solution.status, QpStatus::converged) << test.label << ": " << solution.message;
+    ASSERT_EQ(uncorrected->solve_contact(obstacle).status, QpStatus::converged) << test.label;
+    Eigen::VectorXd other = 0.8 * solution.contact_force;
+    for (Eigen::Index i = 0; i < other.size(); ++i) {
+      other[i] += 0.1 * solution.contact_force.maxCoeff() * (1.0 + std::cos(0.7 * i));
+    }
+    corrected->solve_correction(other - solution.contact_force);
+    long before = corrected->inner_iterations();
+    const double error =
+        relative_difference(corrected->displacement(other), direct->displacement(other));
+    const long corrected_iterations = corrected->inner_iterations() - before;
+    before = uncorrected->inner_iterations();
+    const double uncorrected_error =
+        relative_difference(uncorrected->displacement(other), direct->displacement(other));
+    const long uncorrected_iterations = uncorrected->inner_iterations() - before;
+    EXPECT_LE(error, agreement) << test.label;
+    EXPECT_LE(uncorrected_error, agreement) << test.label;
+    EXPECT_LE(4 * corrected_iterations, uncorrected_iterations) << test.label;
+    std::cout << test.label << ": from u - W " << corrected_iterations << " CG iterations (error "
+              << error << "), from u " << uncorrected_iterations << " (error " << uncorrected_error
+              << ")\n";
   }
 }
 
