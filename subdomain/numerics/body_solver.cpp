@@ -585,8 +585,7 @@ bool BodySolver::dense_interface_operator(long contact_count) const {
 void BodySolver::reset_warm_start() {
   warm_start_ = Eigen::VectorXd::Zero(contact_size());
   primal_state_ = std::make_unique<PrimalContactState>();
-  kept_correction_.resize(0);
-  kept_correction_force_.resize(0);
+  correction_history_.clear();
   warm_multiplier_ = Eigen::VectorXd::Zero(rigid_mode_count());
   rigid_amplitudes_ = Eigen::VectorXd::Zero(rigid_mode_count());
 }
@@ -667,9 +666,11 @@ Eigen::VectorXd BodySolver::solve_correction(const Eigen::VectorXd& interface_fo
     const double tolerance = std::max(
         multigrid_->relative_tolerance() * std::max(load_norm, contact_load_norm) / load_norm,
         relative_accuracy);
-    kept_correction_ = multigrid_->solve(load, {}, tolerance);
-    kept_correction_force_ = interface_force;
-    return trace_ * kept_correction_;
+    const Eigen::VectorXd solution = multigrid_->solve(
+        load, correction_history_.start(interface_force, free_dof_count()), tolerance);
+    Eigen::VectorXd correction = trace_ * solution;
+    if (relative_accuracy == 0.0) correction_history_.add(interface_force, solution, correction);
+    return correction;
   }
   compliance_->apply(interface_force, trace);  // w_N = B K^{-1} B' r
   return trace;
@@ -726,16 +727,10 @@ Eigen::VectorXd BodySolver::displacement(const Eigen::VectorXd& contact_force,
 Eigen::VectorXd BodySolver::displacement_guess(const Eigen::VectorXd& contact_force) const {
   const Eigen::VectorXd& contact_displacement = primal_state_->displacement;
   const Eigen::VectorXd& contact_solution_force = primal_state_->contact_force;  // lambda_u
-  if (kept_correction_.size() != free_dof_count() ||
-      contact_solution_force.size() != contact_force.size()) {
-    return contact_displacement;
-  }
-  // s = W' K (x - u) / W' K W with K x = t f - B' lambda, K u = t f - B' lambda_u, K W = B' r
-  const Eigen::VectorXd correction_trace = trace_ * kept_correction_;  // B W
-  const double energy = correction_trace.dot(kept_correction_force_);  // W' K W
-  if (!(energy > 0.0)) return contact_displacement;
-  const double step = correction_trace.dot(contact_solution_force - contact_force) / energy;
-  return contact_displacement + step * kept_correction_;
+  if (contact_solution_force.size() != contact_force.size()) return contact_displacement;
+  // K^{-1} (t f - B' lambda) = u + K^{-1} B' (lambda_u - lambda)
+  return contact_displacement +
+         correction_history_.start(contact_solution_force - contact_force, free_dof_count());
 }
 
 Eigen::VectorXd BodySolver::reactions(const Eigen::VectorXd& displacement) const {

@@ -70,6 +70,7 @@
 #include "numerics/linear_operator.hpp"
 #include "numerics/mprgp.hpp"
 #include "numerics/setup_progress.hpp"
+#include "numerics/solution_history.hpp"
 
 namespace robin {
 
@@ -257,7 +258,9 @@ class BodySolver {
   static constexpr double maximum_load_factor = 1e6;
 
   /// Paper step 2: w_N = B K^{-1} B' r for an interface force vector r (force); for a floating
-  /// body w_N = B K^dagger B' r (the file comment). `relative_accuracy` in (0, 1) says w_N is
+  /// body w_N = B K^dagger B' r (the file comment). With the multigrid solver conjugate gradients
+  /// start from the projection onto the last corrections solved to full accuracy
+  /// (solution_history.hpp), which keeps them. `relative_accuracy` in (0, 1) says w_N is
   /// needed only to that relative accuracy: the multigrid solver's conjugate gradients then
   /// stop at that relative residual (the direct solver is exact anyway); 0 asks for full
   /// accuracy. Throws InputError for a force of the wrong size or an accuracy outside [0, 1).
@@ -271,11 +274,11 @@ class BodySolver {
   /// Full displacement (mesh.dimension per node, prescribed values included) under contact forces
   /// lambda: u_f = K^+ (t f - B' lambda) + R alpha, alpha the rigid amplitudes of the last contact
   /// solve (none without rigid motions). With the multigrid solver, for a lambda other than the
-  /// last contact solve's lambda_u, conjugate gradients start from u + s W, u that solve's
-  /// displacement and W = K^{-1} B' r the last correction's (K u = t f - B' lambda_u, K W = B' r),
-  /// s = (B W)'(lambda_u - lambda) / (B W)' r the step that minimises the energy norm of the
-  /// start's error: for the other obstacle sequence's force lambda = lambda_u + r (the fields of
-  /// a completed sequence, docs/method.md) the start is already the solution.
+  /// last contact solve's lambda_u, conjugate gradients start from u + x_0, u that solve's
+  /// displacement (K u = t f - B' lambda_u) and x_0 the start of the kept corrections for the
+  /// force lambda_u - lambda (solution_history.hpp): for the other obstacle sequence's force
+  /// lambda = lambda_u + r, r the last correction's force (the fields of a completed sequence,
+  /// docs/method.md), the start is already the solution.
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force) const;
   /// The same with given rigid amplitudes alpha (k values), e.g. the monolithic reference's.
   Eigen::VectorXd displacement(const Eigen::VectorXd& contact_force,
@@ -302,7 +305,7 @@ class BodySolver {
   void fall_back_to_direct_solver();
   /// The local contact problem in its primal form (linear_solver multigrid).
   ContactSolveResult solve_primal_contact(const Eigen::VectorXd& obstacle);
-  /// u + s W of displacement()'s comment (u alone without a kept correction).
+  /// u + x_0 of displacement()'s comment.
   Eigen::VectorXd displacement_guess(const Eigen::VectorXd& contact_force) const;
   /// Assembles K, keeps its prescribed part (DofMap::prescribed_part: the reduced load and the
   /// reactions read nothing else) and returns the lower triangle of K_ff, freeing K.
@@ -338,8 +341,9 @@ class BodySolver {
   std::unique_ptr<GeneralizedInverse> factor_;  // K^{-1}, or K^+ for a floating body (direct)
   std::unique_ptr<MultigridStiffnessSolver> multigrid_;  // K^{-1} by AMG-PCG (multigrid)
   std::unique_ptr<PrimalContactState> primal_state_;     // the last primal contact solve
-  // the last correction (multigrid): r and W = K^{-1} B' r, the start of displacement()'s solves
-  mutable Eigen::VectorXd kept_correction_force_, kept_correction_;
+  // the last corrections (multigrid), the starts of the next ones and of displacement()'s solves
+  static constexpr int kept_corrections = 4;
+  mutable SolutionHistory correction_history_{kept_corrections};
   Eigen::MatrixXd no_rigid_modes_;  // R = free x 0 (multigrid)
   Eigen::VectorXd free_solution_;   // K^{-1} f (free dofs) at load factor 1
 

@@ -664,7 +664,12 @@ void SubdomainServer::on_correction(const protocol::Envelope& request, protocol:
                            std::to_string(relative_accuracy) + ", outside [0, 1)");
   }
   // w_N = B K^-1 B' r
+  const long iterations_before = body_->inner_iterations();
   const Eigen::VectorXd trace = body_->solve_correction(interface_force, relative_accuracy);
+  if (body_->linear_solver() == LinearSolverKind::multigrid) {
+    record.outcome +=
+        ", " + std::to_string(body_->inner_iterations() - iterations_before) + " CG iterations";
+  }
   require_finite(trace, "CorrectionResult.normal_trace", body_->name());
   protocol::CorrectionResult& result = *reply.mutable_correction_result();
   result.mutable_normal_trace()->Assign(trace.begin(), trace.end());

@@ -156,12 +156,13 @@ TEST(MultigridBody, CorrectionWithAnAccuracyHintStopsEarlier) {
   Eigen::VectorXd force(direct->contact_size());
   for (Eigen::Index i = 0; i < force.size(); ++i) force[i] = (i % 2 == 0 ? 1.0 : -1.0);
   const Eigen::VectorXd expected = direct->solve_correction(force);
+  // the hinted one first: a full correction of the same force would be its start (it is kept)
   long before = multigrid->inner_iterations();
-  const Eigen::VectorXd full = multigrid->solve_correction(force);
-  const long full_iterations = multigrid->inner_iterations() - before;
-  before = multigrid->inner_iterations();
   const Eigen::VectorXd hinted = multigrid->solve_correction(force, 1e-3);
   const long hinted_iterations = multigrid->inner_iterations() - before;
+  before = multigrid->inner_iterations();
+  const Eigen::VectorXd full = multigrid->solve_correction(force);
+  const long full_iterations = multigrid->inner_iterations() - before;
   EXPECT_LE(relative_difference(full, expected), agreement);
   const double hinted_error = relative_difference(hinted, expected);
   EXPECT_LE(hinted_error, 1e-2);
@@ -170,6 +171,36 @@ TEST(MultigridBody, CorrectionWithAnAccuracyHintStopsEarlier) {
             << " CG iterations, error " << hinted_error << "\n";
   EXPECT_THROW(multigrid->solve_correction(force, 1.0), InputError);
   EXPECT_THROW(multigrid->solve_correction(force, -1e-3), InputError);
+}
+
+/// Corrections start from the kept earlier ones (solution_history.hpp): a force that combines
+/// two earlier ones costs at most two conjugate gradient iterations, a new one as many as from
+/// zero, and all equal the direct solver's.
+TEST(MultigridBody, CorrectionsStartFromTheKeptOnes) {
+  for (const Case& test : cases()) {
+    const auto direct = make_solver(test.body, LinearSolverKind::direct);
+    const auto multigrid = make_solver(test.body, LinearSolverKind::multigrid);
+    const Eigen::Index size = direct->contact_size();
+    Eigen::VectorXd first(size), second(size), fresh(size), combined(size);
+    for (Eigen::Index i = 0; i < size; ++i) {
+      first[i] = 1.0 + 0.5 * std::cos(1.3 * i);
+      second[i] = std::sin(0.4 * i);
+      fresh[i] = (i % 3 == 0 ? 1.0 : -0.5) + 0.1 * i / size;
+    }
+    combined = 0.5 * first - 2.0 * second;
+    std::vector<long> iterations;
+    for (const Eigen::VectorXd* force : {&first, &second, &combined, &fresh}) {
+      const long before = multigrid->inner_iterations();
+      const double error = relative_difference(multigrid->solve_correction(*force),
+                                               direct->solve_correction(*force));
+      iterations.push_back(multigrid->inner_iterations() - before);
+      EXPECT_LE(error, agreement) << test.label;
+    }
+    EXPECT_LE(iterations[2], 2) << test.label;
+    EXPECT_GT(iterations[3], 4 * iterations[2]) << test.label;
+    std::cout << test.label << ": CG iterations " << iterations[0] << ", " << iterations[1]
+              << ", combined " << iterations[2] << ", new " << iterations[3] << "\n";
+  }
 }
 
 TEST(MultigridBody, ContactSolveEqualsTheDirectSolverAndIsSignorini) {
