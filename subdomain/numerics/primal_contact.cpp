@@ -162,7 +162,7 @@ ActiveSetStep solve_on_active_set(const MultigridStiffnessSolver& stiffness,
   const Eigen::VectorXd load_part = constraints.project(load);
   const Eigen::VectorXd stiffness_part = constraints.project(product);
   const Eigen::VectorXd right_hand_side = load_part - stiffness_part;
-  const double scale = load_part.norm() + stiffness_part.norm();
+  const double scale = load.norm() + product.norm();  // the terms of K u + B' lambda = b
   Eigen::VectorXd step_in_kernel = Eigen::VectorXd::Zero(stiffness.size());
   if (right_hand_side.norm() > tolerance * scale) {
     const ProjectedStiffness projected_stiffness(stiffness.stiffness(), constraints);

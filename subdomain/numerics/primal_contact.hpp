@@ -19,8 +19,10 @@
 //   u = u_0 + v,  v in ker B_A:  P K P v = P (b - K u_0),
 // by conjugate gradients from v = 0 with the preconditioner P M^{-1} P. Its iterates stay in
 // ker B_A, on which P K P and P M^{-1} P are positive definite, so this is PCG on the subspace.
-// It stops when ||P (b - K u)|| <= tolerance (||P b|| + ||P K u_0||): relative to the size of the
-// terms, not of their difference, so a warm start does not tighten the test. Then
+// It stops when ||P (b - K u)|| <= tolerance (||b|| + ||K u_0||): relative to the size of the
+// terms of K u + B' lambda = b, not of their projected difference, so neither a warm start nor a
+// body loaded through its contact alone (b = 0: P K u_0 is small once u_0 is near equilibrium,
+// while K u_0 is the contact force) tightens the test. Then
 //   lambda_A = S^{-1} B_A (b - K u)   (K u + B_A' lambda_A = b in the least-squares sense),
 // lambda = 0 off A, and the next active set is
 //   A' = { j in A : lambda_j >= -tolerance ||lambda||_inf }
