@@ -132,9 +132,10 @@ void read_solver(const CheckedTable& root, SolverOptions& solver) {
                                                         : InterfaceOperatorKind::factor;
   }
   solver.body.dense_limit = integer_at_least(*table, "dense_limit", 1, solver.body.dense_limit);
-  if (const auto kind = table->optional_choice("linear_solver", {"direct", "multigrid"})) {
-    solver.body.linear_solver =
-        *kind == "multigrid" ? LinearSolverKind::multigrid : LinearSolverKind::direct;
+  if (const auto kind = table->optional_choice("linear_solver", {"auto", "direct", "multigrid"})) {
+    solver.body.linear_solver = *kind == "auto"        ? LinearSolverKind::automatic
+                                : *kind == "multigrid" ? LinearSolverKind::multigrid
+                                                       : LinearSolverKind::direct;
   }
   solver.pairing_tolerance =
       number_above(*table, "pairing_tolerance", 0.0, solver.pairing_tolerance);

@@ -70,6 +70,7 @@ std::string linear_solver_name(LinearSolverKind kind) {
     case LinearSolverKind::multigrid:
       return "multigrid";
     case LinearSolverKind::direct:
+    case LinearSolverKind::automatic:  // resolved before (encode_setup_body)
       break;
   }
   return "direct";
@@ -138,7 +139,12 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
   for (const std::string& boundary : definition.contact_boundaries) {
     message.add_contact_boundaries(boundary);
   }
-  encode_solver(solver, *message.mutable_solver());
+  SolverOptions resolved =
+      solver;  // the automatic choice made here: servers get direct or multigrid
+  resolved.body.linear_solver = resolve_linear_solver(
+      solver.body.linear_solver, dimension, static_cast<long>(definition.mesh.dof_count()),
+      floating ? RigidMotions::held_by_contact : RigidMotions::refuse);
+  encode_solver(resolved, *message.mutable_solver());
   message.set_floating(floating);
   return message;
 }

@@ -240,8 +240,19 @@ bool same_factor_options(const BodySolverOptions& left, const BodySolverOptions&
 
 }  // namespace
 
+LinearSolverKind resolve_linear_solver(LinearSolverKind kind, int dimension, long dofs,
+                                       RigidMotions rigid_motions) {
+  if (kind != LinearSolverKind::automatic) return kind;
+  return dimension == 3 && dofs > automatic_multigrid_dofs && rigid_motions == RigidMotions::refuse
+             ? LinearSolverKind::multigrid
+             : LinearSolverKind::direct;
+}
+
 BodySolver::BodySolver(BodyDefinition definition, BodySolverOptions options)
     : definition_(std::move(definition)), options_(options) {
+  options_.linear_solver = resolve_linear_solver(options_.linear_solver, definition_.mesh.dimension,
+                                                 static_cast<long>(definition_.mesh.dof_count()),
+                                                 options_.rigid_motions);
   assemble();
 }
 

@@ -83,23 +83,36 @@ enum class InterfaceOperatorKind {
   factor,     // F applied through the factor: one solve (two triangular solves) per product
 };
 
-/// How the body's stiffness systems K x = b are solved.
-enum class LinearSolverKind {
-  direct,     // a sparse Cholesky factor (CHOLMOD), computed once; contact solved in its dual
-  multigrid,  // conjugate gradients preconditioned by smoothed-aggregation AMG; memory O(dofs);
-              // contact solved in its primal form by a primal-dual active set method
-};
-
 /// What a body whose Dirichlet conditions leave a rigid motion free is.
 enum class RigidMotions {
   refuse,           // an error at setup (SingularBodyError): a forgotten support
   held_by_contact,  // a floating body, held by its contact rows (see the file comment)
 };
 
+/// How the body's stiffness systems K x = b are solved.
+enum class LinearSolverKind {
+  direct,     // a sparse Cholesky factor (CHOLMOD), computed once; contact solved in its dual
+  multigrid,  // conjugate gradients preconditioned by smoothed-aggregation AMG; memory O(dofs);
+              // contact solved in its primal form by a primal-dual active set method
+  automatic,  // by the body's size (resolve_linear_solver)
+};
+
+/// A solid body of more degrees of freedom than this is solved by the multigrid solver when the
+/// choice is automatic: a direct factor of a solid grows like N^(4/3) in memory and N^2 in work,
+/// the multigrid solver like N (docs/benchmarks.md has the measurements behind the limit).
+inline constexpr long automatic_multigrid_dofs = 150000;
+
+/// The solver `kind` stands for, for a body of `dimension` with `dofs` degrees of freedom (2 or
+/// 3 per node, prescribed ones included) and rigid motions `rigid_motions`: automatic is
+/// multigrid for a solid (3D) body of more than automatic_multigrid_dofs that is not floating,
+/// direct otherwise; direct and multigrid stand for themselves.
+LinearSolverKind resolve_linear_solver(LinearSolverKind kind, int dimension, long dofs,
+                                       RigidMotions rigid_motions);
+
 struct BodySolverOptions {
   RigidMotions rigid_motions = RigidMotions::refuse;
   InterfaceOperatorKind interface_operator = InterfaceOperatorKind::automatic;
-  LinearSolverKind linear_solver = LinearSolverKind::direct;
+  LinearSolverKind linear_solver = LinearSolverKind::automatic;
   /// The automatic choice's limit on contact nodes. A dense F costs 8 n_c^2 bytes, and with the
   /// contact dofs last a dense trailing block of (d n_c)^2 / 2 entries in L; a solid body whose
   /// contact face has n_c nodes has a factor of far more entries than both, and applying F

@@ -16,8 +16,10 @@
 #include <limits>
 
 #include "mesh_codec.hpp"
+#include "numerics/box_mesher.hpp"
 #include "numerics/errors.hpp"
 #include "numerics/gmsh_reader.hpp"
+#include "numerics/material.hpp"
 #include "remote/reply_decoding.hpp"
 #include "remote/setup_encoding.hpp"
 #include "remote_test_support.hpp"
@@ -129,6 +131,34 @@ TEST(SetupEncoding, SolverHintsTravelAsTheirProtocolStrings) {
   message = encode_setup_body(upper.definition, upper.context, solver);
   EXPECT_EQ(message.solver().interface_operator(), "factor");
   EXPECT_EQ(message.solver().linear_solver(), "multigrid");
+}
+
+// "auto" never travels: the coordinator resolves it by the body's size (resolve_linear_solver),
+// so that every server, whatever it knows of the hint, gets "direct" or "multigrid". A plane body
+// and a small solid get "direct", a solid of more than automatic_multigrid_dofs "multigrid",
+// unless it is floating.
+TEST(SetupEncoding, AutomaticLinearSolverIsResolvedByTheBodysSize) {
+  CaseDefinition definition = read_case_file(example("two_blocks.toml"));
+  load_meshes(definition);
+  SolverOptions solver = definition.solver;
+  solver.body.linear_solver = LinearSolverKind::automatic;
+  const BodyCase& plane = definition.bodies[1];
+  EXPECT_EQ(encode_setup_body(plane.definition, plane.context, solver).solver().linear_solver(),
+            "direct");
+  BodyDefinition solid = plane.definition;
+  solid.material = make_isotropic_solid_material(1000.0, 0.3, "solid");
+  solid.dirichlet.clear();
+  solid.tractions.clear();
+  solid.contact_boundaries = {"top"};
+  solid.mesh =
+      make_box_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, {10, 10, 10}, ElementType::hexahedron8);
+  EXPECT_LE(solid.mesh.dof_count(), automatic_multigrid_dofs);
+  EXPECT_EQ(encode_setup_body(solid, "small", solver).solver().linear_solver(), "direct");
+  solid.mesh =
+      make_box_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, {37, 37, 37}, ElementType::hexahedron8);
+  EXPECT_GT(solid.mesh.dof_count(), automatic_multigrid_dofs);
+  EXPECT_EQ(encode_setup_body(solid, "large", solver).solver().linear_solver(), "multigrid");
+  EXPECT_EQ(encode_setup_body(solid, "floating", solver, true).solver().linear_solver(), "direct");
 }
 
 TEST(SetupEncoding, ConstraintOperatorTravelsInCompressedRows) {

@@ -347,8 +347,9 @@ TEST(CaseFile, LinearSolverKey) {
   };
   EXPECT_EQ(linear_solver("direct"), LinearSolverKind::direct);
   EXPECT_EQ(linear_solver("multigrid"), LinearSolverKind::multigrid);
+  EXPECT_EQ(linear_solver("auto"), LinearSolverKind::automatic);
   EXPECT_EQ(read_case_file(write_case(base_case())).solver.body.linear_solver,
-            LinearSolverKind::direct);
+            LinearSolverKind::automatic);
 }
 
 /// Every choice converts to the text users write and back; other texts are none of them.
