@@ -4,7 +4,7 @@
 # robin-subdomain processes over tcp://127.0.0.1) and by robin-monolithic.
 # Usage: [INTERFACE_OPERATOR=auto|dense|factor] [LINEAR_SOLVER=direct|multigrid] benchmarks/service_benchmark.sh [build directory] [mesh sizes...]
 # INTERFACE_OPERATOR sets [solver] interface_operator (default: the case's, i.e. auto),
-# LINEAR_SOLVER [solver] linear_solver (default: the case's, i.e. direct).
+# LINEAR_SOLVER [solver] linear_solver (default: the case's, i.e. "auto": direct for these bodies).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}

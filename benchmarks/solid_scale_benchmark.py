@@ -22,8 +22,9 @@ once per interface operator of --operators (`[solver] interface_operator`, set w
 "dense" assembles F = B K^-1 B^T once, "factor" applies it by triangular solves, "auto" is
 dense up to dense_limit = 8000 contact nodes; the contact face has (n+1)^2 nodes, node-to-node
 pairs), and once per linear solver of --linear-solvers (`[solver] linear_solver`, also set with
---set: "direct", the default and the only one run without the option, factorizes K once;
-"multigrid" solves by AMG-preconditioned conjugate gradients, docs/case-format.md). Sizes above
+--set: "direct" factorizes K once; "multigrid" solves by AMG-preconditioned conjugate
+gradients; "auto", the case file's default, chooses by the body's size, docs/case-format.md).
+Sizes above
 2e6 DOFs run only with --include-3e6 (which also adds 3e6 to the sizes).
 
 Prints, per run as it finishes, one line; then two Markdown tables:
@@ -267,8 +268,7 @@ def cell(value, digits=3):
 def run_one(binaries, tool, case, operator, linear_solver, output, arguments):
     command = [str(binaries / tool), str(case), "--output", str(output), "--quiet",
                "--set", f"solver.interface_operator={operator}"]
-    if linear_solver != "direct":  # without the key: as before the option (direct)
-        command += ["--set", f"solver.linear_solver={linear_solver}"]
+    command += ["--set", f"solver.linear_solver={linear_solver}"]
     if tool == "robin-run":
         command += ["--timeout", repr(arguments.robin_timeout)]
     status, wall, maxrss, peaks, largest_sum, stopped, timeline = run_guarded(
@@ -414,7 +414,7 @@ def main():
                         choices=["dense", "factor", "auto"],
                         help="[solver] interface_operator values to run (default dense factor)")
     parser.add_argument("--linear-solvers", nargs="+", default=["direct"],
-                        choices=["direct", "multigrid"],
+                        choices=["direct", "multigrid", "auto"],
                         help="[solver] linear_solver values to run (default direct)")
     parser.add_argument("--tools", nargs="+", default=["robin-run", "robin-monolithic"],
                         choices=["robin-run", "robin-monolithic"], help="the tools to run")

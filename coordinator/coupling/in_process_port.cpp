@@ -29,6 +29,7 @@ InterfaceDescription InProcessPort::setup(const BodyCase& body_case, const Solve
   profile_.setup_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   profile_.transfer_seconds = 0.0;
+  profile_.linear_solver = linear_solver_name(body_->linear_solver());
   return body_->contact_boundary();
 }
 

@@ -44,6 +44,8 @@ nlohmann::json body_profile_json(const BodyProfile& profile, const std::string& 
   body["peak_resident_bytes"] = profile.peak_resident_bytes
                                     ? nlohmann::json(*profile.peak_resident_bytes)
                                     : nlohmann::json(nullptr);
+  body["linear_solver"] = profile.linear_solver.empty() ? nlohmann::json(nullptr)
+                                                        : nlohmann::json(profile.linear_solver);
   return body;
 }
 
@@ -71,6 +73,7 @@ BodyProfile local_body_profile(const BodySolver& body) {
                     {SetupStage::factorization, timings.factorization_seconds},
                     {SetupStage::interface_operator, timings.interface_seconds}};
   profile.setup_seconds = timings.setup_seconds();
+  profile.linear_solver = linear_solver_name(body.linear_solver());
   return profile;
 }
 

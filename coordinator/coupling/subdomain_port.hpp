@@ -57,6 +57,10 @@ struct BodyProfile {
   /// (protocol 2.5: setup, contact assignment, fields); absent when none did (an older server,
   /// in process).
   std::optional<std::uint64_t> peak_resident_bytes;
+  /// "direct" or "multigrid": the solver the body was set up with (in process, the one it uses;
+  /// through a server, the one the coordinator asked for, case file's "auto" resolved); empty
+  /// when unknown.
+  std::string linear_solver;
 };
 
 /// Where a body's fields file goes. By default the port returns the whole mesh and fields and

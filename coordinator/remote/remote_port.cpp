@@ -232,6 +232,8 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   const double round_trip_seconds = seconds_since(sent);
   timings_.compute_seconds += reply.interface().setup_seconds();
   record_setup_profile(reply.interface(), encoding_seconds + round_trip_seconds);
+  const std::string& linear_solver = request.setup_body().solver().linear_solver();
+  profile_.linear_solver = linear_solver.empty() ? "direct" : linear_solver;
   try {
     InterfaceDescription interface = decode_interface(reply.interface());
     contact_size_ = 0;

@@ -65,17 +65,6 @@ std::string interface_operator_name(InterfaceOperatorKind kind) {
   return "auto";
 }
 
-std::string linear_solver_name(LinearSolverKind kind) {
-  switch (kind) {
-    case LinearSolverKind::multigrid:
-      return "multigrid";
-    case LinearSolverKind::direct:
-    case LinearSolverKind::automatic:  // resolved before (encode_setup_body)
-      break;
-  }
-  return "direct";
-}
-
 void encode_solver(const SolverOptions& solver, protocol::SolverSettings& message) {
   message.set_qp_tolerance(solver.qp.relative_tolerance);
   message.set_qp_max_iterations(static_cast<std::uint32_t>(solver.qp.max_iterations));
@@ -139,8 +128,8 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
   for (const std::string& boundary : definition.contact_boundaries) {
     message.add_contact_boundaries(boundary);
   }
-  SolverOptions resolved =
-      solver;  // the automatic choice made here: servers get direct or multigrid
+  // the automatic choice is made here: servers get "direct" or "multigrid"
+  SolverOptions resolved = solver;
   resolved.body.linear_solver = resolve_linear_solver(
       solver.body.linear_solver, dimension, static_cast<long>(definition.mesh.dof_count()),
       floating ? RigidMotions::held_by_contact : RigidMotions::refuse);

@@ -248,6 +248,18 @@ LinearSolverKind resolve_linear_solver(LinearSolverKind kind, int dimension, lon
              : LinearSolverKind::direct;
 }
 
+std::string linear_solver_name(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::multigrid:
+      return "multigrid";
+    case LinearSolverKind::automatic:
+      return "auto";
+    case LinearSolverKind::direct:
+      break;
+  }
+  return "direct";
+}
+
 BodySolver::BodySolver(BodyDefinition definition, BodySolverOptions options)
     : definition_(std::move(definition)), options_(options) {
   options_.linear_solver = resolve_linear_solver(options_.linear_solver, definition_.mesh.dimension,

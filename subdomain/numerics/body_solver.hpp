@@ -108,6 +108,8 @@ inline constexpr long automatic_multigrid_dofs = 150000;
 /// direct otherwise; direct and multigrid stand for themselves.
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, int dimension, long dofs,
                                        RigidMotions rigid_motions);
+/// "direct", "multigrid" or "auto" (the case file's and the protocol's names).
+std::string linear_solver_name(LinearSolverKind kind);
 
 struct BodySolverOptions {
   RigidMotions rigid_motions = RigidMotions::refuse;

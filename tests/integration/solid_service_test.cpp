@@ -128,6 +128,14 @@ TEST(SolidService, RobinRunWithTheMultigridSolverEqualsTheDirectMonolithicOnTheS
   const auto monolithic =
       run_case("robin-monolithic", "hertz_3d.toml", coarse_sphere, output, "mono");
   expect_same_contact_forces(run, monolithic, 1e-7);
+  // summary.json names each body's solver: the one asked for, and "auto"'s choice for these
+  // small bodies (direct)
+  for (const auto& [name, expected] :
+       std::vector<std::pair<std::string, std::string>>{{"run", "multigrid"}, {"mono", "direct"}}) {
+    const nlohmann::json bodies = testing::read_summary(output.path() / name)["profile"]["bodies"];
+    ASSERT_EQ(bodies.size(), 2u) << name;
+    for (const nlohmann::json& body : bodies) EXPECT_EQ(body["linear_solver"], expected) << name;
+  }
 }
 
 TEST(SolidService, PythonServerOwningTheHexahedraEqualsMonolithic) {
