@@ -547,8 +547,12 @@ void BodySolver::update_free_trace() {
 
 bool BodySolver::has_same_stiffness(const BodyDefinition& definition,
                                     const BodySolverOptions& options) const {
+  BodySolverOptions resolved = options;  // "automatic" as the constructor resolves it
+  resolved.linear_solver =
+      resolve_linear_solver(options.linear_solver, definition.mesh.dimension,
+                            static_cast<long>(definition.mesh.dof_count()), options.rigid_motions);
   if (definition.contact_boundaries != definition_.contact_boundaries ||
-      !same_factor_options(options, options_) ||
+      !same_factor_options(resolved, options_) ||
       !same_material(definition.material, definition_.material) ||
       !same_geometry(definition.mesh, definition_.mesh)) {
     return false;

@@ -298,7 +298,7 @@ TEST(CaseFile, MissingOptionalTablesGiveTheDocumentedDefaults) {
   EXPECT_EQ(definition.solver.qp.max_iterations, 20000);
   EXPECT_EQ(definition.solver.body.interface_operator, InterfaceOperatorKind::automatic);
   EXPECT_EQ(definition.solver.body.dense_limit, 8000);
-  EXPECT_EQ(definition.solver.body.linear_solver, LinearSolverKind::direct);
+  EXPECT_EQ(definition.solver.body.linear_solver, LinearSolverKind::automatic);
   EXPECT_EQ(definition.solver.pairing_tolerance, 1e-6);
   EXPECT_EQ(definition.coupling.relaxation, 0.5);
   EXPECT_EQ(definition.coupling.tolerance, 1e-8);
@@ -826,7 +826,7 @@ std::vector<ErrorCase> error_cases() {
        "linear_solver = \"amg\"",
        "amg",
        1,
-       {"case.toml:{line}: solver.linear_solver: 'amg' is not one of: direct, multigrid"}},
+       {"case.toml:{line}: solver.linear_solver: 'amg' is not one of: auto, direct, multigrid"}},
       {"LinearSolverNotAString",
        "qp_tolerance = 1e-12",
        "linear_solver = 2",
