@@ -6,10 +6,20 @@
 #include <malloc.h>
 #endif
 
+// AddressSanitizer replaces malloc: glibc's heap is then not the one in use (GCC defines
+// __SANITIZE_ADDRESS__, Clang answers __has_feature)
+#if defined(__SANITIZE_ADDRESS__)
+#define ROBIN_SANITIZER_ALLOCATOR 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ROBIN_SANITIZER_ALLOCATOR 1
+#endif
+#endif
+
 namespace robin {
 
 void release_free_heap_memory() {
-#if defined(__GLIBC__)
+#if defined(__GLIBC__) && !defined(ROBIN_SANITIZER_ALLOCATOR)
   malloc_trim(0);
 #endif
 }
