@@ -11,22 +11,10 @@
 #include <utility>
 
 #include "numerics/cholesky.hpp"
+#include "numerics/galerkin_product.hpp"
 
 namespace robin {
 namespace {
-
-/// y = A x (A compressed, row-major).
-void multiply(const RowMajorSparseMatrix& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  const int* starts = matrix.outerIndexPtr();
-  const int* columns = matrix.innerIndexPtr();
-  const double* values = matrix.valuePtr();
-  const int rows = static_cast<int>(matrix.rows());
-  for (int row = 0; row < rows; ++row) {
-    double sum = 0.0;
-    for (int k = starts[row]; k < starts[row + 1]; ++k) sum += values[k] * x[columns[k]];
-    y[row] = sum;
-  }
-}
 
 /// y = A_F x: only the entries of A (compressed, row-major) with keep[k] set.
 void multiply_kept(const RowMajorSparseMatrix& matrix, const std::vector<char>& keep,
@@ -44,34 +32,9 @@ void multiply_kept(const RowMajorSparseMatrix& matrix, const std::vector<char>& 
   }
 }
 
-/// The V-cycle's storage of a level's matrix (its lower triangle, diagonal included) and
-/// prolongator: compressed rows in single precision.
+/// The Gauss-Seidel smoother's storage of a level's lower triangle (diagonal included):
+/// compressed rows in single precision.
 using SinglePrecisionRows = Eigen::SparseMatrix<float, Eigen::RowMajor, int>;
-
-/// y = P x (summed in double).
-void multiply(const SinglePrecisionRows& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  const int* starts = matrix.outerIndexPtr();
-  const int* columns = matrix.innerIndexPtr();
-  const float* values = matrix.valuePtr();
-  for (Eigen::Index row = 0; row < matrix.rows(); ++row) {
-    double sum = 0.0;
-    for (int k = starts[row]; k < starts[row + 1]; ++k) sum += values[k] * x[columns[k]];
-    y[row] = sum;
-  }
-}
-
-/// y = P' x: each row of P scattered; y has P's column count.
-void multiply_transpose(const SinglePrecisionRows& matrix, const Eigen::VectorXd& x,
-                        Eigen::VectorXd& y) {
-  const int* starts = matrix.outerIndexPtr();
-  const int* columns = matrix.innerIndexPtr();
-  const float* values = matrix.valuePtr();
-  y.setZero();
-  for (Eigen::Index row = 0; row < matrix.rows(); ++row) {
-    const double value = x[row];
-    for (int k = starts[row]; k < starts[row + 1]; ++k) y[columns[k]] += values[k] * value;
-  }
-}
 
 /// r = b - A x; `product` is workspace.
 void subtract_symmetric_product(const BlockSymmetricMatrix<float>& matrix,
@@ -95,13 +58,13 @@ Eigen::VectorXd inverse_diagonal(const RowMajorSparseMatrix& matrix) {
   return inverse;
 }
 
-/// Largest eigenvalue of D^{-1} A (of D^{-1} A_F with `keep`: multiply_kept), estimated from below
-/// by `steps` Lanczos steps on the symmetric D^{-1/2} A D^{-1/2} (same spectrum) from a fixed
+/// Largest eigenvalue of D^{-1} A, A given by `multiply(x, y)` (y = A x), estimated from below by
+/// `steps` Lanczos steps on the symmetric D^{-1/2} A D^{-1/2} (same spectrum) from a fixed
 /// pseudo-random start: the largest eigenvalue of the Lanczos tridiagonal matrix.
-double estimate_spectral_radius(const RowMajorSparseMatrix& matrix,
-                                const Eigen::VectorXd& inverse_diagonal, int steps,
-                                const std::vector<char>& keep = {}) {
-  const Eigen::Index size = matrix.rows();
+template <typename Multiply>
+double estimate_spectral_radius(Multiply multiply, const Eigen::VectorXd& inverse_diagonal,
+                                int steps) {
+  const Eigen::Index size = inverse_diagonal.size();
   const Eigen::VectorXd scale = inverse_diagonal.cwiseSqrt();
   std::mt19937 generator(2026);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -112,11 +75,7 @@ double estimate_spectral_radius(const RowMajorSparseMatrix& matrix,
   double beta = 0.0;
   for (int step = 0; step < std::min<Eigen::Index>(steps, size); ++step) {
     work = scale.cwiseProduct(current);
-    if (keep.empty()) {
-      multiply(matrix, work, product);
-    } else {
-      multiply_kept(matrix, keep, work, product);
-    }
+    multiply(work, product);
     product = scale.cwiseProduct(product) - beta * previous;
     const double alpha = product.dot(current);
     product -= alpha * current;
@@ -140,42 +99,6 @@ double estimate_spectral_radius(const RowMajorSparseMatrix& matrix,
       .maxCoeff();
 }
 
-/// The unknowns of each node: the unknowns of node i are unknowns[start[i] .. start[i + 1]).
-struct NodeBlocks {
-  std::vector<int> node_of;  // per unknown, the node numbered 0 .. count - 1
-  std::vector<int> start;
-  std::vector<int> unknowns;
-  int count() const { return static_cast<int>(start.size()) - 1; }
-};
-
-/// Node blocks from any non-negative node numbers, renumbered 0 .. count - 1 in increasing order.
-NodeBlocks make_node_blocks(const std::vector<int>& dof_nodes) {
-  NodeBlocks blocks;
-  int largest = -1;
-  for (int node : dof_nodes) {
-    if (node < 0) throw std::invalid_argument("AlgebraicMultigrid: a negative node number");
-    largest = std::max(largest, node);
-  }
-  std::vector<int> renumbered(static_cast<std::size_t>(largest + 1), -1);
-  for (int node : dof_nodes) renumbered[static_cast<std::size_t>(node)] = 0;
-  int count = 0;
-  for (int& number : renumbered) {
-    if (number == 0) number = count++;
-  }
-  blocks.node_of.reserve(dof_nodes.size());
-  for (int node : dof_nodes) blocks.node_of.push_back(renumbered[static_cast<std::size_t>(node)]);
-  blocks.start.assign(static_cast<std::size_t>(count) + 1, 0);
-  for (int node : blocks.node_of) ++blocks.start[static_cast<std::size_t>(node) + 1];
-  for (int node = 0; node < count; ++node) blocks.start[node + 1] += blocks.start[node];
-  blocks.unknowns.resize(dof_nodes.size());
-  std::vector<int> next(blocks.start.begin(), blocks.start.end() - 1);
-  for (std::size_t unknown = 0; unknown < dof_nodes.size(); ++unknown) {
-    blocks.unknowns[static_cast<std::size_t>(next[blocks.node_of[unknown]]++)] =
-        static_cast<int>(unknown);
-  }
-  return blocks;
-}
-
 /// The strong connections of each node (step 1 of the header comment), neighbours of node i in
 /// neighbours[start[i] .. start[i + 1]) with their block norms ||A_ij||_F in weights.
 struct NodeGraph {
@@ -186,15 +109,17 @@ struct NodeGraph {
 
 /// ||A_ij||_F^2 for every node pair of the matrix graph, node by node; `visit(i, j, square)`.
 template <typename Visit>
-void for_each_block_norm(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+void for_each_block_norm(const RowMajorSparseMatrix& matrix, const BlockLayout& blocks,
                          Visit visit) {
   std::vector<double> accumulated(static_cast<std::size_t>(blocks.count()), 0.0);
   std::vector<int> seen_by(static_cast<std::size_t>(blocks.count()), -1);  // the last node
   std::vector<int> touched;
   for (int node = 0; node < blocks.count(); ++node) {
-    for (int k = blocks.start[node]; k < blocks.start[node + 1]; ++k) {
-      for (RowMajorSparseMatrix::InnerIterator entry(matrix, blocks.unknowns[k]); entry; ++entry) {
-        const int other = blocks.node_of[static_cast<std::size_t>(entry.col())];
+    for (int k = blocks.first(node); k < blocks.first(node + 1); ++k) {
+      for (RowMajorSparseMatrix::InnerIterator entry(matrix,
+                                                     blocks.members()[static_cast<std::size_t>(k)]);
+           entry; ++entry) {
+        const int other = blocks.block_of(entry.col());
         if (seen_by[other] != node) {
           seen_by[other] = node;
           accumulated[other] = 0.0;
@@ -211,7 +136,7 @@ void for_each_block_norm(const RowMajorSparseMatrix& matrix, const NodeBlocks& b
 /// The node graph of `matrix` with the pairs i != j whose `strength(i, j, ||A_ij||_F^2)` is
 /// positive, that value as their weight.
 template <typename Strength>
-NodeGraph strong_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+NodeGraph strong_graph(const RowMajorSparseMatrix& matrix, const BlockLayout& blocks,
                        Strength strength) {
   NodeGraph graph;
   graph.start.push_back(0);
@@ -235,7 +160,7 @@ NodeGraph strong_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blo
   return graph;
 }
 
-NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const BlockLayout& blocks,
                             double threshold) {
   std::vector<double> diagonal_norm(static_cast<std::size_t>(blocks.count()), 0.0);
   for_each_block_norm(matrix, blocks, [&](int node, int other, double square) {
@@ -249,12 +174,12 @@ NodeGraph strong_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks
 
 /// The position of each node block: `positions` indexed by the node numbers of `nodes` (the
 /// level's node of each unknown), read at each block's first unknown.
-std::vector<Eigen::Vector3d> block_positions(const NodeBlocks& blocks,
+std::vector<Eigen::Vector3d> block_positions(const BlockLayout& blocks,
                                              const std::vector<int>& nodes,
                                              const std::vector<Eigen::Vector3d>& positions) {
   std::vector<Eigen::Vector3d> result(static_cast<std::size_t>(blocks.count()));
   for (int block = 0; block < blocks.count(); ++block) {
-    const int unknown = blocks.unknowns[static_cast<std::size_t>(blocks.start[block])];
+    const int unknown = blocks.members()[static_cast<std::size_t>(blocks.first(block))];
     result[static_cast<std::size_t>(block)] =
         positions[static_cast<std::size_t>(nodes[static_cast<std::size_t>(unknown)])];
   }
@@ -263,7 +188,7 @@ std::vector<Eigen::Vector3d> block_positions(const NodeBlocks& blocks,
 
 /// The strong connections by the distance Laplacian (step 1 of the header comment), with the
 /// weights w_ij in graph.weights.
-NodeGraph distance_node_graph(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+NodeGraph distance_node_graph(const RowMajorSparseMatrix& matrix, const BlockLayout& blocks,
                               const std::vector<Eigen::Vector3d>& positions, double threshold) {
   const auto weight = [&](int node, int other) {
     const double square =
@@ -302,7 +227,7 @@ std::vector<Eigen::Vector3d> aggregate_positions(const std::vector<int>& aggrega
 
 /// Per stored entry of A (row-major order), whether its two nodes are the same or strongly
 /// connected in `graph`: the entries of the filtered matrix A_F.
-std::vector<char> strong_entries(const RowMajorSparseMatrix& matrix, const NodeBlocks& blocks,
+std::vector<char> strong_entries(const RowMajorSparseMatrix& matrix, const BlockLayout& blocks,
                                  const NodeGraph& graph) {
   std::vector<char> keep(static_cast<std::size_t>(matrix.nonZeros()), 0);
   std::vector<int> strong_for(static_cast<std::size_t>(blocks.count()), -1);
@@ -313,10 +238,10 @@ std::vector<char> strong_entries(const RowMajorSparseMatrix& matrix, const NodeB
     for (int k = graph.start[node]; k < graph.start[node + 1]; ++k) {
       strong_for[static_cast<std::size_t>(graph.neighbours[k])] = node;
     }
-    for (int k = blocks.start[node]; k < blocks.start[node + 1]; ++k) {
-      const int row = blocks.unknowns[k];
+    for (int k = blocks.first(node); k < blocks.first(node + 1); ++k) {
+      const int row = blocks.members()[static_cast<std::size_t>(k)];
       for (int entry = starts[row]; entry < starts[row + 1]; ++entry) {
-        const int other = blocks.node_of[static_cast<std::size_t>(columns[entry])];
+        const int other = blocks.block_of(columns[entry]);
         keep[static_cast<std::size_t>(entry)] = strong_for[static_cast<std::size_t>(other)] == node;
       }
     }
@@ -370,24 +295,26 @@ struct TentativeProlongator {
   std::vector<int> coarse_nodes;
 };
 
-TentativeProlongator tentative_prolongator(const NodeBlocks& blocks,
+TentativeProlongator tentative_prolongator(const BlockLayout& blocks,
                                            const std::vector<int>& aggregate, int aggregate_count,
                                            const Eigen::MatrixXd& near_null_space) {
-  std::vector<int> dof_aggregate(blocks.node_of.size());
+  std::vector<int> dof_aggregate(static_cast<std::size_t>(blocks.size()));
   for (std::size_t unknown = 0; unknown < dof_aggregate.size(); ++unknown) {
-    dof_aggregate[unknown] = aggregate[static_cast<std::size_t>(blocks.node_of[unknown])];
+    dof_aggregate[unknown] =
+        aggregate[static_cast<std::size_t>(blocks.block_of(static_cast<int>(unknown)))];
   }
-  const NodeBlocks members = make_node_blocks(dof_aggregate);  // unknowns per aggregate
+  const BlockLayout members(dof_aggregate);  // unknowns per aggregate
   const Eigen::Index modes = near_null_space.cols();
   std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(blocks.node_of.size() * static_cast<std::size_t>(modes));
+  entries.reserve(static_cast<std::size_t>(blocks.size() * modes));
   std::vector<Eigen::MatrixXd> coarse_rows;
   TentativeProlongator result;
   int columns = 0;
   for (int group = 0; group < aggregate_count; ++group) {
-    const int first = members.start[group], rows = members.start[group + 1] - first;
+    const int first = members.first(group), rows = members.first(group + 1) - first;
     Eigen::MatrixXd local(rows, modes);
-    for (int k = 0; k < rows; ++k) local.row(k) = near_null_space.row(members.unknowns[first + k]);
+    for (int k = 0; k < rows; ++k)
+      local.row(k) = near_null_space.row(members.members()[static_cast<std::size_t>(first + k)]);
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(local);
     qr.setThreshold(1e-10);
     const int rank = std::max<int>(1, static_cast<int>(qr.rank()));
@@ -397,13 +324,14 @@ TentativeProlongator tentative_prolongator(const NodeBlocks& blocks,
     coarse_rows.push_back(upper * qr.colsPermutation().transpose());
     for (int k = 0; k < rows; ++k) {
       for (int c = 0; c < rank; ++c) {
-        entries.emplace_back(members.unknowns[first + k], columns + c, basis(k, c));
+        entries.emplace_back(members.members()[static_cast<std::size_t>(first + k)], columns + c,
+                             basis(k, c));
       }
     }
     for (int c = 0; c < rank; ++c) result.coarse_nodes.push_back(group);
     columns += rank;
   }
-  result.prolongator.resize(static_cast<Eigen::Index>(blocks.node_of.size()), columns);
+  result.prolongator.resize(blocks.size(), columns);
   result.prolongator.setFromTriplets(entries.begin(), entries.end());
   result.coarse_near_null_space.resize(columns, modes);
   for (int group = 0, row = 0; group < aggregate_count; ++group) {
@@ -469,25 +397,6 @@ RowMajorSparseMatrix smooth_prolongator(const RowMajorSparseMatrix& matrix,
   return smoothed;
 }
 
-/// P' A P (step 5) as the sum over blocks of rows J of (P_J)' (A_J P), so that A P (the largest
-/// product of the setup) is never formed whole; symmetrized against rounding: (C + C') / 2.
-RowMajorSparseMatrix galerkin_product(const RowMajorSparseMatrix& matrix,
-                                      const RowMajorSparseMatrix& prolongator) {
-  const Eigen::Index rows = matrix.rows(), block = 16384;
-  RowMajorSparseMatrix coarse(prolongator.cols(), prolongator.cols());
-  for (Eigen::Index first = 0; first < rows; first += block) {
-    const Eigen::Index count = std::min(block, rows - first);
-    const RowMajorSparseMatrix product = matrix.middleRows(first, count) * prolongator;
-    const RowMajorSparseMatrix restriction = prolongator.middleRows(first, count).transpose();
-    const RowMajorSparseMatrix part = restriction * product;
-    coarse += part;
-  }
-  const RowMajorSparseMatrix transposed = coarse.transpose();
-  RowMajorSparseMatrix symmetric = 0.5 * (coarse + transposed);
-  symmetric.makeCompressed();
-  return symmetric;
-}
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -496,15 +405,13 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 SparseMatrixOperator::SparseMatrixOperator(const SparseMatrix& lower,
                                            const std::vector<int>& unknown_blocks)
-    : SparseMatrixOperator(
-          lower.rows() == lower.cols()
-              ? RowMajorSparseMatrix(lower.selfadjointView<Eigen::Lower>())
-              : throw std::invalid_argument("SparseMatrixOperator: the matrix is not square"),
-          unknown_blocks) {}
+    : matrix_(lower.rows() == lower.cols()
+                  ? RowMajorSparseMatrix(lower.selfadjointView<Eigen::Lower>())
+                  : throw std::invalid_argument("SparseMatrixOperator: the matrix is not square"),
+              unknown_blocks) {}
 
-SparseMatrixOperator::SparseMatrixOperator(const RowMajorSparseMatrix& matrix,
-                                           const std::vector<int>& unknown_blocks)
-    : matrix_(matrix, unknown_blocks) {}
+SparseMatrixOperator::SparseMatrixOperator(const RowMajorSparseMatrix& matrix, BlockLayout layout)
+    : matrix_(matrix, std::move(layout)) {}
 
 void SparseMatrixOperator::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   matrix_.multiply(x, y);
@@ -513,11 +420,10 @@ void SparseMatrixOperator::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) c
 struct AlgebraicMultigrid::Level {
   RowMajorSparseMatrix matrix;  // A_l, both triangles (during the setup only)
   Eigen::VectorXd inverse_diagonal;
-  RowMajorSparseMatrix prolongator;  // P (during the setup only; empty on the coarsest level)
-  // what the V-cycle reads, in single precision: A_l by blocks, P, and for the Gauss-Seidel
-  // smoother the scalar lower triangle of A_l
+  // what the V-cycle reads, in single precision: A_l and P by blocks (P empty on the coarsest
+  // level), and for the Gauss-Seidel smoother the scalar lower triangle of A_l
   BlockSymmetricMatrix<float> blocks;
-  SinglePrecisionRows prolongation;
+  BlockSparseMatrix<float> prolongation;
   SinglePrecisionRows lower;
   int unknowns = 0;
   long nonzeros = 0;  // of A_l, both triangles
@@ -570,21 +476,14 @@ AlgebraicMultigrid::AlgebraicMultigrid(SparseMatrix&& lower, const Eigen::Matrix
 
 AlgebraicMultigrid::~AlgebraicMultigrid() = default;
 
-/// Keeps of a set-up level what the V-cycle reads (A_l by the blocks `unknown_blocks` and P in
-/// single precision, A_l's scalar lower triangle for the Gauss-Seidel smoother, the sizes) and
-/// frees its double-precision matrices.
-void AlgebraicMultigrid::finish_level(Level& level, const std::vector<int>& unknown_blocks) const {
-  level.unknowns = static_cast<int>(level.matrix.rows());
-  level.nonzeros = static_cast<long>(level.matrix.nonZeros());
-  level.blocks = BlockSymmetricMatrix<float>(level.matrix, unknown_blocks);
+/// Keeps of a set-up level what the V-cycle reads besides A_l by blocks (A_l's scalar lower
+/// triangle for the Gauss-Seidel smoother, in single precision) and frees A_l in double precision.
+void AlgebraicMultigrid::finish_level(Level& level) const {
   if (options_.smoother == MultigridSmoother::symmetric_gauss_seidel) {
     level.lower = level.matrix.triangularView<Eigen::Lower>().cast<float>();
     level.lower.makeCompressed();
   }
   RowMajorSparseMatrix().swap(level.matrix);  // swapped out: assignment would keep the storage
-  level.prolongation = level.prolongator.cast<float>();
-  level.prolongation.makeCompressed();
-  RowMajorSparseMatrix().swap(level.prolongator);
 }
 
 void AlgebraicMultigrid::build_hierarchy(RowMajorSparseMatrix&& fine_matrix,
@@ -595,25 +494,30 @@ void AlgebraicMultigrid::build_hierarchy(RowMajorSparseMatrix&& fine_matrix,
   std::vector<int> nodes = dof_nodes;
   auto level = std::make_unique<Level>();
   level->matrix.swap(fine_matrix);
-  fine_operator_ =
-      std::make_unique<SparseMatrixOperator>(level->matrix, make_node_blocks(nodes).node_of);
+  fine_operator_ = std::make_unique<SparseMatrixOperator>(level->matrix,
+                                                          BlockLayout(consecutive_numbers(nodes)));
   while (true) {
     const RowMajorSparseMatrix& matrix = level->matrix;
     const int unknowns = static_cast<int>(matrix.rows());
+    level->unknowns = unknowns;
+    level->nonzeros = static_cast<long>(matrix.nonZeros());
     level->inverse_diagonal = inverse_diagonal(matrix);
-    level->spectral_radius =
-        estimate_spectral_radius(matrix, level->inverse_diagonal, options_.lanczos_steps);
-    level->interval_high = options_.spectrum_safety * level->spectral_radius;
-    level->interval_low = level->interval_high / options_.smoother_interval_ratio;
-    const NodeBlocks blocks = make_node_blocks(nodes);
-    level->nodes = blocks.count();
-    level->residual.resize(unknowns);
-    level->update.resize(unknowns);
-    level->product.resize(unknowns);
     if (unknowns <= options_.coarse_size_limit ||
         static_cast<int>(levels_.size()) + 1 >= options_.maximum_levels) {
       break;
     }
+    BlockLayout blocks(consecutive_numbers(nodes));
+    level->nodes = blocks.count();
+    level->blocks = levels_.empty() ? BlockSymmetricMatrix<float>(fine_operator_->blocks())
+                                    : BlockSymmetricMatrix<float>(matrix, blocks);
+    level->spectral_radius = estimate_spectral_radius(
+        [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) { level->blocks.multiply(x, y); },
+        level->inverse_diagonal, options_.lanczos_steps);
+    level->interval_high = options_.spectrum_safety * level->spectral_radius;
+    level->interval_low = level->interval_high / options_.smoother_interval_ratio;
+    level->residual.resize(unknowns);
+    level->update.resize(unknowns);
+    level->product.resize(unknowns);
     std::vector<Eigen::Vector3d> positions_of_blocks;
     if (!positions.empty()) positions_of_blocks = block_positions(blocks, nodes, positions);
     const NodeGraph graph = positions.empty()
@@ -627,29 +531,38 @@ void AlgebraicMultigrid::build_hierarchy(RowMajorSparseMatrix&& fine_matrix,
     if (!positions.empty()) {
       positions = aggregate_positions(aggregate, aggregate_count, positions_of_blocks);
     }
+    RowMajorSparseMatrix prolongator;
     if (options_.prolongator_damping > 0.0) {
       const std::vector<char> keep = strong_entries(matrix, blocks, graph);
       const double omega =
           options_.prolongator_damping /
-          estimate_spectral_radius(matrix, level->inverse_diagonal, options_.lanczos_steps, keep);
-      level->prolongator =
+          estimate_spectral_radius([&](const Eigen::VectorXd& x,
+                                       Eigen::VectorXd& y) { multiply_kept(matrix, keep, x, y); },
+                                   level->inverse_diagonal, options_.lanczos_steps);
+      prolongator =
           smooth_prolongator(matrix, keep, level->inverse_diagonal, omega, tentative.prolongator);
     } else {
-      level->prolongator.swap(tentative.prolongator);  // Eigen 3.4: no move assignment
+      prolongator.swap(tentative.prolongator);  // Eigen 3.4: no move assignment
     }
-    level->prolongator.makeCompressed();
+    RowMajorSparseMatrix().swap(tentative.prolongator);
+    const BlockSparseMatrix<double> block_prolongator(prolongator, std::move(blocks),
+                                                      BlockLayout(tentative.coarse_nodes));
+    RowMajorSparseMatrix().swap(prolongator);
     auto coarse = std::make_unique<Level>();
-    coarse->matrix = galerkin_product(matrix, level->prolongator);
+    coarse->matrix = galerkin_product(matrix, block_prolongator);
+    level->prolongation = BlockSparseMatrix<float>(block_prolongator);
     level->coarse_right_hand_side.resize(coarse->matrix.rows());
     level->coarse_solution.resize(coarse->matrix.rows());
     modes = std::move(tentative.coarse_near_null_space);
     nodes = std::move(tentative.coarse_nodes);
-    finish_level(*level, blocks.node_of);
+    finish_level(*level);
     levels_.push_back(std::move(level));
     level = std::move(coarse);
   }
+  // the coarsest level: solved by its Cholesky factor, no blocks or smoother
+  level->nodes = BlockLayout(consecutive_numbers(nodes)).count();
   const SparseMatrix coarsest = SparseMatrix(level->matrix).triangularView<Eigen::Lower>();
-  finish_level(*level, make_node_blocks(nodes).node_of);
+  RowMajorSparseMatrix().swap(level->matrix);
   levels_.push_back(std::move(level));
   coarse_solver_ = std::make_unique<CoarseSolver>();
   coarse_solver_->factor = std::make_unique<CholeskyFactor>(coarsest, "coarsest multigrid level");
@@ -681,9 +594,9 @@ void AlgebraicMultigrid::cycle(std::size_t index, const Eigen::VectorXd& right_h
   }
   subtract_symmetric_product(level.blocks, right_hand_side, solution, level.product,
                              level.residual);
-  multiply_transpose(level.prolongation, level.residual, level.coarse_right_hand_side);
+  level.prolongation.multiply_transpose(level.residual, level.coarse_right_hand_side);
   cycle(index + 1, level.coarse_right_hand_side, level.coarse_solution);
-  multiply(level.prolongation, level.coarse_solution, level.product);
+  level.prolongation.multiply(level.coarse_solution, level.product);
   solution += level.product;
   if (options_.smoother == MultigridSmoother::chebyshev) {
     smooth(level, right_hand_side, solution, false);

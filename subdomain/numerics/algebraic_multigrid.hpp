@@ -86,13 +86,14 @@ class SparseMatrixOperator final : public LinearOperator {
   /// empty: one block per unknown).
   explicit SparseMatrixOperator(const SparseMatrix& lower,
                                 const std::vector<int>& unknown_blocks = {});
-  /// A from the symmetric `matrix` (both triangles stored).
-  SparseMatrixOperator(const RowMajorSparseMatrix& matrix, const std::vector<int>& unknown_blocks);
+  /// A from the symmetric `matrix` (both triangles stored) in the blocks of `layout`.
+  SparseMatrixOperator(const RowMajorSparseMatrix& matrix, BlockLayout layout);
   int size() const override { return matrix_.size(); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
   /// The lower triangle, diagonal included (column-major), rebuilt from the blocks.
   SparseMatrix lower() const { return matrix_.lower_triangle(); }
   int block_size() const { return matrix_.block_size(); }
+  const BlockSymmetricMatrix<double>& blocks() const { return matrix_; }
 
  private:
   BlockSymmetricMatrix<double> matrix_;
@@ -177,7 +178,7 @@ class AlgebraicMultigrid final : public Preconditioner {
   struct Level;
   void build_hierarchy(RowMajorSparseMatrix&& matrix, const Eigen::MatrixXd& near_null_space,
                        const std::vector<int>& dof_nodes, std::vector<Eigen::Vector3d> positions);
-  void finish_level(Level& level, const std::vector<int>& unknown_blocks) const;
+  void finish_level(Level& level) const;
   void cycle(std::size_t level, const Eigen::VectorXd& right_hand_side,
              Eigen::VectorXd& solution) const;
   void smooth_gauss_seidel(const Level& level, const Eigen::VectorXd& right_hand_side,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 namespace robin {
 namespace {
@@ -9,8 +10,9 @@ namespace {
 /// y += A x on the padded vectors for blocks of the compile-time size B (the file comment of the
 /// header): the diagonal block of each row is its first.
 template <int B, typename Value>
-void multiply_blocks(const int* starts, const int* columns, const Value* values, int block_rows,
-                     const double* x, double* y) {
+void multiply_blocks(const int* __restrict starts, const int* __restrict columns,
+                     const Value* __restrict values, int block_rows, const double* __restrict x,
+                     double* __restrict y) {
   for (int row = 0; row < block_rows; ++row) {
     double x_row[B];
     double sum[B];
@@ -23,16 +25,21 @@ void multiply_blocks(const int* starts, const int* columns, const Value* values,
     }
     for (int k = starts[row] + 1; k < starts[row + 1]; ++k) {
       const Value* block = values + static_cast<long>(B) * B * k;
-      const double* x_column = x + static_cast<long>(B) * columns[k];
-      double* y_column = y + static_cast<long>(B) * columns[k];
-      for (int a = 0; a < B; ++a) {
-        double total = 0.0;
-        for (int c = 0; c < B; ++c) {
-          total += block[a * B + c] * x_column[c];
-          y_column[c] += block[a * B + c] * x_row[a];
-        }
-        sum[a] += total;
+      const long column = static_cast<long>(B) * columns[k];
+      double x_column[B];
+      double y_column[B];
+      for (int c = 0; c < B; ++c) {
+        x_column[c] = x[column + c];
+        y_column[c] = 0.0;
       }
+      for (int a = 0; a < B; ++a) {
+        for (int c = 0; c < B; ++c) {
+          const double value = block[a * B + c];
+          sum[a] += value * x_column[c];
+          y_column[c] += value * x_row[a];
+        }
+      }
+      for (int c = 0; c < B; ++c) y[column + c] += y_column[c];
     }
     for (int a = 0; a < B; ++a) y[B * row + a] += sum[a];
   }
@@ -60,82 +67,28 @@ void multiply_blocks(int size, const int* starts, const int* columns, const Valu
   }
 }
 
-/// The blocks of the unknowns: per block its unknowns in increasing order.
-struct UnknownsOfBlocks {
-  std::vector<int> start;     // blocks + 1
-  std::vector<int> unknowns;  // n values
-};
-
-UnknownsOfBlocks group_unknowns(const std::vector<int>& unknown_blocks, int size) {
-  if (static_cast<int>(unknown_blocks.size()) != size) {
-    throw std::invalid_argument("BlockSymmetricMatrix: the block numbers do not match the matrix");
-  }
-  UnknownsOfBlocks groups;
-  int count = 0;
-  for (int block : unknown_blocks) {
-    if (block < 0 || block >= size) {
-      throw std::invalid_argument("BlockSymmetricMatrix: a block number out of range");
-    }
-    count = std::max(count, block + 1);
-  }
-  groups.start.assign(static_cast<std::size_t>(count) + 1, 0);
-  for (int block : unknown_blocks) ++groups.start[static_cast<std::size_t>(block) + 1];
-  for (int block = 0; block < count; ++block) {
-    if (groups.start[static_cast<std::size_t>(block) + 1] == 0) {
-      throw std::invalid_argument("BlockSymmetricMatrix: a block number without unknowns");
-    }
-    groups.start[static_cast<std::size_t>(block) + 1] +=
-        groups.start[static_cast<std::size_t>(block)];
-  }
-  groups.unknowns.resize(unknown_blocks.size());
-  std::vector<int> next(groups.start.begin(), groups.start.end() - 1);
-  for (int unknown = 0; unknown < size; ++unknown) {
-    groups.unknowns[static_cast<std::size_t>(
-        next[static_cast<std::size_t>(unknown_blocks[static_cast<std::size_t>(unknown)])]++)] =
-        unknown;
-  }
-  return groups;
-}
-
-std::vector<int> one_block_each(int size) {
-  std::vector<int> blocks(static_cast<std::size_t>(size));
-  for (int unknown = 0; unknown < size; ++unknown)
-    blocks[static_cast<std::size_t>(unknown)] = unknown;
-  return blocks;
-}
-
 }  // namespace
 
 template <typename Value>
 BlockSymmetricMatrix<Value>::BlockSymmetricMatrix(const RowMajorSparseMatrix& matrix,
-                                                  const std::vector<int>& unknown_blocks) {
-  const int size = static_cast<int>(matrix.rows());
-  if (matrix.cols() != size) throw std::invalid_argument("BlockSymmetricMatrix: not square");
-  size_ = size;
-  const std::vector<int>& blocks = unknown_blocks.empty() ? one_block_each(size) : unknown_blocks;
-  const UnknownsOfBlocks groups = group_unknowns(blocks, size);
-  const int block_rows = static_cast<int>(groups.start.size()) - 1;
-  block_size_ = 1;
-  for (int row = 0; row < block_rows; ++row) {
-    block_size_ = std::max(block_size_, groups.start[row + 1] - groups.start[row]);
-  }
-  const int b = block_size_;
-  slot_of_unknown_.assign(static_cast<std::size_t>(size), 0);
-  unknown_of_slot_.assign(static_cast<std::size_t>(b) * block_rows, -1);
-  for (int row = 0; row < block_rows; ++row) {
-    for (int k = groups.start[row]; k < groups.start[row + 1]; ++k) {
-      const int unknown = groups.unknowns[static_cast<std::size_t>(k)];
-      const int slot = b * row + (k - groups.start[row]);
-      slot_of_unknown_[static_cast<std::size_t>(unknown)] = slot;
-      unknown_of_slot_[static_cast<std::size_t>(slot)] = unknown;
-      identity_slots_ = identity_slots_ && slot == unknown;
-    }
-  }
-  padding_ = static_cast<long>(unknown_of_slot_.size()) - size;
-  identity_slots_ = identity_slots_ && padding_ == 0;
+                                                  const std::vector<int>& unknown_blocks)
+    : BlockSymmetricMatrix(matrix, unknown_blocks.empty() ? BlockLayout::one_per_unknown(
+                                                                static_cast<int>(matrix.rows()))
+                                                          : BlockLayout(unknown_blocks)) {}
 
+template <typename Value>
+BlockSymmetricMatrix<Value>::BlockSymmetricMatrix(const RowMajorSparseMatrix& matrix,
+                                                  BlockLayout layout)
+    : layout_(std::move(layout)) {
+  if (matrix.rows() != matrix.cols()) {
+    throw std::invalid_argument("BlockSymmetricMatrix: not square");
+  }
+  if (layout_.size() != matrix.rows()) {
+    throw std::invalid_argument("BlockSymmetricMatrix: the block numbers do not match the matrix");
+  }
+  const int block_rows = layout_.count();
+  const int b = layout_.block_size();
   // the block pattern of each block row (the diagonal first), then the values
-  const RowMajorSparseMatrix& a = matrix;
   std::vector<int> position(static_cast<std::size_t>(block_rows), -1);
   std::vector<int> touched;
   starts_.assign(static_cast<std::size_t>(block_rows) + 1, 0);
@@ -146,11 +99,11 @@ BlockSymmetricMatrix<Value>::BlockSymmetricMatrix(const RowMajorSparseMatrix& ma
       position[static_cast<std::size_t>(row)] = first;
       if (pass == 1) columns_[static_cast<std::size_t>(first)] = row;
       touched.assign(1, row);
-      for (int k = groups.start[row]; k < groups.start[row + 1]; ++k) {
-        const int unknown = groups.unknowns[static_cast<std::size_t>(k)];
-        const int slot_row = slot_of_unknown_[static_cast<std::size_t>(unknown)] - b * row;
-        for (RowMajorSparseMatrix::InnerIterator entry(a, unknown); entry; ++entry) {
-          const int column_block = blocks[static_cast<std::size_t>(entry.col())];
+      for (int k = layout_.first(row); k < layout_.first(row + 1); ++k) {
+        const int unknown = layout_.members()[static_cast<std::size_t>(k)];
+        const int slot_row = layout_.slot_of(unknown) - b * row;
+        for (RowMajorSparseMatrix::InnerIterator entry(matrix, unknown); entry; ++entry) {
+          const int column_block = layout_.block_of(static_cast<int>(entry.col()));
           if (column_block > row) continue;
           int& place = position[static_cast<std::size_t>(column_block)];
           if (place < 0) {
@@ -160,7 +113,7 @@ BlockSymmetricMatrix<Value>::BlockSymmetricMatrix(const RowMajorSparseMatrix& ma
           }
           if (pass == 1) {
             const int slot_column =
-                slot_of_unknown_[static_cast<std::size_t>(entry.col())] - b * column_block;
+                layout_.slot_of(static_cast<int>(entry.col())) - b * column_block;
             values_[static_cast<std::size_t>(place) * b * b +
                     static_cast<std::size_t>(slot_row * b + slot_column)] =
                 static_cast<Value>(entry.value());
@@ -182,18 +135,13 @@ void BlockSymmetricMatrix<Value>::multiply(const Eigen::VectorXd& x, Eigen::Vect
   if (x.size() != size()) {
     throw std::invalid_argument("BlockSymmetricMatrix::multiply: the vector's size differs");
   }
-  const bool padded = !identity_slots_;
-  if (padded) {
-    padded_x_.setZero(static_cast<Eigen::Index>(unknown_of_slot_.size()));
-    for (Eigen::Index unknown = 0; unknown < x.size(); ++unknown) {
-      padded_x_[slot_of_unknown_[static_cast<std::size_t>(unknown)]] = x[unknown];
-    }
-  }
+  const bool padded = !layout_.identity();
+  if (padded) layout_.to_slots(x, padded_x_);
   Eigen::VectorXd& output = padded ? padded_y_ : y;
-  output.setZero(static_cast<Eigen::Index>(unknown_of_slot_.size()));
+  output.setZero(layout_.slot_count());
   const double* input = padded ? padded_x_.data() : x.data();
   const int rows = block_rows();
-  switch (block_size_) {
+  switch (layout_.block_size()) {
     case 1:
       multiply_blocks<1>(starts_.data(), columns_.data(), values_.data(), rows, input,
                          output.data());
@@ -211,28 +159,23 @@ void BlockSymmetricMatrix<Value>::multiply(const Eigen::VectorXd& x, Eigen::Vect
                          output.data());
       break;
     default:
-      multiply_blocks(block_size_, starts_.data(), columns_.data(), values_.data(), rows, input,
-                      output.data());
+      multiply_blocks(layout_.block_size(), starts_.data(), columns_.data(), values_.data(), rows,
+                      input, output.data());
   }
-  if (padded) {
-    y.resize(x.size());
-    for (Eigen::Index unknown = 0; unknown < x.size(); ++unknown) {
-      y[unknown] = padded_y_[slot_of_unknown_[static_cast<std::size_t>(unknown)]];
-    }
-  }
+  if (padded) layout_.from_slots(padded_y_, y);
 }
 
 template <typename Value>
 SparseMatrix BlockSymmetricMatrix<Value>::lower_triangle() const {
-  const int b = block_size_;
+  const int b = layout_.block_size();
   std::vector<Eigen::Triplet<double>> triplets;
   for (int row = 0; row < block_rows(); ++row) {
     for (int k = starts_[row]; k < starts_[row + 1]; ++k) {
       const int column = columns_[static_cast<std::size_t>(k)];
       for (int a = 0; a < b; ++a) {
-        const int unknown_row = unknown_of_slot_[static_cast<std::size_t>(b * row + a)];
+        const int unknown_row = layout_.unknown_of_slot(b * row + a);
         for (int c = 0; c < b; ++c) {
-          const int unknown_column = unknown_of_slot_[static_cast<std::size_t>(b * column + c)];
+          const int unknown_column = layout_.unknown_of_slot(b * column + c);
           const double value =
               values_[static_cast<std::size_t>(k) * b * b + static_cast<std::size_t>(a * b + c)];
           if (unknown_row < 0 || unknown_column < 0 || value == 0.0) continue;

@@ -3,8 +3,8 @@
 // multigrid (algebraic_multigrid.hpp) and of conjugate gradients.
 //
 // The unknowns are grouped into blocks (the free dofs of one mesh node, the coarse unknowns of
-// one aggregate); b is the size of the largest block and unknown k of block R has the slot
-// b R + k. The matrix is held as the b x b blocks A_RC, C <= R, of its block lower triangle in
+// one aggregate) with their slots as block_layout.hpp says; b is the size of the largest block.
+// The matrix is held as the b x b blocks A_RC, C <= R, of its block lower triangle in
 // compressed block rows (the diagonal block first in each row, stored whole), each block's
 // entries row by row, padded with zeros where a block has fewer than b unknowns (a node with a
 // prescribed component, a rank-deficient aggregate). Then
@@ -18,6 +18,7 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
+#include "numerics/block_layout.hpp"
 #include "numerics/elasticity.hpp"
 
 namespace robin {
@@ -34,9 +35,19 @@ class BlockSymmetricMatrix {
   /// own). Throws std::invalid_argument when the sizes differ or a block number is negative,
   /// unused or too large.
   BlockSymmetricMatrix(const RowMajorSparseMatrix& matrix, const std::vector<int>& unknown_blocks);
+  /// A from `matrix` and the blocks of `layout`; throws std::invalid_argument when the sizes
+  /// differ.
+  BlockSymmetricMatrix(const RowMajorSparseMatrix& matrix, BlockLayout layout);
+  /// The same blocks with their entries rounded to Value.
+  template <typename Other>
+  explicit BlockSymmetricMatrix(const BlockSymmetricMatrix<Other>& other)
+      : layout_(other.layout_),
+        starts_(other.starts_),
+        columns_(other.columns_),
+        values_(other.values_.begin(), other.values_.end()) {}
 
-  int size() const { return size_; }
-  int block_size() const { return block_size_; }
+  int size() const { return layout_.size(); }
+  int block_size() const { return layout_.block_size(); }
   int block_rows() const { return static_cast<int>(starts_.size()) - 1; }
   /// Stored blocks (the block lower triangle, diagonal blocks included).
   long stored_blocks() const { return static_cast<long>(columns_.size()); }
@@ -48,15 +59,13 @@ class BlockSymmetricMatrix {
   SparseMatrix lower_triangle() const;
 
  private:
-  int size_ = 0;
-  int block_size_ = 1;
-  long padding_ = 0;                  // slots without an unknown
-  bool identity_slots_ = true;        // slot i is unknown i for every i
-  std::vector<int> slot_of_unknown_;  // n values
-  std::vector<int> unknown_of_slot_;  // b x block rows values, -1 for padding
-  std::vector<int> starts_;           // block rows + 1
-  std::vector<int> columns_;          // block column of each stored block
-  std::vector<Value> values_;         // b x b per stored block, row by row
+  template <typename Other>
+  friend class BlockSymmetricMatrix;
+
+  BlockLayout layout_;
+  std::vector<int> starts_;    // block rows + 1
+  std::vector<int> columns_;   // block column of each stored block
+  std::vector<Value> values_;  // b x b per stored block, row by row
   mutable Eigen::VectorXd padded_x_, padded_y_;
 };
 

@@ -103,7 +103,7 @@ TEST(BlockSymmetricMatrix, PaddedAndScatteredBlocksGiveEigensProduct) {
 TEST(BlockSymmetricMatrix, OneBlockPerUnknownWithoutBlockNumbers) {
   const RowMajorSparseMatrix matrix = random_symmetric(150, 5, 13);
   expect_same_matrix<double>(matrix, {}, 1e-14);
-  EXPECT_EQ(BlockSymmetricMatrix<double>(matrix, {}).block_size(), 1);
+  EXPECT_EQ(BlockSymmetricMatrix<double>(matrix, std::vector<int>{}).block_size(), 1);
 }
 
 TEST(BlockSymmetricMatrix, BlocksOfSevenUseTheGeneralKernel) {
@@ -123,7 +123,7 @@ TEST(BlockSymmetricMatrix, InconsistentBlockNumbersAreRefused) {
   std::vector<int> unused(10, 0);
   unused[4] = 2;  // block 1 has no unknown
   EXPECT_THROW(BlockSymmetricMatrix<double>(matrix, unused), std::invalid_argument);
-  const BlockSymmetricMatrix<double> stored(matrix, {});
+  const BlockSymmetricMatrix<double> stored(matrix, std::vector<int>{});
   Eigen::VectorXd product;
   EXPECT_THROW(stored.multiply(Eigen::VectorXd::Zero(9), product), std::invalid_argument);
 }
