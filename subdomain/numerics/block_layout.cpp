@@ -37,6 +37,9 @@ BlockLayout::BlockLayout(const std::vector<int>& unknown_blocks) : block_of_(unk
     identity_ = identity_ && slot == unknown;
   }
   identity_ = identity_ && slot_count() == size;
+  for (int slot = 0; slot < slot_count(); ++slot) {
+    if (unknown_of_slot_[static_cast<std::size_t>(slot)] < 0) padding_slots_.push_back(slot);
+  }
 }
 
 BlockLayout BlockLayout::one_per_unknown(int size) {
@@ -47,7 +50,8 @@ BlockLayout BlockLayout::one_per_unknown(int size) {
 }
 
 void BlockLayout::to_slots(const Eigen::VectorXd& x, Eigen::VectorXd& padded) const {
-  padded.setZero(slot_count());
+  padded.resize(slot_count());
+  for (int slot : padding_slots_) padded[slot] = 0.0;
   for (int unknown = 0; unknown < size(); ++unknown) padded[slot_of(unknown)] = x[unknown];
 }
 

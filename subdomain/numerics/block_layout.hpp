@@ -39,7 +39,8 @@ class BlockLayout {
   const std::vector<int>& members() const { return members_; }
   const std::vector<int>& blocks() const { return block_of_; }
 
-  /// padded = x in slots (padding zero); x has size() entries.
+  /// padded = x in slots (padding zero; the writes are one per unknown and one per padding
+  /// slot); x has size() entries.
   void to_slots(const Eigen::VectorXd& x, Eigen::VectorXd& padded) const;
   /// x = the unknowns' entries of `padded`.
   void from_slots(const Eigen::VectorXd& padded, Eigen::VectorXd& x) const;
@@ -50,6 +51,7 @@ class BlockLayout {
   std::vector<int> members_;          // n values, block by block
   std::vector<int> slot_of_;          // n values
   std::vector<int> unknown_of_slot_;  // b count values
+  std::vector<int> padding_slots_;
   int block_size_ = 1;
   bool identity_ = true;
 };

@@ -41,7 +41,7 @@ void multiply_blocks(const int* __restrict starts, const int* __restrict columns
       }
       for (int c = 0; c < B; ++c) y[column + c] += y_column[c];
     }
-    for (int a = 0; a < B; ++a) y[B * row + a] += sum[a];
+    for (int a = 0; a < B; ++a) y[B * row + a] = sum[a];  // the first write of y_R
   }
 }
 
@@ -53,6 +53,7 @@ void multiply_blocks(int size, const int* starts, const int* columns, const Valu
   for (int row = 0; row < block_rows; ++row) {
     const double* x_row = x + static_cast<long>(size) * row;
     double* y_row = y + static_cast<long>(size) * row;
+    std::fill(y_row, y_row + size, 0.0);  // the first write of y_R
     for (int k = starts[row]; k < starts[row + 1]; ++k) {
       const Value* block = values + area * k;
       const double* x_column = x + static_cast<long>(size) * columns[k];
@@ -138,7 +139,7 @@ void BlockSymmetricMatrix<Value>::multiply(const Eigen::VectorXd& x, Eigen::Vect
   const bool padded = !layout_.identity();
   if (padded) layout_.to_slots(x, padded_x_);
   Eigen::VectorXd& output = padded ? padded_y_ : y;
-  output.setZero(layout_.slot_count());
+  output.resize(layout_.slot_count());  // each y_R written first by its own block row
   const double* input = padded ? padded_x_.data() : x.data();
   const int rows = block_rows();
   switch (layout_.block_size()) {

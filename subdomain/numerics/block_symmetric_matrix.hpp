@@ -7,12 +7,14 @@
 // The matrix is held as the b x b blocks A_RC, C <= R, of its block lower triangle in
 // compressed block rows (the diagonal block first in each row, stored whole), each block's
 // entries row by row, padded with zeros where a block has fewer than b unknowns (a node with a
-// prescribed component, a rank-deficient aggregate). Then
-//   y_R += A_RR x_R,   and for C < R:  y_R += A_RC x_C,  y_C += A_RC' x_R,
+// prescribed component, a rank-deficient aggregate). Then, block row by block row,
+//   y_R = A_RR x_R + sum_{C < R} A_RC x_C,   and for C < R:  y_C += A_RC' x_R,
 // reads each stored block once for both triangles, on padded copies of x and y (none when every
-// block is full and the slots are the unknowns' own numbers). Against compressed rows of the
-// scalar lower triangle it stores one column index per block instead of one per entry and its
-// b x b kernel runs in registers: the product is bound by memory traffic, which both reduce.
+// block is full and the slots are the unknowns' own numbers); y_R is first written by its own
+// block row (the rows before it touch only blocks C < R), so y needs no zeroing. Against compressed
+// rows of the scalar lower triangle it stores one column index per block instead of one per entry
+// and its b x b kernel runs in registers: the product is bound by memory traffic, which both
+// reduce.
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
