@@ -29,7 +29,8 @@
 //     estimated by Lanczos on D^{-1/2} A_F D^{-1/2}. P then spreads only along strong
 //     connections, which keeps the coarse operators sparse.
 //  5. Galerkin coarse operator A_{l+1} = P' A_l P (symmetric positive definite: P has full
-//     column rank).
+//     column rank), computed block by block (galerkin_product.hpp) with P held by blocks of a
+//     node's rows against an aggregate's columns.
 // The coarsest matrix is factorized by CHOLMOD (cholesky.hpp).
 //
 // The preconditioner M^{-1} r is one V-cycle from a zero guess: on each level, pre-smoothing by
@@ -51,15 +52,16 @@
 // Storage. The finest matrix is kept in double by blocks of the unknowns of a node (the lower
 // block triangle, block_symmetric_matrix.hpp: the products of conjugate gradients, y = A x with
 // each stored entry read once for both triangles). After the setup each level keeps A_l the same
-// way in single precision (blocks of a node's, then an aggregate's unknowns), P as compressed
-// rows in single precision, and D^{-1}: the V-cycle sums in double, and it is the exact V-cycle
+// way in single precision (blocks of a node's, then an aggregate's unknowns), P by the same
+// blocks against the next level's (block_sparse_matrix.hpp) in single precision, and D^{-1}: the V-cycle sums in double, and it is the exact V-cycle
 // of the rounded matrices, so still symmetric positive definite, while the products that
 // conjugate gradients converge on stay in double. (Its speed is bound by memory traffic, which
 // single precision, one triangle and one column index per block reduce.) With the Gauss-Seidel
 // smoother a level also keeps its scalar lower triangle in single precision (the sweeps run over
-// its rows). P' x is computed by scattering the rows of P. During the setup A_l is held
-// with both triangles in double, and P' A P is summed over blocks of rows so that A P is never
-// formed whole. The apply allocates only the coarsest level's solution (the
+// its rows). P' x is computed by scattering the block rows of P. During the setup A_l is held
+// with both triangles in double; P' A P is accumulated block row by block row of A P, which is
+// never formed whole, into the block lower triangle of A_{l+1}. The Lanczos estimate of
+// rho(D^{-1} A_l) runs on the single-precision blocks (the smoother's own matrix). The apply allocates only the coarsest level's solution (the
 // CholeskyFactor's solve); its other workspace is kept per level, so one AlgebraicMultigrid must
 // not be applied from two threads at once.
 
