@@ -14,8 +14,11 @@
 // ENDPOINT" line gives the endpoint the coordinator connects to) and forward SIGTERM.
 // Threads: the servers' factorizations run on a multithreaded BLAS (and OpenMP). Servers on
 // this machine share its processors, max(1, processors / local servers) threads each
-// (OPENBLAS_NUM_THREADS, OMP_NUM_THREADS in their environment), unless robin-run's own
-// environment sets those variables; --threads-per-server N gives every server N.
+// (OPENBLAS_NUM_THREADS, OMP_NUM_THREADS and OMP_THREAD_LIMIT in their environment: Debian's
+// CHOLMOD 3.0 runs its supernodal factorization on a team of four OpenMP threads even with
+// OMP_NUM_THREADS=1, which only the limit caps), unless robin-run's own environment sets those
+// variables;
+// --threads-per-server N gives every server N.
 // A server that dies mid-run is restarted (--max-server-restarts times per body, default 2):
 // its body is set up again and the run carries on from its last checkpoint.
 // Exit codes: coordinator_application.hpp.
@@ -51,7 +54,8 @@ struct ServerPlacement {
 
 /// The environment variables that set the thread counts of the BLAS (OpenBLAS) and OpenMP
 /// libraries under the servers' factorizations.
-constexpr std::array<const char*, 2> thread_variables = {"OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"};
+constexpr std::array<const char*, 3> thread_variables = {"OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                                         "OMP_THREAD_LIMIT"};
 
 /// The processors this process may run on (its affinity mask), at least 1.
 int available_processors() {
@@ -210,7 +214,8 @@ void add_server_options(CLI::App& app, ServerPlacement& placement) {
       ->type_name("PATH");
   app.add_option("--threads-per-server", placement.threads_per_server,
                  "BLAS and OpenMP threads of every server (OPENBLAS_NUM_THREADS, "
-                 "OMP_NUM_THREADS); default: this machine's processors shared out among the "
+                 "OMP_NUM_THREADS, OMP_THREAD_LIMIT); default: this machine's processors shared "
+                 "out among the "
                  "servers started on it, unless those variables are set in this environment")
       ->type_name("N")
       ->check(CLI::Range(1, 4096));

@@ -465,16 +465,18 @@ TEST(RobinRunCommandLine, ZeroTimeoutIsRejected) {
 // ---- Threads of the servers -----------------------------------------------------------------
 
 /// What each server of a robin-run on examples/two_blocks.toml had in its environment of
-/// OPENBLAS_NUM_THREADS and OMP_NUM_THREADS ("NAME=value" lines, sorted): --server-executable is
-/// a script that writes those lines into a file of its own and then execs robin-subdomain.
+/// OPENBLAS_NUM_THREADS, OMP_NUM_THREADS and OMP_THREAD_LIMIT ("NAME=value" lines, sorted):
+/// --server-executable is a script that writes those lines into a file of its own and then execs
+/// robin-subdomain.
 std::vector<std::string> server_thread_settings(
     const std::vector<std::string>& options,
     const std::vector<std::pair<std::string, std::string>>& environment) {
   const TemporaryDirectory directory("robin-run-threads");
   const std::filesystem::path script = write_script(
       directory.path(), "server.sh",
-      "env | grep -E '^(OPENBLAS|OMP)_NUM_THREADS=' | sort > '" + directory.path().string() +
-          "/environment-'$$\nexec '" + testing::tool("robin-subdomain").string() + "' \"$@\"\n");
+      "env | grep -E '^(OPENBLAS_NUM_THREADS|OMP_NUM_THREADS|OMP_THREAD_LIMIT)=' | sort > '" +
+          directory.path().string() + "/environment-'$$\nexec '" +
+          testing::tool("robin-subdomain").string() + "' \"$@\"\n");
   std::vector<std::string> arguments = {example("two_blocks.toml").string(), "--output",
                                         (directory.path() / "out").string(), "--server-executable",
                                         script.string()};
@@ -501,10 +503,12 @@ TEST(RobinRunThreads, LocalServersShareTheProcessorsUnlessTheEnvironmentSetsThre
   CPU_ZERO(&set);
   ASSERT_EQ(sched_getaffinity(0, sizeof set, &set), 0);
   const std::string share = std::to_string(std::max(1, CPU_COUNT(&set) / 2));  // two servers
-  // OPENBLAS_NUM_THREADS set for robin-run is passed on; OMP_NUM_THREADS, unless this test's
-  // own environment has it, is the share.
-  const std::string expected = "OMP_NUM_THREADS=" + environment_value("OMP_NUM_THREADS", share) +
-                               "\nOPENBLAS_NUM_THREADS=5\n";
+  // OPENBLAS_NUM_THREADS set for robin-run is passed on; OMP_NUM_THREADS and OMP_THREAD_LIMIT,
+  // unless this test's own environment has them, are the share.
+  const std::string expected =
+      "OMP_NUM_THREADS=" + environment_value("OMP_NUM_THREADS", share) +
+      "\nOMP_THREAD_LIMIT=" + environment_value("OMP_THREAD_LIMIT", share) +
+      "\nOPENBLAS_NUM_THREADS=5\n";
   const std::vector<std::string> settings =
       server_thread_settings({}, {{"OPENBLAS_NUM_THREADS", "5"}});
   EXPECT_EQ(settings, std::vector<std::string>(2, expected));
@@ -513,7 +517,8 @@ TEST(RobinRunThreads, LocalServersShareTheProcessorsUnlessTheEnvironmentSetsThre
 TEST(RobinRunThreads, ThreadsPerServerOverridesTheEnvironment) {
   const std::vector<std::string> settings = server_thread_settings(
       {"--threads-per-server", "3"}, {{"OPENBLAS_NUM_THREADS", "5"}, {"OMP_NUM_THREADS", "7"}});
-  EXPECT_EQ(settings, std::vector<std::string>(2, "OMP_NUM_THREADS=3\nOPENBLAS_NUM_THREADS=3\n"));
+  EXPECT_EQ(settings, std::vector<std::string>(
+                          2, "OMP_NUM_THREADS=3\nOMP_THREAD_LIMIT=3\nOPENBLAS_NUM_THREADS=3\n"));
 }
 
 }  // namespace
