@@ -65,12 +65,14 @@ std::string interface_operator_name(InterfaceOperatorKind kind) {
   return "auto";
 }
 
-void encode_solver(const SolverOptions& solver, protocol::SolverSettings& message) {
+/// The solver settings, with `linear_solver` (resolved: never automatic) for the case's choice.
+void encode_solver(const SolverOptions& solver, LinearSolverKind linear_solver,
+                   protocol::SolverSettings& message) {
   message.set_qp_tolerance(solver.qp.relative_tolerance);
   message.set_qp_max_iterations(static_cast<std::uint32_t>(solver.qp.max_iterations));
   message.set_interface_operator(interface_operator_name(solver.body.interface_operator));
   message.set_dense_limit(static_cast<std::uint32_t>(std::max(solver.body.dense_limit, 0)));
-  message.set_linear_solver(linear_solver_name(solver.body.linear_solver));
+  message.set_linear_solver(linear_solver_name(linear_solver));
 }
 
 }  // namespace
@@ -129,11 +131,10 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
     message.add_contact_boundaries(boundary);
   }
   // the automatic choice is made here: servers get "direct" or "multigrid"
-  SolverOptions resolved = solver;
-  resolved.body.linear_solver = resolve_linear_solver(
+  const LinearSolverKind linear_solver = resolve_linear_solver(
       solver.body.linear_solver, dimension, static_cast<long>(definition.mesh.dof_count()),
       floating ? RigidMotions::held_by_contact : RigidMotions::refuse);
-  encode_solver(resolved, *message.mutable_solver());
+  encode_solver(solver, linear_solver, *message.mutable_solver());
   message.set_floating(floating);
   return message;
 }
