@@ -138,7 +138,9 @@ struct MultigridLevelSummary {
   int unknowns = 0;
   long nonzeros = 0;             // stored entries of A_l (both triangles)
   int nodes = 0;                 // blocks of unknowns (mesh nodes, then aggregates)
-  double spectral_radius = 0.0;  // the estimate of rho(D^{-1} A_l), before the safety factor
+  // the estimate of rho(D^{-1} A_l), before the safety factor; 0 on the coarsest level (solved
+  // by its factor, not smoothed)
+  double spectral_radius = 0.0;
 };
 
 class AlgebraicMultigrid final : public Preconditioner {
