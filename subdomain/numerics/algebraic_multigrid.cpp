@@ -464,6 +464,7 @@ AlgebraicMultigrid::AlgebraicMultigrid(SparseMatrix&& lower, const Eigen::Matrix
     throw std::invalid_argument("AlgebraicMultigrid: smoother_degree below 1");
   }
   for (int node : dof_nodes) {
+    if (node < 0) throw std::invalid_argument("AlgebraicMultigrid: a negative node number");
     if (!node_positions.empty() && node >= static_cast<int>(node_positions.size())) {
       throw std::invalid_argument("AlgebraicMultigrid: a dof's node has no position");
     }
