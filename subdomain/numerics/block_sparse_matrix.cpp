@@ -147,14 +147,7 @@ void BlockSparseMatrix<Value>::multiply(const Eigen::VectorXd& x, Eigen::VectorX
   if (x.size() != cols()) {
     throw std::invalid_argument("BlockSparseMatrix::multiply: the vector's size differs");
   }
-  const bool padded_input = !columns_.identity(), padded_output = !rows_.identity();
-  if (padded_input) columns_.to_slots(x, padded_x_);
-  Eigen::VectorXd& output = padded_output ? padded_y_ : y;
-  output.resize(rows_.slot_count());
-  dispatch(rows_.block_size(), columns_.block_size(), starts_.data(), block_columns_.data(),
-           values_.data(), rows_.count(), padded_input ? padded_x_.data() : x.data(), output.data(),
-           false);
-  if (padded_output) rows_.from_slots(padded_y_, y);
+  product(x, y, false);
 }
 
 template <typename Value>
@@ -163,14 +156,27 @@ void BlockSparseMatrix<Value>::multiply_transpose(const Eigen::VectorXd& x,
   if (x.size() != rows()) {
     throw std::invalid_argument("BlockSparseMatrix::multiply_transpose: the vector's size differs");
   }
-  const bool padded_input = !rows_.identity(), padded_output = !columns_.identity();
-  if (padded_input) rows_.to_slots(x, padded_x_);
-  Eigen::VectorXd& output = padded_output ? padded_y_ : y;
-  output.setZero(columns_.slot_count());
+  product(x, y, true);
+}
+
+template <typename Value>
+void BlockSparseMatrix<Value>::product(const Eigen::VectorXd& x, Eigen::VectorXd& y,
+                                       bool transposed) const {
+  const BlockLayout& input = transposed ? rows_ : columns_;
+  const BlockLayout& output = transposed ? columns_ : rows_;
+  Eigen::VectorXd& input_slots = transposed ? padded_rows_ : padded_columns_;
+  Eigen::VectorXd& output_slots = transposed ? padded_columns_ : padded_rows_;
+  if (!input.identity()) input.to_slots(x, input_slots);
+  Eigen::VectorXd& result = output.identity() ? y : output_slots;
+  if (transposed) {
+    result.setZero(output.slot_count());  // scattered into
+  } else {
+    result.resize(output.slot_count());  // each block row written once
+  }
   dispatch(rows_.block_size(), columns_.block_size(), starts_.data(), block_columns_.data(),
-           values_.data(), rows_.count(), padded_input ? padded_x_.data() : x.data(), output.data(),
-           true);
-  if (padded_output) columns_.from_slots(padded_y_, y);
+           values_.data(), rows_.count(), input.identity() ? x.data() : input_slots.data(),
+           result.data(), transposed);
+  if (!output.identity()) output.from_slots(output_slots, y);
 }
 
 template class BlockSparseMatrix<float>;

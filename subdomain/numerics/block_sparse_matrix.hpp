@@ -55,11 +55,15 @@ class BlockSparseMatrix {
   const std::vector<Value>& values() const { return values_; }
 
  private:
+  /// y = P x, or y = P' x when `transposed`, on padded copies where a layout is not the identity.
+  void product(const Eigen::VectorXd& x, Eigen::VectorXd& y, bool transposed) const;
+
   BlockLayout rows_, columns_;
   std::vector<int> starts_;         // block rows + 1
   std::vector<int> block_columns_;  // per stored block
   std::vector<Value> values_;       // br bc per stored block
-  mutable Eigen::VectorXd padded_x_, padded_y_;
+  // vectors in the row and in the column slots, each of one size: no allocation per product
+  mutable Eigen::VectorXd padded_rows_, padded_columns_;
 };
 
 extern template class BlockSparseMatrix<float>;
