@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <functional>
+#include <optional>
 
 #include "coupling/case_file_body.hpp"
 #include "coupling/case_file_interface.hpp"
@@ -451,24 +453,39 @@ BodyDefinition load_body(const BodyCase& body) {
   return definition;
 }
 
-void load_meshes(CaseDefinition& definition) {
+void load_meshes(CaseDefinition& definition, const std::function<void(std::size_t)>& loaded) {
   std::vector<BodyCase*> bodies;
   std::vector<MeshFileRequest> requests;
   for (BodyCase& body : definition.bodies) {
     bodies.push_back(&body);
     requests.push_back({body.mesh_path, body.mesh_options});
   }
-  std::vector<Mesh> meshes;
+  // a body's checks fail after the reading of every mesh, in body order (a reader's error first)
+  std::vector<std::optional<InputError>> unusable(bodies.size());
+  const auto receive = [&](std::size_t k, Mesh&& mesh) {
+    BodyCase& body = *bodies[k];
+    body.definition.mesh = std::move(mesh);
+    try {
+      require_mesh_dimension(body, body.definition.mesh);
+      check_boundary_names(body, body.definition);
+    } catch (const InputError& error) {
+      unusable[k] = error;
+      return;
+    }
+    if (loaded) loaded(k);
+  };
   try {
-    meshes = read_gmsh_meshes(requests, definition.meshing);
+    read_gmsh_meshes(requests, receive, definition.meshing);
   } catch (const InputError& error) {
     throw mesh_error(bodies, error);
   }
-  for (std::size_t k = 0; k < bodies.size(); ++k) {
-    bodies[k]->definition.mesh = std::move(meshes[k]);
-    require_mesh_dimension(*bodies[k], bodies[k]->definition.mesh);
-    check_boundary_names(*bodies[k], bodies[k]->definition);
+  for (const std::optional<InputError>& error : unusable) {
+    if (error) throw *error;
   }
+}
+
+void load_meshes(CaseDefinition& definition) {
+  load_meshes(definition, {});
 }
 
 std::string in_case_file(const std::filesystem::path& case_file, const std::string& message) {

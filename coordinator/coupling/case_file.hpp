@@ -4,7 +4,9 @@
 // Unknown keys are errors.
 
 #include <array>
+#include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -160,5 +162,10 @@ BodyDefinition load_body(const BodyCase& body);
 /// process of its own, concurrently; definition.meshing is told as it goes) and checks every
 /// boundary name, as load_body does.
 void load_meshes(CaseDefinition& definition);
+
+/// load_meshes, telling `loaded(k)` on the calling thread as soon as body k's mesh is in its
+/// definition and checked, while the other meshes are still being read or meshed. Bodies whose
+/// meshes arrive are told even when another body's mesh fails later (and the call throws).
+void load_meshes(CaseDefinition& definition, const std::function<void(std::size_t body)>& loaded);
 
 }  // namespace robin

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <future>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -13,6 +15,7 @@
 #include "coupling/interface_outputs.hpp"
 #include "coupling/iteration_checkpoint.hpp"
 #include "coupling/local_problem.hpp"
+#include "coupling/mesh_arrivals.hpp"
 #include "coupling/step_outputs.hpp"
 
 namespace robin {
@@ -407,12 +410,13 @@ void run_load_steps(const LoadingOptions& loading, RecoverablePorts& ports,
   }
 }
 
-/// Sets every body up (each once, also across recoveries) and returns their interfaces.
-std::vector<InterfaceDescription> set_up_bodies(RecoverablePorts& ports,
-                                                const CaseDefinition& loaded) {
+/// Sets every body up (each once, also across recoveries), each as soon as its mesh has
+/// arrived; a body whose mesh never arrives (the loading was abandoned) is skipped.
+void set_up_bodies(RecoverablePorts& ports, const CaseDefinition& loaded, MeshArrivals& arrivals) {
   ports.run([&] {
     on_every_port(ports.ports(), [&](SubdomainPort& port, int alpha) {
       if (ports.interface(alpha)) return 0;
+      if (!arrivals.wait(static_cast<std::size_t>(alpha))) return 0;
       const BodyCase& body = loaded.bodies[static_cast<std::size_t>(alpha)];
       try {
         ports.interface(alpha) = port.setup(body, loaded.solver);
@@ -422,6 +426,46 @@ std::vector<InterfaceDescription> set_up_bodies(RecoverablePorts& ports,
       return 0;
     });
   });
+}
+
+/// Reads or meshes every body's mesh into `loaded` and sets the bodies up, each body's setup
+/// beginning as soon as its mesh is in (while the others are still read or meshed); returns
+/// their interfaces. The meshes are loaded on a thread of their own, the setups (and a
+/// recovery's restarted servers, which end with the thread that started them) stay on the
+/// calling thread. `report` tells people, from either thread. A failure of the loading is
+/// thrown after the setups already begun have ended.
+std::vector<InterfaceDescription> load_and_set_up_bodies(
+    RecoverablePorts& ports, CaseDefinition& loaded,
+    const std::function<void(const std::string&)>& report, CoupledRunResult& result) {
+  const auto start = Clock::now();
+  MeshArrivals arrivals(loaded.bodies.size());
+  std::future<void> loading = std::async(std::launch::async, [&] {
+    try {
+      load_meshes(loaded, [&](std::size_t body) {
+        report("setting up body '" + loaded.bodies[body].definition.name +
+               "' (assembly, factorization)");
+        arrivals.arrive(body);
+      });
+    } catch (...) {
+      arrivals.abandon();
+      throw;
+    }
+  });
+  try {
+    set_up_bodies(ports, loaded, arrivals);
+  } catch (...) {
+    arrivals.abandon();  // a setup failed: the loading goes on only to its end
+    loading.wait();
+    throw;
+  }
+  loading.get();  // the loading's error, when it failed
+  // the stages stay consecutive: meshing until the first setup began, setup from there
+  const auto loaded_time = Clock::now();
+  const auto first_setup = arrivals.first_arrival().value_or(start);
+  result.meshing_seconds =
+      std::chrono::duration<double>(arrivals.last_arrival().value_or(start) - start).count();
+  result.profile.meshing_seconds = std::chrono::duration<double>(first_setup - start).count();
+  result.profile.setup_seconds = std::chrono::duration<double>(loaded_time - first_setup).count();
   std::vector<InterfaceDescription> interfaces;
   for (int alpha = 0; alpha < ports.body_count(); ++alpha) {
     interfaces.push_back(*ports.interface(alpha));
@@ -470,18 +514,20 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
                                  : "the " + std::to_string(definition.bodies.size()) + " bodies";
   report_stage(observer, "reading and meshing " + bodies);
   CaseDefinition loaded = definition;
-  load_meshes(loaded);
-  result.meshing_seconds = seconds_since(start);
-  result.profile.meshing_seconds = result.meshing_seconds;
+  std::mutex observer_mutex;  // the meshes are loaded on a thread of their own
   RecoverablePorts recoverable(ports, loaded, continuation.replacement,
                                [&](const std::string& text) {
+                                 const std::lock_guard<std::mutex> lock(observer_mutex);
                                  result.recoveries.push_back(text);
                                  report_warning(observer, text);
                                });
-  report_stage(observer, "setting up " + bodies + " (assembly, factorization)");
-  const auto setup_start = Clock::now();
-  result.interfaces = set_up_bodies(recoverable, loaded);
-  result.profile.setup_seconds = seconds_since(setup_start);
+  result.interfaces = load_and_set_up_bodies(
+      recoverable, loaded,
+      [&](const std::string& text) {
+        const std::lock_guard<std::mutex> lock(observer_mutex);
+        report_stage(observer, text);
+      },
+      result);
   const auto coupling_start = Clock::now();
   result.coupling = couple_interfaces(definition, result.interfaces);
   result.coupling_seconds = seconds_since(coupling_start);

@@ -11,12 +11,15 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <thread>
 
 #include "numerics/errors.hpp"
 #include "numerics/helper_process.hpp"
@@ -189,6 +192,39 @@ class PrivateDirectory {
   std::filesystem::path path_;
 };
 
+/// Hands a read mesh (or the InputError of its reading) to read_gmsh_meshes.
+using MeshDelivery = std::function<void(std::size_t request, const std::function<Mesh()>& read)>;
+
+/// Reads the requests that are not .geo files on concurrent threads, at most one per processor
+/// at a time, and gives each to `deliver` on the calling thread in request order, as soon as it
+/// and those before it are read. Reads nothing when `first_error` is set; after a failure, the
+/// readings already started are waited for but not delivered.
+void read_msh_requests(const std::vector<MeshFileRequest>& requests,
+                       std::vector<Clock::time_point>& started, const MeshReadObserver& observer,
+                       const std::string& first_error, const MeshDelivery& deliver) {
+  std::vector<std::size_t> files;
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    if (lower_extension(requests[k].path) != ".geo") files.push_back(k);
+  }
+  const std::size_t concurrent = std::max(1u, std::thread::hardware_concurrency());
+  std::deque<std::future<Mesh>> readings;
+  std::size_t next = 0;
+  for (std::size_t delivered = 0; delivered < files.size() && first_error.empty(); ++delivered) {
+    while (next < files.size() && readings.size() < concurrent) {
+      const std::size_t k = files[next++];
+      started[k] = Clock::now();
+      if (observer.started) observer.started(k);
+      readings.push_back(std::async(std::launch::async, [&request = requests[k]] {
+        check_request(request.path, request.options);
+        return read_msh_file(request.path, request.path.string());
+      }));
+    }
+    std::future<Mesh> reading = std::move(readings.front());
+    readings.pop_front();
+    deliver(files[delivered], [&reading] { return reading.get(); });
+  }
+}
+
 }  // namespace
 
 std::filesystem::path mesh_reader_executable() {
@@ -208,9 +244,8 @@ Mesh read_gmsh_mesh(const std::filesystem::path& path, const MeshReadOptions& op
   return read_msh_file(path);
 }
 
-std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
-                                   const MeshReadObserver& observer) {
-  std::vector<Mesh> meshes(requests.size());
+void read_gmsh_meshes(const std::vector<MeshFileRequest>& requests, const MeshReceiver& receive,
+                      const MeshReadObserver& observer) {
   std::vector<bool> meshed(requests.size(), false);
   std::vector<std::size_t> geo_requests;
   for (std::size_t k = 0; k < requests.size(); ++k) {
@@ -221,17 +256,19 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
   std::vector<Clock::time_point> started(requests.size());
   const PrivateDirectory directory;
   std::string first_error;
-  const auto read = [&](std::size_t k, const std::filesystem::path& path) {
+  // a read mesh is told to the observer and handed over; a failure is kept, not thrown, so
+  // that every meshing child is waited for
+  const auto deliver = [&](std::size_t k, const std::function<Mesh()>& read) {
     try {
-      meshes[k] = read_msh_file(path, requests[k].path.string());
+      Mesh mesh = read();
+      mesh.source = requests[k].path.string();
+      if (observer.finished) {
+        observer.finished(k, mesh,
+                          std::chrono::duration<double>(Clock::now() - started[k]).count());
+      }
+      receive(k, std::move(mesh));
     } catch (const InputError& error) {
       if (first_error.empty()) first_error = error.what();
-      return;
-    }
-    meshes[k].source = requests[k].path.string();
-    if (observer.finished) {
-      observer.finished(k, meshes[k],
-                        std::chrono::duration<double>(Clock::now() - started[k]).count());
     }
   };
   if (!geo_requests.empty()) {
@@ -248,7 +285,9 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
       if (k >= requests.size() || meshed[k]) continue;
       meshed[k] = true;
       if (!error.empty() && first_error.empty()) first_error = error;
-      if (error.empty() && first_error.empty()) read(k, meshing_output(directory.path(), k));
+      if (!error.empty() || !first_error.empty()) continue;
+      const std::filesystem::path output = meshing_output(directory.path(), k);
+      deliver(k, [&] { return read_msh_file(output, requests[k].path.string()); });
     }
     const std::string process_error = finish_meshing_process(process);
     for (const std::size_t k : geo_requests) {
@@ -258,19 +297,15 @@ std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
           (process_error.empty() ? "the meshing process ended without its mesh" : process_error);
     }
   }
-  for (std::size_t k = 0; k < requests.size() && first_error.empty(); ++k) {
-    if (lower_extension(requests[k].path) == ".geo") continue;
-    started[k] = Clock::now();
-    if (observer.started) observer.started(k);
-    try {
-      check_request(requests[k].path, requests[k].options);
-    } catch (const InputError& error) {
-      first_error = error.what();
-      break;
-    }
-    read(k, requests[k].path);
-  }
+  read_msh_requests(requests, started, observer, first_error, deliver);
   if (!first_error.empty()) throw InputError(first_error);
+}
+
+std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
+                                   const MeshReadObserver& observer) {
+  std::vector<Mesh> meshes(requests.size());
+  read_gmsh_meshes(
+      requests, [&](std::size_t k, Mesh&& mesh) { meshes[k] = std::move(mesh); }, observer);
   return meshes;
 }
 

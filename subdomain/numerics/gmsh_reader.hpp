@@ -52,13 +52,24 @@ struct MeshReadObserver {
   std::function<void()> waiting;
 };
 
-/// Reads several mesh files at once, each as read_gmsh_mesh reads it. The .geo files are meshed
-/// by one robin-mesh-reader process (mesh_reader_executable, --mesh-geo-batch), which loads
-/// libgmsh once and meshes each file in a child process of its own, all concurrently; a child
-/// writes its mesh as binary MSH 4.1 into a private temporary directory, which this process
-/// reads (a .msh is read directly) as soon as that child has ended. Only the user's own
-/// files belong here: a .geo is a program. Throws InputError naming the file for the first
-/// request that fails (in the order the failures are seen), after every child has ended.
+/// Receives the mesh of request `request` as soon as it is read (read_gmsh_meshes).
+using MeshReceiver = std::function<void(std::size_t request, Mesh&& mesh)>;
+
+/// Reads several mesh files at once, each as read_gmsh_mesh reads it, and hands each mesh to
+/// `receive` as soon as it is read, on the calling thread, after observer.finished. The .geo
+/// files are meshed by one robin-mesh-reader process (mesh_reader_executable, --mesh-geo-batch),
+/// which loads libgmsh once and meshes each file in a child process of its own, all
+/// concurrently; a child writes its mesh as binary MSH 4.1 into a private temporary directory,
+/// which this process reads as soon as that child has ended (in the order they end). The .msh
+/// files are read after the .geo files are meshed, on concurrent threads (at most one per
+/// processor), and handed over in request order. Only the user's own files belong here: a .geo
+/// is a program. Throws InputError naming the file for the first request that fails (in the
+/// order the failures are seen), after every child has ended; an InputError thrown by `receive`
+/// counts as that request's failure. No mesh is handed over after a failure.
+void read_gmsh_meshes(const std::vector<MeshFileRequest>& requests, const MeshReceiver& receive,
+                      const MeshReadObserver& observer = {});
+
+/// read_gmsh_meshes, the meshes returned in request order.
 std::vector<Mesh> read_gmsh_meshes(const std::vector<MeshFileRequest>& requests,
                                    const MeshReadObserver& observer = {});
 

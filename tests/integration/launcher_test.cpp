@@ -304,9 +304,7 @@ std::unique_ptr<ChildProcess> start_with_temporary_directory(
 /// pids of its robin-subdomain children; empty when it ended before.
 std::vector<int> servers_once_setting_up(ChildProcess& run, const std::filesystem::path& log) {
   const bool setting_up = wait_until(
-      [&] {
-        return read_text(log).find("setting up both bodies") != std::string::npos || !run.running();
-      },
+      [&] { return read_text(log).find("setting up body") != std::string::npos || !run.running(); },
       120.0);
   if (!setting_up || !run.running()) return {};
   return child_processes(run.pid(), "robin-subdomain");

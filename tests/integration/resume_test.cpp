@@ -294,7 +294,7 @@ TEST(ServerRecovery, RobinRunRestartsAServerKilledDuringSetupAndFields) {
   const std::filesystem::path reference = reference_run(directory.path(), case_file);
   // after the handshake, within the setup request
   const std::string setup =
-      expect_recovery(directory.path(), case_file, reference, "upper", "setting up both bodies",
+      expect_recovery(directory.path(), case_file, reference, "upper", "setting up body 'upper'",
                       "upper-setup", std::chrono::milliseconds(40));
   EXPECT_NE(setup.find("step setup"), std::string::npos) << setup;
   const std::string fields =

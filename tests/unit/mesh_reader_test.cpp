@@ -423,6 +423,55 @@ TEST(MeshReader, ReadGmshMeshesTellsWhenEachMeshBeginsAndIsRead) {
   for (const auto& [request, nodes] : finished) EXPECT_EQ(nodes, meshes[request].node_count());
 }
 
+// The receiver gets every mesh once, as read_gmsh_mesh reads it: several .msh files (read on
+// threads of their own) in request order, after the observer heard of each; after a failing
+// request no later mesh is handed over, and the failure names its file.
+TEST(MeshReader, ReadGmshMeshesHandsEachMeshOverOnceInRequestOrder) {
+  const std::filesystem::path v22 = data_directory / "mesh_square_v22.msh";
+  const std::filesystem::path v41 = data_directory / "mesh_square_v41.msh";
+  const std::vector<MeshFileRequest> requests = {{v22, {}}, {v41, {}}, {v22, {}}, {v41, {}}};
+  std::vector<std::size_t> finished;
+  std::vector<std::size_t> received;
+  std::vector<Mesh> meshes(requests.size());
+  MeshReadObserver observer;
+  observer.finished = [&](std::size_t request, const Mesh&, double) {
+    finished.push_back(request);
+  };
+  read_gmsh_meshes(
+      requests,
+      [&](std::size_t request, Mesh&& mesh) {
+        EXPECT_EQ(finished.size(), received.size() + 1) << request;
+        received.push_back(request);
+        meshes[request] = std::move(mesh);
+      },
+      observer);
+  EXPECT_EQ(received, (std::vector<std::size_t>{0, 1, 2, 3}));
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    const Mesh direct = read_gmsh_mesh(requests[k].path);
+    EXPECT_EQ(meshes[k].nodes, direct.nodes) << k;
+    EXPECT_EQ(meshes[k].blocks[0].connectivity, direct.blocks[0].connectivity) << k;
+    EXPECT_EQ(meshes[k].source, requests[k].path.string()) << k;
+  }
+
+  const std::filesystem::path garbage = data_directory / "mesh_garbage.msh";
+  received.clear();
+  const std::string message = input_error_message([&] {
+    read_gmsh_meshes({{v22, {}}, {garbage, {}}, {v41, {}}},
+                     [&](std::size_t request, Mesh&&) { received.push_back(request); });
+  });
+  EXPECT_EQ(received, (std::vector<std::size_t>{0}));
+  EXPECT_NE(message.find(garbage.string()), std::string::npos) << message;
+
+  // an InputError of the receiver is that request's failure
+  const std::string refused = input_error_message([&] {
+    read_gmsh_meshes({{v22, {}}, {v41, {}}}, [&](std::size_t request, Mesh&&) {
+      if (request == 0) throw InputError("request 0 refused by its receiver");
+      ADD_FAILURE() << "request " << request << " handed over after a failure";
+    });
+  });
+  EXPECT_EQ(refused, "request 0 refused by its receiver");
+}
+
 TEST(MeshReader, ReadGmshMeshesLeavesNoTemporaryFile) {
   // A private temporary directory (through TMPDIR) so that other processes do not interfere.
   const std::filesystem::path directory =
