@@ -10,7 +10,9 @@ find_package(nlohmann_json REQUIRED)
 find_package(Protobuf REQUIRED)
 find_package(cppzmq REQUIRED)
 find_package(PkgConfig REQUIRED)
-# zlib: compression of the binary .vtu output (vtkZLibDataCompressor layout).
+# libdeflate: the zlib streams of the binary .vtu output (vtkZLibDataCompressor layout).
+pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
+# zlib: only benchmarks/vtu_compression_libraries_benchmark.cpp, which compares the two.
 find_package(ZLIB REQUIRED)
 # libsodium: SHA-256 of case files in summary.json (libzmq3-dev depends on it already).
 pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)

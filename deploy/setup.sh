@@ -17,7 +17,7 @@ packages=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-scipy python3-matplotlib python3-zmq python3-protobuf
   iproute2 procps shellcheck python3-yaml
-  zlib1g-dev
+  libdeflate-dev zlib1g-dev
   # ParaView 5.11 and its Python (paraview.simple, and the vtkmodules of its VTK 9.2, which the
   # tests read .vtu files with: python3-paraview conflicts with python3-vtk9 and replaces it on a
   # machine set up before), and a virtual X display for robin-paraview --screenshot

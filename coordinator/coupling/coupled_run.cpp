@@ -538,11 +538,11 @@ CoupledRunResult run_coupled_case(const CaseDefinition& definition,
     report_warning(observer, line);
   for (const std::string& line : overlap_warnings(result.coupling)) report_warning(observer, line);
   const auto assignment_start = Clock::now();
-  recoverable.run([&] {
-    for (int alpha = 0; alpha < recoverable.body_count(); ++alpha) {
-      recoverable.port(alpha).assign_contact(
-          result.coupling.operators[static_cast<std::size_t>(alpha)]);
-    }
+  recoverable.run([&] {  // every body's at once: each server builds its interface operator
+    on_every_port(recoverable.ports(), [&](SubdomainPort& port, int alpha) {
+      port.assign_contact(result.coupling.operators[static_cast<std::size_t>(alpha)]);
+      return 0;
+    });
   });
   recoverable.contact_assigned(result.coupling.operators);
   result.profile.contact_assignment_seconds = seconds_since(assignment_start);

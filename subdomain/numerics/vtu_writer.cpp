@@ -1,6 +1,6 @@
 #include "numerics/vtu_writer.hpp"
 
-#include <zlib.h>
+#include <libdeflate.h>
 
 #include <algorithm>
 #include <array>
@@ -25,43 +25,40 @@ namespace {
 
 /// Uncompressed bytes per zlib block (vtkZLibDataCompressor's default block size).
 constexpr std::size_t compression_block_size = 32768;
-/// zlib's fastest level, with run-length matching only (Z_RLE): the mantissas of computed doubles
-/// are close to random, so a search for earlier matches (every other strategy) mostly spends
-/// time; what compresses is the runs of zeros and of repeated bytes (exponents, sign bytes,
-/// connectivity), which Z_RLE finds. The blocks are ordinary zlib streams.
-constexpr int compression_level = Z_BEST_SPEED;
+/// libdeflate's fastest level. Its blocks are ordinary zlib streams (RFC 1950), as VTK's
+/// vtkZLibDataCompressor reads them; at its level 1 it is faster than zlib's fastest setting
+/// (level 1 with run-length matching only) and its output smaller (docs/benchmarks.md).
+constexpr int compression_level = 1;
 
-/// One zlib deflate state, reused for every block of a file (compress2 would allocate and free
-/// one per block).
+/// One libdeflate compressor, reused for every block of a file.
 class BlockCompressor {
  public:
-  explicit BlockCompressor(const std::filesystem::path& path) : path_(path) {
-    if (deflateInit2(&stream_, compression_level, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK) {
-      throw std::runtime_error("cannot write '" + path_.string() + "': zlib initialization failed");
+  explicit BlockCompressor(const std::filesystem::path& path)
+      : path_(path), compressor_(libdeflate_alloc_compressor(compression_level)) {
+    if (compressor_ == nullptr) {
+      throw std::runtime_error("cannot write '" + path_.string() +
+                               "': no memory for the compressor");
     }
   }
-  ~BlockCompressor() { deflateEnd(&stream_); }
+  ~BlockCompressor() { libdeflate_free_compressor(compressor_); }
   BlockCompressor(const BlockCompressor&) = delete;
   BlockCompressor& operator=(const BlockCompressor&) = delete;
 
   /// The zlib stream of `size` bytes at `data` in `buffer` (resized as needed); returns its size.
-  std::size_t compress(const char* data, std::size_t size, std::vector<Bytef>& buffer) {
-    const uLong bound = deflateBound(&stream_, static_cast<uLong>(size));
+  std::size_t compress(const char* data, std::size_t size, std::vector<std::uint8_t>& buffer) {
+    const std::size_t bound = libdeflate_zlib_compress_bound(compressor_, size);
     if (buffer.size() < bound) buffer.resize(bound);
-    deflateReset(&stream_);
-    stream_.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
-    stream_.avail_in = static_cast<uInt>(size);
-    stream_.next_out = buffer.data();
-    stream_.avail_out = static_cast<uInt>(buffer.size());
-    if (deflate(&stream_, Z_FINISH) != Z_STREAM_END) {
-      throw std::runtime_error("cannot write '" + path_.string() + "': zlib compression failed");
+    const std::size_t written =
+        libdeflate_zlib_compress(compressor_, data, size, buffer.data(), buffer.size());
+    if (written == 0) {
+      throw std::runtime_error("cannot write '" + path_.string() + "': compression failed");
     }
-    return static_cast<std::size_t>(stream_.total_out);
+    return written;
   }
 
  private:
-  z_stream stream_{};
   const std::filesystem::path& path_;
+  libdeflate_compressor* compressor_;
 };
 
 /// Text escaped for an XML attribute value.
@@ -296,8 +293,15 @@ std::vector<FacetKey> boundary_facet_keys(const Mesh& mesh) {
 }
 
 /// Sets each facet of `elements` still without an element (-1) to the flat index of the first
-/// element, in the element order of mesh.blocks, that has it as a side.
+/// element, in the element order of mesh.blocks, that has it as a side. Only the sides whose
+/// corners are all boundary-facet corners are looked up.
 void find_first_elements(const Mesh& mesh, FacetElements& elements) {
+  std::vector<bool> facet_corner(mesh.node_count(), false);
+  for (const auto& [key, element] : elements) {
+    for (const int corner : key) {
+      if (corner >= 0) facet_corner[static_cast<std::size_t>(corner)] = true;
+    }
+  }
   std::int64_t flat = 0;
   for (const ElementBlock& block : mesh.blocks) {
     const int nodes = nodes_per_element(block.type);
@@ -306,7 +310,12 @@ void find_first_elements(const Mesh& mesh, FacetElements& elements) {
       const int* element = block.connectivity.data() + e * static_cast<std::size_t>(nodes);
       for (const std::vector<int>& side : sides) {
         int corners[4];
-        for (std::size_t a = 0; a < side.size(); ++a) corners[a] = element[side[a]];
+        bool candidate = true;
+        for (std::size_t a = 0; a < side.size(); ++a) {
+          corners[a] = element[side[a]];
+          candidate = candidate && facet_corner[static_cast<std::size_t>(corners[a])];
+        }
+        if (!candidate) continue;
         const auto found = elements.find(facet_key(corners, static_cast<int>(side.size())));
         if (found != elements.end() && found->second < 0) found->second = flat;
       }
@@ -334,7 +343,8 @@ constexpr int quadratic_tetrahedron_type = 24;
 /// Puts the quadratic tetrahedron at the end of `connectivity` into VTK's node order: Gmsh's,
 /// except the last two midside nodes (Gmsh: on edges 3-2 and 3-1), which VTK numbers the other
 /// way (edges 1-3, 2-3).
-void to_vtk_node_order(std::vector<std::int64_t>& connectivity) {
+template <typename Index>
+void to_vtk_node_order(std::vector<Index>& connectivity) {
   const std::size_t size = connectivity.size();
   std::swap(connectivity[size - 2], connectivity[size - 1]);
 }
@@ -351,16 +361,35 @@ DataArray points_array(const Mesh& mesh) {
 /// Which array of the Cells section.
 enum class CellArray { connectivity, offsets, types };
 
+/// The length of the connectivity array: every area (volume) element's nodes, and with
+/// boundary cells every boundary facet's.
+std::size_t connectivity_length(const Mesh& mesh, bool boundary_cells) {
+  std::size_t length = 0;
+  for (const ElementBlock& block : mesh.blocks) length += block.connectivity.size();
+  if (boundary_cells) {
+    for (const auto& [name, group] : mesh.boundaries) length += group.connectivity.size();
+  }
+  return length;
+}
+
+/// Whether connectivity and offsets are written as Int32 (half the bytes to compress and
+/// store): when every offset fits, as node indices always do. Int64 otherwise.
+bool narrow_cell_indices(const Mesh& mesh, bool boundary_cells) {
+  return connectivity_length(mesh, boundary_cells) <=
+         static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+}
+
 /// One array of the cells: connectivity, offsets (end of each cell in connectivity) or types,
 /// over the area elements block after block, then (with boundary cells) the boundary facets in
-/// name order.
+/// name order; connectivity and offsets as Index (std::int32_t or std::int64_t).
+template <typename Index>
 DataArray cell_array(const Mesh& mesh, bool boundary_cells, CellArray which) {
-  std::vector<std::int64_t> connectivity, offsets;
+  std::vector<Index> connectivity, offsets;
   std::vector<std::uint8_t> types;
-  std::int64_t end = 0;
+  Index end = 0;
   const auto add_cells = [&](const std::vector<int>& nodes, int per_cell, int type) {
     for (std::size_t k = 0; k < nodes.size(); k += static_cast<std::size_t>(per_cell)) {
-      end += per_cell;
+      end += static_cast<Index>(per_cell);
       if (which == CellArray::connectivity) {
         connectivity.insert(connectivity.end(), nodes.begin() + static_cast<std::ptrdiff_t>(k),
                             nodes.begin() + static_cast<std::ptrdiff_t>(k) + per_cell);
@@ -380,11 +409,12 @@ DataArray cell_array(const Mesh& mesh, bool boundary_cells, CellArray which) {
       add_cells(group.connectivity, nodes_per_facet(group.type), vtk_cell_type(group.type));
     }
   }
+  const std::string index_type = sizeof(Index) == 4 ? "Int32" : "Int64";
   switch (which) {
     case CellArray::connectivity:
-      return {"Int64", "connectivity", 1, {}, std::move(connectivity)};
+      return {index_type, "connectivity", 1, {}, std::move(connectivity)};
     case CellArray::offsets:
-      return {"Int64", "offsets", 1, {}, std::move(offsets)};
+      return {index_type, "offsets", 1, {}, std::move(offsets)};
     case CellArray::types:
       break;
   }
@@ -549,8 +579,24 @@ class ArrayWriter {
   VtuEncoding encoding_;
   std::vector<PendingArray> pending_;
   BlockCompressor compressor_;
-  std::vector<Bytef> buffer_;  // one compressed block
+  std::vector<std::uint8_t> buffer_;  // one compressed block
 };
+
+/// The Cells section's arrays, Int32 or Int64 as narrow_cell_indices says.
+void write_cell_arrays(ArrayWriter& writer, const Mesh& mesh, bool boundary_cells) {
+  const bool narrow = narrow_cell_indices(mesh, boundary_cells);
+  const std::string index_type = narrow ? "Int32" : "Int64";
+  for (const auto& [which, name] : {std::pair{CellArray::connectivity, "connectivity"},
+                                    std::pair{CellArray::offsets, "offsets"}}) {
+    writer.write({index_type, name, 1, {}, {}}, [&mesh, boundary_cells, narrow, which = which] {
+      return narrow ? cell_array<std::int32_t>(mesh, boundary_cells, which)
+                    : cell_array<std::int64_t>(mesh, boundary_cells, which);
+    });
+  }
+  writer.write({"UInt8", "types", 1, {}, {}}, [&mesh, boundary_cells] {
+    return cell_array<std::int32_t>(mesh, boundary_cells, CellArray::types);
+  });
+}
 
 /// The Piece element: its PointData, CellData (with boundary_id when `boundary_cells`), Points
 /// and Cells.
@@ -579,15 +625,7 @@ void write_piece(std::ofstream& out, ArrayWriter& writer, const Mesh& mesh,
   writer.write({"Float64", "Points", 3, {}, {}}, [&mesh] { return points_array(mesh); });
   out << "      </Points>\n"
       << "      <Cells>\n";
-  writer.write({"Int64", "connectivity", 1, {}, {}}, [&mesh, boundary_cells] {
-    return cell_array(mesh, boundary_cells, CellArray::connectivity);
-  });
-  writer.write({"Int64", "offsets", 1, {}, {}}, [&mesh, boundary_cells] {
-    return cell_array(mesh, boundary_cells, CellArray::offsets);
-  });
-  writer.write({"UInt8", "types", 1, {}, {}}, [&mesh, boundary_cells] {
-    return cell_array(mesh, boundary_cells, CellArray::types);
-  });
+  write_cell_arrays(writer, mesh, boundary_cells);
   out << "      </Cells>\n"
       << "    </Piece>\n";
 }

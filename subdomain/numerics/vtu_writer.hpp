@@ -2,13 +2,13 @@
 // ParaView output: VTK XML unstructured grid (.vtu) and collection (.pvd) files.
 //
 // Format: VTKFile version 1.0, header_type UInt64, byte_order of the machine. By default every
-// array is binary in the appended-data section (encoding "raw"), compressed with zlib as
-// vtkZLibDataCompressor writes it: per array, the UInt64 header [number of blocks, uncompressed
-// block size (32768 bytes), uncompressed size of the last block (0 when it is full), compressed
-// size of each block], then the zlib streams of the blocks. The arrays are made and compressed
-// one at a time while the appended data is written (never the whole block in memory), and their
-// offsets written afterwards into room left in the XML: `offset="N"` is followed by spaces up to
-// a fixed width before the element's `/>`. VtuEncoding::ascii writes every
+// array is binary in the appended-data section (encoding "raw"), compressed in zlib's format
+// (RFC 1950, made by libdeflate) as vtkZLibDataCompressor writes it: per array, the UInt64 header
+// [number of blocks, uncompressed block size (32768 bytes), uncompressed size of the last block (0
+// when it is full), compressed size of each block], then the zlib streams of the blocks. The arrays
+// are made and compressed one at a time while the appended data is written (never the whole block
+// in memory), and their offsets written afterwards into room left in the XML: `offset="N"` is
+// followed by spaces up to a fixed width before the element's `/>`. VtuEncoding::ascii writes every
 // array inline as text instead, each real number as the shortest decimal that reads back to the
 // same double. Either way the values read back are the doubles given here, bit for bit.
 //
@@ -26,6 +26,8 @@
 //    (in name order): edges as VTK_LINE (3) or VTK_QUADRATIC_EDGE (21) (Gmsh line3 order: the
 //    two endpoints, then the midpoint, which is VTK's order), faces as VTK_TRIANGLE,
 //    VTK_QUADRATIC_TRIANGLE or VTK_QUAD. A facet in two boundaries is written twice.
+// The cells' connectivity and offsets are Int32 when the connectivity has at most 2^31 - 1
+// entries, else Int64; their types UInt8.
 // The writer adds the cell field "boundary_id" (Int32): 0 on area elements, k on the edges of
 // the k-th boundary (k = 1, 2, ... in name order), and, when there are boundary cells, the
 // field-data string array "boundary_names" whose entry k - 1 is the name of boundary k.

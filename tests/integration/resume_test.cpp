@@ -289,8 +289,9 @@ TEST(ServerRecovery, RobinRunRestartsAServerKilledDuringTheIterations) {
 TEST(ServerRecovery, RobinRunRestartsAServerKilledDuringSetupAndFields) {
   ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
   const TemporaryDirectory directory("robin-recovery-setup");
-  // two_blocks on a finer mesh: a setup of about 0.1 s and fields of about 0.2 s
-  const std::filesystem::path case_file = case_copy(directory.path(), 0.02, "two_blocks.toml");
+  // two_blocks on a finer mesh: a setup of 0.1-0.2 s (each body's begins when its mesh is in; the
+  // kill comes 40 ms after the upper body's began) and fields of about 0.2 s
+  const std::filesystem::path case_file = case_copy(directory.path(), 0.01, "two_blocks.toml");
   const std::filesystem::path reference = reference_run(directory.path(), case_file);
   // after the handshake, within the setup request
   const std::string setup =
