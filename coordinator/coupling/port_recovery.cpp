@@ -27,6 +27,9 @@ PortTimings RecoverablePorts::timings(int body) const {
 
 void RecoverablePorts::restore_body(int body) {
   const auto index = static_cast<std::size_t>(body);
+  // a body not set up yet (its setup was under way, or its mesh not in yet) is set up by the
+  // setup stage when it runs again
+  if (!interfaces_[index]) return;
   SubdomainPort& port = *ports_[index];
   const std::string& name = loaded_.bodies[index].definition.name;
   if (report_) report_("setting body '" + name + "' up again on " + port.describe());

@@ -5,7 +5,8 @@
 // set. A stage of the run (setup, contact assignment, the iteration, the fields) runs through
 // run(): when it fails with a PortError and a server is lost, the server is replaced (by the
 // caller's hook, which bounds the restarts and throws when there are none left), its body set
-// up again, and the stage runs again. The surviving port forgets its unfinished request.
+// up again when it had been set up (else the setup stage, run again, sets it up), and the stage
+// runs again. The surviving port forgets its unfinished request.
 //
 // The iteration stage continues from its last checkpoint (coupled_run.cpp). The survivors'
 // contact is assigned again, which resets their contact QP's warm start to zero as at the
@@ -37,7 +38,8 @@ struct ServerReplacement {
 
 class RecoverablePorts {
  public:
-  /// `loaded` holds the bodies with their meshes (load_meshes); it must outlive this object.
+  /// `loaded` holds the bodies, whose meshes may still be arriving while the setup stage runs
+  /// (load_meshes fills them in); it must outlive this object.
   /// `report` is told, for people, what was recovered.
   /// One port per body of `loaded`, in body order.
   RecoverablePorts(const std::vector<SubdomainPort*>& ports, const CaseDefinition& loaded,
