@@ -18,10 +18,20 @@
 
 namespace robin {
 
-void release_free_heap_memory() {
 #if defined(__GLIBC__) && !defined(ROBIN_SANITIZER_ALLOCATOR)
+void release_free_heap_memory() {
   malloc_trim(0);
-#endif
 }
+
+bool releases_free_heap_memory() {
+  return true;
+}
+#else
+void release_free_heap_memory() {}
+
+bool releases_free_heap_memory() {
+  return false;
+}
+#endif
 
 }  // namespace robin

@@ -10,4 +10,7 @@ namespace robin {
 /// never-used arenas, first called from two setup threads at once, read a null arena pointer.
 void release_free_heap_memory();
 
+/// Whether release_free_heap_memory gives memory back in this build (glibc's allocator in use).
+bool releases_free_heap_memory();
+
 }  // namespace robin
