@@ -287,7 +287,8 @@ void read_gmsh_meshes(const std::vector<MeshFileRequest>& requests, const MeshRe
       if (!error.empty() && first_error.empty()) first_error = error;
       if (!error.empty() || !first_error.empty()) continue;
       const std::filesystem::path output = meshing_output(directory.path(), k);
-      deliver(k, [&] { return read_msh_file(output, requests[k].path.string()); });
+      const std::string label = requests[k].path.string();
+      deliver(k, [&output, &label] { return read_msh_file(output, label); });
     }
     const std::string process_error = finish_meshing_process(process);
     for (const std::size_t k : geo_requests) {
