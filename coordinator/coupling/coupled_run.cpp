@@ -460,12 +460,12 @@ std::vector<InterfaceDescription> load_and_set_up_bodies(
   }
   loading.get();  // the loading's error, when it failed
   // the stages stay consecutive: meshing until the first setup began, setup from there
-  const auto loaded_time = Clock::now();
+  const auto bodies_set_up = Clock::now();
   const auto first_setup = arrivals.first_arrival().value_or(start);
   result.meshing_seconds =
       std::chrono::duration<double>(arrivals.last_arrival().value_or(start) - start).count();
   result.profile.meshing_seconds = std::chrono::duration<double>(first_setup - start).count();
-  result.profile.setup_seconds = std::chrono::duration<double>(loaded_time - first_setup).count();
+  result.profile.setup_seconds = std::chrono::duration<double>(bodies_set_up - first_setup).count();
   std::vector<InterfaceDescription> interfaces;
   for (int alpha = 0; alpha < ports.body_count(); ++alpha) {
     interfaces.push_back(*ports.interface(alpha));
