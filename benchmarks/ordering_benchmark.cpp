@@ -3,8 +3,11 @@
 // MESH_SIZE (the .geo variable h):
 //   dofs:  CHOLMOD's own choice (cholmod_analyze's default: AMD, then METIS when AMD fills
 //          much) on the graph of the degrees of freedom, as robin-contact did before;
-//   nodes: fill_reducing_ordering (AMD and METIS on the graph of the nodes, the one with fewer
-//          flops), as the servers do now;
+//   nodes: fill_reducing_ordering without the nodes' positions (AMD, and METIS when AMD's order
+//          needs many flops, on the graph of the nodes), as servers did before the geometric
+//          dissection and as other callers still do;
+//   geometry: fill_reducing_ordering with the nodes' positions (geometric nested dissection with
+//          CAMD, and METIS when that order needs very many flops), as the servers do now;
 // each without and with the contact boundary's dofs eliminated last (the order the servers use
 // for a dense interface operator), followed by CHOLMOD's supernodal symbolic analysis with
 // that order. Prints one markdown row per body, variant and way: ordering seconds (order and
@@ -36,7 +39,11 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-enum class Way { dofs, nodes };
+enum class Way { dofs, nodes, geometry };
+
+const char* way_name(Way way) {
+  return way == Way::dofs ? "dofs" : way == Way::nodes ? "nodes" : "geometry";
+}
 
 /// CHOLMOD's default order of the matrix without `trailing`, then `trailing`.
 std::vector<int> cholmod_dof_ordering(const robin::SparseMatrix& lower,
@@ -73,13 +80,17 @@ std::vector<int> cholmod_dof_ordering(const robin::SparseMatrix& lower,
 }
 
 void measure(const std::string& body, const robin::SparseMatrix& lower,
-             const std::vector<int>& trailing, Way way, bool factorize) {
+             const std::vector<int>& trailing, const std::vector<Eigen::Vector3d>& points, Way way,
+             bool factorize) {
   cholmod_common common;
   cholmod_start(&common);
   const auto start = Clock::now();
-  std::vector<int> ordering = way == Way::dofs
-                                  ? cholmod_dof_ordering(lower, trailing, common)
-                                  : robin::fill_reducing_ordering(lower, trailing, common, body);
+  const std::vector<Eigen::Vector3d> no_points;
+  std::vector<int> ordering =
+      way == Way::dofs
+          ? cholmod_dof_ordering(lower, trailing, common)
+          : robin::fill_reducing_ordering(lower, trailing,
+                                          way == Way::geometry ? points : no_points, common, body);
   cholmod_sparse view = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
   common.nmethods = 1;
   common.method[0].ordering = CHOLMOD_GIVEN;
@@ -97,8 +108,8 @@ void measure(const std::string& body, const robin::SparseMatrix& lower,
       factorization += " (status " + std::to_string(common.status) + ")";
   }
   std::printf("| %s | %d | %zu | %s | %.3f | %.3e | %.3e | %s |\n", body.c_str(),
-              static_cast<int>(lower.rows()), trailing.size(), way == Way::dofs ? "dofs" : "nodes",
-              ordering_seconds, entries, flops, factorization.c_str());
+              static_cast<int>(lower.rows()), trailing.size(), way_name(way), ordering_seconds,
+              entries, flops, factorization.c_str());
   std::fflush(stdout);
   cholmod_free_factor(&factor, &common);
   cholmod_finish(&common);
@@ -142,9 +153,13 @@ int main(int argc, char** argv) {
         }
       }
     }
+    std::vector<Eigen::Vector3d> points;
+    for (int node : robin::free_dof_nodes(mesh, dofs)) {
+      points.push_back(mesh.nodes[static_cast<std::size_t>(node)]);
+    }
     for (const std::vector<int>& last : {std::vector<int>{}, trailing}) {
-      for (Way way : {Way::dofs, Way::nodes}) {
-        measure(body.definition.name, lower, last, way, factorize);
+      for (Way way : {Way::dofs, Way::nodes, Way::geometry}) {
+        measure(body.definition.name, lower, last, points, way, factorize);
       }
     }
   }

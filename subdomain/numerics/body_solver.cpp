@@ -321,8 +321,9 @@ void BodySolver::assemble() {
                                ? Eigen::MatrixXd(dofs_->free_count(), 0)
                                : rigid_body_modes(mesh, *dofs_);
   factor_ = std::make_unique<GeneralizedInverse>(
-      std::move(reduced_stiffness), std::move(kernel), name(), trailing_unknowns(),
-      options_.maximum_factor_bytes, factorization_observer());
+      std::move(reduced_stiffness), std::move(kernel), name(),
+      FactorizationOptions{trailing_unknowns(), options_.maximum_factor_bytes,
+                           factorization_observer(), free_dof_points()});
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
   rigid_amplitudes_ = Eigen::VectorXd::Zero(rigid_mode_count());
   // the ordering as the factor measured it; the rest (numerical factorization, K^{-1} f) here
@@ -371,8 +372,9 @@ void BodySolver::fall_back_to_direct_solver() {
   SparseMatrix lower = multigrid_->stiffness_matrix();
   multigrid_.reset();
   factor_ = std::make_unique<GeneralizedInverse>(
-      std::move(lower), Eigen::MatrixXd(dofs_->free_count(), 0), name(), std::vector<int>{},
-      options_.maximum_factor_bytes, factorization_observer());
+      std::move(lower), Eigen::MatrixXd(dofs_->free_count(), 0), name(),
+      FactorizationOptions{
+          {}, options_.maximum_factor_bytes, factorization_observer(), free_dof_points()});
   free_solution_ = factor_->solve(reduced_load_);  // K^{-1} f
 }
 
@@ -399,6 +401,15 @@ SetupObserver BodySolver::factorization_observer() const {
     if (stage == SetupStage::factorization) release_free_heap_memory();
     if (observer) observer(stage);
   };
+}
+
+std::vector<Eigen::Vector3d> BodySolver::free_dof_points() const {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(static_cast<std::size_t>(dofs_->free_count()));
+  for (const int node : free_dof_nodes(definition_.mesh, *dofs_)) {
+    points.push_back(definition_.mesh.nodes[static_cast<std::size_t>(node)]);
+  }
+  return points;
 }
 
 std::vector<int> BodySolver::trailing_unknowns() const {

@@ -339,6 +339,8 @@ class BodySolver {
   void update_free_trace();
   /// Free dofs of the contact boundaries' nodes, to be eliminated last (empty when disabled).
   std::vector<int> trailing_unknowns() const;
+  /// The position of each free dof's node, for the ordering's geometric dissection.
+  std::vector<Eigen::Vector3d> free_dof_points() const;
   Eigen::VectorXd apply_transpose_trace(const Eigen::VectorXd& contact_force) const;  // B' lambda
   /// Floating bodies: B R of full column rank and G lambda = h solvable with lambda >= 0.
   void check_held_by_contact() const;

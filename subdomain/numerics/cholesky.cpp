@@ -161,8 +161,7 @@ struct CholeskyFactor::Implementation {
   double ordering_seconds = 0.0;
   double factorization_seconds = 0.0;
 
-  void factorize(SparseMatrix& matrix, const std::vector<int>& trailing,
-                 const SetupObserver& observer);
+  void factorize(SparseMatrix& matrix, FactorizationOptions& options);
   void check_memory_estimate();
   void check_pivots() const;
   void locate_trailing(const std::vector<int>& trailing);
@@ -175,14 +174,16 @@ void throw_if_out_of_memory(const cholmod_common& common) {
 }
 
 void CholeskyFactor::Implementation::factorize(SparseMatrix& matrix,
-                                               const std::vector<int>& trailing,
-                                               const SetupObserver& observer) {
+                                               FactorizationOptions& options) {
+  const std::vector<int>& trailing = options.trailing_unknowns;
   auto start = std::chrono::steady_clock::now();
   cholmod_common& common = cholesky.cholmod();
   common.print = 0;                // CHOLMOD prints nothing, not even warnings
   common.error_handler = nullptr;  // failures are read from common.status instead
   common.supernodal = CHOLMOD_SUPERNODAL;
-  std::vector<int> ordering = fill_reducing_ordering(matrix, trailing, common, body_name);
+  std::vector<int> ordering =
+      fill_reducing_ordering(matrix, trailing, options.unknown_points, common, body_name);
+  std::vector<Eigen::Vector3d>().swap(options.unknown_points);
   cholesky.analyze_pattern_ordered(matrix, ordering);
   if (cholesky.factor() == nullptr || common.status < CHOLMOD_OK) {
     throw_if_out_of_memory(common);
@@ -194,7 +195,7 @@ void CholeskyFactor::Implementation::factorize(SparseMatrix& matrix,
   // factorization allocates what it uses.
   cholmod_free_work(&common);
   ordering_seconds = seconds_since(start);
-  if (observer) observer(SetupStage::factorization);
+  if (options.observer) options.observer(SetupStage::factorization);
   start = std::chrono::steady_clock::now();
   cholesky.factorize_releasing(matrix);
   const cholmod_factor& factor = *cholesky.factor();
@@ -264,17 +265,14 @@ void CholeskyFactor::Implementation::check_pivots() const {
 }
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
-                               const std::vector<int>& trailing_unknowns, double memory_limit_bytes,
-                               const SetupObserver& observer)
-    : CholeskyFactor(SparseMatrix(matrix), body_name, trailing_unknowns, memory_limit_bytes,
-                     observer) {}
+                               FactorizationOptions options)
+    : CholeskyFactor(SparseMatrix(matrix), body_name, std::move(options)) {}
 
 CholeskyFactor::CholeskyFactor(SparseMatrix&& matrix, const std::string& body_name,
-                               const std::vector<int>& trailing_unknowns, double memory_limit_bytes,
-                               const SetupObserver& observer)
+                               FactorizationOptions options)
     : implementation_(std::make_unique<Implementation>()) {
   implementation_->body_name = body_name;
-  implementation_->memory_limit_bytes = memory_limit_bytes;
+  implementation_->memory_limit_bytes = options.memory_limit_bytes;
   if (matrix.rows() != matrix.cols()) {
     throw InputError("body '" + body_name + "': the stiffness matrix is " +
                      std::to_string(matrix.rows()) + " x " + std::to_string(matrix.cols()) +
@@ -285,7 +283,7 @@ CholeskyFactor::CholeskyFactor(SparseMatrix&& matrix, const std::string& body_na
                      "': the stiffness matrix is empty (every degree of freedom is prescribed)");
   }
   implementation_->size = static_cast<int>(matrix.rows());
-  implementation_->factorize(matrix, trailing_unknowns, observer);
+  implementation_->factorize(matrix, options);
 }
 
 CholeskyFactor::~CholeskyFactor() = default;

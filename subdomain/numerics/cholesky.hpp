@@ -19,28 +19,37 @@
 
 namespace robin {
 
+/// What a factorization is told besides the matrix.
+struct FactorizationOptions {
+  /// Eliminated last, in this order (indices into the matrix, distinct): the rest come first,
+  /// in the fill-reducing order of the matrix without them (fill_reducing_ordering.hpp).
+  std::vector<int> trailing_unknowns{};
+  /// > 0: when the symbolic analysis finds that L needs more bytes (8 per stored entry),
+  /// ResourceLimitError is thrown before the numerical factorization allocates them.
+  double memory_limit_bytes = 0.0;
+  /// Told when the numerical factorization begins, after the ordering and symbolic analysis
+  /// (may be empty).
+  SetupObserver observer{};
+  /// The position of each unknown's node (one per unknown), or empty: with positions the
+  /// ordering dissects the body geometrically (fill_reducing_ordering.hpp). Released once the
+  /// ordering is computed.
+  std::vector<Eigen::Vector3d> unknown_points{};
+};
+
 class CholeskyFactor {
  public:
   /// Factorizes the symmetric positive definite `matrix` (only its lower triangle is read).
   /// Throws SingularBodyError naming `body_name` when the matrix is not positive definite or
   /// numerically singular (pivot ratio min L_jj^2 / max L_jj^2 < 1e-13, i.e. cond > 1e13);
-  /// InputError when it is empty or not square; std::bad_alloc when CHOLMOD runs out of memory.
-  /// Solves are not thread-safe (CHOLMOD workspace).
-  /// `trailing_unknowns` (indices into the matrix, distinct) are eliminated last: the rest
-  /// in the fill-reducing order of the matrix without them (fill_reducing_ordering.hpp: AMD or
-  /// METIS on the graph of the nodes), then these in the given order.
-  /// `memory_limit_bytes` > 0 bounds the factor: when the symbolic analysis finds that L needs
-  /// more (8 bytes per stored entry), ResourceLimitError is thrown before the numerical
-  /// factorization allocates it. `observer` (may be empty) is told when the numerical
-  /// factorization begins, after the ordering and symbolic analysis.
+  /// InputError when it is empty or not square; std::bad_alloc when CHOLMOD runs out of memory;
+  /// std::invalid_argument when a trailing unknown is out of range or repeated, or the points
+  /// are not one per unknown. Solves are not thread-safe (CHOLMOD workspace).
   CholeskyFactor(const SparseMatrix& matrix, const std::string& body_name,
-                 const std::vector<int>& trailing_unknowns = {}, double memory_limit_bytes = 0.0,
-                 const SetupObserver& observer = {});
+                 FactorizationOptions options = {});
   /// The same, taking the matrix: it is freed (left empty) during the numerical factorization,
   /// once CHOLMOD has its own permuted copy, so that the two are not resident beside L.
   CholeskyFactor(SparseMatrix&& matrix, const std::string& body_name,
-                 const std::vector<int>& trailing_unknowns = {}, double memory_limit_bytes = 0.0,
-                 const SetupObserver& observer = {});
+                 FactorizationOptions options = {});
   ~CholeskyFactor();
   CholeskyFactor(const CholeskyFactor&) = delete;
   CholeskyFactor& operator=(const CholeskyFactor&) = delete;

@@ -9,13 +9,16 @@
 // node-level elimination does, so the order is as good as one computed on the unknowns, at a
 // fraction of the cost of AMD and METIS on the full graph.
 //
-// On the supervariable graph AMD is computed first. METIS (nested dissection) costs far more and
-// pays off only through a cheaper numerical factorization, so it is computed too only when the
-// factorization with AMD's order needs many floating-point operations per entry of the graph
-// (more than 2e4, the unknowns' flops estimated from the graph's), and the order with fewer flops
-// is kept: METIS is tried on large plane bodies and on solid bodies of every size, not on small
-// and mid-size plane bodies, where its own cost exceeds what it saves (docs/benchmarks.md).
+// When the unknowns' positions are known (a body's mesh), the supervariable graph is ordered by
+// geometric nested dissection (geometric_dissection.hpp) with a constrained minimum-degree order
+// (CAMD) inside each set; otherwise by AMD. METIS (nested dissection by multilevel partitioning)
+// costs far more and pays off only through a cheaper numerical factorization, so it is computed
+// too only when the factorization with the first order needs many floating-point operations per
+// entry of the graph (the unknowns' flops estimated from the graph's): more than 2e4 after AMD
+// (large plane bodies, solid bodies), more than 1e5 after the geometric dissection (large solid
+// bodies). The order with fewer flops is kept (docs/benchmarks.md).
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -29,12 +32,15 @@ namespace robin {
 /// triangle is not read): order[k] is the unknown eliminated k-th. The unknowns other than
 /// `trailing` come first, in the fill-reducing order of the matrix restricted to them (above);
 /// then `trailing`, in the given order. Supervariables are found among consecutive unknowns
-/// (the components of a node are numbered together). `common` is CHOLMOD's workspace; its
+/// (the components of a node are numbered together). `unknown_points`: the position of each
+/// unknown's node (one per unknown), or empty when unknown. `common` is CHOLMOD's workspace; its
 /// ordering settings are restored on return. Throws std::invalid_argument naming `body_name`
 /// when a trailing unknown is out of range or repeated, std::bad_alloc when CHOLMOD runs out of
-/// memory, std::runtime_error when it fails otherwise.
+/// memory, std::runtime_error when it fails otherwise; std::invalid_argument when
+/// unknown_points is neither empty nor one per unknown.
 std::vector<int> fill_reducing_ordering(const SparseMatrix& matrix,
                                         const std::vector<int>& trailing,
+                                        const std::vector<Eigen::Vector3d>& unknown_points,
                                         cholmod_common_struct& common,
                                         const std::string& body_name);
 

@@ -40,20 +40,15 @@ SparseMatrix kept_block(const SparseMatrix& matrix, const std::vector<int>& kept
 }  // namespace
 
 GeneralizedInverse::GeneralizedInverse(const SparseMatrix& stiffness, Eigen::MatrixXd kernel,
-                                       const std::string& body_name,
-                                       const std::vector<int>& trailing_unknowns,
-                                       double memory_limit_bytes, const SetupObserver& observer)
-    : GeneralizedInverse(SparseMatrix(stiffness), std::move(kernel), body_name, trailing_unknowns,
-                         memory_limit_bytes, observer) {}
+                                       const std::string& body_name, FactorizationOptions options)
+    : GeneralizedInverse(SparseMatrix(stiffness), std::move(kernel), body_name,
+                         std::move(options)) {}
 
 GeneralizedInverse::GeneralizedInverse(SparseMatrix&& stiffness, Eigen::MatrixXd kernel,
-                                       const std::string& body_name,
-                                       const std::vector<int>& trailing_unknowns,
-                                       double memory_limit_bytes, const SetupObserver& observer)
+                                       const std::string& body_name, FactorizationOptions options)
     : size_(static_cast<int>(stiffness.rows())), kernel_(std::move(kernel)) {
   if (kernel_.cols() == 0) {
-    factor_ = std::make_unique<CholeskyFactor>(std::move(stiffness), body_name, trailing_unknowns,
-                                               memory_limit_bytes, observer);
+    factor_ = std::make_unique<CholeskyFactor>(std::move(stiffness), body_name, std::move(options));
     return;
   }
   if (kernel_.rows() != size_) {
@@ -61,21 +56,42 @@ GeneralizedInverse::GeneralizedInverse(SparseMatrix&& stiffness, Eigen::MatrixXd
                                 std::to_string(kernel_.rows()) + " rows for a stiffness of size " +
                                 std::to_string(size_));
   }
+  if (!options.unknown_points.empty() && static_cast<int>(options.unknown_points.size()) != size_) {
+    throw std::invalid_argument("body '" + body_name +
+                                "': " + std::to_string(options.unknown_points.size()) +
+                                " unknown points for a stiffness of size " + std::to_string(size_));
+  }
   fixing_dofs_ = choose_fixing_dofs(kernel_);
   kept_index_.assign(static_cast<std::size_t>(size_), 0);
   for (const int dof : fixing_dofs_) kept_index_[static_cast<std::size_t>(dof)] = -1;
   int kept_count = 0;
   for (int& index : kept_index_) index = index < 0 ? -1 : kept_count++;
-  std::vector<int> kept_trailing;
-  for (const int unknown : trailing_unknowns) {
-    if (kept_index_[static_cast<std::size_t>(unknown)] >= 0) {
-      kept_trailing.push_back(kept_index_[static_cast<std::size_t>(unknown)]);
+  options.trailing_unknowns = kept_only(options.trailing_unknowns, body_name);
+  std::vector<Eigen::Vector3d> kept_points;
+  for (int dof = 0; dof < size_ && !options.unknown_points.empty(); ++dof) {
+    if (kept_index_[static_cast<std::size_t>(dof)] >= 0) {
+      kept_points.push_back(options.unknown_points[static_cast<std::size_t>(dof)]);
     }
   }
+  options.unknown_points = std::move(kept_points);
   SparseMatrix kept = kept_block(stiffness, kept_index_, kept_count);
   SparseMatrix().swap(stiffness);  // only K_rr is factorized
-  factor_ = std::make_unique<CholeskyFactor>(std::move(kept), body_name, kept_trailing,
-                                             memory_limit_bytes, observer);
+  factor_ = std::make_unique<CholeskyFactor>(std::move(kept), body_name, std::move(options));
+}
+
+std::vector<int> GeneralizedInverse::kept_only(const std::vector<int>& unknowns,
+                                               const std::string& body_name) const {
+  std::vector<int> kept;
+  for (const int unknown : unknowns) {
+    if (unknown < 0 || unknown >= size_) {
+      throw std::invalid_argument("body '" + body_name + "': trailing unknown " +
+                                  std::to_string(unknown) + " is out of range");
+    }
+    if (kept_index_[static_cast<std::size_t>(unknown)] >= 0) {
+      kept.push_back(kept_index_[static_cast<std::size_t>(unknown)]);
+    }
+  }
+  return kept;
 }
 
 Eigen::VectorXd GeneralizedInverse::restrict_to_kept(const Eigen::VectorXd& values) const {

@@ -31,16 +31,15 @@ namespace robin {
 class GeneralizedInverse {
  public:
   /// Factorizes K (free x free) with kernel `kernel` (free x k orthonormal columns, k = 0 for an
-  /// SPD K). `trailing_unknowns` (free indices) are eliminated last (cholesky.hpp); fixing dofs
-  /// among them are dropped. Throws as CholeskyFactor (SingularBodyError when K_rr is not
-  /// positive definite: the kernel was not the whole null space, e.g. a disconnected mesh).
+  /// SPD K) with `options` (cholesky.hpp; trailing unknowns and points indexed by free dof):
+  /// fixing dofs among the trailing unknowns are dropped. Throws as CholeskyFactor
+  /// (SingularBodyError when K_rr is not positive definite: the kernel was not the whole null
+  /// space, e.g. a disconnected mesh).
   GeneralizedInverse(const SparseMatrix& stiffness, Eigen::MatrixXd kernel,
-                     const std::string& body_name, const std::vector<int>& trailing_unknowns,
-                     double memory_limit_bytes, const SetupObserver& observer);
+                     const std::string& body_name, FactorizationOptions options = {});
   /// The same, taking K: it is freed (left empty) during the factorization (cholesky.hpp).
   GeneralizedInverse(SparseMatrix&& stiffness, Eigen::MatrixXd kernel, const std::string& body_name,
-                     const std::vector<int>& trailing_unknowns, double memory_limit_bytes,
-                     const SetupObserver& observer);
+                     FactorizationOptions options = {});
 
   int size() const { return size_; }
   /// k, the dimension of the kernel.
@@ -68,6 +67,9 @@ class GeneralizedInverse {
   double factorization_seconds() const { return factor_->factorization_seconds(); }
 
  private:
+  /// The K_rr indices of `unknowns` (free indices), fixing dofs dropped; std::invalid_argument
+  /// naming `body_name` for an index out of range.
+  std::vector<int> kept_only(const std::vector<int>& unknowns, const std::string& body_name) const;
   Eigen::VectorXd restrict_to_kept(const Eigen::VectorXd& values) const;
   Eigen::VectorXd expand_from_kept(const Eigen::VectorXd& values) const;
 

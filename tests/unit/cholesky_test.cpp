@@ -169,7 +169,7 @@ TEST(Cholesky, TrailingCongruenceMatchesAnIndependentSolve) {
   const int size = 600;
   const SparseMatrix matrix = random_sparse_spd(size, 4, 51);
   const std::vector<int> trailing = random_unknowns(size, 60, 52);
-  const CholeskyFactor factor(matrix, "block", trailing);
+  const CholeskyFactor factor(matrix, "block", {.trailing_unknowns = trailing});
   ASSERT_TRUE(factor.has_trailing_block());
   // The reordered factor still solves K x = b.
   const Eigen::VectorXd load = Eigen::VectorXd::LinSpaced(size, -2.0, 1.0);
@@ -191,7 +191,7 @@ TEST(Cholesky, TrailingCongruenceRejectsOtherUnknownsAndMissingBlocks) {
   const int size = 200;
   const SparseMatrix matrix = random_sparse_spd(size, 3, 61);
   const std::vector<int> trailing = random_unknowns(size, 20, 62);
-  const CholeskyFactor factor(matrix, "block", trailing);
+  const CholeskyFactor factor(matrix, "block", {.trailing_unknowns = trailing});
   std::vector<int> others;
   for (int j = 0; j < size; ++j) {
     if (std::find(trailing.begin(), trailing.end(), j) == trailing.end()) others.push_back(j);
@@ -204,8 +204,10 @@ TEST(Cholesky, TrailingCongruenceRejectsOtherUnknownsAndMissingBlocks) {
   EXPECT_FALSE(plain.has_trailing_block());
   EXPECT_THROW(plain.trailing_congruence(random_trace(5, size, trailing, 64)), std::logic_error);
 
-  EXPECT_THROW(CholeskyFactor(matrix, "block", {3, 7, 3}), std::invalid_argument);
-  EXPECT_THROW(CholeskyFactor(matrix, "block", {size}), std::invalid_argument);
+  EXPECT_THROW(CholeskyFactor(matrix, "block", {.trailing_unknowns = {3, 7, 3}}),
+               std::invalid_argument);
+  EXPECT_THROW(CholeskyFactor(matrix, "block", {.trailing_unknowns = {size}}),
+               std::invalid_argument);
 }
 
 TEST(Cholesky, EmptyOrNonSquareMatrixIsAnInputError) {

@@ -96,7 +96,7 @@ TEST(GeneralizedInverse, IsAGeneralizedInverseAndGivesTheMoorePenroseSolution) {
        std::vector<std::vector<std::pair<std::string, std::pair<bool, bool>>>>{
            {}, {{"left", {true, false}}, {"right", {true, false}}}, {{"bottom", {false, true}}}}) {
     const Body body = make_body(supports);
-    const GeneralizedInverse inverse(body.stiffness, body.kernel, "b", {}, 0.0, {});
+    const GeneralizedInverse inverse(body.stiffness, body.kernel, "b");
     ASSERT_EQ(inverse.rigid_mode_count(), body.kernel.cols());
     EXPECT_EQ(static_cast<Eigen::Index>(inverse.fixing_dofs().size()), body.kernel.cols());
     const Eigen::MatrixXd dense = Eigen::MatrixXd(body.stiffness);
@@ -116,7 +116,7 @@ TEST(GeneralizedInverse, IsAGeneralizedInverseAndGivesTheMoorePenroseSolution) {
 
 TEST(GeneralizedInverse, WithoutKernelIsTheCholeskyFactor) {
   const Body body = make_body({{"left", {true, true}}});
-  const GeneralizedInverse inverse(body.stiffness, body.kernel, "b", {}, 0.0, {});
+  const GeneralizedInverse inverse(body.stiffness, body.kernel, "b");
   const CholeskyFactor factor(body.stiffness, "b");
   const Eigen::VectorXd load = Eigen::VectorXd::LinSpaced(body.stiffness.rows(), -1.0, 2.0);
   EXPECT_EQ(inverse.solve(load), factor.solve(load));  // bit for bit
