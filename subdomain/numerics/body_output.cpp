@@ -58,18 +58,23 @@ Eigen::Vector3d resultant(const Eigen::VectorXd& nodal_vectors, int dimension) {
 }
 
 /// Voigt stress per node (columns): the average over the elements touching the node of the
-/// element's stress at the node, as recover_stress's nodal_stress.
+/// element's stress at the node, as recover_stress's nodal_stress. The same pass stores each
+/// element's stress at its centroid in `element_stresses` (columns in element order).
 Eigen::MatrixXd nodal_stresses(const Mesh& mesh, const Material& material,
-                               const Eigen::VectorXd& displacement) {
+                               const Eigen::VectorXd& displacement,
+                               Eigen::MatrixXd& element_stresses) {
   Eigen::MatrixXd nodal =
       Eigen::MatrixXd::Zero(material.voigt_size(), static_cast<Eigen::Index>(mesh.node_count()));
   Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
+  element_stresses.resize(material.voigt_size(), static_cast<Eigen::Index>(mesh.element_count()));
+  Eigen::Index element = 0;
   for_each_element_stress(mesh, material, displacement,
                           [&](const ElementGeometry& geometry, const VoigtVector* stresses) {
                             for (int i = 0; i < geometry.node_count(); ++i) {
                               nodal.col(geometry.node(i)) += stresses[i + 1];
                               touching(geometry.node(i)) += 1.0;
                             }
+                            element_stresses.col(element++) = stresses[0];
                           });
   for (Eigen::Index node = 0; node < touching.size(); ++node) {
     if (touching(node) > 0.0) nodal.col(node) /= touching(node);
@@ -86,19 +91,6 @@ void append_stress_tensors(const Material& material, const Eigen::MatrixXd& stre
     tensors.insert(tensors.end(), tensor.data(), tensor.data() + 6);
     von_mises_values.push_back(von_mises(tensor));
   }
-}
-
-/// Appends, per element at its centroid, the stress tensor (6 values, ParaView's order) to
-/// `tensors` and its von Mises stress to `von_mises_values`.
-void append_element_stresses(const Mesh& mesh, const Material& material,
-                             const Eigen::VectorXd& displacement, std::vector<double>& tensors,
-                             std::vector<double>& von_mises_values) {
-  for_each_element_stress(mesh, material, displacement,
-                          [&](const ElementGeometry&, const VoigtVector* stresses) {
-                            const StressTensor tensor = stress_tensor(material, stresses[0]);
-                            tensors.insert(tensors.end(), tensor.data(), tensor.data() + 6);
-                            von_mises_values.push_back(von_mises(tensor));
-                          });
 }
 
 /// Moves `from` into the end of `values` and frees it.
@@ -171,7 +163,8 @@ class StreamedFields {
   }
 
   void append_nodal_stress(std::vector<double>& values) {
-    const Eigen::MatrixXd nodal = nodal_stresses(body_.mesh(), material_, displacement_);
+    const Eigen::MatrixXd nodal =
+        nodal_stresses(body_.mesh(), material_, displacement_, element_stresses_);
     nodal_von_mises_.clear();
     nodal_von_mises_.reserve(static_cast<std::size_t>(nodal.cols()));
     append_stress_tensors(material_, nodal, values, nodal_von_mises_);
@@ -186,9 +179,13 @@ class StreamedFields {
   }
 
   void append_element_stress(std::vector<double>& values) {
+    if (element_stresses_.cols() != static_cast<Eigen::Index>(body_.mesh().element_count())) {
+      nodal_stresses(body_.mesh(), material_, displacement_, element_stresses_);  // not made yet
+    }
     element_von_mises_.clear();
     element_von_mises_.reserve(body_.mesh().element_count());
-    append_element_stresses(body_.mesh(), material_, displacement_, values, element_von_mises_);
+    append_stress_tensors(material_, element_stresses_, values, element_von_mises_);
+    Eigen::MatrixXd().swap(element_stresses_);
   }
 
   void append_element_von_mises(std::vector<double>& values) {
@@ -205,6 +202,7 @@ class StreamedFields {
   const Eigen::VectorXd force_field_;  // -B' lambda per node
   const Eigen::VectorXd reaction_;
   const FieldCheck check_;
+  Eigen::MatrixXd element_stresses_;       // Voigt, at the centroids: made with the nodal stress
   std::vector<double> nodal_von_mises_;    // made with the nodal stress tensors
   std::vector<double> element_von_mises_;  // made with the element stress tensors
 };
