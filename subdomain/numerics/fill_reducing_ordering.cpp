@@ -184,7 +184,7 @@ GraphOrder analyze(cholmod_sparse* graph, int method, int* given, cholmod_common
 GraphOrder order_by_dissection(cholmod_sparse* graph, const AdjacencyGraph& adjacency,
                                const std::vector<Eigen::Vector3d>& points, cholmod_common& common,
                                const std::string& body_name) {
-  constexpr int leaf_size = 64;  // docs/benchmarks.md, "geometric nested dissection"
+  constexpr int leaf_size = 64;  // docs/benchmarks.md, "Geometric nested dissection"
   DissectionSets sets = geometric_dissection(adjacency, points, leaf_size);
   std::vector<int> order(graph->nrow);
   if (!cholmod_camd(graph, nullptr, 0, sets.set_of_vertex.data(), order.data(), &common)) {
