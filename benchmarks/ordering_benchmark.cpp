@@ -13,7 +13,8 @@
 // that order. Prints one markdown row per body, variant and way: ordering seconds (order and
 // symbolic analysis), entries of L, flops of the factorization, the supernodal factor's memory
 // (values: 8 bytes per stored entry, amalgamation zeros included; integer arrays: row indices,
-// supernode and column arrays, permutation), and with --factorize the
+// supernode and column arrays, permutation), the numerical factorization's largest update matrix
+// (CHOLMOD's workspace C, maxcsize doubles), and with --factorize the
 // numerical factorization's seconds. The matrix is the free-free block of the stiffness (the
 // Dirichlet dofs removed, as the servers do); the contact dofs are its free dofs on the contact
 // boundaries. Run through benchmarks/ordering_benchmark.sh.
@@ -104,6 +105,7 @@ void measure(const std::string& body, const robin::SparseMatrix& lower,
   const double value_mebibytes = 8.0 * static_cast<double>(factor->xsize) / mebibyte;
   const double index_mebibytes =
       4.0 * static_cast<double>(factor->ssize + 4 * factor->nsuper + 3 * factor->n) / mebibyte;
+  const double update_mebibytes = 8.0 * static_cast<double>(factor->maxcsize) / mebibyte;
   const double flops = common.fl;
   std::string factorization = "-";
   if (factorize) {
@@ -113,9 +115,10 @@ void measure(const std::string& body, const robin::SparseMatrix& lower,
     if (common.status != CHOLMOD_OK)
       factorization += " (status " + std::to_string(common.status) + ")";
   }
-  std::printf("| %s | %d | %zu | %s | %.3f | %.3e | %.3e | %.1f + %.1f | %s |\n", body.c_str(),
-              static_cast<int>(lower.rows()), trailing.size(), way_name(way), ordering_seconds,
-              entries, flops, value_mebibytes, index_mebibytes, factorization.c_str());
+  std::printf("| %s | %d | %zu | %s | %.3f | %.3e | %.3e | %.1f + %.1f | %.1f | %s |\n",
+              body.c_str(), static_cast<int>(lower.rows()), trailing.size(), way_name(way),
+              ordering_seconds, entries, flops, value_mebibytes, index_mebibytes, update_mebibytes,
+              factorization.c_str());
   std::fflush(stdout);
   cholmod_free_factor(&factor, &common);
   cholmod_finish(&common);
@@ -134,8 +137,8 @@ int main(int argc, char** argv) {
   robin::load_meshes(definition);
   std::printf(
       "| body | dofs | trailing dofs | graph ordered | ordering + symbolic (s) | entries of L | "
-      "flops | factor values + integers (MiB) | numerical factorization (s) |\n"
-      "|---|---|---|---|---|---|---|---|---|\n");
+      "flops | factor values + integers (MiB) | largest update (MiB) | numerical factorization "
+      "(s) |\n|---|---|---|---|---|---|---|---|---|---|\n");
   for (const robin::BodyCase& body : definition.bodies) {
     const robin::Mesh& mesh = body.definition.mesh;
     std::vector<std::optional<double>> prescribed(static_cast<std::size_t>(mesh.dof_count()));

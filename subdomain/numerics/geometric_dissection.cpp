@@ -145,6 +145,12 @@ DissectionSets geometric_dissection(const AdjacencyGraph& graph,
                                 std::to_string(points.size()) + " points");
   }
   if (leaf_size < 1) throw std::invalid_argument("geometric_dissection: leaf size below 1");
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    if (!points[v].allFinite()) {  // the median cuts compare coordinates
+      throw std::invalid_argument("geometric_dissection: point " + std::to_string(v) +
+                                  " is not finite");
+    }
+  }
   Dissection dissection(graph, points, leaf_size);
   std::vector<int> vertices(points.size());
   for (std::size_t v = 0; v < vertices.size(); ++v) vertices[v] = static_cast<int>(v);

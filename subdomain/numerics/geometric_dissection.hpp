@@ -37,7 +37,7 @@ struct DissectionSets {
 };
 
 /// The nested dissection (file comment) of `graph` whose vertex v sits at points[v].
-/// Throws std::invalid_argument when the sizes disagree or leaf_size < 1.
+/// Throws std::invalid_argument when the sizes disagree, leaf_size < 1 or a point is not finite.
 DissectionSets geometric_dissection(const AdjacencyGraph& graph,
                                     const std::vector<Eigen::Vector3d>& points, int leaf_size);
 

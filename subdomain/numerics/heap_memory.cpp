@@ -26,12 +26,18 @@ void release_free_heap_memory() {
 bool releases_free_heap_memory() {
   return true;
 }
+
+void map_large_blocks_separately(std::size_t threshold_bytes) {
+  mallopt(M_MMAP_THRESHOLD, static_cast<int>(threshold_bytes));
+}
 #else
 void release_free_heap_memory() {}
 
 bool releases_free_heap_memory() {
   return false;
 }
+
+void map_large_blocks_separately(std::size_t) {}
 #endif
 
 }  // namespace robin

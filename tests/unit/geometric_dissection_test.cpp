@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -119,11 +120,14 @@ TEST(GeometricDissection, EqualPointsFormOneSetAndTiesStillSplit) {
   set_sizes(split, 144);
 }
 
-TEST(GeometricDissection, RefusesMismatchedSizes) {
+TEST(GeometricDissection, RefusesMismatchedSizesAndPointsThatAreNotFinite) {
   const Grid grid = plane_grid(3);
   std::vector<Eigen::Vector3d> short_points(grid.points.begin(), grid.points.end() - 1);
   EXPECT_THROW(geometric_dissection(grid.graph, short_points, 4), std::invalid_argument);
   EXPECT_THROW(geometric_dissection(grid.graph, grid.points, 0), std::invalid_argument);
+  std::vector<Eigen::Vector3d> not_finite = grid.points;
+  not_finite[4].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(geometric_dissection(grid.graph, not_finite, 4), std::invalid_argument);
 }
 
 }  // namespace
