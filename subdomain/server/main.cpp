@@ -240,9 +240,10 @@ int main(int argc, char** argv) {
   const auto logger = robin::subdomain_logger();
   logger->set_level(spdlog::level::from_str(command_line.log_level));
   install_signal_handlers();
-  // Blocks of 1 MiB and more (stiffness copies, orderings, field arrays) are mapped and unmapped
-  // on their own, so that a freed one is not resident beside the factor (heap_memory.hpp).
-  robin::map_large_blocks_separately(std::size_t{1} << 20);
+  // Blocks of 4 MiB and more (stiffness copies, orderings, field arrays) are mapped and unmapped
+  // on their own, so that a freed one is not resident beside the factor (heap_memory.hpp; the
+  // threshold: docs/benchmarks.md, "Large blocks mapped on their own").
+  robin::map_large_blocks_separately(std::size_t{4} << 20);
   try {
     command_line.loop.curve = curve_options(command_line);
   } catch (const std::exception& error) {
