@@ -201,18 +201,22 @@ GraphOrder order_by_dissection(cholmod_sparse* graph, const AdjacencyGraph& adja
 /// tried when the factorization with the first order needs more than a threshold of flops per
 /// stored entry of the graph (the flops of the unknowns estimated as unknowns_per_vertex^3
 /// times the graph's: a vertex's unknowns form a dense block), and kept when it needs fewer.
-/// Thresholds (docs/benchmarks.md): after AMD, 2e4, below which (small and mid-size plane
-/// bodies) METIS's cost exceeds what it saves; after the geometric dissection, whose orders
-/// of plane bodies need at most a few percent more flops than METIS's, 1e5, above which the
+/// Thresholds (docs/benchmarks.md): 2e4 after AMD, below which (small and mid-size plane
+/// bodies) METIS's cost exceeds what it saves, and after the geometric dissection of a graded
+/// mesh (edge_length_spread above 4), whose straight cuts cross the refined zone (15-60 % more
+/// flops than METIS on the Hertz meshes); 1e5 after the geometric dissection of a quasi-uniform
+/// mesh, whose orders need at most a few percent more flops than METIS's, above which the
 /// factorization takes ten times METIS's time (large solid bodies, where METIS saves up to
 /// 40 %).
 std::vector<int> order_graph(cholmod_sparse* graph, const AdjacencyGraph& adjacency,
                              const std::vector<Eigen::Vector3d>& points, double unknowns_per_vertex,
                              cholmod_common& common, const std::string& body_name) {
+  constexpr double graded_spread = 4.0;
   const bool geometric = !points.empty();
   GraphOrder best = geometric ? order_by_dissection(graph, adjacency, points, common, body_name)
                               : analyze(graph, CHOLMOD_AMD, nullptr, common, body_name);
-  const double metis_threshold = geometric ? 1e5 : 2e4;
+  const bool uniform = geometric && edge_length_spread(adjacency, points) <= graded_spread;
+  const double metis_threshold = uniform ? 1e5 : 2e4;
   const double entries = static_cast<double>(static_cast<const int*>(graph->p)[graph->ncol]);
   const double unknown_flops = best.flops * std::pow(unknowns_per_vertex, 3);
   if (unknown_flops > metis_threshold * entries) {

@@ -15,8 +15,10 @@
 // costs far more and pays off only through a cheaper numerical factorization, so it is computed
 // too only when the factorization with the first order needs many floating-point operations per
 // entry of the graph (the unknowns' flops estimated from the graph's): more than 2e4 after AMD
-// (large plane bodies, solid bodies), more than 1e5 after the geometric dissection (large solid
-// bodies). The order with fewer flops is kept (docs/benchmarks.md).
+// (large plane bodies, solid bodies) and after the geometric dissection of a graded mesh (whose
+// straight cuts cross the refined zone), more than 1e5 after the geometric dissection of a
+// quasi-uniform mesh (large solid bodies). The order with fewer flops is kept
+// (docs/benchmarks.md).
 
 #include <Eigen/Core>
 #include <string>

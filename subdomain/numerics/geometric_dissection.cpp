@@ -1,6 +1,7 @@
 #include "numerics/geometric_dissection.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -134,6 +135,26 @@ class Dissection {
 };
 
 }  // namespace
+
+double edge_length_spread(const AdjacencyGraph& graph, const std::vector<Eigen::Vector3d>& points) {
+  std::vector<double> lengths;
+  lengths.reserve(graph.neighbours.size() / 2);
+  for (int v = 0; v < graph.vertex_count(); ++v) {
+    for (long entry = graph.start[v]; entry < graph.start[v + 1]; ++entry) {
+      const int w = graph.neighbours[entry];
+      if (w > v) lengths.push_back((points[w] - points[v]).norm());
+    }
+  }
+  if (lengths.empty()) return 1.0;
+  const auto percentile = [&lengths](double fraction) {
+    const auto at = lengths.begin() + static_cast<long>(fraction * (lengths.size() - 1));
+    std::nth_element(lengths.begin(), at, lengths.end());
+    return *at;
+  };
+  const double low = percentile(0.1);
+  const double high = percentile(0.9);
+  return low > 0.0 ? high / low : std::numeric_limits<double>::infinity();
+}
 
 DissectionSets geometric_dissection(const AdjacencyGraph& graph,
                                     const std::vector<Eigen::Vector3d>& points, int leaf_size) {

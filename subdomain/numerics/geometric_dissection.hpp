@@ -36,6 +36,12 @@ struct DissectionSets {
   int set_count = 0;
 };
 
+/// How graded the mesh is: the 90th over the 10th percentile of the lengths of the graph's edges
+/// (each edge once). About 1 to 2 on quasi-uniform meshes (diagonals of squares and cubes
+/// included), far more where a zone is refined (the Hertz meshes: 10). Infinity when a tenth of
+/// the edges have length zero; 1 for a graph without edges.
+double edge_length_spread(const AdjacencyGraph& graph, const std::vector<Eigen::Vector3d>& points);
+
 /// The nested dissection (file comment) of `graph` whose vertex v sits at points[v].
 /// Throws std::invalid_argument when the sizes disagree, leaf_size < 1 or a point is not finite.
 DissectionSets geometric_dissection(const AdjacencyGraph& graph,

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -118,6 +119,17 @@ TEST(GeometricDissection, EqualPointsFormOneSetAndTiesStillSplit) {
   const DissectionSets split = geometric_dissection(grid.graph, ties, 4);
   EXPECT_GT(split.set_count, 1);
   set_sizes(split, 144);
+}
+
+TEST(EdgeLengthSpread, IsSmallOnAUniformGridAndLargeOnAGradedOne) {
+  Grid grid = plane_grid(30);
+  // Edges of length 1 (sides) and sqrt(2) (diagonals): the 90th percentile is a diagonal's.
+  EXPECT_NEAR(edge_length_spread(grid.graph, grid.points), std::sqrt(2.0), 1e-12);
+  // Columns at x = 1.2^i: the spacing grows 1.2 times per column, about 200 times across.
+  for (Eigen::Vector3d& point : grid.points) point.x() = std::pow(1.2, point.x());
+  EXPECT_GT(edge_length_spread(grid.graph, grid.points), 10.0);
+  std::fill(grid.points.begin(), grid.points.end(), grid.points[0]);  // every length zero
+  EXPECT_EQ(edge_length_spread(grid.graph, grid.points), std::numeric_limits<double>::infinity());
 }
 
 TEST(GeometricDissection, RefusesMismatchedSizesAndPointsThatAreNotFinite) {
