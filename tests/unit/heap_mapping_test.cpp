@@ -8,24 +8,13 @@
 
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <string>
 #include <vector>
 
+#include "../resident_set.hpp"
 #include "numerics/heap_memory.hpp"
 
 namespace robin {
 namespace {
-
-/// The resident set of this process, MiB (VmRSS).
-double resident_mib() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
-  }
-  return -1.0;
-}
 
 TEST(HeapMemory, LargeBlocksLeaveTheResidentSetWhenFreedOnceMappedSeparately) {
   if (!releases_free_heap_memory()) {

@@ -9,22 +9,12 @@
 
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <string>
 #include <vector>
+
+#include "../resident_set.hpp"
 
 namespace robin {
 namespace {
-
-/// The resident set of this process, MiB (VmRSS).
-double resident_mib() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
-  }
-  return -1.0;
-}
 
 TEST(HeapMemory, FreedBlocksBelowALiveOneLeaveTheResidentSetOnlyWhenReleased) {
   if (!releases_free_heap_memory()) {
