@@ -23,6 +23,13 @@ find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
 add_library(robin_cholmod INTERFACE)
 target_include_directories(robin_cholmod SYSTEM INTERFACE ${CHOLMOD_INCLUDE_DIR})
 target_link_libraries(robin_cholmod INTERFACE ${CHOLMOD_LIBRARY})
+# The BLAS CHOLMOD runs on (libblas.so.3: OpenBLAS through Debian's alternatives once
+# libopenblas0 is installed), called directly through its CBLAS interface for the dense
+# level-3 products of the trailing block (cholesky.cpp).
+find_path(CBLAS_INCLUDE_DIR cblas.h PATH_SUFFIXES x86_64-linux-gnu REQUIRED)
+find_library(BLAS_LIBRARY blas REQUIRED)
+target_include_directories(robin_cholmod SYSTEM INTERFACE ${CBLAS_INCLUDE_DIR})
+target_link_libraries(robin_cholmod INTERFACE ${BLAS_LIBRARY})
 
 # Gmsh's C++ API (libgmsh-dev) has no CMake configuration either.
 find_path(GMSH_INCLUDE_DIR gmsh.h REQUIRED)

@@ -9,7 +9,7 @@ packages=(
   # ~60 test executables).
   ninja-build lld
   clang libclang-rt-14-dev
-  libeigen3-dev libsuitesparse-dev libopenblas0-pthread
+  libeigen3-dev libsuitesparse-dev libblas-dev libopenblas0-pthread
   libzmq3-dev libsodium-dev cppzmq-dev libprotobuf-dev protobuf-compiler
   libspdlog-dev libfmt-dev
   libgmsh-dev gmsh

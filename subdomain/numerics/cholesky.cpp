@@ -1,10 +1,13 @@
 #include "numerics/cholesky.hpp"
 
+#include <cblas.h>
+
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <new>
 #include <sstream>
 #include <stdexcept>
@@ -156,6 +159,9 @@ struct CholeskyFactor::Implementation {
   int trailing_count = 0;
   bool has_trailing_block = false;
   std::vector<int> position;  // position[j] = step at which unknown j is eliminated
+  // L_TT (dense lower triangular), made by the first call that needs it
+  std::once_flag trailing_block_made;
+  Eigen::MatrixXd trailing_block;
 
   double memory_limit_bytes = 0.0;
   double ordering_seconds = 0.0;
@@ -165,6 +171,9 @@ struct CholeskyFactor::Implementation {
   void check_memory_estimate();
   void check_pivots() const;
   void locate_trailing(const std::vector<int>& trailing);
+  const Eigen::MatrixXd& lower_trailing_block();
+  bool within_trailing_block(const Eigen::VectorXd& right_hand_side) const;
+  Eigen::VectorXd solve_from_trailing_block(const Eigen::VectorXd& right_hand_side);
 };
 
 /// CHOLMOD reports an allocation it could not make as a status, not an exception: rethrown as
@@ -247,6 +256,50 @@ void CholeskyFactor::Implementation::locate_trailing(const std::vector<int>& tra
                        });
 }
 
+const Eigen::MatrixXd& CholeskyFactor::Implementation::lower_trailing_block() {
+  std::call_once(trailing_block_made, [this] {
+    trailing_block = trailing_factor_block(*cholesky.factor(), size - trailing_count);
+  });
+  return trailing_block;
+}
+
+bool CholeskyFactor::Implementation::within_trailing_block(
+    const Eigen::VectorXd& right_hand_side) const {
+  if (!has_trailing_block) return false;
+  const int first = size - trailing_count;
+  for (int unknown = 0; unknown < size; ++unknown) {
+    if (right_hand_side[unknown] != 0.0 && position[unknown] < first) return false;
+  }
+  return true;
+}
+
+Eigen::VectorXd CholeskyFactor::Implementation::solve_from_trailing_block(
+    const Eigen::VectorXd& right_hand_side) {
+  // P b is zero before the trailing block, so is L^{-1} P b: its trailing part is
+  // L_TT^{-1} (P b)_T, and x = P' L^{-T} (L^{-1} P b) needs only the backward solve.
+  const int first = size - trailing_count;
+  Eigen::VectorXd forward = Eigen::VectorXd::Zero(size);
+  for (int unknown = 0; unknown < size; ++unknown) {
+    if (position[unknown] >= first) forward[position[unknown]] = right_hand_side[unknown];
+  }
+  lower_trailing_block().triangularView<Eigen::Lower>().solveInPlace(forward.tail(trailing_count));
+  cholmod_common& common = cholesky.cholmod();
+  cholmod_dense view = Eigen::viewAsCholmod(forward);
+  auto* factor = const_cast<cholmod_factor*>(cholesky.factor());
+  cholmod_dense* backward = cholmod_solve(CHOLMOD_Lt, factor, &view, &common);
+  cholmod_dense* solution =
+      backward != nullptr ? cholmod_solve(CHOLMOD_Pt, factor, backward, &common) : nullptr;
+  cholmod_free_dense(&backward, &common);
+  if (solution == nullptr) {
+    throw_if_out_of_memory(common);
+    throw std::runtime_error("body '" + body_name + "': CHOLMOD solve failed");
+  }
+  Eigen::VectorXd result =
+      Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(solution->x), size);
+  cholmod_free_dense(&solution, &common);
+  return result;
+}
+
 void CholeskyFactor::Implementation::check_pivots() const {
   const cholmod_factor& factor = *cholesky.factor();
   if (!factor.is_super) return;  // CHOLMOD_SUPERNODAL was requested: never happens
@@ -298,12 +351,17 @@ Eigen::VectorXd CholeskyFactor::solve(const Eigen::VectorXd& right_hand_side) co
         "body '" + implementation_->body_name + "': right-hand side of size " +
         std::to_string(right_hand_side.size()) + " for a factor of size " + std::to_string(size()));
   }
+  ++solve_count_;
+  if ((right_hand_side.array() == 0.0).all()) return Eigen::VectorXd::Zero(size());
+  if (implementation_->within_trailing_block(right_hand_side)) {
+    ++backward_only_solve_count_;
+    return implementation_->solve_from_trailing_block(right_hand_side);
+  }
   // x = L^{-T} L^{-1} b (with CHOLMOD's fill-reducing permutation)
   Eigen::VectorXd solution = implementation_->cholesky.solve(right_hand_side);
   if (implementation_->cholesky.info() != Eigen::Success) {
     throw std::runtime_error("body '" + implementation_->body_name + "': CHOLMOD solve failed");
   }
-  ++solve_count_;
   return solution;
 }
 
@@ -365,7 +423,7 @@ bool CholeskyFactor::has_trailing_block() const {
 }
 
 Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) const {
-  const Implementation& factor = *implementation_;
+  Implementation& factor = *implementation_;
   if (!factor.has_trailing_block) {
     throw std::logic_error("body '" + factor.body_name + "': the factor has no trailing block");
   }
@@ -387,10 +445,16 @@ Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) c
       reduced(step, entry.row()) += entry.value();
     }
   }
-  const Eigen::MatrixXd block = trailing_factor_block(*factor.cholesky.factor(), first);
-  block.triangularView<Eigen::Lower>().solveInPlace(reduced);
-  Eigen::MatrixXd congruence = Eigen::MatrixXd::Zero(trace.rows(), trace.rows());
-  congruence.selfadjointView<Eigen::Lower>().rankUpdate(reduced.transpose());
+  // BLAS level 3 (the system's, OpenBLAS on Debian with libopenblas0): dtrsm, then dsyrk
+  const Eigen::MatrixXd& block = factor.lower_trailing_block();
+  const int trailing = factor.trailing_count;
+  const int rows = static_cast<int>(trace.rows());
+  Eigen::MatrixXd congruence = Eigen::MatrixXd::Zero(rows, rows);
+  if (rows == 0) return congruence;
+  cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, trailing, rows, 1.0,
+              block.data(), trailing, reduced.data(), trailing);
+  cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, rows, trailing, 1.0, reduced.data(), trailing,
+              0.0, congruence.data(), rows);
   congruence.triangularView<Eigen::StrictlyUpper>() = congruence.transpose();
   return congruence;
 }

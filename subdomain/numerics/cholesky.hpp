@@ -55,7 +55,9 @@ class CholeskyFactor {
   CholeskyFactor& operator=(const CholeskyFactor&) = delete;
 
   int size() const;
-  /// x = K^{-1} b: one forward and one backward triangular solve.
+  /// x = K^{-1} b: one forward and one backward triangular solve; when b is zero outside the
+  /// trailing unknowns (a trailing block exists), the forward solve is the dense L_TT's alone;
+  /// b = 0 gives x = 0 without a solve.
   Eigen::VectorXd solve(const Eigen::VectorXd& right_hand_side) const;
   /// Multiple right-hand sides at once (supernodal solves in blocks of at most 64 columns).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& right_hand_sides) const;
@@ -73,6 +75,9 @@ class CholeskyFactor {
   /// Number of right-hand sides solved so far: +1 per vector solve, +columns per matrix solve
   /// (each right-hand side costs one forward and one backward triangular solve).
   long solve_count() const { return solve_count_; }
+  /// How many of those vector solves had b zero outside the trailing unknowns (forward solve on
+  /// L_TT only, one pass over L instead of two).
+  long backward_only_solve_count() const { return backward_only_solve_count_; }
   /// Wall time of the fill-reducing ordering and symbolic analysis (seconds).
   double ordering_seconds() const;
   /// Wall time of the numerical factorization and its pivot checks (seconds).
@@ -82,6 +87,7 @@ class CholeskyFactor {
   struct Implementation;
   std::unique_ptr<Implementation> implementation_;
   mutable long solve_count_ = 0;
+  mutable long backward_only_solve_count_ = 0;
 };
 
 }  // namespace robin

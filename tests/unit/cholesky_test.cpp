@@ -187,6 +187,40 @@ TEST(Cholesky, TrailingCongruenceMatchesAnIndependentSolve) {
             << "\n";
 }
 
+TEST(Cholesky, LoadOnTheTrailingUnknownsIsSolvedWithTheBackwardSolveAlone) {
+  const int size = 600;
+  const SparseMatrix matrix = random_sparse_spd(size, 4, 71);
+  const std::vector<int> trailing = random_unknowns(size, 60, 72);
+  const CholeskyFactor factor(matrix, "block", {.trailing_unknowns = trailing});
+  ASSERT_TRUE(factor.has_trailing_block());
+  // b = B' lambda for a trace B on the trailing unknowns (the contact forces' load)
+  const SparseMatrix trace = random_trace(35, size, trailing, 73);
+  const Eigen::VectorXd forces = Eigen::VectorXd::LinSpaced(35, -1.0, 2.0);
+  const Eigen::VectorXd load = trace.transpose() * forces;
+  const Eigen::VectorXd expected = reference_solve(matrix, load);
+  const Eigen::VectorXd solution = factor.solve(load);
+  EXPECT_EQ(factor.backward_only_solve_count(), 1);
+  EXPECT_LE((solution - expected).norm(), 1e-12 * expected.norm());
+  // one entry outside the trailing unknowns: the full solve
+  Eigen::VectorXd spread = load;
+  const auto outside =
+      std::find_if(spread.begin(), spread.end(), [](double value) { return value == 0.0; });
+  const auto unknown = static_cast<int>(outside - spread.begin());
+  ASSERT_EQ(std::count(trailing.begin(), trailing.end(), unknown), 0);
+  spread[unknown] = 0.5;
+  const Eigen::VectorXd expected_spread = reference_solve(matrix, spread);
+  EXPECT_LE((factor.solve(spread) - expected_spread).norm(), 1e-12 * expected_spread.norm());
+  EXPECT_EQ(factor.backward_only_solve_count(), 1);
+  EXPECT_EQ(factor.solve_count(), 2);
+  // K^{-1} 0 = 0, with or without a trailing block
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(size);
+  EXPECT_EQ(factor.solve(zero), zero);
+  const CholeskyFactor plain(matrix, "block");
+  EXPECT_EQ(plain.solve(zero), zero);
+  EXPECT_LE((plain.solve(load) - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_EQ(plain.backward_only_solve_count(), 0);
+}
+
 TEST(Cholesky, TrailingCongruenceRejectsOtherUnknownsAndMissingBlocks) {
   const int size = 200;
   const SparseMatrix matrix = random_sparse_spd(size, 3, 61);
