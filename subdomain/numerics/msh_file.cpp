@@ -1,5 +1,9 @@
 #include "numerics/msh_file.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
@@ -7,7 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
+
 #include <limits>
 #include <map>
 #include <optional>
@@ -94,9 +98,43 @@ struct MshModel {
 /// Reads the file's bytes: ASCII tokens (whitespace-separated, as Gmsh's fscanf reads them) and
 /// little-endian binary values; every error names the file and the line (ASCII) or byte offset
 /// (binary files) where it was found.
+/// A file's bytes mapped read-only: the page cache's pages, neither copied nor zeroed first
+/// (reading into a buffer costs a fresh zeroed page and a copy per 4 KiB). Like every mapping,
+/// it assumes the file is not truncated while it is read.
+class MappedFile {
+ public:
+  /// Throws InputError naming `shown` when the file cannot be opened, sized or mapped.
+  MappedFile(const std::filesystem::path& path, const std::string& shown) {
+    const int descriptor = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (descriptor < 0) throw InputError("mesh file '" + shown + "': the file cannot be opened");
+    struct stat status {};
+    const bool sized = fstat(descriptor, &status) == 0 && S_ISREG(status.st_mode);
+    size_ = sized ? static_cast<std::size_t>(status.st_size) : 0;
+    if (sized && size_ > 0) {
+      void* mapped = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, descriptor, 0);
+      data_ = mapped == MAP_FAILED ? nullptr : static_cast<const char*>(mapped);
+    }
+    close(descriptor);
+    if (!sized || (size_ > 0 && data_ == nullptr)) {
+      throw InputError("mesh file '" + shown + "': the file cannot be read");
+    }
+  }
+  ~MappedFile() {
+    if (data_ != nullptr) munmap(const_cast<char*>(data_), size_);
+  }
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+
+  std::string_view bytes() const { return {data_ != nullptr ? data_ : "", size_}; }
+
+ private:
+  const char* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
 class MshScanner {
  public:
-  MshScanner(const std::string& bytes, std::string name) : bytes_(bytes), name_(std::move(name)) {}
+  MshScanner(std::string_view bytes, std::string name) : bytes_(bytes), name_(std::move(name)) {}
 
   [[noreturn]] void fail(const std::string& problem) const { fail_at(position_, problem); }
   [[noreturn]] void fail_at(std::size_t position, const std::string& problem) const {
@@ -129,7 +167,7 @@ class MshScanner {
     skip_space();
     const std::size_t begin = position_;
     while (position_ < bytes_.size() && !is_space(bytes_[position_])) ++position_;
-    return std::string_view(bytes_).substr(begin, position_ - begin);
+    return bytes_.substr(begin, position_ - begin);
   }
   /// Skips the rest of the current line, its end included.
   void next_line() {
@@ -230,7 +268,7 @@ class MshScanner {
       fail_at(begin, std::string(what) + " has no closing double quote on its line");
     }
     position_ = end + 1;
-    return bytes_.substr(begin + 1, end - begin - 1);
+    return std::string(bytes_.substr(begin + 1, end - begin - 1));
   }
 
  private:
@@ -239,7 +277,7 @@ class MshScanner {
            character == '\v' || character == '\f';
   }
 
-  const std::string& bytes_;
+  std::string_view bytes_;
   std::string name_;
   std::size_t position_ = 0;
   bool binary_ = false;
@@ -960,7 +998,7 @@ Mesh body_mesh(const MshModel& model, const std::string& name) {
 
 }  // namespace
 
-Mesh parse_msh_file(const std::string& bytes, const std::string& name) {
+Mesh parse_msh_file(std::string_view bytes, const std::string& name) {
   const std::string label = "mesh file '" + name + "'";
   MshScanner scanner(bytes, label);
   const MshModel model = read_model(scanner);
@@ -969,18 +1007,8 @@ Mesh parse_msh_file(const std::string& bytes, const std::string& name) {
 
 Mesh read_msh_file(const std::filesystem::path& path, const std::string& name) {
   const std::string shown = name.empty() ? path.string() : name;
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError("mesh file '" + shown + "': the file cannot be opened");
-  std::string bytes;
-  file.seekg(0, std::ios::end);
-  const std::streamoff size = file.tellg();
-  file.seekg(0, std::ios::beg);
-  if (size > 0) {
-    bytes.resize(static_cast<std::size_t>(size));
-    file.read(bytes.data(), size);
-  }
-  if (!file) throw InputError("mesh file '" + shown + "': the file cannot be read");
-  Mesh mesh = parse_msh_file(bytes, shown);
+  const MappedFile file(path, shown);
+  Mesh mesh = parse_msh_file(file.bytes(), shown);
   mesh.source = path.string();
   return mesh;
 }

@@ -24,6 +24,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "numerics/mesh.hpp"
@@ -35,7 +36,7 @@ namespace robin {
 Mesh read_msh_file(const std::filesystem::path& path, const std::string& name = "");
 
 /// The mesh in `bytes`, the contents of an MSH file called `name` in messages.
-Mesh parse_msh_file(const std::string& bytes, const std::string& name);
+Mesh parse_msh_file(std::string_view bytes, const std::string& name);
 
 /// Orients the elements of `block` (its connectivity indexes `mesh`'s nodes) positively
 /// (counter-clockwise in 2D, a positive Jacobian in 3D), entity by entity: `entities` holds the
