@@ -3,14 +3,16 @@
 //
 // Format: VTKFile version 1.0, header_type UInt64, byte_order of the machine. By default every
 // array is binary in the appended-data section (encoding "raw"), compressed in zlib's format
-// (RFC 1950, made by libdeflate) as vtkZLibDataCompressor writes it: per array, the UInt64 header
-// [number of blocks, uncompressed block size (32768 bytes), uncompressed size of the last block (0
-// when it is full), compressed size of each block], then the zlib streams of the blocks. The arrays
-// are made and compressed one at a time while the appended data is written (never the whole block
-// in memory), and their offsets written afterwards into room left in the XML: `offset="N"` is
-// followed by spaces up to a fixed width before the element's `/>`. VtuEncoding::ascii writes every
-// array inline as text instead, each real number as the shortest decimal that reads back to the
-// same double. Either way the values read back are the doubles given here, bit for bit.
+// (RFC 1950; Float64 arrays by zero_run_deflate.hpp, whose one pass keeps their zero runs at
+// memory speed, the integer arrays by libdeflate's level 1) as vtkZLibDataCompressor writes it:
+// per array, the UInt64 header [number of blocks, uncompressed block size (32768 bytes),
+// uncompressed size of the last block (0 when it is full), compressed size of each block], then
+// the zlib streams of the blocks. The arrays are made and compressed one at a time while the
+// appended data is written (never the whole block in memory), and their offsets written
+// afterwards into room left in the XML: `offset="N"` is followed by spaces up to a fixed width
+// before the element's `/>`. VtuEncoding::ascii writes every array inline as text instead, each
+// real number as the shortest decimal that reads back to the same double. Either way the values
+// read back are the doubles given here, bit for bit.
 //
 // Points are Float64 (x, y, z; z = 0 for plane bodies). Cells are, in this order:
 //  - the elements, block after block of mesh.blocks, with VTK types

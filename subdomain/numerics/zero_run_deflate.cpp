@@ -62,30 +62,34 @@ std::array<LengthCode, 259> length_codes() {
   return codes;
 }
 
-/// Bits packed least significant first into a byte vector.
+/// Bits packed least significant first into a buffer sized for the whole stream beforehand.
 class BitWriter {
  public:
-  explicit BitWriter(std::vector<std::uint8_t>& bytes) : bytes_(bytes) {}
+  explicit BitWriter(std::uint8_t* out) : out_(out) {}
 
   void write(std::uint32_t value, int bits) {
     buffer_ |= static_cast<std::uint64_t>(value) << count_;
     count_ += bits;
-    while (count_ >= 8) {
-      bytes_.push_back(static_cast<std::uint8_t>(buffer_));
-      buffer_ >>= 8;
-      count_ -= 8;
+    if (count_ >= 32) {  // four whole bytes out, little-endian
+      for (int k = 0; k < 4; ++k) out_[k] = static_cast<std::uint8_t>(buffer_ >> (8 * k));
+      out_ += 4;
+      buffer_ >>= 32;
+      count_ -= 32;
     }
   }
   void write(const Code& code) { write(code.value, code.bits); }
-  /// Pads the last byte with zero bits.
-  void finish() {
-    if (count_ > 0) bytes_.push_back(static_cast<std::uint8_t>(buffer_));
-    buffer_ = 0;
+  /// Writes the bits left, the last byte padded with zero bits; returns the end of the output.
+  std::uint8_t* finish() {
+    for (; count_ > 0; count_ -= 8) {
+      *out_++ = static_cast<std::uint8_t>(buffer_);
+      buffer_ >>= 8;
+    }
     count_ = 0;
+    return out_;
   }
 
  private:
-  std::vector<std::uint8_t>& bytes_;
+  std::uint8_t* out_;
   std::uint64_t buffer_ = 0;
   int count_ = 0;
 };
@@ -113,12 +117,12 @@ std::size_t zero_run_deflate(const std::uint8_t* data, std::size_t size,
                              std::vector<std::uint8_t>& stream) {
   static const std::array<Code, 288> codes = fixed_literal_codes();
   static const std::array<LengthCode, 259> lengths = length_codes();
-  stream.clear();
-  stream.reserve(size + size / 8 + 16);
+  // at most 9 bits per byte, 3 bits of block header and 7 of end of block, 2 + 4 framing bytes
+  stream.resize(size + size / 8 + 16);
   // zlib header: deflate with a 32 KiB window (0x78), fastest-level flag, FCHECK (RFC 1950)
-  stream.push_back(0x78);
-  stream.push_back(0x01);
-  BitWriter writer(stream);
+  stream[0] = 0x78;
+  stream[1] = 0x01;
+  BitWriter writer(stream.data() + 2);
   writer.write(1, 1);  // BFINAL: the only block
   writer.write(1, 2);  // BTYPE 01: fixed Huffman codes
   std::size_t position = 0;
@@ -140,11 +144,11 @@ std::size_t zero_run_deflate(const std::uint8_t* data, std::size_t size,
     position = end;
   }
   writer.write(codes[256]);  // end of block
-  writer.finish();
+  std::uint8_t* end = writer.finish();
   const std::uint32_t checksum = libdeflate_adler32(1, data, size);
-  for (int shift = 24; shift >= 0; shift -= 8) {
-    stream.push_back(static_cast<std::uint8_t>(checksum >> shift));
-  }
+  for (int shift = 24; shift >= 0; shift -= 8)
+    *end++ = static_cast<std::uint8_t>(checksum >> shift);
+  stream.resize(static_cast<std::size_t>(end - stream.data()));
   return stream.size();
 }
 
