@@ -203,7 +203,8 @@ def compare(reference_x, reference_force, x, force):
 
 
 def mib(kib):
-    return f"{kib / 1024:.0f}"
+    """MiB of a peak in KiB; "–" when the polling saw no sample (a run shorter than 0.1 s)."""
+    return f"{kib / 1024:.0f}" if kib > 0 else "–"
 
 
 # --------------------------------------------------------------------------- driver
@@ -369,7 +370,8 @@ def main():
     def median_rss(values, index=None):
         return statistics.median(value if index is None else value[index] for value in values)
 
-    print("\nTimes (median of the interleaved runs; meshing excluded) and peak RSS (median; MiB):\n")
+    print("\nTimes (median of the interleaved runs; meshing excluded) and peak RSS (median; MiB; "
+          "–: the process ended before the first 0.1 s poll):\n")
     print("| h | DOFs | runs | contact pairs | robin-run wall | robin-monolithic wall | GetFEM wall | "
           "GetFEM / robin-run | robin-run peak RSS: coordinator, larger server (sum) | "
           "robin-monolithic peak RSS | GetFEM peak RSS |")
