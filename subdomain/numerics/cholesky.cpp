@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <new>
 #include <sstream>
 #include <stdexcept>
@@ -159,9 +158,6 @@ struct CholeskyFactor::Implementation {
   int trailing_count = 0;
   bool has_trailing_block = false;
   std::vector<int> position;  // position[j] = step at which unknown j is eliminated
-  // L_TT (dense lower triangular), made by the first call that needs it
-  std::once_flag trailing_block_made;
-  Eigen::MatrixXd trailing_block;
 
   double memory_limit_bytes = 0.0;
   double ordering_seconds = 0.0;
@@ -171,7 +167,6 @@ struct CholeskyFactor::Implementation {
   void check_memory_estimate();
   void check_pivots() const;
   void locate_trailing(const std::vector<int>& trailing);
-  const Eigen::MatrixXd& lower_trailing_block();
   bool within_trailing_block(const Eigen::VectorXd& right_hand_side) const;
   Eigen::VectorXd solve_from_trailing_block(const Eigen::VectorXd& right_hand_side);
 };
@@ -256,13 +251,6 @@ void CholeskyFactor::Implementation::locate_trailing(const std::vector<int>& tra
                        });
 }
 
-const Eigen::MatrixXd& CholeskyFactor::Implementation::lower_trailing_block() {
-  std::call_once(trailing_block_made, [this] {
-    trailing_block = trailing_factor_block(*cholesky.factor(), size - trailing_count);
-  });
-  return trailing_block;
-}
-
 bool CholeskyFactor::Implementation::within_trailing_block(
     const Eigen::VectorXd& right_hand_side) const {
   if (!has_trailing_block) return false;
@@ -276,28 +264,30 @@ bool CholeskyFactor::Implementation::within_trailing_block(
 Eigen::VectorXd CholeskyFactor::Implementation::solve_from_trailing_block(
     const Eigen::VectorXd& right_hand_side) {
   // P b is zero before the trailing block, so is L^{-1} P b: its trailing part is
-  // L_TT^{-1} (P b)_T, and x = P' L^{-T} (L^{-1} P b) needs only the backward solve.
+  // L_TT^{-1} (P b)_T, and x = P' L^{-T} (L^{-1} P b) needs only the backward solve. L_TT is
+  // extracted for the solve (the trailing supernodes only), not kept beside L.
   const int first = size - trailing_count;
+  const cholmod_factor& factor = *cholesky.factor();
   Eigen::VectorXd forward = Eigen::VectorXd::Zero(size);
   for (int unknown = 0; unknown < size; ++unknown) {
     if (position[unknown] >= first) forward[position[unknown]] = right_hand_side[unknown];
   }
-  lower_trailing_block().triangularView<Eigen::Lower>().solveInPlace(forward.tail(trailing_count));
+  trailing_factor_block(factor, first)
+      .triangularView<Eigen::Lower>()
+      .solveInPlace(forward.tail(trailing_count));
   cholmod_common& common = cholesky.cholmod();
   cholmod_dense view = Eigen::viewAsCholmod(forward);
-  auto* factor = const_cast<cholmod_factor*>(cholesky.factor());
-  cholmod_dense* backward = cholmod_solve(CHOLMOD_Lt, factor, &view, &common);
-  cholmod_dense* solution =
-      backward != nullptr ? cholmod_solve(CHOLMOD_Pt, factor, backward, &common) : nullptr;
-  cholmod_free_dense(&backward, &common);
-  if (solution == nullptr) {
+  cholmod_dense* backward =
+      cholmod_solve(CHOLMOD_Lt, const_cast<cholmod_factor*>(&factor), &view, &common);
+  if (backward == nullptr) {
     throw_if_out_of_memory(common);
     throw std::runtime_error("body '" + body_name + "': CHOLMOD solve failed");
   }
-  Eigen::VectorXd result =
-      Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(solution->x), size);
-  cholmod_free_dense(&solution, &common);
-  return result;
+  const auto* values = static_cast<const double*>(backward->x);
+  Eigen::VectorXd solution(size);  // x = P' y: unknown j was eliminated at step position[j]
+  for (int unknown = 0; unknown < size; ++unknown) solution[unknown] = values[position[unknown]];
+  cholmod_free_dense(&backward, &common);
+  return solution;
 }
 
 void CholeskyFactor::Implementation::check_pivots() const {
@@ -423,7 +413,7 @@ bool CholeskyFactor::has_trailing_block() const {
 }
 
 Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) const {
-  Implementation& factor = *implementation_;
+  const Implementation& factor = *implementation_;
   if (!factor.has_trailing_block) {
     throw std::logic_error("body '" + factor.body_name + "': the factor has no trailing block");
   }
@@ -446,7 +436,7 @@ Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) c
     }
   }
   // BLAS level 3 (the system's, OpenBLAS on Debian with libopenblas0): dtrsm, then dsyrk
-  const Eigen::MatrixXd& block = factor.lower_trailing_block();
+  const Eigen::MatrixXd block = trailing_factor_block(*factor.cholesky.factor(), first);
   const int trailing = factor.trailing_count;
   const int rows = static_cast<int>(trace.rows());
   Eigen::MatrixXd congruence = Eigen::MatrixXd::Zero(rows, rows);
