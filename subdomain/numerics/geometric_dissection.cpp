@@ -137,12 +137,14 @@ class Dissection {
 }  // namespace
 
 double edge_length_spread(const AdjacencyGraph& graph, const std::vector<Eigen::Vector3d>& points) {
+  // every edge once (from its lower vertex), or every edge of every stride-th vertex
+  const int stride = std::max(1, graph.vertex_count() / spread_sample_vertices);
   std::vector<double> lengths;
-  lengths.reserve(graph.neighbours.size() / 2);
-  for (int v = 0; v < graph.vertex_count(); ++v) {
+  lengths.reserve(graph.neighbours.size() / (2 * static_cast<std::size_t>(stride)) + 1);
+  for (int v = 0; v < graph.vertex_count(); v += stride) {
     for (long entry = graph.start[v]; entry < graph.start[v + 1]; ++entry) {
       const int w = graph.neighbours[entry];
-      if (w > v) lengths.push_back((points[w] - points[v]).norm());
+      if (stride > 1 || w > v) lengths.push_back((points[w] - points[v]).norm());
     }
   }
   if (lengths.empty()) return 1.0;

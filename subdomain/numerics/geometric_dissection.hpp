@@ -36,8 +36,12 @@ struct DissectionSets {
   int set_count = 0;
 };
 
+/// Vertices whose edges edge_length_spread reads at most (about: a systematic sample).
+constexpr int spread_sample_vertices = 20000;
+
 /// How graded the mesh is: the 90th over the 10th percentile of the lengths of the graph's edges
-/// (each edge once). About 1 to 2 on quasi-uniform meshes (diagonals of squares and cubes
+/// (each edge once; above spread_sample_vertices vertices, the edges of every k-th vertex, k the
+/// vertex count over that). About 1 to 2 on quasi-uniform meshes (diagonals of squares and cubes
 /// included), far more where a zone is refined (the Hertz meshes: 10). Infinity when a tenth of
 /// the edges have length zero; 1 for a graph without edges.
 double edge_length_spread(const AdjacencyGraph& graph, const std::vector<Eigen::Vector3d>& points);

@@ -132,6 +132,34 @@ TEST(EdgeLengthSpread, IsSmallOnAUniformGridAndLargeOnAGradedOne) {
   EXPECT_EQ(edge_length_spread(grid.graph, grid.points), std::numeric_limits<double>::infinity());
 }
 
+/// The spread from every edge once, sorted: the definition, independently of the sampling.
+double every_edge_spread(const Grid& grid) {
+  std::vector<double> lengths;
+  for (int v = 0; v < grid.graph.vertex_count(); ++v) {
+    for (long entry = grid.graph.start[v]; entry < grid.graph.start[v + 1]; ++entry) {
+      const int w = grid.graph.neighbours[entry];
+      if (w > v) lengths.push_back((grid.points[w] - grid.points[v]).norm());
+    }
+  }
+  std::sort(lengths.begin(), lengths.end());
+  const auto at = [&lengths](double fraction) {
+    return lengths[static_cast<std::size_t>(fraction * static_cast<double>(lengths.size() - 1))];
+  };
+  return at(0.9) / at(0.1);
+}
+
+TEST(EdgeLengthSpread, ASampleOfTheVerticesOfALargeGraphGivesTheSpreadOfEveryEdge) {
+  // 300 x 300 = 90 000 vertices, above spread_sample_vertices: every 4th vertex's edges
+  Grid grid = plane_grid(300);
+  ASSERT_GT(grid.graph.vertex_count(), 2 * spread_sample_vertices);
+  EXPECT_NEAR(edge_length_spread(grid.graph, grid.points), every_edge_spread(grid), 1e-12);
+  // spacing growing 1.01 times per column: about 20 times across, graded
+  for (Eigen::Vector3d& point : grid.points) point.x() = std::pow(1.01, point.x());
+  const double exact = every_edge_spread(grid);
+  EXPECT_GT(exact, 4.0);
+  EXPECT_NEAR(edge_length_spread(grid.graph, grid.points), exact, 0.05 * exact);
+}
+
 TEST(GeometricDissection, RefusesMismatchedSizesAndPointsThatAreNotFinite) {
   const Grid grid = plane_grid(3);
   std::vector<Eigen::Vector3d> short_points(grid.points.begin(), grid.points.end() - 1);
