@@ -179,31 +179,34 @@ class MshScanner {
   std::int64_t integer(const char* what, std::int64_t minimum, std::int64_t maximum) {
     skip_space();
     const std::size_t begin = position_;
-    const std::string_view text = word();
     std::int64_t value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty()) fail_at(begin, std::string("the file ends where ") + what + " is expected");
-    if (error != std::errc() || end != text.data() + text.size() || value < minimum ||
-        value > maximum) {
+    const auto [end, error] =
+        std::from_chars(bytes_.data() + begin, bytes_.data() + bytes_.size(), value);
+    if (error != std::errc() || !ends_word(end) || value < minimum || value > maximum) {
+      const std::string_view text = word();  // for the message
+      if (text.empty()) fail_at(begin, std::string("the file ends where ") + what + " is expected");
       fail_at(begin, std::string(what) + " '" + std::string(text.substr(0, 40)) +
                          "' is not an integer in [" + std::to_string(minimum) + ", " +
                          std::to_string(maximum) + "]");
     }
+    position_ = static_cast<std::size_t>(end - bytes_.data());
     return value;
   }
   /// The next ASCII real number, finite.
   double real(const char* what) {
     skip_space();
     const std::size_t begin = position_;
-    std::string_view text = word();
-    if (text.empty()) fail_at(begin, std::string("the file ends where ") + what + " is expected");
-    const std::string_view digits = text.front() == '+' ? text.substr(1) : text;
+    const bool plus = begin < bytes_.size() && bytes_[begin] == '+';
     double value = 0.0;
-    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-    if (error != std::errc() || end != digits.data() + digits.size() || !std::isfinite(value)) {
+    const auto [end, error] = std::from_chars(bytes_.data() + begin + (plus ? 1 : 0),
+                                              bytes_.data() + bytes_.size(), value);
+    if (error != std::errc() || !ends_word(end) || !std::isfinite(value)) {
+      const std::string_view text = word();  // for the message
+      if (text.empty()) fail_at(begin, std::string("the file ends where ") + what + " is expected");
       fail_at(begin, std::string(what) + " '" + std::string(text.substr(0, 40)) +
                          "' is not a finite real number");
     }
+    position_ = static_cast<std::size_t>(end - bytes_.data());
     return value;
   }
 
@@ -272,6 +275,10 @@ class MshScanner {
   }
 
  private:
+  /// True when a number parsed up to `end` is a whole word: whitespace or the end follows.
+  bool ends_word(const char* end) const {
+    return end == bytes_.data() + bytes_.size() || is_space(*end);
+  }
   static bool is_space(char character) {
     return character == ' ' || character == '\n' || character == '\r' || character == '\t' ||
            character == '\v' || character == '\f';
@@ -934,16 +941,28 @@ void orient_elements_positively(const std::string& name, const Mesh& mesh, Eleme
       {ElementType::tetrahedron10, {0, 2, 1, 3, 6, 5, 4, 7, 9, 8}},
       {ElementType::hexahedron8, {0, 3, 2, 1, 4, 7, 6, 5}}};
   const int count = nodes_per_element(block.type);
+  // each element's measure once; the entity's sum looked up again only when the entity changes
+  // (the elements of an entity come together)
+  std::vector<double> measures(block.element_count());
   std::map<int, double> entity_measure;
+  auto entity = entity_measure.end();
   for (std::size_t e = 0; e < block.element_count(); ++e) {
-    entity_measure[entities[e]] += signed_measure(mesh, block.type, &block.connectivity[e * count]);
+    measures[e] = signed_measure(mesh, block.type, &block.connectivity[e * count]);
+    if (entity == entity_measure.end() || entity->first != entities[e]) {
+      entity = entity_measure.try_emplace(entities[e], 0.0).first;
+    }
+    entity->second += measures[e];
   }
   const std::vector<int>& order = reversed.at(block.type);
   const bool solid = element_dimension(block.type) == 3;
+  entity = entity_measure.end();
   for (std::size_t e = 0; e < block.element_count(); ++e) {
     int* nodes = &block.connectivity[e * count];
-    const double measure = signed_measure(mesh, block.type, nodes);
-    const double orientation = entity_measure[entities[e]] < 0.0 ? -1.0 : 1.0;
+    const double measure = measures[e];
+    if (entity == entity_measure.end() || entity->first != entities[e]) {
+      entity = entity_measure.find(entities[e]);
+    }
+    const double orientation = entity->second < 0.0 ? -1.0 : 1.0;
     if (measure * orientation <= 0.0) {
       throw InputError(name + ": " + block.element_label(e) + " (" + to_string(block.type) +
                        " at node tag " + std::to_string(mesh.node_tags[nodes[0]]) + ") " +
