@@ -4,6 +4,7 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
@@ -11,7 +12,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-
 #include <limits>
 #include <map>
 #include <optional>
@@ -95,9 +95,6 @@ struct MshModel {
 // ---------------------------------------------------------------------------------------------
 // The byte scanner
 
-/// Reads the file's bytes: ASCII tokens (whitespace-separated, as Gmsh's fscanf reads them) and
-/// little-endian binary values; every error names the file and the line (ASCII) or byte offset
-/// (binary files) where it was found.
 /// A file's bytes mapped read-only: the page cache's pages, neither copied nor zeroed first
 /// (reading into a buffer costs a fresh zeroed page and a copy per 4 KiB). Like every mapping,
 /// it assumes the file is not truncated while it is read.
@@ -132,6 +129,9 @@ class MappedFile {
   std::size_t size_ = 0;
 };
 
+/// Reads the file's bytes: ASCII tokens (whitespace-separated, as Gmsh's fscanf reads them) and
+/// little-endian binary values; every error names the file and the line (ASCII) or byte offset
+/// (binary files) where it was found.
 class MshScanner {
  public:
   MshScanner(std::string_view bytes, std::string name) : bytes_(bytes), name_(std::move(name)) {}
