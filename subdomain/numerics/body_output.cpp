@@ -69,10 +69,10 @@ Eigen::MatrixXd nodal_stresses(const Mesh& mesh, const Material& material,
   element_stresses.resize(material.voigt_size(), static_cast<Eigen::Index>(mesh.element_count()));
   Eigen::Index element = 0;
   for_each_element_stress(mesh, material, displacement,
-                          [&](const ElementGeometry& geometry, const VoigtVector* stresses) {
-                            for (int i = 0; i < geometry.node_count(); ++i) {
-                              nodal.col(geometry.node(i)) += stresses[i + 1];
-                              touching(geometry.node(i)) += 1.0;
+                          [&](const int* nodes, int count, const VoigtVector* stresses) {
+                            for (int i = 0; i < count; ++i) {
+                              nodal.col(nodes[i]) += stresses[i + 1];
+                              touching(nodes[i]) += 1.0;
                             }
                             element_stresses.col(element++) = stresses[0];
                           });

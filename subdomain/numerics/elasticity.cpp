@@ -395,7 +395,7 @@ VoigtVector stress_at(const ElementGeometry& geometry, const ReferenceShape& sha
   return c * (b * local);
 }
 
-/// Calls `visit` for every element of block `b` (for_each_element_stress).
+/// Calls `visit` for every element of block `b` (for_each_element_stress), any element type.
 void visit_block_stresses(const Mesh& mesh, std::size_t b, const VoigtMatrix& c,
                           const Eigen::VectorXd& displacement, const ElementStressVisitor& visit) {
   const ElementBlock& block = mesh.blocks[b];
@@ -413,7 +413,50 @@ void visit_block_stresses(const Mesh& mesh, std::size_t b, const VoigtMatrix& c,
       stresses[k] =
           same[k] == k ? stress_at(geometry, shapes[k], c, local, scratch) : stresses[same[k]];
     }
-    visit(geometry, stresses.data());
+    visit(geometry.nodes(), geometry.node_count(), stresses.data());
+  }
+}
+
+/// The same for a block of affine simplices (3-node triangles in 2D, 4-node tetrahedra in 3D),
+/// whose dN/dx is constant: with J = [x_1 - x_0, ..., x_d - x_0] (J_ij = dx_i / dxi_j) and
+/// U = [u_1 - u_0, ..., u_d - u_0], the displacement gradient is H = U J^-1 (H_ac = du_a/dx_c),
+/// the Voigt strain has H_aa and H_ac + H_ca, and one stress C strain holds at the centroid
+/// and at every node. An element with det J <= 0 gets ElementGeometry's error.
+template <int Dimension>
+void visit_affine_block_stresses(const Mesh& mesh, std::size_t b, const VoigtMatrix& c,
+                                 const Eigen::VectorXd& displacement,
+                                 const ElementStressVisitor& visit) {
+  constexpr int count = Dimension + 1;
+  constexpr int voigt_size = Dimension == 2 ? 3 : 6;
+  const int(*pairs)[2] = Dimension == 2 ? plane_voigt_pairs : solid_voigt_pairs;
+  using Square = Eigen::Matrix<double, Dimension, Dimension>;
+  const Eigen::Matrix<double, voigt_size, voigt_size> stiffness = c;
+  const ElementBlock& block = mesh.blocks[b];
+  std::array<VoigtVector, count + 1> stresses;  // centroid, then node by node: all equal
+  for (std::size_t e = 0; e < block.element_count(); ++e) {
+    const int* nodes = &block.connectivity[e * count];
+    Square jacobian;
+    Square differences;
+    for (int j = 0; j < Dimension; ++j) {
+      jacobian.col(j) =
+          (mesh.nodes[nodes[j + 1]] - mesh.nodes[nodes[0]]).template head<Dimension>();
+      differences.col(j) = displacement.template segment<Dimension>(Dimension * nodes[j + 1]) -
+                           displacement.template segment<Dimension>(Dimension * nodes[0]);
+    }
+    if (!(jacobian.determinant() > 0.0)) {
+      ElementGeometry(mesh, b, e).evaluate(reference_centroid(block.type));  // throws
+    }
+    const Square gradient = differences * jacobian.inverse();
+    Eigen::Matrix<double, voigt_size, 1> strain;
+    for (int row = 0; row < voigt_size; ++row) {
+      const int first = pairs[row][0];
+      const int second = pairs[row][1];
+      strain(row) = first == second ? gradient(first, first)
+                                    : gradient(first, second) + gradient(second, first);
+    }
+    stresses[0] = stiffness * strain;
+    for (int k = 1; k <= count; ++k) stresses[k] = stresses[0];
+    visit(nodes, count, stresses.data());
   }
 }
 
@@ -435,7 +478,14 @@ void for_each_element_stress(const Mesh& mesh, const Material& material,
   check_material_dimension(mesh, material);
   const VoigtMatrix c = material.stiffness;
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
-    visit_block_stresses(mesh, b, c, displacement, visit);
+    const ElementType type = mesh.blocks[b].type;
+    if (type == ElementType::triangle3 && mesh.dimension == 2) {
+      visit_affine_block_stresses<2>(mesh, b, c, displacement, visit);
+    } else if (type == ElementType::tetrahedron4 && mesh.dimension == 3) {
+      visit_affine_block_stresses<3>(mesh, b, c, displacement, visit);
+    } else {
+      visit_block_stresses(mesh, b, c, displacement, visit);
+    }
   }
 }
 
@@ -449,11 +499,11 @@ StressField recover_stress(const Mesh& mesh, const Material& material,
   Eigen::VectorXd touching = Eigen::VectorXd::Zero(mesh.node_count());
   Eigen::Index element = 0;
   for_each_element_stress(mesh, material, displacement,
-                          [&](const ElementGeometry& geometry, const VoigtVector* stresses) {
+                          [&](const int* nodes, int count, const VoigtVector* stresses) {
                             field.element_stress.col(element++) = stresses[0];
-                            for (int i = 0; i < geometry.node_count(); ++i) {
-                              field.nodal_stress.col(geometry.node(i)) += stresses[i + 1];
-                              touching(geometry.node(i)) += 1.0;
+                            for (int i = 0; i < count; ++i) {
+                              field.nodal_stress.col(nodes[i]) += stresses[i + 1];
+                              touching(nodes[i]) += 1.0;
                             }
                           });
   for (Eigen::Index node = 0; node < touching.size(); ++node) {

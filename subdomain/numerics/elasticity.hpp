@@ -60,11 +60,11 @@ std::vector<Eigen::Vector3d> unit_normals(const Mesh& mesh,
                                           const std::vector<Eigen::Vector3d>& sums,
                                           const std::vector<int>& nodes, const std::string& what);
 
-/// Called for one element with its Voigt stresses s = C B u_e (material.hpp: 3 components in
-/// 2D, 6 in 3D): stresses[0] at the element's reference centroid, stresses[1 + i] at its local
-/// node i (i < geometry.node_count()).
+/// Called for one element, whose mesh nodes are nodes[0 .. count - 1], with its Voigt stresses
+/// s = C B u_e (material.hpp: 3 components in 2D, 6 in 3D): stresses[0] at the element's
+/// reference centroid, stresses[1 + i] at its local node i (i < count).
 using ElementStressVisitor =
-    std::function<void(const ElementGeometry& geometry, const VoigtVector* stresses)>;
+    std::function<void(const int* nodes, int count, const VoigtVector* stresses)>;
 
 /// Calls `visit` for every element, in the element order of mesh.blocks. Points of an element
 /// type with the same reference gradients share one evaluation (the same J and dN/dx).

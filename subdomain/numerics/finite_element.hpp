@@ -130,6 +130,8 @@ class ElementGeometry {
   int node_count() const { return static_cast<int>(coordinates_.rows()); }
   /// Mesh index of local node `local`.
   int node(int local) const { return nodes_[local]; }
+  /// Mesh indices of the local nodes, node_count() of them.
+  const int* nodes() const { return nodes_; }
   /// Throws InputError naming the element when det(dx/dxi) <= 0 at `reference`.
   ElementPoint evaluate(const Eigen::Vector3d& reference) const;
   /// The same at a tabulated point of this element's type.

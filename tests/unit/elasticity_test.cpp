@@ -311,6 +311,57 @@ TEST(Normals, CornerOfTwoSidesInOneGroupAveragesByLength) {
   EXPECT_NEAR((normals[2] - Eigen::Vector3d(1.0, 0.0, 0.0)).norm(), 0.0, 1e-15);
 }
 
+TEST(Stress, RightTriangleAndTetrahedronByHand) {
+  // On the right simplex with legs a, b (, c) along the axes, du/dx = (u_1 - u_0) / a,
+  // du/dy = (u_2 - u_0) / b (, du/dz = (u_3 - u_0) / c); with C = I the stress is the Voigt
+  // strain (e_xx, e_yy, [e_zz, 2 e_yz, 2 e_xz,] 2 e_xy), the same at the centroid and nodes.
+  Mesh plane;
+  plane.nodes = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {0.0, 0.5, 0.0}};
+  plane.blocks.push_back({ElementType::triangle3, {0, 1, 2}, {}});
+  Eigen::VectorXd u(6);
+  u << 0.1, -0.2, 0.5, 0.3, -0.4, 0.25;  // u_0, u_1, u_2
+  const Eigen::Vector2d dudx = (u.segment<2>(2) - u.segment<2>(0)) / 2.0;
+  const Eigen::Vector2d dudy = (u.segment<2>(4) - u.segment<2>(0)) / 0.5;
+  const Material plane_identity =
+      make_voigt_material(Eigen::Matrix3d::Identity(), PlaneModel::plane_stress, "identity");
+  const StressField plane_stress = recover_stress(plane, plane_identity, u);
+  const Eigen::Vector3d plane_expected(dudx(0), dudy(1), dudy(0) + dudx(1));
+  EXPECT_LT((plane_stress.element_stress.col(0) - plane_expected).norm(), 1e-15);
+  EXPECT_LT((plane_stress.nodal_stress.colwise() - plane_expected).norm(), 1e-15);
+
+  Mesh solid;
+  solid.dimension = 3;
+  solid.nodes = {{0.0, 0.0, 0.0}, {0.5, 0.0, 0.0}, {0.0, 2.0, 0.0}, {0.0, 0.0, 4.0}};
+  solid.blocks.push_back({ElementType::tetrahedron4, {0, 1, 2, 3}, {}});
+  Eigen::VectorXd v(12);
+  v << 0.1, -0.2, 0.3, 0.5, 0.3, -0.1, -0.4, 0.25, 0.2, 0.05, 0.15, -0.35;
+  Eigen::Matrix3d gradient;  // gradient(a, c) = du_a / dx_c
+  gradient.col(0) = (v.segment<3>(3) - v.segment<3>(0)) / 0.5;
+  gradient.col(1) = (v.segment<3>(6) - v.segment<3>(0)) / 2.0;
+  gradient.col(2) = (v.segment<3>(9) - v.segment<3>(0)) / 4.0;
+  Eigen::Matrix<double, 6, 1> solid_expected;
+  solid_expected << gradient(0, 0), gradient(1, 1), gradient(2, 2), gradient(1, 2) + gradient(2, 1),
+      gradient(0, 2) + gradient(2, 0), gradient(0, 1) + gradient(1, 0);
+  const Material solid_identity =
+      make_voigt_material(Eigen::MatrixXd::Identity(6, 6), PlaneModel::plane_strain, "identity");
+  const StressField solid_stress = recover_stress(solid, solid_identity, v);
+  EXPECT_LT((solid_stress.element_stress.col(0) - solid_expected).norm(), 1e-15);
+  EXPECT_LT((solid_stress.nodal_stress.colwise() - solid_expected).norm(), 1e-15);
+}
+
+TEST(Errors, InvertedTriangleHasNoStress) {
+  Mesh mesh = unit_triangle();
+  mesh.blocks[0].connectivity = {0, 2, 1};  // clockwise
+  const Material material = make_isotropic_material(1.0, 0.3, PlaneModel::plane_strain, "m");
+  try {
+    recover_stress(mesh, material, Eigen::VectorXd::Zero(6));
+    FAIL() << "no InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("non-positive Jacobian"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(Errors, InvertedElementAndDetachedEdgeAreInputErrors) {
   Mesh mesh = unit_triangle();
   mesh.blocks[0].connectivity = {0, 2, 1};  // clockwise
