@@ -15,6 +15,8 @@
 #include <memory>
 #include <stdexcept>
 #include <string_view>
+#include <tuple>
+#include <type_traits>
 #include <unordered_map>
 #include <variant>
 
@@ -212,6 +214,46 @@ struct DataArray {
       values;
 };
 
+/// Storage reused by the arrays of one file, made one after another: an array's values are made
+/// in the vector of their type taken from here and given back once written (emptied, their
+/// capacity kept), so that the pages of a file's arrays are touched in once rather than once
+/// per array (a block above the mapping threshold is a fresh mapping each time: heap_memory.hpp).
+class ValueStorage {
+ public:
+  /// The vector for values of type Value, empty, with the capacity of the largest given back.
+  template <typename Value>
+  std::vector<Value> take() {
+    std::vector<Value> values = std::move(std::get<std::vector<Value>>(vectors_));
+    values.clear();
+    return values;
+  }
+
+  /// Makes room for `count` values of type Value (the largest array of that type, made first, so
+  /// that the later ones do not reallocate).
+  template <typename Value>
+  void reserve(std::size_t count) {
+    std::get<std::vector<Value>>(vectors_).reserve(count);
+  }
+
+  /// Keeps the vector of `array`'s values (a string array's are dropped).
+  void give_back(DataArray&& array) {
+    std::visit(
+        [this](auto& values) {
+          using Vector = std::decay_t<decltype(values)>;
+          if constexpr (!std::is_same_v<typename Vector::value_type, std::string>) {
+            Vector& kept = std::get<Vector>(vectors_);
+            if (values.capacity() >= kept.capacity()) kept = std::move(values);
+          }
+        },
+        array.values);
+  }
+
+ private:
+  std::tuple<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int32_t>,
+             std::vector<std::uint8_t>>
+      vectors_;
+};
+
 /// Makes `values` (`count` items of `components` values) the array as written, in place: 2
 /// components padded to 3 (the third zero), then one item per entry of `source`, a copy of
 /// item source[j] (NaN where source[j] is -1).
@@ -245,9 +287,9 @@ struct FieldPlace {
 };
 
 /// The array of `field` as written (lay_out_items), its values made by the field's source.
-DataArray field_array(const FieldSource& field, const FieldPlace& place) {
+DataArray field_array(const FieldSource& field, const FieldPlace& place, ValueStorage& storage) {
   const int written = written_components(field.components);
-  std::vector<double> values;
+  std::vector<double> values = storage.take<double>();
   values.reserve((place.count + place.source.size()) * static_cast<std::size_t>(written));
   field.append_values(values);
   check_value_count(field, values.size(), place.count, place.location, place.path);
@@ -358,8 +400,8 @@ void to_vtk_node_order(std::vector<Index>& connectivity) {
 }
 
 /// The points (x, y, z per node).
-DataArray points_array(const Mesh& mesh) {
-  std::vector<double> points;
+DataArray points_array(const Mesh& mesh, ValueStorage& storage) {
+  std::vector<double> points = storage.take<double>();
   points.reserve(3 * mesh.node_count());
   for (const Eigen::Vector3d& node : mesh.nodes)
     points.insert(points.end(), {node.x(), node.y(), node.z()});
@@ -391,9 +433,24 @@ bool narrow_cell_indices(const Mesh& mesh, bool boundary_cells) {
 /// over the area elements block after block, then (with boundary cells) the boundary facets in
 /// name order; connectivity and offsets as Index (std::int32_t or std::int64_t).
 template <typename Index>
-DataArray cell_array(const Mesh& mesh, bool boundary_cells, CellArray which) {
+DataArray cell_array(const Mesh& mesh, bool boundary_cells, CellArray which,
+                     ValueStorage& storage) {
   std::vector<Index> connectivity, offsets;
   std::vector<std::uint8_t> types;
+  std::size_t cell_count = mesh.element_count();
+  if (boundary_cells) {
+    for (const auto& [name, group] : mesh.boundaries) cell_count += group.facet_count();
+  }
+  if (which == CellArray::connectivity) {
+    connectivity = storage.take<Index>();
+    connectivity.reserve(connectivity_length(mesh, boundary_cells));
+  } else if (which == CellArray::offsets) {
+    offsets = storage.take<Index>();
+    offsets.reserve(cell_count);
+  } else {
+    types = storage.take<std::uint8_t>();
+    types.reserve(cell_count);
+  }
   Index end = 0;
   const auto add_cells = [&](const std::vector<int>& nodes, int per_cell, int type) {
     for (std::size_t k = 0; k < nodes.size(); k += static_cast<std::size_t>(per_cell)) {
@@ -496,7 +553,7 @@ class ArrayWriter {
 
   /// `array` holds the attributes (and a string array's values); `make` makes its values when
   /// they are written (called once, after the XML in binary mode).
-  void write(const DataArray& array, std::function<DataArray()> make) {
+  void write(const DataArray& array, std::function<DataArray(ValueStorage&)> make) {
     out_ << "        <DataArray type=\"" << array.type << "\" Name=\"" << escape_xml(array.name)
          << '"';
     if (const auto* strings = std::get_if<std::vector<std::string>>(&array.values)) {
@@ -509,7 +566,9 @@ class ArrayWriter {
     }
     if (encoding_ == VtuEncoding::ascii) {
       out_ << " format=\"ascii\">";
-      write_ascii_values(out_, make());
+      DataArray values = make(storage_);
+      write_ascii_values(out_, values);
+      storage_.give_back(std::move(values));
       out_ << "</DataArray>\n";
       return;
     }
@@ -518,10 +577,13 @@ class ArrayWriter {
     out_ << std::string(offset_width, ' ') << "/>\n";
   }
 
+  /// Room for the largest floating-point array (ValueStorage::reserve).
+  void reserve_floating_point_values(std::size_t count) { storage_.reserve<double>(count); }
+
   /// A small array whose values are at hand.
   void write(DataArray array) {
     auto values = std::make_shared<DataArray>(std::move(array));
-    write(*values, [values] { return std::move(*values); });
+    write(*values, [values](ValueStorage&) { return std::move(*values); });
   }
 
   /// Binary: the appended data (every record, in the order of the elements), then the offsets.
@@ -533,9 +595,10 @@ class ArrayWriter {
     for (PendingArray& pending : pending_) {
       offsets.push_back(offset);
       std::string storage;
-      const DataArray array = pending.make();
+      DataArray array = pending.make(storage_);
       const bool floating_point = std::holds_alternative<std::vector<double>>(array.values);
       offset += write_compressed_record(value_bytes(array, storage), floating_point);
+      storage_.give_back(std::move(array));
       pending.make = nullptr;
     }
     out_ << "\n  </AppendedData>\n"
@@ -550,7 +613,7 @@ class ArrayWriter {
  private:
   struct PendingArray {
     std::streampos position;  // of the offset's room
-    std::function<DataArray()> make;
+    std::function<DataArray(ValueStorage&)> make;
   };
 
   /// Writes the appended-data record of `bytes` in vtkZLibDataCompressor's layout (see the
@@ -590,6 +653,7 @@ class ArrayWriter {
   std::vector<PendingArray> pending_;
   BlockCompressor compressor_;
   std::vector<std::uint8_t> buffer_;  // one compressed block
+  ValueStorage storage_;
 };
 
 /// The Cells section's arrays, Int32 or Int64 as narrow_cell_indices says.
@@ -598,13 +662,14 @@ void write_cell_arrays(ArrayWriter& writer, const Mesh& mesh, bool boundary_cell
   const std::string index_type = narrow ? "Int32" : "Int64";
   for (const auto& [which, name] : {std::pair{CellArray::connectivity, "connectivity"},
                                     std::pair{CellArray::offsets, "offsets"}}) {
-    writer.write({index_type, name, 1, {}, {}}, [&mesh, boundary_cells, narrow, which = which] {
-      return narrow ? cell_array<std::int32_t>(mesh, boundary_cells, which)
-                    : cell_array<std::int64_t>(mesh, boundary_cells, which);
-    });
+    writer.write({index_type, name, 1, {}, {}},
+                 [&mesh, boundary_cells, narrow, which = which](ValueStorage& storage) {
+                   return narrow ? cell_array<std::int32_t>(mesh, boundary_cells, which, storage)
+                                 : cell_array<std::int64_t>(mesh, boundary_cells, which, storage);
+                 });
   }
-  writer.write({"UInt8", "types", 1, {}, {}}, [&mesh, boundary_cells] {
-    return cell_array<std::int32_t>(mesh, boundary_cells, CellArray::types);
+  writer.write({"UInt8", "types", 1, {}, {}}, [&mesh, boundary_cells](ValueStorage& storage) {
+    return cell_array<std::int32_t>(mesh, boundary_cells, CellArray::types, storage);
   });
 }
 
@@ -618,21 +683,35 @@ void write_piece(std::ofstream& out, ArrayWriter& writer, const Mesh& mesh,
   static const std::vector<std::int64_t> no_items;
   const FieldPlace points{"point", mesh.node_count(), no_items, path};
   const FieldPlace cells{"cell", mesh.element_count(), adjacent, path};
+  std::size_t largest = 3 * points.count;  // the points
+  for (const FieldSource& field : point_fields) {
+    largest = std::max(largest, points.count * written_components(field.components));
+  }
+  for (const FieldSource& field : cell_fields) {
+    largest =
+        std::max(largest, (cells.count + adjacent.size()) * written_components(field.components));
+  }
+  writer.reserve_floating_point_values(largest);
   out << "    <Piece NumberOfPoints=\"" << points.count << "\" NumberOfCells=\""
       << boundary_id.size() << "\">\n"
       << "      <PointData>\n";
   for (const FieldSource& field : point_fields) {
-    writer.write(attributes_of(field), [&field, points] { return field_array(field, points); });
+    writer.write(attributes_of(field), [&field, points](ValueStorage& storage) {
+      return field_array(field, points, storage);
+    });
   }
   out << "      </PointData>\n"
       << "      <CellData>\n";
   for (const FieldSource& field : cell_fields) {
-    writer.write(attributes_of(field), [&field, cells] { return field_array(field, cells); });
+    writer.write(attributes_of(field), [&field, cells](ValueStorage& storage) {
+      return field_array(field, cells, storage);
+    });
   }
   if (boundary_cells) writer.write({"Int32", "boundary_id", 1, {}, std::move(boundary_id)});
   out << "      </CellData>\n"
       << "      <Points>\n";
-  writer.write({"Float64", "Points", 3, {}, {}}, [&mesh] { return points_array(mesh); });
+  writer.write({"Float64", "Points", 3, {}, {}},
+               [&mesh](ValueStorage& storage) { return points_array(mesh, storage); });
   out << "      </Points>\n"
       << "      <Cells>\n";
   write_cell_arrays(writer, mesh, boundary_cells);
