@@ -12,6 +12,7 @@
 #include "coupling/case_file_table.hpp"
 #include "coupling/gap_function.hpp"
 #include "numerics/errors.hpp"
+#include "numerics/msh_file.hpp"
 
 namespace robin {
 
@@ -453,12 +454,71 @@ BodyDefinition load_body(const BodyCase& body) {
   return definition;
 }
 
+/// `observer` told of the requests whose bodies are `body_indices` by body index.
+MeshReadObserver for_bodies(const MeshReadObserver& observer,
+                            const std::vector<std::size_t>& body_indices) {
+  MeshReadObserver translated = observer;
+  if (observer.started) {
+    translated.started = [&observer, &body_indices](std::size_t request) {
+      observer.started(body_indices[request]);
+    };
+  }
+  if (observer.finished) {
+    translated.finished = [&observer, &body_indices](std::size_t request, const Mesh& mesh,
+                                                     double seconds) {
+      observer.finished(body_indices[request], mesh, seconds);
+    };
+  }
+  return translated;
+}
+
+/// Whether the head of `body`'s .msh file vouches for the checks load_body makes (its dimension,
+/// every boundary name the body refers to), so that its server may read the file itself; sets
+/// the body's node count. The full read gives the exact error of a file it does not vouch for.
+bool head_vouches_for(BodyCase& body) {
+  const MeshReadOptions defaults;
+  if (body.mesh_options.size != defaults.size ||
+      body.mesh_options.element_order != defaults.element_order ||
+      body.mesh_options.recombine != defaults.recombine) {
+    return false;  // options of a .geo: the full read refuses them
+  }
+  std::optional<MshSummary> summary;
+  try {
+    summary = summarize_msh_file(body.mesh_path);
+  } catch (const InputError&) {
+    return false;
+  }
+  if (!summary || summary->dimension != body.dimension) return false;
+  const std::vector<BoundaryReference> references =
+      body.boundary_references.empty() ? references_of(body.definition) : body.boundary_references;
+  for (const BoundaryReference& reference : references) {
+    const std::vector<std::string>& names = summary->boundary_names;
+    if (std::find(names.begin(), names.end(), reference.name) == names.end()) return false;
+  }
+  body.mesh_file_node_count = summary->node_count;
+  return true;
+}
+
 void load_meshes(CaseDefinition& definition, const std::function<void(std::size_t)>& loaded) {
-  std::vector<BodyCase*> bodies;
+  std::vector<BodyCase*> bodies;  // the bodies whose meshes are read here, request by request
+  std::vector<std::size_t> body_indices;
   std::vector<MeshFileRequest> requests;
-  for (BodyCase& body : definition.bodies) {
+  std::vector<std::size_t> read_by_servers;
+  for (std::size_t k = 0; k < definition.bodies.size(); ++k) {
+    BodyCase& body = definition.bodies[k];
+    if (body.mesh_delivery == MeshDelivery::file_on_server) {
+      if (head_vouches_for(body)) {
+        read_by_servers.push_back(k);
+        continue;
+      }
+      body.mesh_delivery = MeshDelivery::data;
+    }
     bodies.push_back(&body);
+    body_indices.push_back(k);
     requests.push_back({body.mesh_path, body.mesh_options});
+  }
+  if (loaded) {  // these setups begin at once, while the coordinator reads the other meshes
+    for (const std::size_t k : read_by_servers) loaded(k);
   }
   // a body's checks fail after the reading of every mesh, in body order (a reader's error first)
   std::vector<std::optional<InputError>> unusable(bodies.size());
@@ -472,10 +532,10 @@ void load_meshes(CaseDefinition& definition, const std::function<void(std::size_
       unusable[k] = error;
       return;
     }
-    if (loaded) loaded(k);
+    if (loaded) loaded(body_indices[k]);
   };
   try {
-    read_gmsh_meshes(requests, receive, definition.meshing);
+    read_gmsh_meshes(requests, receive, for_bodies(definition.meshing, body_indices));
   } catch (const InputError& error) {
     throw mesh_error(bodies, error);
   }

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -32,7 +33,20 @@ struct BoundaryReference {
   std::string location;  // "case.toml:31" (file:line of the value)
 };
 
-/// One body as written in the case file. `definition.mesh` is empty until load_meshes.
+/// How a body's mesh reaches its server.
+enum class MeshDelivery {
+  /// The coordinator reads (or meshes) the file and sends the mesh as data (SetupBody.mesh).
+  data,
+  /// The server reads the .msh file itself (SetupBody.mesh_path: the file's name, under the
+  /// data directory its launcher gave it, the file's directory); the coordinator reads only
+  /// the file's head for its checks (summarize_msh_file). load_meshes turns it into `data` when
+  /// that head cannot vouch for them (no summary, another dimension, a boundary name it does
+  /// not list), so that the full read gives its exact error.
+  file_on_server,
+};
+
+/// One body as written in the case file. `definition.mesh` is empty until load_meshes, and
+/// stays empty when the server reads the file (MeshDelivery::file_on_server).
 struct BodyCase {
   BodyDefinition definition;
   std::filesystem::path mesh_path;  // absolute (resolved against the case file's directory)
@@ -50,6 +64,11 @@ struct BodyCase {
   bool floating = false;
   /// The case's dimension: 2 (a plane body) or 3 (a solid one); its mesh must have it.
   int dimension = 2;
+  MeshDelivery mesh_delivery = MeshDelivery::data;
+  /// file_on_server: SetupBody.mesh_path, the file's name under the server's data directory.
+  std::string server_mesh_path;
+  /// file_on_server: the file's node count (summarize_msh_file), for the solver's choice.
+  std::uint64_t mesh_file_node_count = 0;
 };
 
 /// Options of the Robin iteration (coordinator); command-line flags override them.

@@ -216,15 +216,14 @@ void RemotePort::handshake() {
 
 InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions& solver) {
   body_label_ = body.definition.name;
-  if (body.definition.mesh.node_count() == 0) {
+  if (body.definition.mesh.node_count() == 0 && body.mesh_delivery == MeshDelivery::data) {
     fail("setup", "body '" + body_label_ + "' has no mesh (load_meshes first)");
   }
   run_id_ = new_run_id();  // a new run: this port's requests carry it from now on
   if (server_name_.empty()) handshake();
   const auto encoding_start = Clock::now();
   Envelope request;
-  *request.mutable_setup_body() =
-      encode_setup_body(body.definition, body.context, solver, body.floating);
+  *request.mutable_setup_body() = encode_setup_body(body, solver);
   const double encoding_seconds = seconds_since(encoding_start);
   const auto sent = Clock::now();
   const Envelope reply =
@@ -236,6 +235,15 @@ InterfaceDescription RemotePort::setup(const BodyCase& body, const SolverOptions
   profile_.linear_solver = linear_solver.empty() ? "direct" : linear_solver;
   try {
     InterfaceDescription interface = decode_interface(reply.interface());
+    const int dimension =
+        body.mesh_delivery == MeshDelivery::data ? body.definition.mesh.dimension : body.dimension;
+    if (interface.dimension != dimension) {
+      fail("setup", "the server set body '" + body_label_ + "' up as a " +
+                        std::to_string(interface.dimension) + "D body, not " +
+                        std::to_string(dimension) + "D (is its mesh file " +
+                        (interface.dimension == 3 ? "a solid" : "a plane") +
+                        " mesh? the case has dimension = " + std::to_string(body.dimension) + ")");
+    }
     contact_size_ = 0;
     set_up_ = true;
     return interface;

@@ -3,8 +3,9 @@
 // executable) on tcp://127.0.0.1 with ephemeral ports, logs of the servers in
 // DIR/logs/server-<body>.log, runs the coordinator against them and stops them. SIGINT/SIGTERM stop
 // everything cleanly. These servers get --output-root DIR and write their bodies' .vtu files
-// themselves, in parallel (FieldsRequest.write_directory, docs/outputs.md); with any --server-*
-// option below the coordinator writes them.
+// themselves, in parallel (FieldsRequest.write_directory, docs/outputs.md), and read their
+// bodies' .msh files themselves (--data-directory, the file's directory; SetupBody.mesh_path);
+// with any --server-* option below the coordinator writes the files and sends the meshes.
 // --curve encrypts the local connections with CurveZMQ, with keys made for this run only
 // (curve_options.hpp); without it the loopback connections are not encrypted.
 // Servers on other hosts: --server-command "ssh HOST" (or "srun -N1 -n1 ...", "ip netns exec
@@ -28,8 +29,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <future>
 #include <optional>
 #include <sstream>
@@ -123,6 +126,27 @@ bool writes_own_files(const ServerPlacement& placement) {
   return placement.commands.empty() && placement.listens.empty() && placement.executables.empty();
 }
 
+/// Lets the server of every body whose mesh is a .msh file read it itself
+/// (MeshDelivery::file_on_server): the file's real directory is its --data-directory, the
+/// file's name there its SetupBody.mesh_path. Only for this build's servers on this machine
+/// (writes_own_files), which see the same files.
+void let_servers_read_mesh_files(robin::CaseDefinition& definition,
+                                 std::vector<robin::ServerLaunchOptions>& options) {
+  for (std::size_t k = 0; k < definition.bodies.size(); ++k) {
+    robin::BodyCase& body = definition.bodies[k];
+    std::string extension = body.mesh_path.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::error_code error;
+    const std::filesystem::path real = std::filesystem::canonical(body.mesh_path, error);
+    if (extension != ".msh" || error) continue;  // a .geo, or a file the coordinator's read names
+    options[k].extra_arguments.push_back("--data-directory");
+    options[k].extra_arguments.push_back(real.parent_path().string());
+    body.mesh_delivery = robin::MeshDelivery::file_on_server;
+    body.server_mesh_path = real.filename().string();
+  }
+}
+
 /// Starts the servers, runs the case against them and stops them; returns the exit code.
 int run_with_local_servers(const robin::CaseDefinition& definition,
                            robin::CoordinatorSettings settings, bool curve,
@@ -151,6 +175,8 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
     std::vector<robin::ServerLaunchOptions> options =
         placed(launch, placement, definition.bodies.size());
     set_server_threads(options, placement.threads_per_server);
+    robin::CaseDefinition served = definition;
+    if (writes_own_files(placement)) let_servers_read_mesh_files(served, options);
     robin::LocalServers servers(robin::body_names(definition), options);
     servers.await_listening(robin::throw_if_stop_requested);
     if (keys) keys->remove_files();  // read by the servers; the coordinator's are in memory
@@ -187,7 +213,7 @@ int run_with_local_servers(const robin::CaseDefinition& definition,
       }
     };
     settings.servers_write_fields = writes_own_files(placement);
-    code = robin::run_coordinator(definition, settings, servers.endpoints(), channels, restart,
+    code = robin::run_coordinator(served, settings, servers.endpoints(), channels, restart,
                                   stop_in_background);
     if (stopping.valid()) stopping.get();
     servers.stop();  // idempotent: stops them here when the run never started

@@ -101,12 +101,16 @@ void encode_material(const Material& material, const std::string& context,
   }
 }
 
-protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
-                                      const SolverOptions& solver, bool floating) {
+namespace {
+
+/// Everything of the SetupBody request but the mesh, for a mesh of `dimension` with
+/// `dof_count` degrees of freedom (the automatic choice of the linear solver).
+protocol::SetupBody encode_body_without_mesh(const BodyDefinition& definition,
+                                             const std::string& context,
+                                             const SolverOptions& solver, bool floating,
+                                             int dimension, long dof_count) {
   protocol::SetupBody message;
   message.set_body_name(definition.name);
-  *message.mutable_mesh() = encode_mesh(definition.mesh);
-  const int dimension = definition.mesh.dimension;
   if (definition.material.dimension() != dimension) {
     throw InputError(context + ": material: a " +
                      (definition.material.dimension() == 3 ? "solid (6x6)" : "plane (3x3)") +
@@ -131,11 +135,33 @@ protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const st
     message.add_contact_boundaries(boundary);
   }
   // the automatic choice is made here: servers get "direct" or "multigrid"
-  const LinearSolverKind linear_solver = resolve_linear_solver(
-      solver.body.linear_solver, dimension, static_cast<long>(definition.mesh.dof_count()),
-      floating ? RigidMotions::held_by_contact : RigidMotions::refuse);
+  const LinearSolverKind linear_solver =
+      resolve_linear_solver(solver.body.linear_solver, dimension, dof_count,
+                            floating ? RigidMotions::held_by_contact : RigidMotions::refuse);
   encode_solver(solver, linear_solver, *message.mutable_solver());
   message.set_floating(floating);
+  return message;
+}
+
+}  // namespace
+
+protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
+                                      const SolverOptions& solver, bool floating) {
+  protocol::SetupBody message =
+      encode_body_without_mesh(definition, context, solver, floating, definition.mesh.dimension,
+                               static_cast<long>(definition.mesh.dof_count()));
+  *message.mutable_mesh() = encode_mesh(definition.mesh);
+  return message;
+}
+
+protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions& solver) {
+  if (body.mesh_delivery == MeshDelivery::data) {
+    return encode_setup_body(body.definition, body.context, solver, body.floating);
+  }
+  const long dof_count = body.dimension * static_cast<long>(body.mesh_file_node_count);
+  protocol::SetupBody message = encode_body_without_mesh(body.definition, body.context, solver,
+                                                         body.floating, body.dimension, dof_count);
+  message.set_mesh_path(body.server_mesh_path);
   return message;
 }
 

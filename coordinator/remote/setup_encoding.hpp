@@ -18,6 +18,12 @@ namespace robin {
 protocol::SetupBody encode_setup_body(const BodyDefinition& definition, const std::string& context,
                                       const SolverOptions& solver, bool floating = false);
 
+/// The SetupBody request of `body` as its mesh_delivery says: encode_setup_body of its
+/// definition (MeshDelivery::data), or (file_on_server) the same with mesh_path, the file's name
+/// under the server's data directory, instead of the mesh, the case's dimension and the file's
+/// node count standing for the mesh's.
+protocol::SetupBody encode_setup_body(const BodyCase& body, const SolverOptions& solver);
+
 /// Writes `material` into `message` exactly (the server rebuilds the same Material bit for bit):
 ///  - an isotropic plane-strain material (the only kind with out_of_plane_poisson != 0) is sent
 ///    as young_modulus/poisson_ratio, because the server can only recover the out-of-plane

@@ -100,15 +100,21 @@ struct MshModel {
 /// it assumes the file is not truncated while it is read.
 class MappedFile {
  public:
+  /// How much of the file will be read: all of it (its pages are mapped at once) or its
+  /// beginning (pages mapped as they are read).
+  enum class Reading { whole, beginning };
+
   /// Throws InputError naming `shown` when the file cannot be opened, sized or mapped.
-  MappedFile(const std::filesystem::path& path, const std::string& shown) {
+  MappedFile(const std::filesystem::path& path, const std::string& shown,
+             Reading reading = Reading::whole) {
     const int descriptor = open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (descriptor < 0) throw InputError("mesh file '" + shown + "': the file cannot be opened");
     struct stat status {};
     const bool sized = fstat(descriptor, &status) == 0 && S_ISREG(status.st_mode);
     size_ = sized ? static_cast<std::size_t>(status.st_size) : 0;
     if (sized && size_ > 0) {
-      void* mapped = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, descriptor, 0);
+      const int populate = reading == Reading::whole ? MAP_POPULATE : 0;
+      void* mapped = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | populate, descriptor, 0);
       data_ = mapped == MAP_FAILED ? nullptr : static_cast<const char*>(mapped);
     }
     close(descriptor);
@@ -623,6 +629,18 @@ int read_mesh_format(MshScanner& scanner) {
   return version == "2.2" ? 2 : 4;
 }
 
+/// The name of the section that begins next ("$Nodes"), after which the scanner stands at its
+/// first value.
+std::string next_section(MshScanner& scanner) {
+  const std::size_t at = scanner.next_position();
+  const std::string section(scanner.word());
+  if (section.empty() || section.front() != '$') {
+    scanner.fail_at(at, "expected a section such as $Nodes, found '" + section.substr(0, 40) + "'");
+  }
+  if (scanner.binary()) scanner.next_line();  // binary data or a count line follows
+  return section;
+}
+
 MshModel read_model(MshScanner& scanner) {
   MshModel model;
   const int version = read_mesh_format(scanner);
@@ -630,15 +648,10 @@ MshModel read_model(MshScanner& scanner) {
   bool nodes_read = false, elements_read = false;
   while (scanner.skip_space()) {
     const std::size_t at = scanner.next_position();
-    const std::string section(scanner.word());
-    if (section.empty() || section.front() != '$') {
-      scanner.fail_at(at,
-                      "expected a section such as $Nodes, found '" + section.substr(0, 40) + "'");
-    }
+    const std::string section = next_section(scanner);
     const bool repeated =
         (section == "$Nodes" && nodes_read) || (section == "$Elements" && elements_read);
     if (repeated) scanner.fail_at(at, "a second " + section + " section");
-    if (scanner.binary()) scanner.next_line();  // binary data or a count line follows
     if (section == "$PhysicalNames") {
       read_physical_names(scanner, model);
     } else if (section == "$Entities" && version == 4) {
@@ -707,10 +720,21 @@ const MshEntityElements* entity_elements(const MshModel& model, int dimension, i
   return found == model.elements.end() ? nullptr : &found->second;
 }
 
+/// Appends `from` to `to`, taking its storage when `to` is empty (the usual single entity per
+/// element type: no copy).
+template <typename Value>
+void append_taking(std::vector<Value>& from, std::vector<Value>& to) {
+  if (to.empty()) {
+    to = std::move(from);
+  } else {
+    to.insert(to.end(), from.begin(), from.end());
+  }
+  std::vector<Value>().swap(from);
+}
+
 /// The elements of the physical groups of the body's dimension (of every entity of it when it
-/// has no physical group), entity by entity in ascending tags.
-void collect_domain(const MshModel& model, const std::string& name, int dimension,
-                    BodyElements& body) {
+/// has no physical group), entity by entity in ascending tags, taken out of `model`.
+void collect_domain(MshModel& model, const std::string& name, int dimension, BodyElements& body) {
   std::vector<int> entities;
   for (const auto& [group, members] : physical_groups(model, dimension)) {
     entities.insert(entities.end(), members.begin(), members.end());
@@ -721,9 +745,9 @@ void collect_domain(const MshModel& model, const std::string& name, int dimensio
   std::sort(entities.begin(), entities.end());
   entities.erase(std::unique(entities.begin(), entities.end()), entities.end());
   for (const int entity : entities) {
-    const MshEntityElements* elements = entity_elements(model, dimension, entity);
-    if (elements == nullptr) continue;
-    for (const auto& [msh_type, list] : *elements) {
+    const auto found = model.elements.find({dimension, entity});
+    if (found == model.elements.end()) continue;
+    for (auto& [msh_type, list] : found->second) {
       const std::optional<ElementType> type = domain_element_type(dimension, msh_type);
       if (!type) {
         throw InputError(name + ": unsupported " + std::to_string(dimension) + "D element " +
@@ -733,10 +757,9 @@ void collect_domain(const MshModel& model, const std::string& name, int dimensio
                               : "; use 3-node or 6-node triangles or 4-node quadrilaterals"));
       }
       DomainList& domain = body.domain[*type];
-      domain.node_tags.insert(domain.node_tags.end(), list.node_tags.begin(), list.node_tags.end());
-      domain.element_tags.insert(domain.element_tags.end(), list.element_tags.begin(),
-                                 list.element_tags.end());
       domain.entities.insert(domain.entities.end(), list.element_tags.size(), entity);
+      append_taking(list.node_tags, domain.node_tags);
+      append_taking(list.element_tags, domain.element_tags);
     }
   }
   if (body.domain.empty()) {
@@ -748,15 +771,20 @@ void collect_domain(const MshModel& model, const std::string& name, int dimensio
   }
 }
 
+/// The name of physical group `group` of dimension `dimension`: its $PhysicalNames name, its
+/// tag when it has none.
+std::string group_name(const MshModel& model, int dimension, int group) {
+  const auto named = model.physical_names.find({dimension, group});
+  return named == model.physical_names.end() || named->second.empty() ? std::to_string(group)
+                                                                      : named->second;
+}
+
 /// Every physical group of dimension `dimension` - 1 as a named boundary of facets.
 void collect_boundaries(const MshModel& model, const std::string& name, int dimension,
                         BodyElements& body) {
   const int facet_dimension = dimension - 1;
   for (const auto& [group, members] : physical_groups(model, facet_dimension)) {
-    const auto named = model.physical_names.find({facet_dimension, group});
-    const std::string boundary = named == model.physical_names.end() || named->second.empty()
-                                     ? std::to_string(group)
-                                     : named->second;
+    const std::string boundary = group_name(model, facet_dimension, group);
     for (const int member : members) {
       const MshEntityElements* elements = entity_elements(model, facet_dimension, member);
       if (elements == nullptr) continue;
@@ -989,7 +1017,7 @@ bool has_physical_group(const MshModel& model) {
   return false;
 }
 
-Mesh body_mesh(const MshModel& model, const std::string& name) {
+Mesh body_mesh(MshModel&& model, const std::string& name) {
   if (!has_physical_group(model)) {
     throw InputError(
         name +
@@ -1020,8 +1048,63 @@ Mesh body_mesh(const MshModel& model, const std::string& name) {
 Mesh parse_msh_file(std::string_view bytes, const std::string& name) {
   const std::string label = "mesh file '" + name + "'";
   MshScanner scanner(bytes, label);
-  const MshModel model = read_model(scanner);
-  return body_mesh(model, label);
+  return body_mesh(read_model(scanner), label);
+}
+
+namespace {
+
+/// The summary of a file whose head up to $Nodes is in `model`, its $Nodes count `node_count`.
+std::optional<MshSummary> summary_of(const MshModel& model, int version, std::uint64_t node_count) {
+  MshSummary summary;
+  summary.node_count = node_count;
+  if (version == 4) {  // the entities and their groups, as body_mesh decides
+    if (!has_physical_group(model)) return std::nullopt;
+    summary.dimension = model.entities[3].empty() ? 2 : 3;
+    for (const auto& [group, members] : physical_groups(model, summary.dimension - 1)) {
+      summary.boundary_names.push_back(group_name(model, summary.dimension - 1, group));
+    }
+    return summary;
+  }
+  if (model.physical_names.empty()) return std::nullopt;  // 2.2: groups known from elements only
+  for (const auto& [group, name] : model.physical_names) {
+    if (group.first == 3) summary.dimension = 3;
+  }
+  for (const auto& [group, name] : model.physical_names) {
+    if (group.first == summary.dimension - 1) {
+      summary.boundary_names.push_back(group_name(model, group.first, group.second));
+    }
+  }
+  return summary;
+}
+
+}  // namespace
+
+std::optional<MshSummary> summarize_msh_file(const std::filesystem::path& path,
+                                             const std::string& name) {
+  const std::string shown = name.empty() ? path.string() : name;
+  const MappedFile file(path, shown, MappedFile::Reading::beginning);
+  MshScanner scanner(file.bytes(), "mesh file '" + shown + "'");
+  MshModel model;
+  const int version = read_mesh_format(scanner);
+  while (scanner.skip_space()) {
+    const std::string section = next_section(scanner);
+    if (section == "$PhysicalNames") {
+      read_physical_names(scanner, model);
+    } else if (section == "$Entities" && version == 4) {
+      read_entities(scanner, model);
+    } else if (section == "$Nodes") {
+      if (version == 2) {
+        return summary_of(
+            model, version,
+            static_cast<std::uint64_t>(scanner.integer("the number of nodes", 0, int64_maximum)));
+      }
+      read_size(scanner, "a block count");
+      return summary_of(model, version, read_size(scanner, "a node count"));
+    } else {
+      scanner.skip_section(section);
+    }
+  }
+  return std::nullopt;  // no $Nodes: read_msh_file names the problem
 }
 
 Mesh read_msh_file(const std::filesystem::path& path, const std::string& name) {

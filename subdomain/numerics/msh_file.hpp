@@ -22,7 +22,9 @@
 // "mesh file 'NAME' line L: ..." (ASCII) or "mesh file 'NAME' byte B: ..." (binary data), or
 // "mesh file 'NAME': ..." for a problem of the mesh as a whole.
 
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +36,26 @@ namespace robin {
 /// The mesh in the MSH file `path`; messages name the file `name` (its path when empty).
 /// Throws InputError when the file cannot be read or is refused.
 Mesh read_msh_file(const std::filesystem::path& path, const std::string& name = "");
+
+/// What the head of an MSH file, up to its $Nodes header, tells of the body in it: what a
+/// coordinator checks of a body whose server reads the file itself.
+struct MshSummary {
+  /// 4.1: as read_msh_file decides (3 when there is a volume entity); 2.2: 3 when $PhysicalNames
+  /// names a volume group.
+  int dimension = 2;
+  std::uint64_t node_count = 0;  // $Nodes' count (a 2.2 file may list nodes no element uses)
+  /// The physical groups of one dimension less, as read_msh_file names its boundaries (by their
+  /// names, or their tags when unnamed), except that a group without facets is listed too and a
+  /// 2.2 file's unnamed groups are not (they show only in its elements).
+  std::vector<std::string> boundary_names;
+};
+
+/// The summary of the MSH file `path` (messages name it `name`, its path when empty), read
+/// without its nodes and elements; nullopt when its head cannot tell: a 2.2 file without
+/// $PhysicalNames (its groups show only in its elements), a 4.1 file without physical groups, a
+/// file without $Nodes. Throws InputError like read_msh_file for a malformed head.
+std::optional<MshSummary> summarize_msh_file(const std::filesystem::path& path,
+                                             const std::string& name = "");
 
 /// The mesh in `bytes`, the contents of an MSH file called `name` in messages.
 Mesh parse_msh_file(std::string_view bytes, const std::string& name);

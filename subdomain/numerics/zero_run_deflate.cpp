@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cstring>
 
 namespace robin {
 namespace {
@@ -62,20 +64,33 @@ std::array<LengthCode, 259> length_codes() {
   return codes;
 }
 
-/// Bits packed least significant first into a buffer sized for the whole stream beforehand.
+/// Bits packed least significant first into a buffer sized for the whole stream beforehand, with
+/// 8 bytes to spare after it (flush stores 8 bytes at a time).
 class BitWriter {
  public:
   explicit BitWriter(std::uint8_t* out) : out_(out) {}
 
-  void write(std::uint32_t value, int bits) {
+  /// Adds `bits` bits without flushing: at most 56 bits between two flushes.
+  void add(std::uint32_t value, int bits) {
     buffer_ |= static_cast<std::uint64_t>(value) << count_;
     count_ += bits;
-    if (count_ >= 32) {  // four whole bytes out, little-endian
-      for (int k = 0; k < 4; ++k) out_[k] = static_cast<std::uint8_t>(buffer_ >> (8 * k));
-      out_ += 4;
-      buffer_ >>= 32;
-      count_ -= 32;
+  }
+  void add(const Code& code) { add(code.value, code.bits); }
+  /// Stores the whole bytes of the buffer (little-endian), keeping at most 7 bits.
+  void flush() {
+    if constexpr (std::endian::native == std::endian::little) {
+      std::memcpy(out_, &buffer_, sizeof buffer_);
+    } else {
+      for (int k = 0; k < 8; ++k) out_[k] = static_cast<std::uint8_t>(buffer_ >> (8 * k));
     }
+    const int whole = count_ & ~7;
+    out_ += whole / 8;
+    buffer_ = whole == 64 ? 0 : buffer_ >> whole;
+    count_ -= whole;
+  }
+  void write(std::uint32_t value, int bits) {
+    add(value, bits);
+    flush();
   }
   void write(const Code& code) { write(code.value, code.bits); }
   /// Writes the bits left, the last byte padded with zero bits; returns the end of the output.
@@ -117,8 +132,9 @@ std::size_t zero_run_deflate(const std::uint8_t* data, std::size_t size,
                              std::vector<std::uint8_t>& stream) {
   static const std::array<Code, 288> codes = fixed_literal_codes();
   static const std::array<LengthCode, 259> lengths = length_codes();
-  // at most 9 bits per byte, 3 bits of block header and 7 of end of block, 2 + 4 framing bytes
-  stream.resize(size + size / 8 + 16);
+  // at most 9 bits per byte, 3 bits of block header and 7 of end of block, 2 + 4 framing bytes,
+  // 8 bytes for the writer's last store
+  stream.resize(size + size / 8 + 24);
   // zlib header: deflate with a 32 KiB window (0x78), fastest-level flag, FCHECK (RFC 1950)
   stream[0] = 0x78;
   stream[1] = 0x01;
@@ -127,11 +143,18 @@ std::size_t zero_run_deflate(const std::uint8_t* data, std::size_t size,
   writer.write(1, 2);  // BTYPE 01: fixed Huffman codes
   std::size_t position = 0;
   while (position < size) {
-    if (data[position] != 0) {
-      writer.write(codes[data[position]]);
-      ++position;
-      continue;
+    // the literals up to the next zero byte, six (at most 54 bits) per flush
+    const void* zero = std::memchr(data + position, 0, size - position);
+    const std::size_t stretch_end =
+        zero == nullptr ? size
+                        : static_cast<std::size_t>(static_cast<const std::uint8_t*>(zero) - data);
+    for (; position + 6 <= stretch_end; position += 6) {
+      for (std::size_t k = 0; k < 6; ++k) writer.add(codes[data[position + k]]);
+      writer.flush();
     }
+    for (; position < stretch_end; ++position) writer.add(codes[data[position]]);
+    writer.flush();
+    if (position == size) break;
     std::size_t end = position + 1;
     while (end < size && data[end] == 0) ++end;
     const std::size_t run = end - position;

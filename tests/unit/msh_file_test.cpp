@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,30 @@ std::string input_error_message(Read&& read) {
   return "";
 }
 
+/// summarize_msh_file agrees with `reference`, the file's mesh read whole: the same dimension
+/// and boundary names (an MSH 2.2 file's unnamed groups, known from its elements only, are
+/// missing), at least its node count; no summary only for a 2.2 file without $PhysicalNames.
+void expect_summary_agrees(const std::filesystem::path& path, const Mesh& reference) {
+  const std::optional<MshSummary> summary = summarize_msh_file(path);
+  const std::string text = testing::file_text(path);
+  const bool old_format = text.rfind("$MeshFormat\n2.2", 0) == 0;
+  if (!summary) {
+    EXPECT_TRUE(old_format) << path << ": no summary of an MSH 4.1 file";
+    EXPECT_EQ(text.find("$PhysicalNames"), std::string::npos) << path << ": names but no summary";
+    return;
+  }
+  EXPECT_EQ(summary->dimension, reference.dimension) << path;
+  std::vector<std::string> names;  // an unnamed group is named by its tag
+  for (const auto& [name, group] : reference.boundaries) {
+    const bool tag = name.find_first_not_of("0123456789") == std::string::npos;
+    if (!(old_format && tag)) names.push_back(name);
+  }
+  std::vector<std::string> listed = summary->boundary_names;
+  std::sort(listed.begin(), listed.end());
+  EXPECT_EQ(listed, names) << path;
+  EXPECT_GE(summary->node_count, reference.node_count()) << path;
+}
+
 /// Reads `path` with both readers: the same mesh, or both refuse it.
 void expect_same_as_gmsh(const std::filesystem::path& path) {
   Mesh reference;
@@ -75,6 +100,7 @@ void expect_same_as_gmsh(const std::filesystem::path& path) {
   ASSERT_EQ(native_error, "") << path;
   expect_identical(reference, native, path.string());
   EXPECT_EQ(native.source, path.string());
+  expect_summary_agrees(path, reference);
 }
 
 TEST(MshFile, ShippedMeshFilesReadAsGmshReadsThem) {
