@@ -154,6 +154,30 @@ inline std::string read_text(const std::filesystem::path& path) {
   return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
 }
 
+/// robin-run `case_file` --output `output` --quiet, its standard error in OUTPUT-logs/; with
+/// `coordinator_does_it_all` also --server-executable (this build's robin-subdomain by path):
+/// the servers then neither read the mesh files nor write the .vtu files, the coordinator does.
+inline ProcessOutcome run_robin_run(const std::filesystem::path& case_file,
+                                    const std::filesystem::path& output,
+                                    bool coordinator_does_it_all) {
+  std::vector<std::string> arguments = {case_file.string(), "--output", output.string(), "--quiet"};
+  if (coordinator_does_it_all) {
+    arguments.push_back("--server-executable");
+    arguments.push_back(tool("robin-subdomain").string());
+  }
+  const std::filesystem::path logs = output.parent_path() / (output.filename().string() + "-logs");
+  std::filesystem::create_directories(logs);
+  return run_tool("robin-run", arguments, logs, 300.0);
+}
+
+/// NumberOfPoints of a .vtu file's piece (0 when it has none).
+inline long vtu_point_count(const std::filesystem::path& vtu) {
+  std::smatch match;
+  const std::string text = read_text(vtu).substr(0, 4096);  // the XML header
+  if (!std::regex_search(text, match, std::regex("NumberOfPoints=\"([0-9]+)\""))) return 0;
+  return std::stol(match[1].str());
+}
+
 inline bool wait_until(const std::function<bool()>& condition, double seconds) {
   const auto start = std::chrono::steady_clock::now();
   while (!condition()) {

@@ -29,7 +29,6 @@ namespace {
 using nlohmann::json;
 using testing::example;
 using testing::read_text;
-using testing::run_tool;
 using testing::TemporaryDirectory;
 
 /// examples/meshes/block_`body`.geo meshed by the gmsh command at h = 0.05 into `path` in
@@ -55,42 +54,14 @@ std::filesystem::path msh_case(const std::filesystem::path& directory) {
   return path;
 }
 
-struct RunResult {
-  std::string exit;
-  std::string errors;
-};
-
-/// robin-run on `case_file` into `output`; `coordinator_reads` adds --server-executable (this
-/// build's robin-subdomain by path: the coordinator then reads and sends every mesh).
-RunResult run_robin_run(const std::filesystem::path& case_file, const std::filesystem::path& output,
-                        bool coordinator_reads) {
-  std::vector<std::string> arguments = {case_file.string(), "--output", output.string(), "--quiet"};
-  if (coordinator_reads) {
-    arguments.push_back("--server-executable");
-    arguments.push_back(testing::tool("robin-subdomain").string());
-  }
-  const std::filesystem::path logs = output.parent_path() / (output.filename().string() + "-logs");
-  std::filesystem::create_directories(logs);
-  const auto outcome = run_tool("robin-run", arguments, logs, 300.0);
-  return {outcome.exit, outcome.errors};
-}
-
-/// NumberOfPoints of a .vtu file's piece.
-long point_count(const std::filesystem::path& vtu) {
-  std::smatch match;
-  const std::string text = read_text(vtu).substr(0, 4096);  // the XML header
-  if (!std::regex_search(text, match, std::regex("NumberOfPoints=\"([0-9]+)\""))) return 0;
-  return std::stol(match[1].str());
-}
-
 TEST(ServerReadMeshes, SameResultsAsWhenTheCoordinatorSendsTheMeshes) {
   const TemporaryDirectory directory("server-read-meshes");
   const std::filesystem::path case_file = msh_case(directory.path());
   const std::filesystem::path servers = directory.path() / "servers";
   const std::filesystem::path coordinator = directory.path() / "coordinator";
-  const RunResult read_by_servers = run_robin_run(case_file, servers, false);
+  const auto read_by_servers = testing::run_robin_run(case_file, servers, false);
   ASSERT_EQ(read_by_servers.exit, "exited with status 0") << read_by_servers.errors;
-  const RunResult sent = run_robin_run(case_file, coordinator, true);
+  const auto sent = testing::run_robin_run(case_file, coordinator, true);
   ASSERT_EQ(sent.exit, "exited with status 0") << sent.errors;
   for (const char* file : {"lower.vtu", "upper.vtu", "contact.csv"}) {
     EXPECT_TRUE(read_text(servers / file) == read_text(coordinator / file))
@@ -102,7 +73,7 @@ TEST(ServerReadMeshes, SameResultsAsWhenTheCoordinatorSendsTheMeshes) {
   EXPECT_EQ(by_servers["contact_force_resultant"], by_coordinator["contact_force_resultant"]);
   for (std::size_t body = 0; body < 2; ++body) {
     const std::string name = by_servers["bodies"][body]["name"];
-    const long nodes = point_count(servers / (name + ".vtu"));
+    const long nodes = testing::vtu_point_count(servers / (name + ".vtu"));
     ASSERT_GT(nodes, 0) << name;
     EXPECT_LT(by_servers["bodies"][body]["bytes_sent"].get<long>(), 8 * nodes)
         << name << ": the mesh was sent anyway";
@@ -117,7 +88,7 @@ TEST(ServerReadMeshes, ABoundaryTheHeadDoesNotListGetsTheCoordinatorsError) {
   std::string text = read_text(case_file);
   text = std::regex_replace(text, std::regex("boundary = \"bottom\""), "boundary = \"floor\"");
   std::ofstream(case_file) << text;
-  const RunResult result = run_robin_run(case_file, directory.path() / "out", false);
+  const auto result = testing::run_robin_run(case_file, directory.path() / "out", false);
   EXPECT_EQ(result.exit, "exited with status 1") << result.errors;
   for (const std::string fragment : {"case.toml:", "body 'lower'", "dirichlet",
                                      "boundary 'floor' is not a physical curve", "lower.msh"}) {

@@ -35,27 +35,11 @@ using testing::read_text;
 using testing::run_tool;
 using testing::TemporaryDirectory;
 
-/// Runs robin-run on `case_file` into `output`; `coordinator_writes` adds --server-executable
-/// (this build's robin-subdomain, by path: the coordinator then writes every file).
+/// Runs robin-run on `case_file` into `output` (testing::run_robin_run) and expects success.
 void run_robin_run(const std::filesystem::path& case_file, const std::filesystem::path& output,
                    bool coordinator_writes) {
-  std::vector<std::string> arguments = {case_file.string(), "--output", output.string(), "--quiet"};
-  if (coordinator_writes) {
-    arguments.push_back("--server-executable");
-    arguments.push_back(testing::tool("robin-subdomain").string());
-  }
-  const std::filesystem::path logs = output.parent_path() / (output.filename().string() + "-logs");
-  std::filesystem::create_directories(logs);
-  const auto outcome = run_tool("robin-run", arguments, logs, 300.0);
+  const auto outcome = testing::run_robin_run(case_file, output, coordinator_writes);
   ASSERT_EQ(outcome.exit, "exited with status 0") << outcome.errors;
-}
-
-/// NumberOfPoints of a .vtu file's piece.
-long point_count(const std::filesystem::path& vtu) {
-  std::smatch match;
-  const std::string text = read_text(vtu).substr(0, 4096);  // the XML header
-  if (!std::regex_search(text, match, std::regex("NumberOfPoints=\"([0-9]+)\""))) return 0;
-  return std::stol(match[1].str());
 }
 
 /// The same bytes at `relative` in both result directories (and a file that is not empty).
@@ -110,7 +94,7 @@ TEST(ServerWrittenFields, SameFilesAndNumbersAsWhenTheCoordinatorWritesThem) {
     const std::string name = written["bodies"][body]["name"];
     const long saved = sent["bodies"][body]["bytes_received"].get<long>() -
                        written["bodies"][body]["bytes_received"].get<long>();
-    const long nodes = point_count(servers / (name + ".vtu"));
+    const long nodes = testing::vtu_point_count(servers / (name + ".vtu"));
     ASSERT_GT(nodes, 0) << name;
     EXPECT_GE(saved, 4 * 8 * nodes) << name << ": the fields came back anyway";
   }
