@@ -1,6 +1,7 @@
 #include "numerics/mesh_validity.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -63,6 +64,31 @@ double size_power(const NodeCoordinates& coordinates) {
   throw InputError(text.str());
 }
 
+/// The checks of check_element_validity on a block of affine simplices (3-node triangles in 2D,
+/// 4-node tetrahedra in 3D), in fixed size: J = [x_1 - x_0, ..., x_d - x_0] at every point.
+template <int Dimension>
+void check_affine_block(const Mesh& mesh, const ElementBlock& block, const std::string& context) {
+  constexpr int count = Dimension + 1;
+  for (std::size_t element = 0; element < block.element_count(); ++element) {
+    const int* nodes = &block.connectivity[element * count];
+    Eigen::Matrix<double, Dimension, count> corners;
+    for (int i = 0; i < count; ++i) {
+      corners.col(i) = mesh.nodes[nodes[i]].template head<Dimension>();
+    }
+    Eigen::Matrix<double, Dimension, Dimension> jacobian;
+    for (int j = 0; j < Dimension; ++j) jacobian.col(j) = corners.col(j + 1) - corners.col(0);
+    double longest = 0.0;  // the longest corner distance, squared
+    for (int i = 0; i < count; ++i) {
+      for (int j = i + 1; j < count; ++j) {
+        longest = std::max(longest, (corners.col(i) - corners.col(j)).squaredNorm());
+      }
+    }
+    const double extent = Dimension == 2 ? longest : longest * std::sqrt(longest);
+    const double determinant = jacobian.determinant();
+    if (!(determinant > 1e-12 * extent)) refuse(mesh, block, element, determinant, extent, context);
+  }
+}
+
 }  // namespace
 
 void check_element_validity(const Mesh& mesh, const std::string& context) {
@@ -74,6 +100,14 @@ void check_element_validity(const Mesh& mesh, const std::string& context) {
                        "D mesh has a block of " + to_string(block.type) + " elements (" +
                        std::to_string(dimension) + "D)" +
                        (mesh.source.empty() ? std::string() : "; mesh '" + mesh.source + "'"));
+    }
+    if (block.type == ElementType::triangle3) {
+      check_affine_block<2>(mesh, block, context);
+      continue;
+    }
+    if (block.type == ElementType::tetrahedron4) {
+      check_affine_block<3>(mesh, block, context);
+      continue;
     }
     const std::vector<ShapeGradients> gradients_at_points = check_gradients(block.type);
     NodeCoordinates coordinates(count, dimension);
