@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <new>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -110,6 +111,44 @@ Eigen::MatrixXd trailing_factor_block(const cholmod_factor& factor, int first) {
     }
   }
   return block;
+}
+
+/// X' X for X = L^{-1} Y, with L the trailing block (lower triangular, n x n) and Y (n x m)
+/// whose column k is zero above row top[order[k]] (nondecreasing in k): the lower triangle of
+/// the result, in Y's column order. Column blocks of `width` are solved from their first
+/// nonzero row down (X is zero above it, rows below it need only L's trailing part), and each
+/// block's products skip the rows where it is zero: a third of the flops of a dense
+/// dtrsm and dsyrk when the tops spread evenly. BLAS level 3 (the system's, OpenBLAS on
+/// Debian with libopenblas0).
+Eigen::MatrixXd staircase_congruence(const Eigen::MatrixXd& lower, Eigen::MatrixXd& y,
+                                     const std::vector<int>& order, const std::vector<int>& top) {
+  constexpr int width = 64;
+  const int n = static_cast<int>(lower.rows());
+  const int m = static_cast<int>(y.cols());
+  const auto block_top = [&](int start) { return top[static_cast<std::size_t>(order[start])]; };
+  for (int start = 0; start < m; start += width) {
+    const int count = std::min(width, m - start);
+    const int from = block_top(start);
+    if (from >= n) continue;  // rows of B without a trailing entry: zero columns
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, n - from, count,
+                1.0, lower.data() + from + static_cast<long>(from) * n, n,
+                y.data() + from + static_cast<long>(start) * n, n);
+  }
+  Eigen::MatrixXd result = Eigen::MatrixXd::Zero(m, m);
+  for (int start = 0; start < m; start += width) {
+    const int count = std::min(width, m - start);
+    const int from = block_top(start);
+    if (from >= n) continue;
+    const double* block = y.data() + from + static_cast<long>(start) * n;
+    // the diagonal block, then the block row left of it: X_J' X_I over the rows from J's top
+    cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, count, n - from, 1.0, block, n, 0.0,
+                result.data() + start + static_cast<long>(start) * m, m);
+    if (start > 0) {
+      cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, count, start, n - from, 1.0, block, n,
+                  y.data() + from, n, 0.0, result.data() + start, m);
+    }
+  }
+  return result;
 }
 
 /// Pivots d_j = L_jj^2 of a supernodal factor: column j of supernode s is stored in
@@ -423,8 +462,11 @@ Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) c
                                 std::to_string(size()));
   }
   const int first = size() - factor.trailing_count;
-  // Y = (P B')_T, then Y <- L_TT^{-1} Y and B K^{-1} B' = Y' Y
-  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(factor.trailing_count, trace.rows());
+  const int trailing = factor.trailing_count;
+  const int rows = static_cast<int>(trace.rows());
+  // Y = (P B')_T, its columns (the rows of B) in the order of their first nonzero row top_j;
+  // then X = L_TT^{-1} Y is zero above top_j in column j, and B K^{-1} B' = X' X
+  std::vector<int> top(static_cast<std::size_t>(rows), trailing);
   for (int column = 0; column < trace.outerSize(); ++column) {
     for (SparseMatrix::InnerIterator entry(trace, column); entry; ++entry) {
       const int step = factor.position[column] - first;
@@ -432,20 +474,33 @@ Eigen::MatrixXd CholeskyFactor::trailing_congruence(const SparseMatrix& trace) c
         throw std::invalid_argument("body '" + factor.body_name + "': the trace reads unknown " +
                                     std::to_string(column) + ", not a trailing unknown");
       }
-      reduced(step, entry.row()) += entry.value();
+      int& row_top = top[static_cast<std::size_t>(entry.row())];
+      row_top = std::min(row_top, step);
     }
   }
-  // BLAS level 3 (the system's, OpenBLAS on Debian with libopenblas0): dtrsm, then dsyrk
-  const Eigen::MatrixXd block = trailing_factor_block(*factor.cholesky.factor(), first);
-  const int trailing = factor.trailing_count;
-  const int rows = static_cast<int>(trace.rows());
+  std::vector<int> order(static_cast<std::size_t>(rows));  // sorted position -> row of B
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&top](int a, int b) { return top[a] < top[b]; });
+  std::vector<int> place(static_cast<std::size_t>(rows));  // row of B -> sorted position
+  for (int k = 0; k < rows; ++k) place[static_cast<std::size_t>(order[k])] = k;
+  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(trailing, rows);
+  for (int column = 0; column < trace.outerSize(); ++column) {
+    for (SparseMatrix::InnerIterator entry(trace, column); entry; ++entry) {
+      reduced(factor.position[column] - first, place[static_cast<std::size_t>(entry.row())]) +=
+          entry.value();
+    }
+  }
   Eigen::MatrixXd congruence = Eigen::MatrixXd::Zero(rows, rows);
   if (rows == 0) return congruence;
-  cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, trailing, rows, 1.0,
-              block.data(), trailing, reduced.data(), trailing);
-  cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, rows, trailing, 1.0, reduced.data(), trailing,
-              0.0, congruence.data(), rows);
-  congruence.triangularView<Eigen::StrictlyUpper>() = congruence.transpose();
+  const Eigen::MatrixXd block = trailing_factor_block(*factor.cholesky.factor(), first);
+  const Eigen::MatrixXd sorted = staircase_congruence(block, reduced, order, top);
+  for (int j = 0; j < rows; ++j) {
+    for (int i = j; i < rows; ++i) {
+      const double value = sorted(i, j);
+      congruence(order[i], order[j]) = value;
+      congruence(order[j], order[i]) = value;
+    }
+  }
   return congruence;
 }
 

@@ -187,6 +187,24 @@ TEST(Cholesky, TrailingCongruenceMatchesAnIndependentSolve) {
             << "\n";
 }
 
+TEST(Cholesky, TrailingCongruenceOfManyRowsMatchesAnIndependentSolve) {
+  // more rows than one column block of the staircase solve (64), some without a trailing entry
+  const int size = 900;
+  const SparseMatrix matrix = random_sparse_spd(size, 4, 81);
+  const std::vector<int> trailing = random_unknowns(size, 400, 82);
+  const CholeskyFactor factor(matrix, "block", {.trailing_unknowns = trailing});
+  ASSERT_TRUE(factor.has_trailing_block());
+  SparseMatrix trace = random_trace(230, size, trailing, 83);
+  for (const int empty : {0, 117, 229}) trace.row(empty) *= 0.0;
+  trace.prune(0.0);
+  const Eigen::MatrixXd congruence = factor.trailing_congruence(trace);
+  const Eigen::MatrixXd expected =
+      trace * reference_solve(matrix, Eigen::MatrixXd(trace.transpose()));
+  EXPECT_LE((congruence - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_EQ((congruence - congruence.transpose()).norm(), 0.0);
+  EXPECT_EQ(congruence.row(117).norm(), 0.0);
+}
+
 TEST(Cholesky, LoadOnTheTrailingUnknownsIsSolvedWithTheBackwardSolveAlone) {
   const int size = 600;
   const SparseMatrix matrix = random_sparse_spd(size, 4, 71);
