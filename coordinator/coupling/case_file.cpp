@@ -454,6 +454,8 @@ BodyDefinition load_body(const BodyCase& body) {
   return definition;
 }
 
+namespace {
+
 /// `observer` told of the requests whose bodies are `body_indices` by body index.
 MeshReadObserver for_bodies(const MeshReadObserver& observer,
                             const std::vector<std::size_t>& body_indices) {
@@ -498,6 +500,8 @@ bool head_vouches_for(BodyCase& body) {
   body.mesh_file_node_count = summary->node_count;
   return true;
 }
+
+}  // namespace
 
 void load_meshes(CaseDefinition& definition, const std::function<void(std::size_t)>& loaded) {
   std::vector<BodyCase*> bodies;  // the bodies whose meshes are read here, request by request
