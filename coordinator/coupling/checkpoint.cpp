@@ -168,6 +168,62 @@ void CheckpointWriter::write(const RunCheckpoint& checkpoint) {
       document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
+BackgroundCheckpointWriter::BackgroundCheckpointWriter(std::filesystem::path directory)
+    : writer_(std::move(directory)), thread_([this] { write_in_turn(); }) {}
+
+BackgroundCheckpointWriter::~BackgroundCheckpointWriter() {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  thread_.join();  // the thread writes what is waiting before it ends
+}
+
+void BackgroundCheckpointWriter::write(const RunCheckpoint& checkpoint) {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    throw_error();
+    waiting_ = checkpoint;
+  }
+  changed_.notify_all();
+}
+
+void BackgroundCheckpointWriter::finish() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [this] { return !waiting_ && !writing_; });
+  throw_error();
+}
+
+void BackgroundCheckpointWriter::throw_error() {
+  if (!error_) return;
+  std::exception_ptr error = error_;
+  error_ = nullptr;
+  std::rethrow_exception(error);
+}
+
+void BackgroundCheckpointWriter::write_in_turn() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    changed_.wait(lock, [this] { return waiting_ || stopping_; });
+    if (!waiting_) return;  // stopping, nothing left to write
+    const RunCheckpoint checkpoint = std::move(*waiting_);
+    waiting_.reset();
+    writing_ = true;
+    lock.unlock();
+    std::exception_ptr error;
+    try {
+      writer_.write(checkpoint);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    lock.lock();
+    writing_ = false;
+    if (error) error_ = error;
+    changed_.notify_all();
+  }
+}
+
 RunCheckpoint read_checkpoint(const std::filesystem::path& directory) {
   const std::filesystem::path path = directory / checkpoint_file_name;
   std::ifstream file(path);

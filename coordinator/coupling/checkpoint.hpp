@@ -20,9 +20,14 @@
 //                                command-line options that change the computation.
 // Per iteration this writes O(interface x history depth) bytes plus the residual records.
 
+#include <condition_variable>
+#include <exception>
 #include <filesystem>
+#include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "coupling/iteration_checkpoint.hpp"
@@ -67,6 +72,37 @@ class CheckpointWriter {
   std::filesystem::path directory_;
   std::size_t iterates_written_ = 0;
   bool first_ = true;
+};
+
+/// A CheckpointWriter on a thread of its own, so that the iteration does not wait for the files
+/// and their fsyncs: write() hands a copy of the checkpoint over and returns. A checkpoint handed
+/// over while an earlier one is still being written replaces the one waiting: only the newest is
+/// written, and the files may then skip an iteration, which a resumed run repeats (resuming from
+/// any checkpoint gives the uninterrupted run's answer). An error of the writing thread is thrown
+/// by the next write() or by finish(); the destructor waits for the writing, errors dropped.
+class BackgroundCheckpointWriter {
+ public:
+  explicit BackgroundCheckpointWriter(std::filesystem::path directory);
+  ~BackgroundCheckpointWriter();
+  BackgroundCheckpointWriter(const BackgroundCheckpointWriter&) = delete;
+  BackgroundCheckpointWriter& operator=(const BackgroundCheckpointWriter&) = delete;
+
+  void write(const RunCheckpoint& checkpoint);
+  /// Waits until the newest checkpoint handed over is written; throws the writing's error.
+  void finish();
+
+ private:
+  void write_in_turn();
+  void throw_error();  // the writing thread's error, once (mutex_ held)
+
+  CheckpointWriter writer_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::optional<RunCheckpoint> waiting_;
+  bool writing_ = false;
+  bool stopping_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;
 };
 
 /// Reads the checkpoint files of `directory`. Throws CheckpointFormatError

@@ -512,7 +512,7 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     continuation.resume_steps = &settings.resume->steps;
     checkpoint.steps = settings.resume->steps;
   }
-  CheckpointWriter writer(settings.output_directory);
+  BackgroundCheckpointWriter writer(settings.output_directory);
   continuation.checkpoint = [&](const IterationCheckpoint& iteration) {
     checkpoint.step =
         definition.loading.stepped() ? static_cast<int>(checkpoint.steps.size()) + 1 : 0;
@@ -581,6 +581,7 @@ int run_coordinator(const CaseDefinition& definition, const CoordinatorSettings&
     }
     const CoupledRunResult result = run_coupled_case(
         observed, run_ports, options, make_observer(log, options, display), continuation);
+    writer.finish();  // the last checkpoint is on disk (or its error thrown) before the outputs
     display->finish();
     release_servers();  // the fields are in: the servers can stop while the files are written
     write_coupled_outputs(*results, definition, result);

@@ -79,6 +79,23 @@ std::filesystem::path reference_run(const std::filesystem::path& directory,
   return output;
 }
 
+/// The checkpoint.json of result directory `output` (an empty object while there is none: the
+/// coordinator writes it on a thread of its own, after the iteration it records is logged).
+nlohmann::json checkpoint_on_disk(const std::filesystem::path& output) {
+  std::ifstream file(output / "checkpoint.json");
+  const nlohmann::json checkpoint = nlohmann::json::parse(file, nullptr, false);
+  return checkpoint.is_object() ? checkpoint : nlohmann::json::object();
+}
+
+/// Whether the checkpoint on disk in `output` records iteration `iteration` or a later one (of
+/// load step `step` when it is not 0).
+bool checkpointed_iteration(const std::filesystem::path& output, int iteration, int step = 0) {
+  const nlohmann::json checkpoint = checkpoint_on_disk(output);
+  if (!checkpoint.contains("loop")) return false;
+  if (step != 0 && checkpoint.value("step", 0) != step) return false;
+  return checkpoint["loop"].value("iteration", 0) >= iteration;
+}
+
 // ---- Checkpoint and resume ----------------------------------------------------------------
 
 TEST(Resume, KilledCoordinatorResumesToTheSameHistoryAndAnswer) {
@@ -92,8 +109,7 @@ TEST(Resume, KilledCoordinatorResumesToTheSameHistoryAndAnswer) {
   const auto run = start_tool(
       "robin-run", with({case_file.string(), "--output", output.string()}, joint_stopping),
       first_log);
-  ASSERT_TRUE(wait_until(
-      [&] { return read_text(first_log).find("iteration 10:") != std::string::npos; }, 60.0))
+  ASSERT_TRUE(wait_until([&] { return checkpointed_iteration(output, 10); }, 60.0))
       << read_text(first_log);
   ASSERT_EQ(kill(run->pid(), SIGKILL), 0);
   ASSERT_TRUE(run->wait_for_exit(10.0));
@@ -174,8 +190,7 @@ TEST(Resume, KilledRobinCoordinatorResumesAgainstTheSameServers) {
   const std::filesystem::path output = directory.path() / "resumed";
   const std::filesystem::path killed_log = directory.path() / "killed.stderr";
   const auto run = start_tool("robin-coordinator", coordinator_arguments(output), killed_log);
-  ASSERT_TRUE(wait_until(
-      [&] { return read_text(killed_log).find("iteration 10:") != std::string::npos; }, 60.0))
+  ASSERT_TRUE(wait_until([&] { return checkpointed_iteration(output, 10); }, 60.0))
       << read_text(killed_log);
   ASSERT_EQ(kill(run->pid(), SIGKILL), 0);
   ASSERT_TRUE(run->wait_for_exit(10.0));
@@ -517,11 +532,11 @@ TEST(Resume, KilledLoadStepRunResumesAtTheInterruptedStep) {
   ASSERT_EQ(read_summary(reference)["load_steps"].size(), 4u);
 
   // Killed while the cylinder's server waits in iteration 2 of step 2: after the checkpoint of
-  // that step's iteration 1.
+  // that step's iteration 1 is on disk.
   const std::filesystem::path output = directory.path() / "resumed";
   const std::filesystem::path first_log = directory.path() / "killed.stderr";
   const auto run = start_delayed_steps(directory.path(), case_file, output, first_log);
-  ASSERT_TRUE(wait_until([&] { return shows_step_iteration(read_text(first_log), 2, 1); }, 60.0))
+  ASSERT_TRUE(wait_until([&] { return checkpointed_iteration(output, 1, 2); }, 60.0))
       << read_text(first_log);
   ASSERT_EQ(kill(run->pid(), SIGKILL), 0);
   ASSERT_TRUE(run->wait_for_exit(10.0));
